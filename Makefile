@@ -1,0 +1,134 @@
+# posedrop: build, test, benchmark and install.  `make help` lists the targets.
+#
+# Switches: WERROR=1 (warnings are errors), SANITIZE=1 (address + undefined),
+# DEBUG=1 (no optimisation, internal checks on). Each combination builds in its
+# own directory under build/, so switching never mixes objects.
+
+CC      ?= cc
+PREFIX  ?= /usr/local
+PKG_CONFIG ?= pkg-config
+
+# Libraries the project links through pkg-config. Only GSL is used so far;
+# ODE, libccd and Bullet arrive with the dynamic backends. qhull_r is for the
+# tests' and the benchmark's reference hull only, never for libposedrop.
+LIB_PKGS  := gsl
+TEST_PKGS := qhull_r
+
+CONFIG := opt
+CFLAGS_OPT := -O2
+ifeq ($(DEBUG),1)
+CONFIG := debug
+CFLAGS_OPT := -O0 -g3 -DPD_DEBUG
+endif
+ifeq ($(SANITIZE),1)
+CONFIG := $(CONFIG)-san
+CFLAGS_OPT += -fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer
+LDFLAGS_SAN := -fsanitize=address,undefined
+endif
+ifeq ($(WERROR),1)
+CFLAGS_WERROR := -Werror
+endif
+
+BUILD := build/$(CONFIG)
+
+WARN := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototypes \
+        -Wvla -Wdouble-promotion
+# -ffp-contract=off: no fused multiply-add, so results are bit-identical across
+# machines and compilers; never -ffast-math.
+CFLAGS_ALL := -std=c11 -g $(CFLAGS_OPT) $(WARN) $(CFLAGS_WERROR) -ffp-contract=off \
+              -D_DEFAULT_SOURCE -Iinclude -Isrc $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null) \
+              $(CFLAGS)
+LDLIBS_LIB := $(shell $(PKG_CONFIG) --libs $(LIB_PKGS) 2>/dev/null) -lm
+LDLIBS_TEST := $(shell $(PKG_CONFIG) --libs $(TEST_PKGS) 2>/dev/null)
+CFLAGS_TEST := $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/dev/null)
+
+LIB_SRCS   := $(filter-out src/cli.c,$(wildcard src/*.c))
+LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o)
+LIB        := $(BUILD)/libposedrop.a
+CLI        := $(BUILD)/posedrop
+TEST_SRCS  := $(filter-out tests/bench.c,$(wildcard tests/*.c))
+TEST_OBJS  := $(TEST_SRCS:%.c=$(BUILD)/%.o)
+TEST_BIN   := $(BUILD)/test_posedrop
+BENCH_SRCS := tests/bench.c tests/shapes.c tests/qhull_ref.c
+BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
+BENCH_BIN  := $(BUILD)/bench_posedrop
+DEMO_PART  := parts/cap.off
+
+.PHONY: all check test bench demo install uninstall clean help deps
+.DEFAULT_GOAL := all
+
+all: $(LIB) $(CLI)
+
+$(BUILD)/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
+
+$(BUILD)/tests/%.o: tests/%.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -DPD_CLI_PATH='"$(CLI)"' -MMD -MP -c $< -o $@
+
+$(BUILD)/bench-%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -MMD -MP -c $< -o $@
+
+$(LIB): $(LIB_OBJS)
+	@rm -f $@
+	$(AR) rcs $@ $^
+
+$(CLI): $(BUILD)/src/cli.o $(LIB)
+	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
+
+$(TEST_BIN): $(TEST_OBJS) $(LIB)
+	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+
+$(BENCH_BIN): $(BENCH_OBJS) $(LIB)
+	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+
+# Installs the Debian packages when pkg-config cannot find them (quick no-op
+# otherwise). The targets a new user runs first go through it; their real work
+# runs in a sub-make so that pkg-config is asked again after the install.
+deps:
+	@scripts/install-deps.sh
+
+test: $(TEST_BIN) $(CLI)
+	$(TEST_BIN) $(SUITES)
+
+check: deps
+	@$(MAKE) --no-print-directory test
+
+demo: deps
+	@$(MAKE) --no-print-directory all
+	$(CLI) $(DEMO_PART)
+
+bench: deps
+	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
+	$(BENCH_BIN)
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
+	           $(DESTDIR)$(PREFIX)/include/posedrop
+	install -m 755 $(CLI) $(DESTDIR)$(PREFIX)/bin/posedrop
+	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/libposedrop.a
+	install -m 644 include/posedrop/*.h $(DESTDIR)$(PREFIX)/include/posedrop/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(shell sed -n 's/.*PD_VERSION_STRING "\(.*\)"/\1/p' include/posedrop/posedrop.h)|' \
+	    -e 's|@REQUIRES@|$(LIB_PKGS)|' scripts/posedrop.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
+
+uninstall:
+	rm -f $(DESTDIR)$(PREFIX)/bin/posedrop $(DESTDIR)$(PREFIX)/lib/libposedrop.a \
+	      $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
+	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop
+
+clean:
+	rm -rf build
+
+help:
+	@echo "make            build libposedrop.a and the posedrop command ($(BUILD)/)"
+	@echo "make demo       install missing packages, build, run posedrop on $(DEMO_PART)"
+	@echo "make check      install missing packages, build and run the tests"
+	@echo "                (SUITES='hull static' runs only those suites)"
+	@echo "make bench      speed figures, as ratios against reference runs"
+	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
+	@echo "make clean      remove build/"
+	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
+
+-include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli.d

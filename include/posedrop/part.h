@@ -1,0 +1,51 @@
+/* posedrop/part.h: the immutable part model.
+ *
+ * Built once from a mesh: welded, oriented, its mass properties and convex
+ * hull computed and the centre of mass checked to lie strictly inside the
+ * hull. Everything downstream (static estimators, drops) takes it const. */
+#ifndef POSEDROP_PART_H
+#define POSEDROP_PART_H
+
+#include "posedrop/diag.h"
+#include "posedrop/hull.h"
+#include "posedrop/mass.h"
+#include "posedrop/mesh.h"
+#include "posedrop/status.h"
+#include "posedrop/types.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+typedef struct pd_part_options {
+    int com_given;  /* 1: use com below instead of the mesh's own centre of mass */
+    pd_vec3 com;    /* metres, in the mesh's frame; read only when com_given */
+} pd_part_options;
+
+void pd_part_options_default(pd_part_options *options);
+
+typedef struct pd_part {
+    pd_mesh *mesh;     /* welded and, when closed, consistently oriented */
+    double size;       /* bounding-box diagonal, m: the length scale of all tolerances */
+    int closed;        /* 1 if the mesh is a closed surface */
+    int mass_known;    /* 1 if mass holds the mesh's own mass properties */
+    pd_mass mass;      /* volume and inertia valid only when mass_known */
+    pd_vec3 com;       /* centre of mass used: given or computed, m */
+    pd_hull *hull;
+} pd_part;
+
+/* Builds a part from a mesh (the mesh is copied, not kept). Steps: weld at
+ * PD_TOL_WELD_REL of the size; orient (faces flipped are reported by a warning);
+ * mass properties; convex hull; centre of mass strictly inside the hull.
+ * A mesh that is not closed is accepted only with options->com_given.
+ * options may be NULL. Returns the statuses of pd_mesh_orient, pd_mass_compute
+ * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM. */
+pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
+                        pd_part **part, pd_diag *diag);
+
+void pd_part_free(pd_part *part);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

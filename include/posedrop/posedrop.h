@@ -1,0 +1,29 @@
+/* posedrop/posedrop.h: the whole public API of libposedrop.
+ *
+ * Typical use:
+ *   pd_mesh *mesh; pd_part *part; pd_static_result *res; pd_diag diag;
+ *   pd_diag_init(&diag);
+ *   pd_mesh_read("cap.stl", NULL, &mesh, &diag);
+ *   pd_part_build(mesh, NULL, &part, &diag);
+ *   pd_static_estimate(part, NULL, &res, &diag);
+ *   ... res->poses[i].p_qs, res->poses[i].p_pqs ...
+ * each call returning a pd_status to check (PD_OK == 0). */
+#ifndef POSEDROP_POSEDROP_H
+#define POSEDROP_POSEDROP_H
+
+#define PD_VERSION_MAJOR 0
+#define PD_VERSION_MINOR 1
+#define PD_VERSION_PATCH 0
+#define PD_VERSION_STRING "0.1.0"
+
+#include "posedrop/diag.h"
+#include "posedrop/hull.h"
+#include "posedrop/mass.h"
+#include "posedrop/mesh.h"
+#include "posedrop/part.h"
+#include "posedrop/static.h"
+#include "posedrop/status.h"
+#include "posedrop/tolerances.h"
+#include "posedrop/types.h"
+
+#endif

@@ -1,0 +1,93 @@
+/* posedrop/tolerances.h: every numerical tolerance and input limit, in one place.
+ *
+ * Lengths are relative to the part's size L, the diagonal of the bounding box
+ * of its (welded) vertices, so that scaling a part by 1e-3 or 1e3, moving it or
+ * rotating it changes no decision the library takes. Absolute tolerances are
+ * PD_TOL_..._REL * L. Probabilities are compared relatively. Angles are in
+ * radians; comments give degrees.
+ *
+ * The values sit between two bounds that each comment names: above the
+ * round-off of the computation they guard (a few 1e-16 relative for double
+ * precision on the operations involved), and below the smallest genuine
+ * feature the library must keep apart. */
+#ifndef POSEDROP_TOLERANCES_H
+#define POSEDROP_TOLERANCES_H
+
+/* --- mesh input ------------------------------------------------------------ */
+
+/* Vertices closer than this are one vertex (welding of triangle soups).
+ * Why 1e-6: binary STL stores float32 (6e-8 relative) and many ASCII exporters
+ * print six significant digits (up to 5e-7 relative), so the copies of one
+ * vertex written by different triangles can differ by that much. Smaller: such
+ * files stay open soups and are refused. Larger: would merge features of a
+ * millionth of the part's size, far below anything manufactured. */
+#define PD_TOL_WELD_REL 1e-6
+
+/* --- convex hull ----------------------------------------------------------- */
+
+/* Hull triangles whose vertices lie within this distance of a common plane are
+ * merged into one polygonal facet, and a hull vertex that ends up on fewer than
+ * three facets (a point on an edge) is dropped. Also the distance below which
+ * input points count as coplanar or collinear.
+ * Why 1e-11: coplanar points of a rotated or scaled CAD face scatter off their
+ * plane by round-off, a few 1e-16 L; 1e-11 leaves five orders of margin. Two
+ * genuine facets meeting at 1e-7 rad (5.7e-6 deg) over a unit edge lie 1e-7 L
+ * apart, four orders above it, so they stay two facets. Larger: nearly flat
+ * facets of finely tessellated curves would merge; smaller: round-off would
+ * split flat faces into slivers. */
+#define PD_TOL_PLANE_REL 1e-11
+
+/* --- static estimators ----------------------------------------------------- */
+
+/* The centre of mass must lie at least this far inside every hull facet
+ * plane; closer is "on the hull" and the part is refused (it would balance on
+ * a facet it touches with its own centre). Same bound as the plane tolerance:
+ * the hull itself is only known to that accuracy. */
+#define PD_TOL_COM_INSIDE_REL PD_TOL_PLANE_REL
+
+/* Knife edge: the centre of mass projects within this distance of a facet's
+ * boundary. Stability means "strictly inside", so such a facet is unstable and
+ * a warning names it. Why 1e-11: the projection carries round-off of a few
+ * 1e-16 L, from the centre of mass and the facet plane; the tests move the
+ * centre 1e-9 L to either side of an edge and must see stable and unstable,
+ * so the tolerance must stay well below 1e-9. */
+#define PD_TOL_KNIFE_REL 1e-11
+
+/* Two probabilities tie when they differ by at most this fraction of the larger.
+ * Ties decide PQS transfers (a tie does not transfer, or a symmetric part would
+ * lose its symmetry to round-off) and the order of poses (ties go by normal).
+ * Why 1e-9: solid angles are computed to a few 1e-16 relative, summed over
+ * facets of up to 1e5 triangles; 1e-9 is far above that and far below any
+ * difference a user can measure (it would take 1e18 drops). */
+#define PD_TOL_PROB_TIE_REL 1e-9
+
+/* Quasi-static descent works on the unit sphere of gravity directions. An exit
+ * point of a vertex region closer than this angle to a facet normal is snapped
+ * to it; a descent step shorter than this is a knife edge.
+ * Why 1e-12 rad (6e-11 deg): unit vectors carry round-off ~1e-16; facet normals
+ * that must stay distinct differ by 1e-7 rad or more (see PD_TOL_PLANE_REL). */
+#define PD_TOL_ANGLE 1e-12
+
+/* Descent must lower the centre of mass along every quasi-static link. A rise
+ * smaller than this (relative to L) is accepted as round-off; a larger one is
+ * reported as PD_ERR_INTERNAL. Why: heights are differences of plane offsets of
+ * size ~L, each with round-off ~1e-16 L. */
+#define PD_TOL_HEIGHT_REL 1e-12
+
+/* Exact PQS band: relative accuracy asked of the adaptive quadrature of the
+ * band area. Why 1e-10: well below the 1e-9 tie tolerance that decides
+ * transfers, above what GSL's 21-point rule reaches on smooth integrands. */
+#define PD_TOL_BAND_QUAD_REL 1e-10
+
+/* --- limits ---------------------------------------------------------------- */
+
+/* Largest vertex or face count a file may declare. Counts are also checked
+ * against the bytes left in the file before any allocation, so a lying header
+ * fails with a parse error, not an out-of-memory. 2^26 = 67M elements is ten
+ * times the largest CAD meshes users feed to a pose estimator. */
+#define PD_MAX_ELEMENTS (1 << 26)
+
+/* Largest polygon a mesh face may have (vertex count of one OFF/OBJ face). */
+#define PD_MAX_FACE_VERTICES 65536
+
+#endif

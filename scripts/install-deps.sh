@@ -1,0 +1,38 @@
+#!/bin/sh
+# Installs the Debian packages posedrop builds and tests with, when pkg-config
+# (or, for the reference hull, the qhull command) cannot find them.
+# Quiet and quick when everything is present. Uses sudo only when not root.
+set -eu
+
+missing=""
+command -v pkg-config >/dev/null 2>&1 || missing="pkg-config"
+check_pc() { # module package
+    if ! command -v pkg-config >/dev/null 2>&1 || ! pkg-config --exists "$1"; then
+        missing="$missing $2"
+    fi
+}
+check_pc gsl libgsl-dev
+check_pc ode libode-dev
+check_pc ccd libccd-dev
+check_pc bullet libbullet-dev
+check_pc qhull_r libqhull-dev
+command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
+
+[ -z "$missing" ] && exit 0
+
+echo "posedrop: installing missing packages:$missing" >&2
+if ! command -v apt-get >/dev/null 2>&1; then
+    echo "posedrop: apt-get not found; install the equivalents of:$missing" >&2
+    exit 1
+fi
+SUDO=""
+if [ "$(id -u)" -ne 0 ]; then
+    if command -v sudo >/dev/null 2>&1; then SUDO="sudo"; else
+        echo "posedrop: not root and no sudo; install as root:$missing" >&2
+        exit 1
+    fi
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+# shellcheck disable=SC2086
+$SUDO apt-get install -y -qq --no-install-recommends $missing

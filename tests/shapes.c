@@ -1,0 +1,262 @@
+/* shapes.c: test fixtures (see shapes.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "shapes.h"
+#include "vec3.h"
+
+uint64_t rng_next(test_rng *r)
+{
+    uint64_t z = (r->s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+double rng_uniform(test_rng *r) { return (double)(rng_next(r) >> 11) * 0x1.0p-53; }
+
+double rng_range(test_rng *r, double lo, double hi) { return lo + (hi - lo) * rng_uniform(r); }
+
+pd_vec3 rng_unit_vector(test_rng *r)
+{
+    /* Archimedes: z uniform in [-1, 1] and a uniform azimuth is uniform on S^2. */
+    double z = rng_range(r, -1.0, 1.0), phi = rng_range(r, 0.0, 2.0 * M_PI);
+    double s = sqrt(fmax(0.0, 1.0 - z * z));
+    return v3(s * cos(phi), s * sin(phi), z);
+}
+
+void rng_rotation(test_rng *r, double R[3][3])
+{
+    /* Uniform unit quaternion (Shoemake 1992). */
+    double u1 = rng_uniform(r), u2 = 2.0 * M_PI * rng_uniform(r), u3 = 2.0 * M_PI * rng_uniform(r);
+    double a = sqrt(1.0 - u1), b = sqrt(u1);
+    double w = a * sin(u2), x = a * cos(u2), y = b * sin(u3), z = b * cos(u3);
+    R[0][0] = 1 - 2 * (y * y + z * z); R[0][1] = 2 * (x * y - w * z);     R[0][2] = 2 * (x * z + w * y);
+    R[1][0] = 2 * (x * y + w * z);     R[1][1] = 1 - 2 * (x * x + z * z); R[1][2] = 2 * (y * z - w * x);
+    R[2][0] = 2 * (x * z - w * y);     R[2][1] = 2 * (y * z + w * x);     R[2][2] = 1 - 2 * (x * x + y * y);
+}
+
+pd_vec3 rot_apply(const double R[3][3], pd_vec3 v)
+{
+    return v3(R[0][0] * v.x + R[0][1] * v.y + R[0][2] * v.z,
+              R[1][0] * v.x + R[1][1] * v.y + R[1][2] * v.z,
+              R[2][0] * v.x + R[2][1] * v.y + R[2][2] * v.z);
+}
+
+void points_transform(pd_vec3 *p, int n, const double R[3][3], double scale, pd_vec3 t)
+{
+    for (int i = 0; i < n; i++)
+        p[i] = v3_add(v3_scale(rot_apply(R, p[i]), scale), t);
+}
+
+void mesh_transform(pd_mesh *m, const double R[3][3], double scale, pd_vec3 t)
+{
+    points_transform(m->verts, m->nverts, R, scale, t);
+}
+
+/* --- brute-force hull ----------------------------------------------------- */
+
+typedef struct { pd_vec3 n; double d; } plane;
+
+/* All distinct supporting planes through three of the points. */
+static int find_planes(const pd_vec3 *p, int n, plane **out)
+{
+    double size = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = i + 1; j < n; j++)
+            size = fmax(size, v3_dist(p[i], p[j]));
+    double tol = 1e-9 * size;
+    int cap = 64, np = 0;
+    plane *pl = malloc(sizeof *pl * (size_t)cap);
+    for (int i = 0; i < n; i++)
+        for (int j = i + 1; j < n; j++)
+            for (int k = j + 1; k < n; k++) {
+                pd_vec3 nn = v3_cross(v3_sub(p[j], p[i]), v3_sub(p[k], p[i]));
+                if (v3_norm(nn) <= 1e-9 * size * size)
+                    continue;
+                nn = v3_unit(nn);
+                double d = v3_dot(nn, p[i]);
+                int above = 0, below = 0;
+                for (int m = 0; m < n; m++) {
+                    double s = v3_dot(nn, p[m]) - d;
+                    above += s > tol;
+                    below += s < -tol;
+                }
+                if (above && below)
+                    continue;
+                if (above) {
+                    nn = v3_neg(nn);
+                    d = -d;
+                }
+                int dup = 0;
+                for (int q = 0; q < np && !dup; q++)
+                    dup = v3_dot(pl[q].n, nn) > 1.0 - 1e-12 && fabs(pl[q].d - d) <= tol;
+                if (dup)
+                    continue;
+                if (np == cap)
+                    pl = realloc(pl, sizeof *pl * (size_t)(cap *= 2));
+                pl[np].n = nn;
+                pl[np].d = d;
+                np++;
+            }
+    *out = pl;
+    return np;
+}
+
+int convex_facet_count(const pd_vec3 *pts, int n)
+{
+    plane *pl;
+    int np = find_planes(pts, n, &pl);
+    free(pl);
+    return np;
+}
+
+typedef struct { double ang; int idx; } angle_idx;
+
+static int cmp_angle(const void *a, const void *b)
+{
+    double x = ((const angle_idx *)a)->ang, y = ((const angle_idx *)b)->ang;
+    return (x > y) - (x < y);
+}
+
+pd_mesh *convex_mesh(const pd_vec3 *pts, int n)
+{
+    plane *pl;
+    int np = find_planes(pts, n, &pl);
+    if (np < 4) {
+        free(pl);
+        return NULL;
+    }
+    double size = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = i + 1; j < n; j++)
+            size = fmax(size, v3_dist(pts[i], pts[j]));
+    pd_mesh *m = calloc(1, sizeof *m);
+    m->verts = malloc(sizeof *m->verts * (size_t)n);
+    memcpy(m->verts, pts, sizeof *m->verts * (size_t)n);
+    m->nverts = n;
+    int cap = 3 * n + 16;
+    m->tris = malloc(sizeof *m->tris * (size_t)cap);
+    angle_idx *loop = malloc(sizeof *loop * (size_t)n);
+    for (int f = 0; f < np; f++) {
+        int k = 0;
+        pd_vec3 c = v3(0, 0, 0);
+        for (int i = 0; i < n; i++)
+            if (fabs(v3_dot(pl[f].n, pts[i]) - pl[f].d) <= 1e-9 * size) {
+                loop[k++].idx = i;
+                c = v3_add(c, pts[i]);
+            }
+        c = v3_scale(c, 1.0 / k);
+        pd_vec3 u = v3_unit(v3_sub(pts[loop[0].idx], c)), w = v3_cross(pl[f].n, u);
+        for (int i = 0; i < k; i++) {
+            pd_vec3 d = v3_sub(pts[loop[i].idx], c);
+            loop[i].ang = atan2(v3_dot(d, w), v3_dot(d, u));
+        }
+        qsort(loop, (size_t)k, sizeof *loop, cmp_angle);
+        /* Fan from the centroid would add a vertex; fan from the first corner
+         * instead is exact for a convex loop (points on edges give zero-area
+         * triangles only if collinear with the apex, which a loop start avoids
+         * when it is a corner: start from the point farthest from c). */
+        int start = 0;
+        double best = -1.0;
+        for (int i = 0; i < k; i++) {
+            double dd = v3_dist(pts[loop[i].idx], c);
+            if (dd > best) {
+                best = dd;
+                start = i;
+            }
+        }
+        for (int i = 1; i + 1 < k; i++) {
+            if (m->ntris == cap)
+                m->tris = realloc(m->tris, sizeof *m->tris * (size_t)(cap *= 2));
+            m->tris[m->ntris][0] = loop[start].idx;
+            m->tris[m->ntris][1] = loop[(start + i) % k].idx;
+            m->tris[m->ntris][2] = loop[(start + i + 1) % k].idx;
+            m->ntris++;
+        }
+    }
+    free(loop);
+    free(pl);
+    return m;
+}
+
+/* --- standard solids -------------------------------------------------------- */
+
+int pts_box(double ax, double ay, double az, pd_vec3 *out)
+{
+    for (int i = 0; i < 8; i++)
+        out[i] = v3((i & 1 ? 0.5 : -0.5) * ax, (i & 2 ? 0.5 : -0.5) * ay, (i & 4 ? 0.5 : -0.5) * az);
+    return 8;
+}
+
+int pts_prism(int nsides, double radius, double height, pd_vec3 *out)
+{
+    for (int i = 0; i < nsides; i++) {
+        double t = 2.0 * M_PI * i / nsides;
+        out[i] = v3(radius * cos(t), radius * sin(t), -0.5 * height);
+        out[nsides + i] = v3(radius * cos(t), radius * sin(t), 0.5 * height);
+    }
+    return 2 * nsides;
+}
+
+int pts_tetrahedron(pd_vec3 *out)
+{
+    out[0] = v3(1, 1, 1);
+    out[1] = v3(1, -1, -1);
+    out[2] = v3(-1, 1, -1);
+    out[3] = v3(-1, -1, 1);
+    return 4;
+}
+
+int pts_cube(pd_vec3 *out) { return pts_box(2, 2, 2, out); }
+
+int pts_octahedron(pd_vec3 *out)
+{
+    for (int i = 0; i < 3; i++) {
+        double a[3] = {0, 0, 0};
+        a[i] = 1;
+        out[2 * i] = v3(a[0], a[1], a[2]);
+        out[2 * i + 1] = v3(-a[0], -a[1], -a[2]);
+    }
+    return 6;
+}
+
+int pts_icosahedron(pd_vec3 *out)
+{
+    double g = (1.0 + sqrt(5.0)) / 2.0;
+    int k = 0;
+    for (int s1 = -1; s1 <= 1; s1 += 2)
+        for (int s2 = -1; s2 <= 1; s2 += 2) {
+            out[k++] = v3(0, s1, s2 * g);
+            out[k++] = v3(s1, s2 * g, 0);
+            out[k++] = v3(s2 * g, 0, s1);
+        }
+    return k;
+}
+
+int pts_dodecahedron(pd_vec3 *out)
+{
+    double g = (1.0 + sqrt(5.0)) / 2.0, h = 1.0 / g;
+    int k = 0;
+    for (int i = 0; i < 8; i++)
+        out[k++] = v3(i & 1 ? 1 : -1, i & 2 ? 1 : -1, i & 4 ? 1 : -1);
+    for (int s1 = -1; s1 <= 1; s1 += 2)
+        for (int s2 = -1; s2 <= 1; s2 += 2) {
+            out[k++] = v3(0, s1 * h, s2 * g);
+            out[k++] = v3(s1 * h, s2 * g, 0);
+            out[k++] = v3(s2 * g, 0, s1 * h);
+        }
+    return k;
+}
+
+pd_mesh *mesh_box(double ax, double ay, double az)
+{
+    pd_vec3 p[8];
+    return convex_mesh(p, pts_box(ax, ay, az, p));
+}
+
+pd_mesh *mesh_prism(int nsides, double radius, double height)
+{
+    pd_vec3 p[64];
+    return convex_mesh(p, pts_prism(nsides, radius, height, p));
+}

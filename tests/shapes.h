@@ -1,0 +1,49 @@
+/* shapes.h: test fixtures: a seeded random stream, rigid transforms, and
+ * closed meshes of convex solids with known closed-form answers. */
+#ifndef PD_TEST_SHAPES_H
+#define PD_TEST_SHAPES_H
+
+#include <stdint.h>
+#include "posedrop/mesh.h"
+#include "posedrop/types.h"
+
+/* splitmix64: tiny, seedable, identical on every platform. */
+typedef struct { uint64_t s; } test_rng;
+uint64_t rng_next(test_rng *r);
+double rng_uniform(test_rng *r);              /* [0, 1) */
+double rng_range(test_rng *r, double lo, double hi);
+pd_vec3 rng_unit_vector(test_rng *r);        /* uniform on the sphere */
+
+/* A rotation matrix (row-major 3x3), uniform over SO(3). */
+void rng_rotation(test_rng *r, double R[3][3]);
+pd_vec3 rot_apply(const double R[3][3], pd_vec3 v);
+
+/* x -> scale * R x + t on every vertex of a mesh, or of a point array. */
+void mesh_transform(pd_mesh *m, const double R[3][3], double scale, pd_vec3 t);
+void points_transform(pd_vec3 *p, int n, const double R[3][3], double scale, pd_vec3 t);
+
+/* A closed, outward-oriented triangle mesh of the convex hull of a small point
+ * set (n <= ~200), found by brute force over all triples: an oracle that shares
+ * no code with the library's hull. Every point on the hull's boundary becomes a
+ * mesh vertex; each planar face is fanned around its centroid-sorted loop.
+ * Returns NULL for degenerate input. Free with pd_mesh_free. */
+pd_mesh *convex_mesh(const pd_vec3 *pts, int n);
+
+/* Number of distinct facet planes found by the same brute force. */
+int convex_facet_count(const pd_vec3 *pts, int n);
+
+/* Point sets of standard solids, centred at the origin. Each returns the count
+ * and writes into out (room for at least 64 points). */
+int pts_box(double ax, double ay, double az, pd_vec3 *out);   /* edge lengths */
+int pts_prism(int nsides, double radius, double height, pd_vec3 *out); /* n <= 32 */
+int pts_tetrahedron(pd_vec3 *out);
+int pts_cube(pd_vec3 *out);
+int pts_octahedron(pd_vec3 *out);
+int pts_dodecahedron(pd_vec3 *out);
+int pts_icosahedron(pd_vec3 *out);
+
+/* Convenience: convex_mesh of the points above. */
+pd_mesh *mesh_box(double ax, double ay, double az);
+pd_mesh *mesh_prism(int nsides, double radius, double height);
+
+#endif

@@ -1,0 +1,18 @@
+/* suites.h: the table of suites, one per module (tests/test_<module>.c). */
+#ifndef PD_TEST_SUITES_H
+#define PD_TEST_SUITES_H
+
+#define PD_SUITES   \
+    PD_SUITE(status) \
+    PD_SUITE(mesh)   \
+    PD_SUITE(hull)   \
+    PD_SUITE(mass)   \
+    PD_SUITE(part)   \
+    PD_SUITE(static) \
+    PD_SUITE(cli)
+
+#define PD_SUITE(name) void suite_##name(void);
+PD_SUITES
+#undef PD_SUITE
+
+#endif
