@@ -1,6 +1,308 @@
+/* test_cli.c: the posedrop command as a user runs it: exit codes, CSV on
+ * stdout only on success, clear messages on stderr, determinism, and the batch
+ * scripts. Runs the built binary (PD_CLI_PATH) from the repository root. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
 #include "check.h"
 #include "suites.h"
 
+#ifndef PD_CLI_PATH
+#define PD_CLI_PATH "build/opt/posedrop"
+#endif
+
+static char *slurp(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *buf = malloc((size_t)n + 1);
+    size_t got = fread(buf, 1, (size_t)n, f);
+    buf[got] = '\0';
+    fclose(f);
+    return buf;
+}
+
+static int write_file(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return 0;
+    fputs(text, f);
+    return fclose(f) == 0;
+}
+
+static char tmpdir[64];
+
+/* Runs "posedrop ARGS" (or any shell command when raw), returns the exit code
+ * and the captured stdout and stderr (caller frees). */
+static int run_cmd(const char *cmd, int raw, char **out, char **err)
+{
+    char line[2048], outp[128], errp[128];
+    snprintf(outp, sizeof outp, "%s/out", tmpdir);
+    snprintf(errp, sizeof errp, "%s/err", tmpdir);
+    snprintf(line, sizeof line, "%s %s >%s 2>%s </dev/null", raw ? "" : PD_CLI_PATH, cmd, outp,
+             errp);
+    int status = system(line);
+    *out = slurp(outp);
+    *err = slurp(errp);
+    if (!*out)
+        *out = calloc(1, 1);
+    if (!*err)
+        *err = calloc(1, 1);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+static int run(const char *args, char **out, char **err) { return run_cmd(args, 0, out, err); }
+
+/* A failed run: the exit code, nothing on stdout, and stderr mentions what. */
+static void expect_failure(const char *args, int code, const char *mention)
+{
+    char *out, *err;
+    int rc = run(args, &out, &err);
+    CHECK_INT(rc, code);
+    CHECK_INT((int)strlen(out), 0);
+    if (!strstr(err, mention))
+        printf("     stderr of '%s' lacks '%s':\n     %s", args, mention, err);
+    CHECK(strstr(err, mention) != NULL);
+    free(out);
+    free(err);
+}
+
+typedef struct {
+    int nrows;
+    double p_qs_sum, p_pqs_sum;
+    int ordered, numbered;
+} csv_summary;
+
+/* Finds columns by name, as the output contract says tools must. */
+static int summarise(const char *csv, csv_summary *s)
+{
+    memset(s, 0, sizeof *s);
+    s->ordered = s->numbered = 1;
+    const char *nl = strchr(csv, '\n');
+    if (!nl)
+        return 0;
+    char header[256];
+    size_t hl = (size_t)(nl - csv);
+    if (hl >= sizeof header)
+        return 0;
+    memcpy(header, csv, hl);
+    header[hl] = '\0';
+    int col_pose = -1, col_qs = -1, col_pqs = -1, ncol = 0;
+    for (char *tok = strtok(header, ","); tok; tok = strtok(NULL, ","), ncol++) {
+        if (strcmp(tok, "pose") == 0)
+            col_pose = ncol;
+        if (strcmp(tok, "p_qs") == 0)
+            col_qs = ncol;
+        if (strcmp(tok, "p_pqs") == 0)
+            col_pqs = ncol;
+    }
+    if (col_pose < 0 || col_qs < 0 || col_pqs < 0)
+        return 0;
+    double prev = 2.0;
+    for (const char *p = nl + 1; *p; ) {
+        const char *e = strchr(p, '\n');
+        if (!e)
+            return 0;
+        double v[16] = {0};
+        int k = 0;
+        for (const char *q = p; q < e && k < 16; k++) {
+            v[k] = strtod(q, NULL);
+            const char *c = memchr(q, ',', (size_t)(e - q));
+            q = c ? c + 1 : e;
+        }
+        if (k != ncol)
+            return 0;
+        s->nrows++;
+        s->numbered &= (int)v[col_pose] == s->nrows;
+        s->ordered &= v[col_qs] <= prev;
+        prev = v[col_qs];
+        s->p_qs_sum += v[col_qs];
+        s->p_pqs_sum += v[col_pqs];
+        p = e + 1;
+    }
+    return 1;
+}
+
+static void test_usage(void)
+{
+    char *out, *err;
+    CHECK_INT(run("--help", &out, &err), 0);
+    CHECK(strstr(out, "usage: posedrop") != NULL);
+    CHECK(strstr(out, "--epsilon") != NULL);
+    free(out);
+    free(err);
+    CHECK_INT(run("--version", &out, &err), 0);
+    CHECK(strncmp(out, "posedrop ", 9) == 0);
+    free(out);
+    free(err);
+
+    expect_failure("", 2, "expected one PART file");
+    expect_failure("parts/cap.off parts/cap.off", 2, "exactly one PART");
+    /* -h is reserved for the drop height; help is --help only. */
+    expect_failure("-h parts/cap.off", 2, "unknown option");
+    expect_failure("--frobnicate parts/cap.off", 2, "unknown option '--frobnicate'");
+    expect_failure("--units furlong parts/cap.off", 2, "--units");
+    expect_failure("--epsilon 91 parts/cap.off", 2, "--epsilon");
+    expect_failure("--epsilon nan parts/cap.off", 2, "--epsilon");
+    expect_failure("--com 1,2 parts/cap.off", 2, "--com");
+    expect_failure("--com 1,2,inf parts/cap.off", 2, "--com");
+    expect_failure("--topple sideways parts/cap.off", 2, "--topple");
+    expect_failure("parts/cap.off --epsilon", 2, "needs a value");
+}
+
+static void test_bad_input(void)
+{
+    char path[160], args[256];
+    expect_failure("/nonexistent/part.off", 2, "/nonexistent/part.off");
+
+    snprintf(path, sizeof path, "%s/bad.off", tmpdir);
+    write_file(path, "OFF\n# a comment\n4 4 0\n0 0 0\n1 0 0\n0 x 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n");
+    snprintf(args, sizeof args, "%s", path);
+    char where[200];
+    snprintf(where, sizeof where, "%s:6:", path);
+    expect_failure(args, 2, where);
+
+    /* Coplanar points: no volume. */
+    snprintf(path, sizeof path, "%s/flat.off", tmpdir);
+    write_file(path, "OFF\n4 2 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n3 0 1 2\n3 0 2 3\n");
+    expect_failure(path, 2, "flat.off");
+
+    /* A centre of mass outside the hull is refused. */
+    expect_failure("--com 1,0,0 parts/cap.off", 2, "centre of mass");
+    expect_failure("--com 0,0,0.014 parts/cap.off", 2, "centre of mass");
+
+    /* An open mesh needs --com. */
+    snprintf(path, sizeof path, "%s/open.off", tmpdir);
+    write_file(path, "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+    expect_failure(path, 2, "--com");
+    char *out, *err;
+    snprintf(args, sizeof args, "--com 0.2,0.2,0.2 %s", path);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(strstr(err, "warning") != NULL);
+    free(out);
+    free(err);
+}
+
+static void test_results(void)
+{
+    char *out, *err, *out2, *err2;
+    csv_summary s;
+
+    /* Every shipped part runs and gives a consistent table. The sums carry the
+     * rounding of 10 printed significant digits: at most 5e-11 per row. */
+    const char *parts[] = {"parts/cap.off", "parts/button.off", "--units mm parts/block.stl",
+                           "--units mm parts/hexnut.obj"};
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) {
+        CHECK_INT(run(parts[i], &out, &err), 0);
+        CHECK(strncmp(out, "pose,nx,ny,nz,area,height,p_qs,p_pqs\n", 37) == 0);
+        CHECK(summarise(out, &s));
+        CHECK(s.nrows >= 2);
+        CHECK(s.ordered);
+        CHECK(s.numbered);
+        CHECK_NEAR(s.p_qs_sum, 1.0, 1e-9, "10 printed digits per row");
+        CHECK_NEAR(s.p_pqs_sum, 1.0, 1e-9, "10 printed digits per row");
+        CHECK(strstr(out, "nan") == NULL && strstr(out, "inf") == NULL);
+        free(out);
+        free(err);
+    }
+
+    /* Same input, same bytes. */
+    CHECK_INT(run("--topple edge parts/cap.off", &out, &err), 0);
+    CHECK_INT(run("--topple edge parts/cap.off", &out2, &err2), 0);
+    CHECK(strcmp(out, out2) == 0);
+    free(out);
+    free(err);
+    free(out2);
+    free(err2);
+
+    /* Units: the block is 40 x 20 x 10 mm; resting on its largest face the
+     * centre is 5 mm up and the face is 8e-4 m^2 (float32 coordinates of
+     * integers are exact, so to printed precision). */
+    CHECK_INT(run("--units mm parts/block.stl", &out, &err), 0);
+    CHECK(strstr(out, "\n1,0,0,-1,0.0008,0.005,") != NULL); /* tie with +z: by normal */
+    free(out);
+    free(err);
+
+    /* A facet table covers the whole hull. */
+    CHECK_INT(run("--facets parts/cap.off", &out, &err), 0);
+    CHECK(strncmp(out, "facet,nx,ny,nz,area,height,p_raw,stable,knife,next,rest,pose\n", 62) == 0);
+    free(out);
+    free(err);
+
+    /* epsilon 0: PQS equals QS column for column. */
+    CHECK_INT(run("--epsilon 0 parts/button.off", &out, &err), 0);
+    int same = 1;
+    for (const char *p = strchr(out, '\n') + 1; *p; p = strchr(p, '\n') + 1) {
+        const char *c = p;
+        for (int k = 0; k < 6; k++)
+            c = strchr(c, ',') + 1;
+        double qs = strtod(c, NULL), pqs = strtod(strchr(c, ',') + 1, NULL);
+        same &= qs == pqs;
+    }
+    CHECK(same);
+    free(out);
+    free(err);
+}
+
+static void test_scripts(void)
+{
+    char cmd[512], *out, *err;
+    snprintf(cmd, sizeof cmd, "scripts/posedrop-batch -o %s/batch -- parts/cap.off parts/button.off",
+             tmpdir);
+    int rc = run_cmd(cmd, 1, &out, &err);
+    CHECK_INT(rc, 0);
+    if (rc)
+        printf("     %s", err);
+    free(out);
+    free(err);
+    char path[160];
+    snprintf(path, sizeof path, "%s/batch/all.csv", tmpdir);
+    char *all = slurp(path);
+    CHECK(all != NULL && strncmp(all, "part,pose,nx,ny,nz,area,height,p_qs,p_pqs\n", 42) == 0);
+    CHECK(all != NULL && strstr(all, "\ncap,1,") != NULL && strstr(all, "\nbutton,1,") != NULL);
+    free(all);
+
+    /* A bad file among good ones: the batch reports it and fails, the good
+     * results are still collected. */
+    snprintf(path, sizeof path, "%s/broken.off", tmpdir);
+    write_file(path, "OFF\n8 1 0\n");
+    snprintf(cmd, sizeof cmd, "scripts/posedrop-batch -o %s/batch2 -- parts/cap.off %s", tmpdir, path);
+    rc = run_cmd(cmd, 1, &out, &err);
+    CHECK(rc != 0);
+    CHECK(strstr(err, "broken.off") != NULL);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/batch2/all.csv", tmpdir);
+    all = slurp(path);
+    CHECK(all != NULL && strstr(all, "\ncap,1,") != NULL && strstr(all, "broken") == NULL);
+    free(all);
+}
+
 void suite_cli(void)
 {
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        CHECK(!"cannot create a temporary directory");
+        return;
+    }
+    if (access(PD_CLI_PATH, X_OK) != 0) {
+        printf("     %s not built\n", PD_CLI_PATH);
+        CHECK(!"posedrop binary missing");
+        return;
+    }
+    test_usage();
+    test_bad_input();
+    test_results();
+    test_scripts();
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    if (system(cmd) != 0)
+        printf("     could not remove %s\n", tmpdir);
 }

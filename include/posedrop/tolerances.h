@@ -79,6 +79,14 @@
  * transfers, above what GSL's 21-point rule reaches on smooth integrands. */
 #define PD_TOL_BAND_QUAD_REL 1e-10
 
+/* --- output ----------------------------------------------------------------- */
+
+/* Printed unit-normal components and probabilities smaller than this in
+ * magnitude are written as 0: an axis-aligned normal carries round-off
+ * components of ~1e-17 and they would print as noise (or as -0). 1e-12 is far
+ * below any printed digit that matters (10 significant digits are printed). */
+#define PD_PRINT_ZERO 1e-12
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked
