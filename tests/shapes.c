@@ -2,6 +2,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "posedrop/hull.h"
 #include "shapes.h"
 #include "vec3.h"
 
@@ -259,4 +260,27 @@ pd_mesh *mesh_prism(int nsides, double radius, double height)
 {
     pd_vec3 p[64];
     return convex_mesh(p, pts_prism(nsides, radius, height, p));
+}
+
+pd_mesh *mesh_of_hull(const pd_hull *h)
+{
+    pd_mesh *m = calloc(1, sizeof *m);
+    m->nverts = h->nverts;
+    m->verts = malloc(sizeof *m->verts * (size_t)h->nverts);
+    memcpy(m->verts, h->verts, sizeof *m->verts * (size_t)h->nverts);
+    int nt = 0;
+    for (int f = 0; f < h->nfacets; f++)
+        nt += h->facet_start[f + 1] - h->facet_start[f] - 2;
+    m->tris = malloc(sizeof *m->tris * (size_t)nt);
+    for (int f = 0; f < h->nfacets; f++) {
+        const int *loop = h->facet_vert + h->facet_start[f];
+        int k = h->facet_start[f + 1] - h->facet_start[f];
+        for (int i = 1; i + 1 < k; i++) {
+            m->tris[m->ntris][0] = loop[0];
+            m->tris[m->ntris][1] = loop[i];
+            m->tris[m->ntris][2] = loop[i + 1];
+            m->ntris++;
+        }
+    }
+    return m;
 }

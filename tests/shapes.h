@@ -42,6 +42,11 @@ int pts_octahedron(pd_vec3 *out);
 int pts_dodecahedron(pd_vec3 *out);
 int pts_icosahedron(pd_vec3 *out);
 
+/* A closed mesh of a hull's facets (each fanned from its first corner), so a
+ * point cloud can go through pd_part_build like a file would. */
+struct pd_hull;
+pd_mesh *mesh_of_hull(const struct pd_hull *h);
+
 /* Convenience: convex_mesh of the points above. */
 pd_mesh *mesh_box(double ax, double ay, double az);
 pd_mesh *mesh_prism(int nsides, double radius, double height);
