@@ -257,9 +257,14 @@ static int parse_args(int argc, char **argv, cli_args *a)
     return -1;
 }
 
-static int fail_status(pd_status st, const pd_diag *diag)
+/* Reader messages already start with "FILE:LINE:"; later stages know no file
+ * name, so path (when given) is put in front of theirs. */
+static int fail_status(pd_status st, const pd_diag *diag, const char *path)
 {
-    fprintf(stderr, "%s: %s\n", prog, diag->message[0] ? diag->message : pd_status_str(st));
+    fprintf(stderr, "%s: %s%s%s%s\n", prog, path ? path : "", path ? ": " : "",
+            diag->message[0] ? diag->message : pd_status_str(st),
+            st == PD_ERR_NOT_CLOSED || st == PD_ERR_ORIENTATION
+                ? "; give its centre of mass with --com X,Y,Z to use it anyway" : "");
     return pd_status_is_input_error(st) ? EXIT_USAGE : EXIT_INTERNAL;
 }
 
@@ -291,12 +296,15 @@ int main(int argc, char **argv)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
-    if (st == PD_OK)
-        st = pd_part_build(mesh, &a.part, &part, &diag);
+    if (st != PD_OK) {
+        code = fail_status(st, &diag, NULL);
+        goto done;
+    }
+    st = pd_part_build(mesh, &a.part, &part, &diag);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a.estimate, &res, &diag);
     if (st != PD_OK) {
-        code = fail_status(st, &diag);
+        code = fail_status(st, &diag, a.path);
     } else {
         if (a.verbose)
             print_summary(&a, part, res);
@@ -308,6 +316,7 @@ int main(int argc, char **argv)
         if (code)
             fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
     }
+done:
     pd_static_result_free(res);
     pd_part_free(part);
     pd_mesh_free(mesh);

@@ -61,6 +61,13 @@
  * difference a user can measure (it would take 1e18 drops). */
 #define PD_TOL_PROB_TIE_REL 1e-9
 
+/* Unit normals whose components differ by at most this are equal when poses
+ * that tie in probability are ordered by normal. Why 1e-9: computed normals
+ * carry round-off of ~1e-16 per component, so a mirror-symmetric pair must not
+ * be ordered by noise; distinct facets differ by 1e-7 rad or more (see
+ * PD_TOL_PLANE_REL), two orders above. */
+#define PD_TOL_NORMAL_TIE 1e-9
+
 /* Quasi-static descent works on the unit sphere of gravity directions. An exit
  * point of a vertex region closer than this angle to a facet normal is snapped
  * to it; a descent step shorter than this is a knife edge.

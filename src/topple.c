@@ -1,0 +1,212 @@
+/* topple.c: the quasi-static graph (QSG): where each unstable facet topples.
+ *
+ * Orientations are gravity directions g on the unit sphere of the part's
+ * frame. Resting on the floor with gravity g, the centre of mass c is at height
+ *   h(g) = max over hull points x of (x - c) . g
+ * (the support function), and quasi-static motion is steepest descent of h.
+ * The sphere is tiled by the hull's normal cones: a facet is a point (its
+ * normal), an edge an arc between its two facets' normals, a vertex the
+ * spherical polygon around it. Descent from a facet normal n_f:
+ *  - the foot of c on the facet lies nearest an edge's interior: the part
+ *    rotates about that edge and lands on the facet across it;
+ *  - it lies nearest a vertex v: the part pivots about v, g moving on the
+ *    great circle away from the direction of v - c, until it leaves v's cone
+ *    across the arc of an edge (v, w). There the projection of c on the edge
+ *    line decides: inside the segment, the part rotates about the edge to the
+ *    arc's lower end (a facet that may share only v with the start); beyond
+ *    w, it pivots about w and the walk goes on.
+ * h falls strictly along the way, so the walk ends. The paper's rule
+ * (PD_TOPPLE_EDGE) instead always topples across the edge of the facet beyond
+ * whose line the foot lies farthest, which keeps links between edge-adjacent
+ * facets. */
+#include <stdlib.h>
+#include "diag.h"
+#include "posedrop/tolerances.h"
+#include "static_internal.h"
+#include "vec3.h"
+
+/* The edges leaving each hull vertex, with the facets on either side. */
+typedef struct out_edge {
+    int to;            /* the other end */
+    int left, right;   /* facet with the edge v -> to in its loop, and the one across */
+} out_edge;
+
+typedef struct vert_star {
+    int *start;        /* nverts + 1 */
+    out_edge *edge;
+} vert_star;
+
+static pd_status star_build(const pd_hull *h, vert_star *s)
+{
+    int nloop = h->facet_start[h->nfacets];
+    s->start = calloc((size_t)h->nverts + 1, sizeof *s->start);
+    s->edge = malloc(sizeof *s->edge * (size_t)(nloop > 0 ? nloop : 1));
+    if (!s->start || !s->edge)
+        return PD_ERR_NOMEM;
+    for (int k = 0; k < nloop; k++)
+        s->start[h->facet_vert[k] + 1]++;
+    for (int v = 0; v < h->nverts; v++)
+        s->start[v + 1] += s->start[v];
+    int *fill = malloc(sizeof *fill * (size_t)(h->nverts > 0 ? h->nverts : 1));
+    if (!fill)
+        return PD_ERR_NOMEM;
+    for (int v = 0; v < h->nverts; v++)
+        fill[v] = s->start[v];
+    for (int f = 0; f < h->nfacets; f++) {
+        int b = h->facet_start[f], n = h->facet_start[f + 1] - b;
+        for (int i = 0; i < n; i++) {
+            int v = h->facet_vert[b + i];
+            out_edge *e = &s->edge[fill[v]++];
+            e->to = h->facet_vert[b + (i + 1) % n];
+            e->left = f;
+            e->right = h->facet_adj[b + i];
+        }
+    }
+    free(fill);
+    return PD_OK;
+}
+
+static void star_free(vert_star *s)
+{
+    free(s->start);
+    free(s->edge);
+}
+
+/* The component of x perpendicular to the unit vector g. */
+static pd_vec3 tangential(pd_vec3 x, pd_vec3 g)
+{
+    return v3_sub(x, v3_scale(g, v3_dot(x, g)));
+}
+
+/* Rotation about edge (v, w), gravity g on its arc between the normals of
+ * facets left and right: the facet at the end the centre of mass descends to. */
+static int roll_about_edge(const pd_hull *h, pd_vec3 com, pd_vec3 v, pd_vec3 w, pd_vec3 g,
+                           int left, int right)
+{
+    pd_vec3 tau = v3_unit(v3_cross(v3_sub(w, v), g));
+    /* dh/ds moving along +tau: both edge ends are support points on the arc. */
+    if (v3_dot(v3_sub(v, com), tau) > 0.0)
+        tau = v3_neg(tau);
+    return v3_dot(h->normal[left], tau) >= v3_dot(h->normal[right], tau) ? left : right;
+}
+
+/* Steepest descent from facet f whose foot lies nearest its corner v. */
+static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, int f, int v,
+                            int *next)
+{
+    pd_vec3 g = h->normal[f];
+    pd_vec3 d = v3_unit(tangential(v3_sub(com, h->verts[v]), g));
+    int limit = 2 * h->nverts + 8; /* every pivot lowers h, so vertices don't repeat */
+    for (int step = 0; step < limit; step++) {
+        pd_vec3 pv = h->verts[v];
+        /* Leave v's normal cone where (v - w) . g(s) first reaches zero on
+         * g(s) = g cos s + d sin s: s = atan2(A, -B) for A = (v-w).g > 0. */
+        double s_exit = 4.0;
+        const out_edge *exit = NULL;
+        for (int k = s->start[v]; k < s->start[v + 1]; k++) {
+            pd_vec3 u = v3_sub(pv, h->verts[s->edge[k].to]);
+            double A = v3_dot(u, g), B = v3_dot(u, d), tol = PD_TOL_ANGLE * v3_norm(u);
+            double sk;
+            if (A <= tol) {
+                if (B > 0.0)
+                    continue; /* on this boundary but moving inward */
+                sk = 0.0;
+            } else {
+                sk = atan2(A, -B);
+            }
+            if (sk < s_exit) {
+                s_exit = sk;
+                exit = &s->edge[k];
+            }
+        }
+        if (!exit)
+            return PD_ERR_INTERNAL;
+        pd_vec3 g1 = v3_unit(v3_add(v3_scale(g, cos(s_exit)), v3_scale(d, sin(s_exit))));
+        /* Leaving through a corner of the cone: the part lands on that facet. */
+        if (exit->left != f && v3_angle(g1, h->normal[exit->left]) <= PD_TOL_ANGLE) {
+            *next = exit->left;
+            return PD_OK;
+        }
+        if (exit->right != f && v3_angle(g1, h->normal[exit->right]) <= PD_TOL_ANGLE) {
+            *next = exit->right;
+            return PD_OK;
+        }
+        pd_vec3 pw = h->verts[exit->to], e = v3_sub(pw, pv);
+        double lambda = v3_dot(v3_sub(com, pv), e) / v3_dot(e, e);
+        pd_vec3 dw = tangential(v3_sub(com, pw), g1);
+        if (lambda < 1.0 || v3_norm(dw) <= PD_TOL_ANGLE * v3_norm(e)) {
+            /* Centre of mass over the segment (lambda > 0 whenever the edge
+             * was reached by pivoting about v; round-off below 0 is clamped
+             * here too): roll about the edge to the lower end of its arc. */
+            *next = roll_about_edge(h, com, pv, pw, g1, exit->left, exit->right);
+            return PD_OK;
+        }
+        /* Beyond w: w takes over as the pivot. */
+        v = exit->to;
+        g = g1;
+        d = v3_unit(dw);
+    }
+    return PD_ERR_NO_CONVERGENCE;
+}
+
+/* Resolves rest[] by following next[] (heights fall along it, so chains are
+ * at most nfacets long; a longer one is a cycle and a bug). */
+static pd_status resolve_rest(pd_static_result *res, pd_diag *diag)
+{
+    pd_facet_result *fr = res->facets;
+    for (int f = 0; f < res->nfacets; f++)
+        fr[f].rest = fr[f].stable ? f : -1;
+    for (int f = 0; f < res->nfacets; f++) {
+        int g = f, len = 0;
+        while (fr[g].rest < 0) {
+            g = fr[g].next;
+            if (++len > res->nfacets)
+                return pd_fail(diag, PD_ERR_INTERNAL, "quasi-static graph has a cycle at facet %d",
+                               f + 1);
+        }
+        int r = fr[g].rest;
+        for (g = f; fr[g].rest < 0; g = fr[g].next)
+            fr[g].rest = r;
+    }
+    return PD_OK;
+}
+
+pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
+                          pd_topple_rule rule, pd_static_result *res, pd_diag *diag)
+{
+    vert_star star = {NULL, NULL};
+    pd_status st = PD_OK;
+    if (rule == PD_TOPPLE_DESCENT)
+        st = star_build(hull, &star);
+    for (int f = 0; f < hull->nfacets && st == PD_OK; f++) {
+        pd_facet_result *r = &res->facets[f];
+        const facet_geom *g = &geom[f];
+        int base = hull->facet_start[f];
+        r->next = -1;
+        if (r->stable)
+            continue;
+        if (rule == PD_TOPPLE_EDGE || r->knife)
+            r->next = hull->facet_adj[base + g->best_edge];
+        else if (g->near_vertex < 0)
+            r->next = hull->facet_adj[base + g->near_edge];
+        else
+            st = pivot_walk(hull, &star, com, f, g->near_vertex, &r->next);
+        if (st == PD_ERR_NO_CONVERGENCE)
+            st = pd_fail(diag, st, "quasi-static descent from facet %d did not end", f + 1);
+        else if (st == PD_ERR_INTERNAL)
+            st = pd_fail(diag, st, "quasi-static descent from facet %d left no vertex cone", f + 1);
+        if (st != PD_OK)
+            break;
+        /* Every link must lower the centre of mass: that is what makes the
+         * graph acyclic and the propagation well defined. */
+        double rise = res->facets[r->next].height - r->height;
+        if (r->next == f || rise > PD_TOL_HEIGHT_REL * hull->size)
+            st = pd_fail(diag, PD_ERR_INTERNAL,
+                         "quasi-static link from facet %d to %d raises the centre of mass by %.3g m",
+                         f + 1, r->next + 1, rise);
+    }
+    star_free(&star);
+    if (st == PD_OK)
+        st = resolve_rest(res, diag);
+    return st;
+}
