@@ -76,6 +76,13 @@ static double solid_angle(pd_vec3 a, pd_vec3 b, pd_vec3 c)
     double la = v3_norm(a), lb = v3_norm(b), lc = v3_norm(c);
     double num = v3_dot(a, v3_cross(b, c));
     double den = la * lb * lc + v3_dot(a, b) * lc + v3_dot(b, c) * la + v3_dot(c, a) * lb;
+    /* den <= 0 with num ~ 0: the point lies on the closed triangle (in its
+     * plane, to PD_TOL_PLANE_REL of its distances, and within its corners),
+     * where the angle jumps between -2 pi and 2 pi on the sign of round-off.
+     * Counting 0 instead leaves the winding number at a half-integer, which
+     * the caller recognises as "on the surface" and moves to another point. */
+    if (den <= 0.0 && fabs(num) <= PD_TOL_PLANE_REL * la * lb * lc)
+        return 0.0;
     return 2.0 * atan2(num, den);
 }
 
