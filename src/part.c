@@ -57,6 +57,10 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
 
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
+    /* Every size-relative tolerance below needs a finite size. */
+    for (int i = 0; i < p->mesh->nverts; i++)
+        if (!v3_isfinite(p->mesh->verts[i]))
+            return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
     p->size = pd_mesh_size(p->mesh);
     if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
         return PD_ERR_NOMEM;

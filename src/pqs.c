@@ -104,17 +104,17 @@ pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geo
                 continue;
             pd_vec3 a = v3_sub(hull->verts[hull->facet_vert[base + e]], com);
             pd_vec3 b = v3_sub(hull->verts[hull->facet_vert[base + (e + 1) % k]], com);
-            double tri = pd_solid_angle_triangle(a, b, foot), band;
+            double tri = pd_solid_angle_triangle(a, b, foot), area;
             if (opt->band == PD_PQS_BAND_EXACT) {
                 pd_status st = pd_band_area_exact(v3_unit(a), v3_unit(b), hull->normal[i],
-                                                  opt->epsilon, &band);
+                                                  opt->epsilon, &area);
                 if (st != PD_OK)
                     return pd_fail(diag, st, "PQS band of facet %d, edge %d: quadrature failed",
                                    i + 1, e + 1);
             } else {
-                band = v3_angle(a, b) * opt->epsilon;
+                area = v3_angle(a, b) * opt->epsilon;
             }
-            double dp = fmin(band, tri) / (4.0 * M_PI);
+            double dp = fmin(area, tri) / (4.0 * M_PI);
             pert[i] -= dp;
             pert[j] += dp;
         }

@@ -14,6 +14,10 @@ double rng_uniform(test_rng *r);              /* [0, 1) */
 double rng_range(test_rng *r, double lo, double hi);
 pd_vec3 rng_unit_vector(test_rng *r);        /* uniform on the sphere */
 
+/* C before C23 will not pass a double[3][3] where a const one is expected
+ * without a cast: CR(R) is that cast. */
+#define CR(m) ((const double(*)[3])(m))
+
 /* A rotation matrix (row-major 3x3), uniform over SO(3). */
 void rng_rotation(test_rng *r, double R[3][3]);
 pd_vec3 rot_apply(const double R[3][3], pd_vec3 v);

@@ -23,10 +23,6 @@
 #define REL 1e-12
 #define REL_SRC "round-off: 1e-12 relative (exact formula, double precision)"
 
-/* C before C23 will not pass a double[3][3] where a const one is expected
- * without a cast. */
-#define CR(m) ((const double(*)[3])(m))
-
 /* --- helpers ------------------------------------------------------------------ */
 
 static pd_mesh *mesh_new(int nverts, int ntris)

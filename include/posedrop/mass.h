@@ -23,8 +23,10 @@ typedef struct pd_mass {
 } pd_mass;
 
 /* Makes the faces of a welded mesh consistently oriented with outward normals.
- * Flips the faces that disagree with their neighbours and, if the enclosed
- * signed volume is negative, all of them. *nflipped (may be NULL) receives the
+ * Works shell by shell (connected components): flips the faces that disagree
+ * with their neighbours, then turns each shell so that it encloses positive
+ * volume if it lies inside an even number of other shells (an outer surface)
+ * and negative volume otherwise (a void). *nflipped (may be NULL) receives the
  * number of faces flipped. PD_ERR_NOT_CLOSED if an edge is not shared by exactly
  * two faces (boundary or non-manifold), PD_ERR_ORIENTATION if no consistent
  * orientation exists. The mesh is unchanged on failure. */
