@@ -190,11 +190,8 @@ int pd_parse_int(const char *s, size_t n, long long *out)
     for (; i < n; i++) {
         if (s[i] < '0' || s[i] > '9')
             return 0;
-        if (v < cap)
-            v = v * 10 + (s[i] - '0');
+        v = v <= (cap - 9) / 10 ? v * 10 + (s[i] - '0') : cap;
     }
-    if (v > cap)
-        v = cap;
     *out = neg ? -v : v;
     return 1;
 }
