@@ -12,9 +12,14 @@
 #include "mesh_reader.h"
 #include "vec3.h"
 
-/* Cell coordinates are kept below this so that they stay exact in a double
- * and their neighbours (+-1) cannot overflow an int64_t. */
-#define CELL_LIMIT 0x1p50
+/* Coordinates in cell units are kept below this, so a quotient v / w is
+ * rounded by at most half an ulp of 2^44, 2^-9, and cell indices and their
+ * neighbours cannot overflow an int64_t. Above it the grid is not used. */
+#define CELL_LIMIT 0x1p44
+/* Bound on how much two computed quotients can differ beyond the true
+ * difference: two roundings of 2^-9 each, plus the relative round-off of the
+ * distance test, far smaller. */
+#define CELL_SLACK 0x1p-8
 
 typedef struct cell {
     int64_t c[3];
@@ -52,9 +57,10 @@ static cell *find_cell(const grid *g, const int64_t c[3])
  * too large for cells of this size (the caller falls back to exact bits). */
 static pd_status grid_reps(const pd_mesh *m, double tol, int *rep, int *usable)
 {
-    /* Cells twice tol wide: two points within tol then differ by less than one
-     * cell on each axis even after the division rounds, so the 27 cells around
-     * a point's own always hold every point within tol of it. */
+    /* Cells twice tol wide: two points within tol differ by at most half a
+     * cell (plus CELL_SLACK) on each axis, so only the neighbours on the side
+     * of the cell a point is nearer to can hold a match: 8 cells on average
+     * instead of 27. */
     double w = 2.0 * tol;
     *usable = 0;
     for (int i = 0; i < m->nverts; i++) {
@@ -80,11 +86,19 @@ static pd_status grid_reps(const pd_mesh *m, double tol, int *rep, int *usable)
         g.slot[k].head = -1;
     for (int i = 0; i < m->nverts; i++) {
         pd_vec3 v = m->verts[i];
-        int64_t c[3] = {(int64_t)floor(v.x / w), (int64_t)floor(v.y / w), (int64_t)floor(v.z / w)};
+        double u[3] = {v.x / w, v.y / w, v.z / w};
+        int64_t c[3];
+        int lo[3], hi[3];
+        for (int k = 0; k < 3; k++) {
+            double f = floor(u[k]);
+            c[k] = (int64_t)f;
+            lo[k] = u[k] - f < 0.5 + CELL_SLACK ? -1 : 0;
+            hi[k] = u[k] - f > 0.5 - CELL_SLACK ? 1 : 0;
+        }
         int best = -1;
-        for (int dx = -1; dx <= 1; dx++)
-            for (int dy = -1; dy <= 1; dy++)
-                for (int dz = -1; dz <= 1; dz++) {
+        for (int dx = lo[0]; dx <= hi[0]; dx++)
+            for (int dy = lo[1]; dy <= hi[1]; dy++)
+                for (int dz = lo[2]; dz <= hi[2]; dz++) {
                     int64_t nc[3] = {c[0] + dx, c[1] + dy, c[2] + dz};
                     for (int r = find_cell(&g, nc)->head; r >= 0; r = g.next[r])
                         if ((best < 0 || r < best) && v3_dist(m->verts[r], v) <= tol)

@@ -622,6 +622,58 @@ static void test_weld(void)
     CHECK_INT(m->ntris, 2);
     pd_mesh_free(m);
 
+    /* Against brute force: clusters of points jittered by 0.05 to 1 tol
+     * (seeded). Each triangle (i, A, B) joins point i to two far anchors, so
+     * none collapses and the corner of triangle i shows i's survivor, which
+     * must be the first earlier survivor within tol, as an O(n^2) scan says. */
+    {
+        enum { NP = 600 };
+        test_rng g = {7};
+        pd_vec3 *p = malloc(sizeof *p * (NP + 2));
+        int (*pt)[3] = malloc(sizeof *pt * NP);
+        int *ref = malloc(sizeof *ref * (NP + 2));
+        p[0] = (pd_vec3){100, 0, 0};
+        p[1] = (pd_vec3){0, 100, 0};
+        for (int i = 2; i < NP + 2; i++) {
+            pd_vec3 c = {(double)(rng_next(&g) % 8) * 0.01, (double)(rng_next(&g) % 8) * 0.01, 0.5};
+            pd_vec3 u = rng_unit_vector(&g);
+            double s = tol * rng_range(&g, 0.05, 1.0);
+            p[i] = (pd_vec3){c.x + s * u.x, c.y + s * u.y, c.z + s * u.z};
+            pt[i - 2][0] = i;
+            pt[i - 2][1] = 0;
+            pt[i - 2][2] = 1;
+        }
+        for (int i = 0; i < NP + 2; i++) {
+            ref[i] = i;
+            for (int r = 0; r < i; r++) {
+                pd_vec3 dv = {p[i].x - p[r].x, p[i].y - p[r].y, p[i].z - p[r].z};
+                if (ref[r] == r && sqrt(dv.x * dv.x + dv.y * dv.y + dv.z * dv.z) <= tol) {
+                    ref[i] = r;
+                    break;
+                }
+            }
+        }
+        int nrep = 0;
+        for (int i = 0; i < NP + 2; i++)
+            nrep += ref[i] == i;
+        m = make_mesh(p, NP + 2, (const int (*)[3])pt, NP);
+        CHECK_STATUS(pd_mesh_weld(m, tol, &merged), PD_OK);
+        CHECK_INT(m->nverts, nrep);
+        CHECK(nrep > 66 && nrep < NP / 2); /* the test does merge, and not everything */
+        if (!(nrep > 66 && nrep < NP / 2))
+            printf("     nrep %d\n", nrep);
+        int agree = m->ntris == NP;
+        for (int t2 = 0; agree && t2 < NP; t2++) {
+            pd_vec3 got = m->verts[m->tris[t2][0]], want = p[ref[t2 + 2]];
+            agree = got.x == want.x && got.y == want.y && got.z == want.z;
+        }
+        CHECK(agree);
+        pd_mesh_free(m);
+        free(p);
+        free(pt);
+        free(ref);
+    }
+
     /* A jittered soup of a closed box welds back to the box: every corner
      * copy moved by up to 0.1 tol (a random direction, seeded). */
     test_rng r = {42};
