@@ -24,6 +24,10 @@ void pd_text_init(pd_text *t, const void *data, size_t size, const char *name, c
     t->name = name;
     t->p = data;
     t->end = t->p ? t->p + size : NULL;
+    /* Editors on some systems start UTF-8 text with a byte-order mark; it
+     * would otherwise glue itself to the first keyword. */
+    if (size >= 3 && memcmp(t->p, "\xEF\xBB\xBF", 3) == 0)
+        t->p += 3;
     t->comment = comment;
     t->join = join;
 }

@@ -113,6 +113,7 @@ static void test_off(void)
         "0 0 1 0 0 1 1 1 1 1\n3 0 1 2\n3 0 1 3\n",
         "STOFF\n4 2 0\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n0 0 1 1 1\n3 0 1 2\n3 0 1 3\n",
         "nOFF 3\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n",
+        "\xEF\xBB\xBFOFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n", /* UTF-8 BOM */
         "OFF\r\n4 2 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n3 0 1 2\r\n3 0 1 3", /* CRLF, no final newline */
     };
     for (size_t i = 0; i < sizeof variants / sizeof variants[0]; i++) {
@@ -419,7 +420,7 @@ static void test_format(void)
     m = parse_ok(tetra_off, "misnamed.stl");
     CHECK(m && m->ntris == 4);
     pd_mesh_free(m);
-    m = parse_ok("# only a comment first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "noext");
+    m = parse_ok("\xEF\xBB\xBF# only a comment first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "noext");
     CHECK(m && m->ntris == 1);
     pd_mesh_free(m);
     /* ...the name breaks ties when content says nothing... */
