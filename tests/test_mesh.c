@@ -1,6 +1,743 @@
+/* test_mesh.c: reading OFF, STL and OBJ, format detection, units, bad input,
+ * and welding.
+ *
+ * Coordinates written as short decimals are compared exactly: strtod rounds
+ * correctly, so the reader must return the same double as the C literal.
+ * Every malformed input must fail with its own status and a message that
+ * names the file and, for text formats, the line. */
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
 #include "check.h"
+#include "posedrop/mesh.h"
+#include "posedrop/tolerances.h"
+#include "shapes.h"
 #include "suites.h"
+
+static const char *const exact = "exact: correctly rounded decimal";
+
+static pd_status parse_as(const char *text, const char *name, pd_mesh_format format,
+                          pd_units units, pd_mesh **m, pd_diag *d)
+{
+    pd_mesh_read_options o;
+    pd_mesh_read_options_default(&o);
+    o.format = format;
+    o.units = units;
+    pd_diag_init(d);
+    return pd_mesh_parse(text, strlen(text), name, &o, m, d);
+}
+
+static pd_mesh *parse_ok(const char *text, const char *name)
+{
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_status st = parse_as(text, name, PD_FORMAT_AUTO, PD_UNITS_M, &m, &d);
+    CHECK_STATUS(st, PD_OK);
+    if (st != PD_OK) {
+        printf("     %s: %s\n", name, d.message);
+        return NULL;
+    }
+    return m;
+}
+
+/* Bad input: the expected status, a message containing needle, and *mesh
+ * left as it was. */
+static void expect_bad_as(const char *text, const char *name, pd_mesh_format format,
+                          pd_status expected, const char *needle)
+{
+    pd_mesh sentinel_mesh = {0};
+    pd_mesh *m = &sentinel_mesh;
+    pd_diag d;
+    pd_status st = parse_as(text, name, format, PD_UNITS_M, &m, &d);
+    CHECK_STATUS(st, expected);
+    CHECK(m == &sentinel_mesh);
+    int found = strstr(d.message, needle) != NULL;
+    CHECK(found);
+    if (!found || st != expected)
+        printf("     wanted '%s' in: %s\n", needle, d.message);
+    if (st == PD_OK && m != &sentinel_mesh)
+        pd_mesh_free(m);
+}
+
+static void expect_bad(const char *text, const char *name, pd_status expected, const char *needle)
+{
+    expect_bad_as(text, name, PD_FORMAT_AUTO, expected, needle);
+}
+
+static int tri_is(const pd_mesh *m, int t, int a, int b, int c)
+{
+    return m->tris[t][0] == a && m->tris[t][1] == b && m->tris[t][2] == c;
+}
+
+/* --- OFF ------------------------------------------------------------------- */
+
+static const char tetra_off[] =
+    "# a tetrahedron\n"
+    "OFF\n"
+    "\n"
+    "4 4 6  # counts\n"
+    "0 0 0\n"
+    "1.5 0 0   # trailing comment\n"
+    "# full-line comment between vertices\n"
+    "0 2.25 0\n"
+    "0 0 -0.125\n"
+    "3 0 2 1\n"
+    "3 0 1 3\n"
+    "\n"
+    "3 0 3 2\n"
+    "3 1 2 3\n";
+
+static void test_off(void)
+{
+    pd_mesh *m = parse_ok(tetra_off, "tetra.off");
+    if (m) {
+        CHECK_INT(m->nverts, 4);
+        CHECK_INT(m->ntris, 4);
+        CHECK_NEAR(m->verts[1].x, 1.5, 0.0, exact);
+        CHECK_NEAR(m->verts[2].y, 2.25, 0.0, exact);
+        CHECK_NEAR(m->verts[3].z, -0.125, 0.0, exact);
+        CHECK(tri_is(m, 0, 0, 2, 1) && tri_is(m, 3, 1, 2, 3));
+        pd_mesh_free(m);
+    }
+
+    /* Header variants: counts on the keyword's line, colours, normals and
+     * texture coordinates after the coordinates, colours after faces. */
+    static const char *const variants[] = {
+        "OFF 4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n",
+        "COFF\n4 2 0\n0 0 0 1 0 0 1\n1 0 0 1 0 0 1\n0 1 0 1 0 0 1\n0 0 1 1 0 0 1\n"
+        "3 0 1 2 255 0 0\n3 0 1 3 0.5 0.5 0.5 1\n",
+        "NOFF\n4 2\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n0 0 1 0 0 1\n3 0 1 2\n3 0 1 3\n",
+        "CNOFF\n4 2 0\n0 0 0 0 0 1 1 1 1 1\n1 0 0 0 0 1 1 1 1 1\n0 1 0 0 0 1 1 1 1 1\n"
+        "0 0 1 0 0 1 1 1 1 1\n3 0 1 2\n3 0 1 3\n",
+        "STOFF\n4 2 0\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n0 0 1 1 1\n3 0 1 2\n3 0 1 3\n",
+        "nOFF 3\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n",
+        "\xEF\xBB\xBFOFF\n4 2 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n", /* UTF-8 BOM */
+        "OFF\r\n4 2 0\r\n0 0 0\r\n1 0 0\r\n0 1 0\r\n0 0 1\r\n3 0 1 2\r\n3 0 1 3", /* CRLF, no final newline */
+    };
+    for (size_t i = 0; i < sizeof variants / sizeof variants[0]; i++) {
+        m = parse_ok(variants[i], "variant.off");
+        if (!m)
+            continue;
+        CHECK_INT(m->nverts, 4);
+        CHECK_INT(m->ntris, 2);
+        CHECK_NEAR(m->verts[3].z, 1.0, 0.0, exact);
+        CHECK(tri_is(m, 1, 0, 1, 3));
+        pd_mesh_free(m);
+    }
+
+    /* Polygons are fanned from their first vertex: a quad gives 2 triangles,
+     * a pentagon 3, all sharing that vertex. */
+    m = parse_ok("OFF\n5 2 0\n0 0 0\n1 0 0\n2 1 0\n1 2 0\n0 1 0\n5 0 1 2 3 4\n4 4 3 2 1\n", "poly.off");
+    if (m) {
+        CHECK_INT(m->ntris, 5);
+        CHECK(tri_is(m, 0, 0, 1, 2) && tri_is(m, 1, 0, 2, 3) && tri_is(m, 2, 0, 3, 4));
+        CHECK(tri_is(m, 3, 4, 3, 2) && tri_is(m, 4, 4, 2, 1));
+        pd_mesh_free(m);
+    }
+}
+
+static void test_off_bad(void)
+{
+    /* The example of the CLI test: a non-numeric coordinate on line 6. */
+    expect_bad("OFF\n# a comment\n4 4 0\n0 0 0\n1 0 0\n0 x 0\n0 0 1\n3 0 1 2\n3 0 1 3\n3 0 2 3\n3 1 2 3\n",
+               "bad.off", PD_ERR_PARSE, "bad.off:6: expected a coordinate, found 'x'");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0\n0 1 0\n0 0 1\n3 0 1 2\n", "short.off", PD_ERR_PARSE,
+               "short.off:4: expected 3 coordinates, found 2");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 nan\n0 1 0\n0 0 1\n3 0 1 2\n", "nan.off", PD_ERR_NONFINITE,
+               "nan.off:4:");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 inf 0\n0 0 1\n3 0 1 2\n", "inf.off", PD_ERR_NONFINITE,
+               "inf.off:5:");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1e999\n3 0 1 2\n", "big.off", PD_ERR_NONFINITE,
+               "big.off:6:");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 4\n", "idx.off", PD_ERR_RANGE,
+               "idx.off:7: vertex index 4 out of range");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 -1 2\n", "neg.off", PD_ERR_RANGE,
+               "neg.off:7:");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n2 0 1\n", "two.off", PD_ERR_PARSE,
+               "two.off:7: face with 2 vertices");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n4 0 1 2\n", "few.off", PD_ERR_PARSE,
+               "few.off:7: expected 4 vertex indices, found 3");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 z\n", "tok.off", PD_ERR_PARSE,
+               "tok.off:7: expected a vertex index, found 'z'");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n70000 0 1 2\n", "huge.off", PD_ERR_RANGE,
+               "huge.off:7: face with 70000 vertices");
+    expect_bad("OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n3 0 1 3\n", "faces.off",
+               PD_ERR_PARSE, "faces.off:");
+    expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\ngarbage here\n", "tail.off",
+               PD_ERR_PARSE, "tail.off:8: expected end of file");
+    expect_bad("OFF\n4 1 0 7\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 2\n", "cnt.off", PD_ERR_PARSE,
+               "cnt.off:2:");
+    expect_bad("OFF\n-4 1 0\n", "negc.off", PD_ERR_PARSE, "negc.off:2: expected the vertex count");
+    expect_bad("OFF\n0 0 0\n", "empty.off", PD_ERR_PARSE, "no faces");
+    expect_bad("OFF\n", "hdr.off", PD_ERR_PARSE, "hdr.off:");
+    expect_bad("", "nothing.off", PD_ERR_PARSE, "nothing.off");
+    expect_bad("OFX\n4 1 0\n", "kw.off", PD_ERR_PARSE, "kw.off:1: expected OFF header");
+    /* Lying counts: refused before any allocation, by the limit or by the
+     * bytes that follow. */
+    expect_bad("OFF\n2000000000 2000000000 0\n0 0 0\n", "liar.off", PD_ERR_RANGE, "liar.off:2:");
+    expect_bad("OFF\n1000000 1 0\n0 0 0\n", "liar2.off", PD_ERR_PARSE, "bytes");
+    expect_bad("OFF\n99999999999999999999999 1 0\n", "liar3.off", PD_ERR_RANGE, "liar3.off:2:");
+    /* Variants not read. */
+    expect_bad("4OFF\n4 1 0\n0 0 0 1\n", "h.off", PD_ERR_FORMAT, "4-D");
+    expect_bad("OFF BINARY\n\x00\x00", "bin.off", PD_ERR_FORMAT, "binary OFF");
+    expect_bad("nOFF 4\n4 1 0\n", "n4.off", PD_ERR_FORMAT, "dimension 4");
+}
+
+/* --- STL ------------------------------------------------------------------- */
+
+static const char tetra_stl[] =
+    "solid tetra made by hand\n"
+    "  facet normal 0 0 -1\n"
+    "    outer loop\n"
+    "      vertex 0 0 0\n"
+    "      vertex 0 1 0\n"
+    "      vertex 1 0 0\n"
+    "    endloop\n"
+    "  endfacet\n"
+    "  FACET NORMAL 0 -1 0\n"
+    "    OUTER LOOP\n"
+    "      VERTEX -0.0 0 0\n" /* -0 and 0 are one vertex */
+    "      VERTEX 1 0 0\n"
+    "      VERTEX 0 0 1\n"
+    "    ENDLOOP\n"
+    "  ENDFACET\n"
+    "endsolid tetra made by hand\n"
+    "solid second\n"
+    "  facet normal nan nan nan\n"
+    "    outer loop\n"
+    "      vertex 0 0 0\n"
+    "      vertex 0 0 1\n"
+    "      vertex 0 1 0\n"
+    "    endloop\n"
+    "  endfacet\n"
+    "  facet normal 1 1 1 outer loop vertex 1 0 0 vertex 0 1 0 vertex 0 0 1 endloop endfacet\n"
+    "endsolid\n";
+
+static void test_stl_ascii(void)
+{
+    pd_mesh *m = parse_ok(tetra_stl, "tetra.stl");
+    if (m) {
+        /* 12 corners, 4 distinct points: bit-identical corners are merged. */
+        CHECK_INT(m->nverts, 4);
+        CHECK_INT(m->ntris, 4);
+        CHECK(tri_is(m, 0, 0, 1, 2) && tri_is(m, 1, 0, 2, 3) && tri_is(m, 3, 2, 1, 3));
+        CHECK_NEAR(m->verts[1].y, 1.0, 0.0, exact);
+        pd_mesh_free(m);
+    }
+    /* Near-duplicates are for pd_mesh_weld, not the reader. */
+    m = parse_ok("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+                 "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 1e-12\n"
+                 "vertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid s\n", "near.stl");
+    if (m) {
+        CHECK_INT(m->nverts, 4);
+        pd_mesh_free(m);
+    }
+
+    const char *head = "solid s\nfacet normal 0 0 1\nouter loop\n";
+    char buf[512];
+    snprintf(buf, sizeof buf, "%svertex 0 0 0\nvertex 1 x 0\n", head);
+    expect_bad(buf, "a.stl", PD_ERR_PARSE, "a.stl:5: expected a y coordinate, found 'x'");
+    snprintf(buf, sizeof buf, "%svertex 0 0 0\nvertex 1 0 inf\n", head);
+    expect_bad(buf, "b.stl", PD_ERR_NONFINITE, "b.stl:5:");
+    snprintf(buf, sizeof buf, "%svertex 0 0 0\nvertex 1 0 0\nendloop\n", head);
+    expect_bad(buf, "c.stl", PD_ERR_PARSE, "c.stl:6: expected 'vertex', found 'endloop'");
+    snprintf(buf, sizeof buf,
+             "%svertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\n", head);
+    expect_bad(buf, "d.stl", PD_ERR_PARSE, "d.stl:8: expected 'facet' or 'endsolid', found end of file");
+    snprintf(buf, sizeof buf,
+             "%svertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid\nrubbish\n", head);
+    expect_bad(buf, "e.stl", PD_ERR_PARSE, "e.stl:10: expected 'solid' or end of file, found 'rubbish'");
+    expect_bad("solid empty\nendsolid empty\n", "f.stl", PD_ERR_PARSE, "no faces");
+}
+
+/* A binary STL in memory; the header starts with "solid" as some exporters
+ * write it, which must not make the reader take it for ASCII. */
+static unsigned char *binary_stl(const float (*tri)[9], uint32_t n, uint32_t declared, size_t *size)
+{
+    *size = 84 + 50 * (size_t)n;
+    unsigned char *b = calloc(1, *size);
+    memset(b, ' ', 80);
+    memcpy(b, "solid exported by a tool that writes ASCII words", 48);
+    for (int i = 0; i < 4; i++)
+        b[80 + i] = (unsigned char)(declared >> (8 * i));
+    for (uint32_t t = 0; t < n; t++) {
+        unsigned char *r = b + 84 + 50 * t + 12;
+        for (int k = 0; k < 9; k++) {
+            uint32_t u;
+            memcpy(&u, &tri[t][k], 4);
+            for (int i = 0; i < 4; i++)
+                r[4 * k + i] = (unsigned char)(u >> (8 * i));
+        }
+    }
+    return b;
+}
+
+static const float tetra_tris[4][9] = {
+    {0, 0, 0, 0, 1, 0, 1, 0, 0},
+    {0, 0, 0, 1, 0, 0, 0, 0, 1},
+    {0, 0, 0, 0, 0, 1, 0, 1, 0},
+    {1, 0, 0, 0, 1, 0, 0, 0, 0.25f},
+};
+
+static void test_stl_binary(void)
+{
+    size_t size;
+    unsigned char *b = binary_stl(tetra_tris, 4, 4, &size);
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    /* Told apart from ASCII by content, without help from the name. */
+    CHECK_STATUS(pd_mesh_parse(b, size, "noext", NULL, &m, &d), PD_OK);
+    if (m) {
+        /* Corners (1,0,0), (0,1,0) repeat bit-identically; (0,0,1) and
+         * (0,0,0.25) differ: 5 vertices. */
+        CHECK_INT(m->nverts, 5);
+        CHECK_INT(m->ntris, 4);
+        CHECK(tri_is(m, 0, 0, 1, 2) && tri_is(m, 1, 0, 2, 3) && tri_is(m, 3, 2, 1, 4));
+        CHECK_NEAR(m->verts[4].z, 0.25, 0.0, "exact: 0.25 is a float");
+        pd_mesh_free(m);
+        m = NULL;
+    }
+    /* Units: millimetres are 1e-3 m, applied by one multiplication. */
+    pd_mesh_read_options o;
+    pd_mesh_read_options_default(&o);
+    o.units = PD_UNITS_MM;
+    CHECK_STATUS(pd_mesh_parse(b, size, "tetra.stl", &o, &m, &d), PD_OK);
+    if (m) {
+        CHECK_NEAR(m->verts[4].z, 0.25 * 0.001, 0.0, "exact: same multiplication");
+        pd_mesh_free(m);
+        m = NULL;
+    }
+
+    /* Truncated: the size does not hold the declared triangles. */
+    pd_mesh sentinel_mesh = {0};
+    m = &sentinel_mesh;
+    CHECK_STATUS(pd_mesh_parse(b, size - 1, "cut.stl", NULL, &m, &d), PD_ERR_PARSE);
+    CHECK(strstr(d.message, "cut.stl") && strstr(d.message, "4 triangles"));
+    CHECK(m == &sentinel_mesh);
+    /* A lying count is refused before allocating. */
+    free(b);
+    b = binary_stl(tetra_tris, 4, 2000000000u, &size);
+    CHECK_STATUS(pd_mesh_parse(b, size, "liar.stl", NULL, &m, &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "liar.stl") && strstr(d.message, "2000000000"));
+    free(b);
+    b = binary_stl(tetra_tris, 4, 5000000u, &size);
+    CHECK_STATUS(pd_mesh_parse(b, size, "liar2.stl", NULL, &m, &d), PD_ERR_PARSE);
+    CHECK(strstr(d.message, "5000000 triangles") != NULL);
+    free(b);
+    /* A NaN corner names its triangle. */
+    float bad[4][9];
+    memcpy(bad, tetra_tris, sizeof bad);
+    bad[1][4] = NAN;
+    b = binary_stl((const float (*)[9])bad, 4, 4, &size);
+    CHECK_STATUS(pd_mesh_parse(b, size, "nan.stl", NULL, &m, &d), PD_ERR_NONFINITE);
+    CHECK(strstr(d.message, "nan.stl: triangle 2") != NULL);
+    free(b);
+    CHECK(m == &sentinel_mesh);
+    /* Too short for a header. */
+    m = &sentinel_mesh;
+    CHECK_STATUS(pd_mesh_parse("\x01\x00\x02", 3, "tiny.stl", NULL, &m, &d), PD_ERR_PARSE);
+    CHECK(strstr(d.message, "tiny.stl") != NULL);
+}
+
+/* --- OBJ ------------------------------------------------------------------- */
+
+static void test_obj(void)
+{
+    pd_mesh *m = parse_ok("# cube corner\n"
+                          "mtllib a.mtl\n"
+                          "o thing\n"
+                          "v 0 0 0\n"
+                          "v 1.5 0 0 1.0\n" /* w ignored */
+                          "v 0 1 0 0.5 0.5 0.5\n"
+                          "vt 0 0\nvt 1 0\nvt 0 1\n"
+                          "vn 0 0 1\n"
+                          "g side\ns off\nusemtl red\n"
+                          "f 1 3 2\n"
+                          "f 1/1 2/2 3/3  # trailing comment\n"
+                          "f 1/1/1 2/2/1 3/3/1\n"
+                          "f 1//1 2//1 3//1\n"
+                          "v 0 0 -2\n"
+                          "f -4 -3 -1\n"     /* relative: 1 2 4 */
+                          "f 1 2 \\\n 3 4\n" /* continued line: a quad */
+                          "l 1 2\n",
+                          "thing.obj");
+    if (m) {
+        CHECK_INT(m->nverts, 4);
+        CHECK_INT(m->ntris, 7);
+        CHECK_NEAR(m->verts[1].x, 1.5, 0.0, exact);
+        CHECK_NEAR(m->verts[3].z, -2.0, 0.0, exact);
+        CHECK(tri_is(m, 0, 0, 2, 1) && tri_is(m, 1, 0, 1, 2) && tri_is(m, 3, 0, 1, 2));
+        CHECK(tri_is(m, 4, 0, 1, 3));
+        CHECK(tri_is(m, 5, 0, 1, 2) && tri_is(m, 6, 0, 2, 3));
+        pd_mesh_free(m);
+    }
+    /* A hexagon fans into 4 triangles. */
+    m = parse_ok("v 1 0 0\nv 2 0 0\nv 3 1 0\nv 2 2 0\nv 1 2 0\nv 0 1 0\nf 1 2 3 4 5 6\n", "hex.obj");
+    if (m) {
+        CHECK_INT(m->ntris, 4);
+        CHECK(tri_is(m, 3, 0, 4, 5));
+        pd_mesh_free(m);
+    }
+
+    const char *v3 = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    char buf[256];
+    snprintf(buf, sizeof buf, "%sf 1 2 0\n", v3);
+    expect_bad(buf, "a.obj", PD_ERR_RANGE, "a.obj:4: vertex index 0");
+    snprintf(buf, sizeof buf, "%sf 1 2 4\n", v3);
+    expect_bad(buf, "b.obj", PD_ERR_RANGE, "b.obj:4: vertex index 4 out of range");
+    snprintf(buf, sizeof buf, "%sf -1 -2 -4\n", v3);
+    expect_bad(buf, "c.obj", PD_ERR_RANGE, "c.obj:4: relative vertex index -4");
+    snprintf(buf, sizeof buf, "%sf 1 2\n", v3);
+    expect_bad(buf, "d.obj", PD_ERR_PARSE, "d.obj:4: face with 2 vertices");
+    snprintf(buf, sizeof buf, "%sf 1/x 2 3\n", v3);
+    expect_bad(buf, "e.obj", PD_ERR_PARSE, "e.obj:4: expected a face corner");
+    snprintf(buf, sizeof buf, "%sf 1/2/3/4 2 3\n", v3);
+    expect_bad(buf, "e2.obj", PD_ERR_PARSE, "e2.obj:4: expected a face corner");
+    snprintf(buf, sizeof buf, "%sf one 2 3\n", v3);
+    expect_bad(buf, "f.obj", PD_ERR_PARSE, "f.obj:4: expected a vertex index, found 'one'");
+    expect_bad("v 0 0 0\nv 1 y 0\n", "g.obj", PD_ERR_PARSE, "g.obj:2: expected a y coordinate, found 'y'");
+    expect_bad("v 0 0 0\nv 1 0\n", "h.obj", PD_ERR_PARSE, "h.obj:2: expected a z coordinate, found end of line");
+    expect_bad("v 0 0 0\nv 1 0 NaN\n", "i.obj", PD_ERR_NONFINITE, "i.obj:2:");
+    snprintf(buf, sizeof buf, "%sf 1 2 3\n0.5 0.5 0.5\n", v3);
+    expect_bad(buf, "j.obj", PD_ERR_PARSE, "j.obj:5: expected an OBJ keyword, found '0.5'");
+    expect_bad("v 0 0 0\nv 1 0 0\nv 0 1 0\n", "k.obj", PD_ERR_PARSE, "no faces");
+    /* Some exporter's own keyword is skipped, not fatal. */
+    snprintf(buf, sizeof buf, "%smyext 1 2\nf 1 2 3\n", v3);
+    m = parse_ok(buf, "ext.obj");
+    pd_mesh_free(m);
+}
+
+/* --- format, units, files ---------------------------------------------------- */
+
+static void test_format(void)
+{
+    pd_mesh *m = NULL;
+    pd_diag d;
+    /* Content decides over the name... */
+    m = parse_ok(tetra_off, "misnamed.stl");
+    CHECK(m && m->ntris == 4);
+    pd_mesh_free(m);
+    m = parse_ok("\xEF\xBB\xBF# only a comment first\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "noext");
+    CHECK(m && m->ntris == 1);
+    pd_mesh_free(m);
+    /* ...the name breaks ties when content says nothing... */
+    expect_bad("# nothing but comments\n", "x.obj", PD_ERR_PARSE, "x.obj: no faces");
+    expect_bad("# nothing but comments\n", "x.OFF", PD_ERR_PARSE, "x.OFF: expected OFF header");
+    /* ...and an explicit format is obeyed. */
+    expect_bad_as(tetra_off, "tetra.off", PD_FORMAT_OBJ, PD_ERR_PARSE, "tetra.off:4: expected an OBJ keyword");
+    /* Not ASCII STL, so binary: its "count" is bytes of text, far too many. */
+    expect_bad_as(tetra_off, "tetra.off", PD_FORMAT_STL, PD_ERR_RANGE, "tetra.off: binary STL declares");
+    CHECK_STATUS(parse_as(tetra_off, "x.txt", PD_FORMAT_OFF, PD_UNITS_M, &m, &d), PD_OK);
+    pd_mesh_free(m);
+    /* Unrecognisable. */
+    expect_bad("hello world\n", "x.txt", PD_ERR_FORMAT, "x.txt");
+    expect_bad("", "empty", PD_ERR_FORMAT, "empty");
+}
+
+static void test_units(void)
+{
+    CHECK_NEAR(pd_units_scale(PD_UNITS_M), 1.0, 0.0, "definition");
+    CHECK_NEAR(pd_units_scale(PD_UNITS_CM), 0.01, 0.0, "definition");
+    CHECK_NEAR(pd_units_scale(PD_UNITS_MM), 0.001, 0.0, "definition");
+    CHECK_NEAR(pd_units_scale(PD_UNITS_IN), 0.0254, 0.0, "definition of the inch");
+    pd_units u = PD_UNITS_M;
+    CHECK_STATUS(pd_units_parse("mm", &u), PD_OK);
+    CHECK_INT(u, PD_UNITS_MM);
+    CHECK_STATUS(pd_units_parse("in", &u), PD_OK);
+    CHECK_INT(u, PD_UNITS_IN);
+    CHECK_STATUS(pd_units_parse("cm", &u), PD_OK);
+    CHECK_INT(u, PD_UNITS_CM);
+    CHECK_STATUS(pd_units_parse("m", &u), PD_OK);
+    CHECK_INT(u, PD_UNITS_M);
+    CHECK_STATUS(pd_units_parse("furlong", &u), PD_ERR_USAGE);
+    CHECK_STATUS(pd_units_parse("MM", &u), PD_ERR_USAGE);
+
+    /* Every coordinate read in mm is the metre reading times 1e-3, exactly:
+     * one multiplication by pd_units_scale. */
+    pd_mesh *m = NULL, *mm = NULL;
+    pd_diag d;
+    CHECK_STATUS(parse_as(tetra_off, "t.off", PD_FORMAT_AUTO, PD_UNITS_M, &m, &d), PD_OK);
+    CHECK_STATUS(parse_as(tetra_off, "t.off", PD_FORMAT_AUTO, PD_UNITS_MM, &mm, &d), PD_OK);
+    if (m && mm) {
+        int same = 1;
+        for (int i = 0; i < m->nverts; i++)
+            same &= mm->verts[i].x == m->verts[i].x * 0.001 && mm->verts[i].y == m->verts[i].y * 0.001 &&
+                    mm->verts[i].z == m->verts[i].z * 0.001;
+        CHECK(same);
+        CHECK_NEAR(mm->verts[1].x, 1.5 * 0.001, 0.0, "exact: same multiplication");
+    }
+    pd_mesh_free(m);
+    pd_mesh_free(mm);
+}
+
+static void test_files(void)
+{
+    char path[] = "/tmp/pd_test_mesh_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    if (fd < 0)
+        return;
+    FILE *f = fdopen(fd, "wb");
+    fputs(tetra_off, f);
+    fclose(f);
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_mesh_read_options o;
+    pd_mesh_read_options_default(&o);
+    o.format = PD_FORMAT_OFF; /* the temp name has no extension */
+    CHECK_STATUS(pd_mesh_read(path, &o, &m, &d), PD_OK);
+    if (m) {
+        CHECK_INT(m->ntris, 4);
+        CHECK_NEAR(m->verts[2].y, 2.25, 0.0, exact);
+        pd_mesh_free(m);
+    }
+    remove(path);
+    m = NULL;
+    CHECK_STATUS(pd_mesh_read("/nonexistent/part.off", NULL, &m, &d), PD_ERR_IO);
+    CHECK(strstr(d.message, "/nonexistent/part.off") != NULL);
+    CHECK(m == NULL);
+    /* A directory opens but cannot be read as a file. */
+    CHECK_STATUS(pd_mesh_read("/tmp", NULL, &m, &d), PD_ERR_IO);
+    CHECK(m == NULL);
+}
+
+/* --- every prefix ------------------------------------------------------------ */
+
+/* Each prefix of a valid file, in a buffer of exactly that size (so the
+ * sanitizer sees any read past it), must parse or fail with an input error
+ * and a message; never crash or hang. */
+static void all_prefixes(const void *data, size_t size, const char *name, pd_mesh_format format)
+{
+    int clean = 1, full_ok = 0;
+    for (size_t n = 0; n <= size; n++) {
+        unsigned char *copy = malloc(n ? n : 1);
+        memcpy(copy, data, n);
+        pd_mesh_read_options o;
+        pd_mesh_read_options_default(&o);
+        for (int pass = 0; pass < 2; pass++) {
+            o.format = pass ? format : PD_FORMAT_AUTO;
+            pd_mesh *m = NULL;
+            pd_diag d;
+            pd_diag_init(&d);
+            pd_status st = pd_mesh_parse(copy, n, name, &o, &m, &d);
+            if (st == PD_OK) {
+                clean &= m != NULL && m->ntris > 0;
+                if (n == size)
+                    full_ok++;
+                pd_mesh_free(m);
+            } else {
+                clean &= m == NULL && pd_status_is_input_error(st) && d.message[0] != '\0';
+            }
+        }
+        free(copy);
+    }
+    CHECK(clean);
+    CHECK_INT(full_ok, 2);
+}
+
+static void test_prefixes(void)
+{
+    all_prefixes(tetra_off, strlen(tetra_off), "p.off", PD_FORMAT_OFF);
+    all_prefixes(tetra_stl, strlen(tetra_stl), "p.stl", PD_FORMAT_STL);
+    static const char obj[] = "# c\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\n"
+                              "f 1/1 3/1 2/1\nf 1//1 2//1 4//1\nf -4 -1 -2 \\\n\nf 2 3 4\n";
+    all_prefixes(obj, strlen(obj), "p.obj", PD_FORMAT_OBJ);
+    size_t size;
+    unsigned char *b = binary_stl(tetra_tris, 4, 4, &size);
+    all_prefixes(b, size, "p.stl", PD_FORMAT_STL);
+    free(b);
+}
+
+/* --- weld, clone, size ---------------------------------------------------------- */
+
+static pd_mesh *make_mesh(const pd_vec3 *v, int nv, const int (*t)[3], int nt)
+{
+    pd_mesh *m = malloc(sizeof *m);
+    m->nverts = nv;
+    m->ntris = nt;
+    m->verts = malloc(sizeof *m->verts * (size_t)nv);
+    m->tris = malloc(sizeof *m->tris * (size_t)(nt ? nt : 1));
+    memcpy(m->verts, v, sizeof *m->verts * (size_t)nv);
+    memcpy(m->tris, t, sizeof *m->tris * (size_t)nt);
+    return m;
+}
+
+static void test_weld(void)
+{
+    const double tol = 1e-6;
+    /* Two triangles of a square given as a soup (6 corners) plus copies at
+     * 0.5 tol (merged) and 2 tol (kept), a -0.0 copy (bit-identical to 0)
+     * and an unused vertex. */
+    const pd_vec3 v[] = {
+        {0, 0, 0}, {1, 0, 0}, {1, 1, 0},          /* 0 1 2 */
+        {-0.0, 0, 0}, {1, 1, 0}, {0, 1, 0},       /* 3 = 0, 4 = 2, 5 */
+        {1 + 0.5 * tol, 0, 0}, {0, 1, 2 * tol},   /* 6 ~ 1, 7 kept */
+        {5, 5, 5},                                /* 8 unused */
+        {0, 1 + 0.5 * tol, 0},                    /* 9 ~ 5 */
+    };
+    const int t[][3] = {{0, 1, 2}, {3, 4, 5}, {6, 2, 7}, {5, 9, 2}};
+    pd_mesh *m = make_mesh(v, 10, t, 4);
+    int merged = -1;
+    CHECK_STATUS(pd_mesh_weld(m, tol, &merged), PD_OK);
+    /* Survivors: 0 1 2 5 7 (in that order); 3 4 6 9 merged, 8 dropped. */
+    CHECK_INT(m->nverts, 5);
+    CHECK_INT(merged, 5);
+    /* Triangle {5, 9, 2} collapsed (9 is 5) and is gone. */
+    CHECK_INT(m->ntris, 3);
+    CHECK(tri_is(m, 0, 0, 1, 2) && tri_is(m, 1, 0, 2, 3) && tri_is(m, 2, 1, 2, 4));
+    /* The survivor of a cluster is its first vertex, bit for bit. */
+    CHECK_NEAR(m->verts[1].x, 1.0, 0.0, "exact: first vertex survives");
+    CHECK_NEAR(m->verts[3].y, 1.0, 0.0, "exact: first vertex survives");
+    CHECK_NEAR(m->verts[4].z, 2 * tol, 0.0, "exact: vertex kept as is");
+    pd_mesh_free(m);
+
+    /* Order decides the survivor: the same cluster listed the other way round. */
+    const pd_vec3 w[] = {{0.4e-6, 0, 0}, {0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+    const int wt[][3] = {{1, 2, 3}, {0, 2, 3}};
+    m = make_mesh(w, 4, wt, 2);
+    CHECK_STATUS(pd_mesh_weld(m, tol, NULL), PD_OK);
+    CHECK_INT(m->nverts, 3);
+    CHECK_INT(m->ntris, 2);
+    CHECK_NEAR(m->verts[0].x, 0.4e-6, 0.0, "exact: first in order survives");
+    pd_mesh_free(m);
+
+    /* tol 0: only bit-identical vertices merge (and -0 with 0). */
+    m = make_mesh(v, 10, t, 4);
+    CHECK_STATUS(pd_mesh_weld(m, 0.0, &merged), PD_OK);
+    CHECK_INT(m->nverts, 7); /* 0 1 2 5 6 7 9: 3 and 4 merged, 8 dropped */
+    CHECK_INT(merged, 3);
+    CHECK_INT(m->ntris, 4);
+    pd_mesh_free(m);
+
+    /* Coordinates too large for grid cells of this size: exact merging only,
+     * and no overflow. */
+    const pd_vec3 big[] = {{1e300, 0, 0}, {0, 1e300, 0}, {0, 0, 1e300}, {1e300, 0, 0}};
+    const int bt[][3] = {{0, 1, 2}, {3, 2, 1}};
+    m = make_mesh(big, 4, bt, 2);
+    CHECK_STATUS(pd_mesh_weld(m, tol, &merged), PD_OK);
+    CHECK_INT(m->nverts, 3);
+    CHECK_INT(m->ntris, 2);
+    pd_mesh_free(m);
+
+    /* Against brute force: clusters of points jittered by 0.05 to 1 tol
+     * (seeded). Each triangle (i, A, B) joins point i to two far anchors, so
+     * none collapses and the corner of triangle i shows i's survivor, which
+     * must be the first earlier survivor within tol, as an O(n^2) scan says. */
+    {
+        enum { NP = 600 };
+        test_rng g = {7};
+        pd_vec3 *p = malloc(sizeof *p * (NP + 2));
+        int (*pt)[3] = malloc(sizeof *pt * NP);
+        int *ref = malloc(sizeof *ref * (NP + 2));
+        p[0] = (pd_vec3){100, 0, 0};
+        p[1] = (pd_vec3){0, 100, 0};
+        for (int i = 2; i < NP + 2; i++) {
+            pd_vec3 c = {(double)(rng_next(&g) % 8) * 0.01, (double)(rng_next(&g) % 8) * 0.01, 0.5};
+            pd_vec3 u = rng_unit_vector(&g);
+            double s = tol * rng_range(&g, 0.05, 1.0);
+            p[i] = (pd_vec3){c.x + s * u.x, c.y + s * u.y, c.z + s * u.z};
+            pt[i - 2][0] = i;
+            pt[i - 2][1] = 0;
+            pt[i - 2][2] = 1;
+        }
+        for (int i = 0; i < NP + 2; i++) {
+            ref[i] = i;
+            for (int r = 0; r < i; r++) {
+                pd_vec3 dv = {p[i].x - p[r].x, p[i].y - p[r].y, p[i].z - p[r].z};
+                if (ref[r] == r && sqrt(dv.x * dv.x + dv.y * dv.y + dv.z * dv.z) <= tol) {
+                    ref[i] = r;
+                    break;
+                }
+            }
+        }
+        int nrep = 0;
+        for (int i = 0; i < NP + 2; i++)
+            nrep += ref[i] == i;
+        m = make_mesh(p, NP + 2, (const int (*)[3])pt, NP);
+        CHECK_STATUS(pd_mesh_weld(m, tol, &merged), PD_OK);
+        CHECK_INT(m->nverts, nrep);
+        CHECK(nrep > 66 && nrep < NP / 2); /* the test does merge, and not everything */
+        if (!(nrep > 66 && nrep < NP / 2))
+            printf("     nrep %d\n", nrep);
+        int agree = m->ntris == NP;
+        for (int t2 = 0; agree && t2 < NP; t2++) {
+            pd_vec3 got = m->verts[m->tris[t2][0]], want = p[ref[t2 + 2]];
+            agree = got.x == want.x && got.y == want.y && got.z == want.z;
+        }
+        CHECK(agree);
+        pd_mesh_free(m);
+        free(p);
+        free(pt);
+        free(ref);
+    }
+
+    /* A jittered soup of a closed box welds back to the box: every corner
+     * copy moved by up to 0.1 tol (a random direction, seeded). */
+    test_rng r = {42};
+    pd_mesh *box = mesh_box(2, 1, 0.5);
+    if (box) {
+        int nt = box->ntris;
+        pd_vec3 *sv = malloc(sizeof *sv * (size_t)(3 * nt));
+        int (*st)[3] = malloc(sizeof *st * (size_t)nt);
+        for (int i = 0; i < nt; i++)
+            for (int k = 0; k < 3; k++) {
+                pd_vec3 p = box->verts[box->tris[i][k]], u = rng_unit_vector(&r);
+                double s = 0.1 * tol * rng_uniform(&r);
+                sv[3 * i + k] = (pd_vec3){p.x + s * u.x, p.y + s * u.y, p.z + s * u.z};
+                st[i][k] = 3 * i + k;
+            }
+        m = make_mesh(sv, 3 * nt, (const int (*)[3])st, nt);
+        CHECK_STATUS(pd_mesh_weld(m, tol * pd_mesh_size(box), &merged), PD_OK);
+        CHECK_INT(m->nverts, box->nverts);
+        CHECK_INT(m->ntris, nt);
+        CHECK_INT(merged, 3 * nt - box->nverts);
+        pd_mesh_free(m);
+        free(sv);
+        free(st);
+        pd_mesh_free(box);
+    }
+}
+
+static void test_clone_size(void)
+{
+    pd_mesh *box = mesh_box(3, 4, 12);
+    CHECK(box != NULL);
+    if (!box)
+        return;
+    CHECK_REL(pd_mesh_size(box), 13.0, 1e-15, "round-off of one sqrt: 3-4-12 box has diagonal 13");
+    pd_mesh *c = pd_mesh_clone(box);
+    CHECK(c != NULL);
+    if (c) {
+        CHECK(c->verts != box->verts && c->tris != box->tris);
+        CHECK_INT(c->nverts, box->nverts);
+        CHECK_INT(c->ntris, box->ntris);
+        CHECK(memcmp(c->verts, box->verts, sizeof *c->verts * (size_t)c->nverts) == 0);
+        CHECK(memcmp(c->tris, box->tris, sizeof *c->tris * (size_t)c->ntris) == 0);
+        /* Deep: changing the copy leaves the original alone. */
+        c->verts[0].x += 100.0;
+        c->tris[0][0] = c->tris[0][1];
+        CHECK(box->verts[0].x != c->verts[0].x && box->tris[0][0] != c->tris[0][0]);
+        pd_mesh_free(c);
+    }
+    pd_mesh_free(box);
+    CHECK_NEAR(pd_mesh_size(NULL), 0.0, 0.0, "definition: no vertices");
+}
 
 void suite_mesh(void)
 {
+    test_off();
+    test_off_bad();
+    test_stl_ascii();
+    test_stl_binary();
+    test_obj();
+    test_format();
+    test_units();
+    test_files();
+    test_prefixes();
+    test_weld();
+    test_clone_size();
 }
