@@ -29,6 +29,7 @@ void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
      * in-plane direction is perpendicular to n, so the two agree exactly in
      * exact arithmetic and com carries one rounding less. */
     double inside = DBL_MAX, best_d2 = DBL_MAX;
+    pd_vec3 nearest = c0;
     int best_edge = 0, near_edge = 0, near_vertex = -1;
     for (int i = 0; i < k; i++) {
         pd_vec3 a = hull->verts[loop[i]], b = hull->verts[loop[(i + 1) % k]];
@@ -53,6 +54,7 @@ void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
         double d2 = v3_dot(w, w);
         if (d2 < best_d2) {
             best_d2 = d2;
+            nearest = v3_add(a, v3_scale(e, t));
             near_edge = i;
             near_vertex = vert;
         }
@@ -60,6 +62,7 @@ void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
 
     double knife = PD_TOL_KNIFE_REL * hull->size;
     g->foot = v3_add(com, v3_scale(n, h));
+    g->nearest = inside >= 0.0 ? g->foot : nearest;
     g->inside = inside;
     g->near_edge = near_edge;
     g->near_vertex = near_vertex;

@@ -104,7 +104,7 @@ pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geo
                 continue;
             pd_vec3 a = v3_sub(hull->verts[hull->facet_vert[base + e]], com);
             pd_vec3 b = v3_sub(hull->verts[hull->facet_vert[base + (e + 1) % k]], com);
-            double tri = pd_solid_angle_triangle(a, b, foot), area;
+            double tri = pd_solid_angle_from_nearest(foot, a, b), area;
             if (opt->band == PD_PQS_BAND_EXACT) {
                 pd_status st = pd_band_area_exact(v3_unit(a), v3_unit(b), hull->normal[i],
                                                   opt->epsilon, &area);
@@ -119,5 +119,12 @@ pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geo
             pert[j] += dp;
         }
     }
+    /* A facet whose every band is clipped gives away its whole solid angle,
+     * summed over its triangles T, which matches p_raw (summed over another
+     * fan) only to round-off: what is left may be -1e-20, never a real
+     * negative probability. */
+    for (int f = 0; f < hull->nfacets; f++)
+        if (pert[f] < 0.0)
+            pert[f] = 0.0;
     return PD_OK;
 }

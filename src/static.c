@@ -85,7 +85,7 @@ static pd_status estimate(const pd_part *part, const pd_static_options *opt,
     pd_facet_result *fr = res->facets;
     for (int f = 0; f < hull->nfacets; f++) {
         pd_facet_classify(hull, part->com, f, &geom[f], &fr[f]);
-        fr[f].solid_angle = pd_solid_angle_facet(hull, part->com, f);
+        fr[f].solid_angle = pd_solid_angle_facet(hull, part->com, f, geom[f].nearest);
         fr[f].p_raw = fr[f].solid_angle / (4.0 * M_PI);
         res->nknife += fr[f].knife;
     }

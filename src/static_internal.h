@@ -16,6 +16,8 @@
 /* Where the centre of mass projects relative to one facet's polygon. */
 typedef struct facet_geom {
     pd_vec3 foot;    /* projection of the centre of mass onto the facet plane */
+    pd_vec3 nearest; /* point of the facet polygon nearest the foot (the foot
+                        itself when it lies inside) */
     double inside;   /* signed distance of foot from the nearest edge line,
                         positive inside the polygon (min over the edges) */
     int near_edge;   /* loop position k of the boundary edge (corner k to k+1)
@@ -30,8 +32,13 @@ typedef struct facet_geom {
 void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
                        pd_facet_result *r);
 
-/* Solid angle of facet f's polygon seen from com (fan of atan2 triangles). */
-double pd_solid_angle_facet(const pd_hull *hull, pd_vec3 com, int f);
+/* Solid angle of facet f's polygon seen from com, fanned from the facet's
+ * point nearest com (see solid_angle.c for why). */
+double pd_solid_angle_facet(const pd_hull *hull, pd_vec3 com, int f, pd_vec3 nearest);
+
+/* Solid angle seen from the origin of triangle (q, b, c), where q is the
+ * point of a convex facet containing b and c that is nearest the origin. */
+double pd_solid_angle_from_nearest(pd_vec3 q, pd_vec3 b, pd_vec3 c);
 
 /* The quasi-static successor of every unstable facet: res->facets[f].next,
  * and .rest for all facets. Checks that every link lowers the centre of mass

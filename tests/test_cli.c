@@ -121,7 +121,7 @@ static int summarise(const char *csv, csv_summary *s)
             return 0;
         s->nrows++;
         s->numbered &= (int)v[col_pose] == s->nrows;
-        s->ordered &= v[col_qs] <= prev;
+        s->ordered &= v[col_qs] <= prev * (1 + 1e-6); /* PD_TOL_PROB_TIE_REL */
         prev = v[col_qs];
         s->p_qs_sum += v[col_qs];
         s->p_pqs_sum += v[col_pqs];
@@ -232,7 +232,7 @@ static void test_results(void)
 
     /* A facet table covers the whole hull. */
     CHECK_INT(run("--facets parts/cap.off", &out, &err), 0);
-    CHECK(strncmp(out, "facet,nx,ny,nz,area,height,p_raw,stable,knife,next,rest,pose\n", 62) == 0);
+    CHECK(strncmp(out, "facet,nx,ny,nz,area,height,p_raw,stable,knife,next,rest,pose\n", 61) == 0);
     free(out);
     free(err);
 

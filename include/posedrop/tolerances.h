@@ -55,11 +55,17 @@
 
 /* Two probabilities tie when they differ by at most this fraction of the larger.
  * Ties decide PQS transfers (a tie does not transfer, or a symmetric part would
- * lose its symmetry to round-off) and the order of poses (ties go by normal).
- * Why 1e-9: solid angles are computed to a few 1e-16 relative, summed over
- * facets of up to 1e5 triangles; 1e-9 is far above that and far below any
- * difference a user can measure (it would take 1e18 drops). */
-#define PD_TOL_PROB_TIE_REL 1e-9
+ * lose its symmetry) and the order of poses (ties go by normal).
+ * Why 1e-6: our own round-off is a few 1e-16, but the files are coarser:
+ * binary STL stores float32 (6e-8 relative) and CAD exporters print 6 to 9
+ * significant digits, which moves the solid angles of a part's symmetric
+ * facets apart by up to ~1e-7 relative (shipped parts/cap.off, 9 digits:
+ * 1e-9). PQS's "strictly less probable" rule is discontinuous, so a smaller
+ * tie would hand a symmetric part an asymmetric answer decided by how its
+ * file was printed. Larger: genuinely different facets would stop
+ * transferring; but telling two probabilities 1e-6 apart takes ~1e12 drops,
+ * so no measurement can see the difference. */
+#define PD_TOL_PROB_TIE_REL 1e-6
 
 /* Unit normals whose components differ by at most this are equal when poses
  * that tie in probability are ordered by normal. Why 1e-9: computed normals
