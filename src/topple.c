@@ -27,6 +27,8 @@
 
 /* The edges leaving each hull vertex, with the facets on either side. */
 typedef struct out_edge {
+    pd_vec3 u;         /* v - to: the cone's boundary is the plane u . g = 0 */
+    double len;        /* |u| */
     int to;            /* the other end */
     int left, right;   /* facet with the edge v -> to in its loop, and the one across */
 } out_edge;
@@ -58,6 +60,8 @@ static pd_status star_build(const pd_hull *h, vert_star *s)
             int v = h->facet_vert[b + i];
             out_edge *e = &s->edge[fill[v]++];
             e->to = h->facet_vert[b + (i + 1) % n];
+            e->u = v3_sub(h->verts[v], h->verts[e->to]);
+            e->len = v3_norm(e->u);
             e->left = f;
             e->right = h->facet_adj[b + i];
         }
@@ -90,7 +94,20 @@ static int roll_about_edge(const pd_hull *h, pd_vec3 com, pd_vec3 v, pd_vec3 w, 
     return v3_dot(h->normal[left], tau) >= v3_dot(h->normal[right], tau) ? left : right;
 }
 
-/* Steepest descent from facet f whose foot lies nearest its corner v. */
+/* 1 if g is within PD_TOL_ANGLE of the unit vector n (chord ~ angle there). */
+static int at_normal(pd_vec3 g, pd_vec3 n)
+{
+    pd_vec3 d = v3_sub(g, n);
+    return v3_dot(d, d) <= PD_TOL_ANGLE * PD_TOL_ANGLE;
+}
+
+/* Steepest descent from facet f whose foot lies nearest its corner v. On a
+ * finely tessellated smooth part the walk crosses tens of vertex cones, so
+ * each step is kept free of trigonometry: on g(s) = g cos s + d sin s the
+ * boundary u . g(s) = A cos s + B sin s (A = u.g >= 0, B = u.d) is reached
+ * at the angle of the vector (-B, A), and the first boundary reached is the
+ * one whose vector turns least, found by cross products; the exit point is
+ * (-B g + A d) / |(A, B)|, a unit vector since g and d are orthonormal. */
 static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, int f, int v,
                             int *next)
 {
@@ -98,43 +115,42 @@ static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, i
     pd_vec3 d = v3_unit(tangential(v3_sub(com, h->verts[v]), g));
     int limit = 2 * h->nverts + 8; /* every pivot lowers h, so vertices don't repeat */
     for (int step = 0; step < limit; step++) {
-        pd_vec3 pv = h->verts[v];
-        /* Leave v's normal cone where (v - w) . g(s) first reaches zero on
-         * g(s) = g cos s + d sin s: s = atan2(A, -B) for A = (v-w).g > 0. */
-        double s_exit = 4.0;
+        double bx = 0.0, by = -1.0; /* direction of the best exit so far */
         const out_edge *exit = NULL;
         for (int k = s->start[v]; k < s->start[v + 1]; k++) {
-            pd_vec3 u = v3_sub(pv, h->verts[s->edge[k].to]);
-            double A = v3_dot(u, g), B = v3_dot(u, d), tol = PD_TOL_ANGLE * v3_norm(u);
-            double sk;
-            if (A <= tol) {
+            const out_edge *e = &s->edge[k];
+            double A = v3_dot(e->u, g), B = v3_dot(e->u, d), x = -B, y = A;
+            if (A <= PD_TOL_ANGLE * e->len) {
                 if (B > 0.0)
                     continue; /* on this boundary but moving inward */
-                sk = 0.0;
-            } else {
-                sk = atan2(A, -B);
+                x = 1.0;      /* leaving through it at once */
+                y = 0.0;
             }
-            if (sk < s_exit) {
-                s_exit = sk;
-                exit = &s->edge[k];
+            if (!exit || x * by - y * bx > 0.0) {
+                bx = x;
+                by = y;
+                exit = e;
             }
         }
         if (!exit)
             return PD_ERR_INTERNAL;
-        pd_vec3 g1 = v3_unit(v3_add(v3_scale(g, cos(s_exit)), v3_scale(d, sin(s_exit))));
+        pd_vec3 g1 = g;
+        if (by > 0.0)
+            g1 = v3_scale(v3_add(v3_scale(g, bx), v3_scale(d, by)), 1.0 / sqrt(bx * bx + by * by));
         /* Leaving through a corner of the cone: the part lands on that facet. */
-        if (exit->left != f && v3_angle(g1, h->normal[exit->left]) <= PD_TOL_ANGLE) {
+        if (exit->left != f && at_normal(g1, h->normal[exit->left])) {
             *next = exit->left;
             return PD_OK;
         }
-        if (exit->right != f && v3_angle(g1, h->normal[exit->right]) <= PD_TOL_ANGLE) {
+        if (exit->right != f && at_normal(g1, h->normal[exit->right])) {
             *next = exit->right;
             return PD_OK;
         }
-        pd_vec3 pw = h->verts[exit->to], e = v3_sub(pw, pv);
-        double lambda = v3_dot(v3_sub(com, pv), e) / v3_dot(e, e);
+        pd_vec3 pv = h->verts[v], pw = h->verts[exit->to];
+        double lambda = -v3_dot(v3_sub(com, pv), exit->u) / (exit->len * exit->len);
         pd_vec3 dw = tangential(v3_sub(com, pw), g1);
-        if (lambda < 1.0 || v3_norm(dw) <= PD_TOL_ANGLE * v3_norm(e)) {
+        double ndw = v3_norm(dw);
+        if (lambda < 1.0 || ndw <= PD_TOL_ANGLE * exit->len) {
             /* Centre of mass over the segment (lambda > 0 whenever the edge
              * was reached by pivoting about v; round-off below 0 is clamped
              * here too): roll about the edge to the lower end of its arc. */
@@ -144,7 +160,7 @@ static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, i
         /* Beyond w: w takes over as the pivot. */
         v = exit->to;
         g = g1;
-        d = v3_unit(dw);
+        d = v3_scale(dw, 1.0 / ndw);
     }
     return PD_ERR_NO_CONVERGENCE;
 }
