@@ -18,6 +18,8 @@
 /* Most facet steps a point-location walk may take before the check falls
  * back to testing the point against every facet. */
 #define WALK_STEPS_PER_FACET 4
+/* Relative slack of the walk's side tests (see locate). */
+#define WALK_SLACK 1e-14
 
 /* Signed distance of x above facet f and the bound on its round-off (about
  * 4 roundings on terms of the size of |n_i x_i| and |offset|; 8 for margin). */
@@ -43,7 +45,13 @@ static int locate(const pd_hull *h, pd_vec3 c, pd_vec3 d, int f, unsigned *rot)
         for (int i = 0; i < k; i++) {
             pd_vec3 a = v3_sub(h->verts[h->facet_vert[s + i]], c);
             pd_vec3 b = v3_sub(h->verts[h->facet_vert[s + (i + 1) % k]], c);
-            if (v3_dot(v3_cross(a, b), d) < 0.0) {
+            pd_vec3 e = v3_cross(a, b);
+            /* A direction within WALK_SLACK of an edge plane counts as
+             * inside: directions through a vertex lie on several edge
+             * planes at once and round-off must not make the walk circle
+             * that vertex. The plane test then errs by at most ~1e-14 of
+             * the distance from c, far below PD_TOL_PLANE_REL. */
+            if (v3_dot(e, d) < -WALK_SLACK * v3_norm(e) * v3_norm(d)) {
                 nviol++;
                 if (pick < 0 || want % (unsigned)nviol == 0)
                     pick = s + i;
@@ -54,6 +62,34 @@ static int locate(const pd_hull *h, pd_vec3 c, pd_vec3 d, int f, unsigned *rot)
         f = h->facet_adj[pick];
     }
     return -1;
+}
+
+typedef struct {
+    unsigned long key;
+    int idx;
+} walk_key;
+
+static int cmp_walk_key(const void *a, const void *b)
+{
+    const walk_key *x = a, *y = b;
+    if (x->key != y->key)
+        return (x->key > y->key) - (x->key < y->key);
+    return (x->idx > y->idx) - (x->idx < y->idx);
+}
+
+/* Morton code of a unit direction quantised to 10 bits per axis: sorting by
+ * it keeps nearby directions together. */
+static unsigned long direction_key(pd_vec3 u)
+{
+    const double c[3] = {u.x, u.y, u.z};
+    unsigned long key = 0;
+    for (int k = 0; k < 3; k++) {
+        double t = (c[k] + 1.0) * 511.5;
+        unsigned long q = t > 0.0 ? (unsigned long)fmin(t, 1023.0) : 0;
+        for (int b = 0; b < 10; b++)
+            key |= ((q >> b) & 1ul) << (3 * b + k);
+    }
+    return key;
 }
 
 pd_status pd_hull_check(const pd_hull *h, const pd_vec3 *pts, int npts, pd_diag *diag)
@@ -137,22 +173,38 @@ pd_status pd_hull_check(const pd_hull *h, const pd_vec3 *pts, int npts, pd_diag 
         c = v3_add(c, v3_sub(h->verts[v], h->verts[0]));
     c = v3_add(h->verts[0], v3_scale(c, 1.0 / nv));
     /* Each point is tested against the facet its ray from the centroid
-     * leaves through (inside iff below that facet); the walk starts where
-     * the last one ended. Few facets: test them all. */
+     * leaves through (inside iff below that facet). Points are walked to in
+     * the order of a Morton code of their direction, so each walk starts
+     * from a nearby facet and is short. Few facets: test them all. */
     int brute = (double)npts * nf <= 4e7;
+    walk_key *order = NULL;
+    if (!brute) {
+        order = malloc(sizeof *order * (size_t)npts);
+        if (!order)
+            return pd_fail(diag, PD_ERR_NOMEM, "hull check: out of memory");
+        for (int i = 0; i < npts; i++) {
+            order[i].key = direction_key(v3_unit(v3_sub(pts[i], c)));
+            order[i].idx = i;
+        }
+        qsort(order, (size_t)npts, sizeof *order, cmp_walk_key);
+    }
     int f = 0;
     unsigned rot = 0;
-    for (int i = 0; i < npts; i++) {
+    for (int j = 0; j < npts; j++) {
+        int i = brute ? j : order[j].idx;
         int g = brute ? -1 : locate(h, c, v3_sub(pts[i], c), f, &rot);
         int first = g >= 0 ? g : 0, last = g >= 0 ? g + 1 : nf;
         for (int k = first; k < last; k++) {
             double err, d = plane_dist(h, k, pts[i], &err);
-            if (!(d <= tol + err))
+            if (!(d <= tol + err)) {
+                free(order);
                 return pd_fail(diag, PD_ERR_INTERNAL, "hull check: input point %d is %.3g outside facet %d "
                                "(tolerance %.3g)", i, d, k, tol + err);
+            }
         }
         if (g >= 0)
             f = g;
     }
+    free(order);
     return PD_OK;
 }

@@ -15,6 +15,7 @@
  * Each region is a disc; its boundary loop is walked from the triangles'
  * edges, and a loop vertex where the neighbouring facet does not change (a
  * point on an edge) is dropped, leaving the corners: vertices on >= 3 facets. */
+#include <float.h>
 #include <stdlib.h>
 #include <string.h>
 #include "diag.h"
@@ -27,6 +28,7 @@ typedef struct {
     pd_vec3 s;    /* sum of (b-a) x (c-a): twice the area vector */
     double w;     /* sum of |(b-a) x (c-a)| */
     pd_vec3 cw;   /* sum of |(b-a) x (c-a)| * centroid, relative to ref */
+    double uv;    /* sum of |b-a| |c-a|: scale of the round-off of s */
 } plane_acc;
 
 typedef struct {
@@ -37,20 +39,43 @@ typedef struct {
     int *order;
 } merger;
 
-static void tri_terms(const merger *m, int t, pd_vec3 ref, pd_vec3 *cr, double *w, pd_vec3 *cw)
+static void tri_terms(const merger *m, int t, pd_vec3 ref, pd_vec3 *cr, double *w, pd_vec3 *cw, double *uv)
 {
     const int *v = m->th->tri[t];
     pd_vec3 a = v3_sub(m->p[v[0]], ref), b = v3_sub(m->p[v[1]], ref), c = v3_sub(m->p[v[2]], ref);
     *cr = v3_cross(v3_sub(b, a), v3_sub(c, a));
+    *uv = v3_norm(v3_sub(b, a)) * v3_norm(v3_sub(c, a));
     *w = v3_norm(*cr);
     *cw = v3_scale(v3_add(v3_add(a, b), c), *w / 3.0);
+}
+
+/* Cross products whose length is below this multiple of eps |u| |v| (u, v
+ * its edge vectors) have round-off comparable to their size: their direction
+ * says nothing. 16 roundings cover the subtractions and products. */
+#define SLIVER_DIRECTION_EPS (16.0 * DBL_EPSILON)
+
+/* A triangle whose normal reliably points against the region's is across a
+ * fold (a rim where both sides lie within the tolerance of one plane), never
+ * part of the same facet; letting it in would cancel the area vector. Slivers
+ * (and regions) whose computed normal is round-off are not judged by it. */
+static int faces_against(const merger *m, int t, const plane_acc *acc)
+{
+    const int *v = m->th->tri[t];
+    pd_vec3 a = m->p[v[0]];
+    pd_vec3 u = v3_sub(m->p[v[1]], a), w = v3_sub(m->p[v[2]], a);
+    pd_vec3 cr = v3_cross(u, w);
+    if (v3_norm(cr) <= SLIVER_DIRECTION_EPS * v3_norm(u) * v3_norm(w) ||
+        v3_norm(acc->s) <= SLIVER_DIRECTION_EPS * acc->uv)
+        return 0;
+    return v3_dot(cr, acc->s) < 0.0;
 }
 
 static void acc_add(const merger *m, plane_acc *acc, int t)
 {
     pd_vec3 cr, cw;
-    double w;
-    tri_terms(m, t, acc->ref, &cr, &w, &cw);
+    double w, uv;
+    tri_terms(m, t, acc->ref, &cr, &w, &cw, &uv);
+    acc->uv += uv;
     acc->s = v3_add(acc->s, cr);
     acc->w += w;
     acc->cw = v3_add(acc->cw, cw);
@@ -104,6 +129,8 @@ static int grow_region(merger *m, int r, int start, pd_vec3 *normal, double *off
                     continue;
                 plane_acc trial = acc;
                 acc_add(m, &trial, u);
+                if (faces_against(m, u, &acc))
+                    continue;
                 acc_plane(&trial, &n, &c);
                 if (!tri_within(m, u, acc.ref, n, c))
                     continue;
@@ -134,6 +161,7 @@ static int grow_region(merger *m, int r, int start, pd_vec3 *normal, double *off
         end = start + verified;
         memset(&acc.s, 0, sizeof acc.s);
         acc.w = 0.0;
+        acc.uv = 0.0;
         memset(&acc.cw, 0, sizeof acc.cw);
         for (int i = start; i < end; i++)
             acc_add(m, &acc, m->order[i]);
@@ -143,6 +171,19 @@ static int grow_region(merger *m, int r, int start, pd_vec3 *normal, double *off
     *normal = n;
     *offset = v3_dot(n, v3_add(acc.ref, c));
     return end;
+}
+
+typedef struct {
+    double area;
+    int t;
+} seed_key;
+
+static int cmp_seed(const void *a, const void *b)
+{
+    const seed_key *x = a, *y = b;
+    if (x->area != y->area)
+        return (x->area < y->area) - (x->area > y->area);
+    return (x->t > y->t) - (x->t < y->t);
 }
 
 pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd_diag *diag)
@@ -168,8 +209,26 @@ pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd
     }
     for (int t = 0; t < nt; t++)
         m.reg[t] = -1;
-    int nreg = 0, end = 0;
+    /* Seeds in order of decreasing area: a large triangle's normal is
+     * accurate, a sliver's (three nearly collinear points) can be off by
+     * radians, and a sliver seed among sliver neighbours would reject them
+     * all and stay a facet of its own. Ties by index, so the order is
+     * deterministic. */
+    seed_key *seeds = malloc(sizeof *seeds * (size_t)nt);
+    if (!seeds) {
+        st = pd_fail(diag, PD_ERR_NOMEM, "convex hull: out of memory merging %d triangles", nt);
+        goto done;
+    }
     for (int t = 0; t < nt; t++) {
+        const int *v = th->tri[t];
+        pd_vec3 a = pts[v[0]];
+        seeds[t].area = v3_norm(v3_cross(v3_sub(pts[v[1]], a), v3_sub(pts[v[2]], a)));
+        seeds[t].t = t;
+    }
+    qsort(seeds, (size_t)nt, sizeof *seeds, cmp_seed);
+    int nreg = 0, end = 0;
+    for (int i = 0; i < nt; i++) {
+        int t = seeds[i].t;
         if (m.reg[t] != -1)
             continue;
         rstart[nreg] = end;
@@ -178,6 +237,7 @@ pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd
         nreg++;
     }
     rstart[nreg] = end;
+    free(seeds);
 
     /* Boundary loops -> corners. Loops have at most 3 nt edges in total. */
     loopv = malloc(sizeof *loopv * (size_t)(3 * nt));
@@ -241,7 +301,13 @@ pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd
             prev_adj = seq[i];
         }
         if (k < 3) {
-            st = pd_fail(diag, PD_ERR_INTERNAL, "convex hull: merged facet %d has %d corners", r, k);
+            /* Only a rim where both sides lie within the tolerance of one
+             * plane leaves a facet with its whole boundary on one
+             * neighbour: the points are flat to within the tolerance there. */
+            st = pd_fail(diag, PD_ERR_COPLANAR,
+                         "convex hull: facet %d has %d corners: the points form a sheet thinner than %.3g "
+                         "(tolerance %.3g of the size %.3g) along its rim",
+                         r, k, m.tol, PD_TOL_PLANE_REL, h->size);
             goto done;
         }
         for (int i = 0; i < k; i++)
