@@ -173,19 +173,6 @@ static int grow_region(merger *m, int r, int start, pd_vec3 *normal, double *off
     return end;
 }
 
-typedef struct {
-    double area;
-    int t;
-} seed_key;
-
-static int cmp_seed(const void *a, const void *b)
-{
-    const seed_key *x = a, *y = b;
-    if (x->area != y->area)
-        return (x->area < y->area) - (x->area > y->area);
-    return (x->t > y->t) - (x->t < y->t);
-}
-
 pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd_diag *diag)
 {
     int nt = th->ntris, npts = 0;
@@ -209,35 +196,38 @@ pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *h, pd
     }
     for (int t = 0; t < nt; t++)
         m.reg[t] = -1;
-    /* Seeds in order of decreasing area: a large triangle's normal is
-     * accurate, a sliver's (three nearly collinear points) can be off by
-     * radians, and a sliver seed among sliver neighbours would reject them
-     * all and stay a facet of its own. Ties by index, so the order is
-     * deterministic. */
-    seed_key *seeds = malloc(sizeof *seeds * (size_t)nt);
-    if (!seeds) {
+    /* Seeds by shape quality, best first, in a few passes of decreasing
+     * threshold (an O(n) stand-in for sorting): a well-shaped triangle's
+     * normal is accurate, a sliver's (three nearly collinear points) can be
+     * off by radians, and a sliver seed among sliver neighbours would reject
+     * them all and stay a facet of its own. Within a pass, by index, so the
+     * order is deterministic. */
+    float *quality = malloc(sizeof *quality * (size_t)nt);
+    if (!quality) {
         st = pd_fail(diag, PD_ERR_NOMEM, "convex hull: out of memory merging %d triangles", nt);
         goto done;
     }
     for (int t = 0; t < nt; t++) {
         const int *v = th->tri[t];
-        pd_vec3 a = pts[v[0]];
-        seeds[t].area = v3_norm(v3_cross(v3_sub(pts[v[1]], a), v3_sub(pts[v[2]], a)));
-        seeds[t].t = t;
+        pd_vec3 e0 = v3_sub(pts[v[1]], pts[v[0]]), e1 = v3_sub(pts[v[2]], pts[v[1]]),
+                e2 = v3_sub(pts[v[0]], pts[v[2]]);
+        double lmax = fmax(v3_dot(e0, e0), fmax(v3_dot(e1, e1), v3_dot(e2, e2)));
+        /* |cross| / longest^2: scale-free, 0 for a degenerate triangle */
+        quality[t] = (float)(v3_norm(v3_cross(e0, e1)) / lmax);
     }
-    qsort(seeds, (size_t)nt, sizeof *seeds, cmp_seed);
+    static const float pass_quality[] = {0.1f, 1e-4f, 1e-8f, -1.0f};
     int nreg = 0, end = 0;
-    for (int i = 0; i < nt; i++) {
-        int t = seeds[i].t;
-        if (m.reg[t] != -1)
-            continue;
-        rstart[nreg] = end;
-        m.order[end] = t;
-        end = grow_region(&m, nreg, end, &rn[nreg], &roff[nreg]);
-        nreg++;
-    }
+    for (int pass = 0; pass < 4; pass++)
+        for (int t = 0; t < nt; t++) {
+            if (m.reg[t] != -1 || !(quality[t] >= pass_quality[pass]))
+                continue;
+            rstart[nreg] = end;
+            m.order[end] = t;
+            end = grow_region(&m, nreg, end, &rn[nreg], &roff[nreg]);
+            nreg++;
+        }
+    free(quality);
     rstart[nreg] = end;
-    free(seeds);
 
     /* Boundary loops -> corners. Loops have at most 3 nt edges in total. */
     loopv = malloc(sizeof *loopv * (size_t)(3 * nt));
