@@ -20,11 +20,13 @@
 #include "diag.h"
 #include "hull_internal.h"
 #include "predicates.h"
+#include "vec3.h"
 
 typedef struct {
     int v[3];         /* counter-clockwise seen from outside */
     int nb[3];        /* across edge v[i] -> v[i+1] */
-    double nx, ny, nz; /* (v1 - v0) x (v2 - v0), rounded: ranks distances only */
+    pd_vec3 n;        /* (v1 - v0) x (v2 - v0), rounded: filter and ranking */
+    pd_vec3 nperm;    /* its permanent, for the filter's error bound */
     size_t os;        /* outside set: pool[os .. os + oc) */
     int oc;
     int far;          /* offset in the set of its furthest point */
@@ -91,9 +93,12 @@ static int new_tri(qhull *q, int a, int b, int c)
     const pd_vec3 *pa = &q->pts[a], *pb = &q->pts[b], *pc = &q->pts[c];
     double ux = pb->x - pa->x, uy = pb->y - pa->y, uz = pb->z - pa->z;
     double vx = pc->x - pa->x, vy = pc->y - pa->y, vz = pc->z - pa->z;
-    t->nx = uy * vz - uz * vy;
-    t->ny = uz * vx - ux * vz;
-    t->nz = ux * vy - uy * vx;
+    t->n.x = uy * vz - uz * vy;
+    t->n.y = uz * vx - ux * vz;
+    t->n.z = ux * vy - uy * vx;
+    t->nperm.x = fabs(uy * vz) + fabs(uz * vy);
+    t->nperm.y = fabs(uz * vx) + fabs(ux * vz);
+    t->nperm.z = fabs(ux * vy) + fabs(uy * vx);
     t->os = 0;
     t->oc = t->far = 0;
     t->mark = 0;
@@ -156,9 +161,9 @@ static int distribute(qhull *q, size_t m, int first, int nnew, size_t mincap)
             int j = last + k < nnew ? last + k : last + k - nnew;
             const qtri *t = &q->t[nf[j]];
             const pd_vec3 *a = &q->pts[t->v[0]];
-            if (pd_orient3d(a, &q->pts[t->v[1]], &q->pts[t->v[2]], &r->p) > 0) {
+            if (pd_orient3d_plane(&t->n, &t->nperm, a, &q->pts[t->v[1]], &q->pts[t->v[2]], &r->p) > 0) {
                 q->asg[i] = j;
-                q->dist[i] = t->nx * (r->p.x - a->x) + t->ny * (r->p.y - a->y) + t->nz * (r->p.z - a->z);
+                q->dist[i] = v3_dot(t->n, v3_sub(r->p, *a));
                 q->cnt[j]++;
                 assigned++;
                 last = j;
@@ -256,7 +261,8 @@ static int add_point(qhull *q, int f, size_t mincap)
             qtri *th = &q->t[h];
             if (th->mark != q->stamp) {
                 th->mark = q->stamp;
-                th->vis = pd_orient3d(&q->pts[th->v[0]], &q->pts[th->v[1]], &q->pts[th->v[2]], &apex.p) > 0;
+                th->vis = pd_orient3d_plane(&th->n, &th->nperm, &q->pts[th->v[0]], &q->pts[th->v[1]],
+                                            &q->pts[th->v[2]], &apex.p) > 0;
                 if (th->vis) {
                     if (grow((void **)&q->list, &q->caplist, nvis + 1, sizeof *q->list))
                         return -1;

@@ -53,4 +53,23 @@ static inline int pd_orient3d(const pd_vec3 *a, const pd_vec3 *b, const pd_vec3 
     return pd_orient3d_exact(a, b, c, d);
 }
 
+/* The same predicate with the triangle's part precomputed, for testing many
+ * points d against one triangle: n = (b - a) x (c - a) rounded, and nperm its
+ * permanent (|uy vz| + |uz vy|, ...). Bound: n carries <= 4 roundings of
+ * 2^-53 relative to nperm, w = d - a one, the dot product three: 8 * 2^-53 of
+ * nperm . |w|, and PD_ORIENT3D_FILTER_REL is twice that. */
+static inline int pd_orient3d_plane(const pd_vec3 *n, const pd_vec3 *nperm, const pd_vec3 *a,
+                                    const pd_vec3 *b, const pd_vec3 *c, const pd_vec3 *d)
+{
+    double wx = d->x - a->x, wy = d->y - a->y, wz = d->z - a->z;
+    double det = n->x * wx + n->y * wy + n->z * wz;
+    double bound = PD_ORIENT3D_FILTER_REL * (nperm->x * fabs(wx) + nperm->y * fabs(wy) + nperm->z * fabs(wz)) +
+                   PD_ORIENT3D_FILTER_ABS;
+    if (det > bound)
+        return 1;
+    if (det < -bound)
+        return -1;
+    return pd_orient3d_exact(a, b, c, d);
+}
+
 #endif

@@ -145,6 +145,11 @@ static void test_predicate(void)
         }
         int got = pd_orient3d(&a, &b, &c, &d), want = orient_ref(a, b, c, d);
         mismatches += got != want;
+        /* the precomputed-plane form used by quickhull */
+        pd_vec3 u = v3_sub(b, a), w = v3_sub(c, a), n = v3_cross(u, w);
+        pd_vec3 np = v3(fabs(u.y * w.z) + fabs(u.z * w.y), fabs(u.z * w.x) + fabs(u.x * w.z),
+                        fabs(u.x * w.y) + fabs(u.y * w.x));
+        mismatches += pd_orient3d_plane(&n, &np, &a, &b, &c, &d) != want;
         antisym += pd_orient3d(&b, &a, &c, &d) != -got || pd_orient3d(&a, &b, &d, &c) != -got;
         zeros += want == 0;
         pos += want > 0;
