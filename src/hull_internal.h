@@ -1,0 +1,27 @@
+/* hull_internal.h (private): the stages of pd_hull_build.
+ *
+ * hull.c classifies the input and picks a starting tetrahedron,
+ * hull_tri.c builds the exactly convex triangulated hull (quickhull on exact
+ * predicates), hull_merge.c merges its coplanar triangles into the polygonal
+ * facets of pd_hull, hull_check.c validates the result. */
+#ifndef PD_HULL_INTERNAL_H
+#define PD_HULL_INTERNAL_H
+
+#include "posedrop/hull.h"
+
+/* A closed triangulated convex surface over input point indices. */
+typedef struct {
+    int ntris;
+    int (*tri)[3]; /* vertex indices, counter-clockwise seen from outside */
+    int (*nb)[3];  /* nb[t][i]: triangle across edge tri[t][i] -> tri[t][(i+1)%3] */
+} pd_trihull;
+
+/* Quickhull of pts from the non-degenerate tetrahedron seed[0..3]. */
+pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_trihull *out,
+                           pd_diag *diag);
+void pd_trihull_free(pd_trihull *th);
+
+/* Merges the triangles of th into the facets of hull (whose size is set). */
+pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *hull, pd_diag *diag);
+
+#endif
