@@ -28,14 +28,22 @@
 /* Hull triangles whose vertices lie within this distance of a common plane are
  * merged into one polygonal facet, and a hull vertex that ends up on fewer than
  * three facets (a point on an edge) is dropped. Also the distance below which
- * input points count as coplanar or collinear.
- * Why 1e-11: coplanar points of a rotated or scaled CAD face scatter off their
- * plane by round-off, a few 1e-16 L; 1e-11 leaves five orders of margin. Two
- * genuine facets meeting at 1e-7 rad (5.7e-6 deg) over a unit edge lie 1e-7 L
- * apart, four orders above it, so they stay two facets. Larger: nearly flat
- * facets of finely tessellated curves would merge; smaller: round-off would
- * split flat faces into slivers. */
-#define PD_TOL_PLANE_REL 1e-11
+ * input points count as coplanar or collinear (a sheet thinner than this has
+ * no volume the hull can resolve).
+ * Why 1e-7: the hull's triangles are exact, but the files are not. Binary STL
+ * stores float32 (6e-8 relative) and CAD exporters print 6 to 9 digits, so the
+ * four corners of a face that is flat in the designer's model scatter off one
+ * plane by up to ~1e-7 L; shipped parts/cap.off (9 digits) splits its conical
+ * faces at 1e-9. A face split by that noise becomes two facets, the centre of
+ * mass lands on the crease as a knife edge, and a symmetric part's poses stop
+ * being symmetric. Larger: on a tessellated curved surface, neighbouring
+ * triangles within 1e-6 L of one plane already merge by the hundreds
+ * (10^4 points on an ellipsoid); merging there changes no probability beyond
+ * 1e-6, but it departs from the exact hull for no gain. Smaller: print noise
+ * splits faces again. Facets meeting at 1e-7 rad merge (their poses differ by
+ * less than any drop can show); at 1e-5 rad over a facet of size 0.1 L they
+ * stay two. */
+#define PD_TOL_PLANE_REL 1e-7
 
 /* Smallest point-set size (bounding-box diagonal, metres) the hull accepts;
  * below it the points count as colocated. Why 1e-90: the exact orientation
@@ -65,16 +73,16 @@
 /* Two probabilities tie when they differ by at most this fraction of the larger.
  * Ties decide PQS transfers (a tie does not transfer, or a symmetric part would
  * lose its symmetry) and the order of poses (ties go by normal).
- * Why 1e-6: our own round-off is a few 1e-16, but the files are coarser:
- * binary STL stores float32 (6e-8 relative) and CAD exporters print 6 to 9
- * significant digits, which moves the solid angles of a part's symmetric
- * facets apart by up to ~1e-7 relative (shipped parts/cap.off, 9 digits:
- * 1e-9). PQS's "strictly less probable" rule is discontinuous, so a smaller
- * tie would hand a symmetric part an asymmetric answer decided by how its
- * file was printed. Larger: genuinely different facets would stop
- * transferring; but telling two probabilities 1e-6 apart takes ~1e12 drops,
- * so no measurement can see the difference. */
-#define PD_TOL_PROB_TIE_REL 1e-6
+ * Why 1e-4: our own round-off is a few 1e-16, but the files are coarser. The
+ * sides of a 32-gon prism, printed with 9, 7 (about float32) and 6 significant
+ * digits, have solid angles spread by 6e-9, 1.0e-6 and 5.5e-6 relative
+ * (measured). PQS's "strictly less probable" rule is discontinuous: a tie
+ * below that spread hands a symmetric part an asymmetric answer decided by how
+ * its file was printed (a band of a whole side jumps to its neighbour). 1e-4
+ * leaves a margin of 18 over 6-digit files. Larger: genuinely different
+ * facets would stop exchanging bands; but telling two probabilities of ~0.01
+ * apart by 1e-4 relative takes ~1e10 drops, so no measurement can see it. */
+#define PD_TOL_PROB_TIE_REL 1e-4
 
 /* Unit normals whose components differ by at most this are equal when poses
  * that tie in probability are ordered by normal. Why 1e-9: computed normals
