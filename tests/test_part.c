@@ -109,7 +109,12 @@ static void test_refusals(void)
     expect_refused(open, &o, PD_ERR_COM_OUTSIDE, "outside the convex hull");
     o.com = v3(0.2, 0.2, 0.0);
     expect_refused(open, &o, PD_ERR_COM_OUTSIDE, "on the convex hull");
-    o.com = v3(0.2, 0.2, 1e-9);
+    /* The bound is PD_TOL_COM_INSIDE_REL of the size (sqrt 3 here): half of
+     * it inside is still "on", twice of it inside is accepted. */
+    double tol = PD_TOL_COM_INSIDE_REL * sqrt(3.0);
+    o.com = v3(0.2, 0.2, 0.5 * tol);
+    expect_refused(open, &o, PD_ERR_COM_OUTSIDE, "on the convex hull");
+    o.com = v3(0.2, 0.2, 2 * tol);
     p = NULL;
     CHECK_STATUS(pd_part_build(open, &o, &p, NULL), PD_OK);
     pd_part_free(p);

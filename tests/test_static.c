@@ -787,36 +787,37 @@ static void test_hard_cases(void)
     pd_part_free(welded);
     pd_part_free(plain);
 
-    /* Two facets whose normals differ by 1e-7 rad stay two facets: a box
-     * with a shallow roof whose ridge runs off centre. The com's side of the
-     * roof is stable, the other topples onto it. */
-    {
-        /* Ridge at x = -0.25 over a 2 x 1 x 0.5 box: the two roof slopes add
-         * up to 1e-7 rad. */
-        double rise = 1e-7 / (1 / 0.75 + 1 / 1.25);
+    /* A box whose top is a shallow roof with its ridge off centre: at a
+     * crease of 1e-7 rad the two slopes are one facet within the plane
+     * tolerance (PD_TOL_PLANE_REL) and the part is the box; at 1e-4 rad they
+     * stay two, the com's side is stable and the other topples onto it, so
+     * the box's top probability is kept in either case. */
+    const double creases[] = {1e-7, 1e-4};
+    for (int c = 0; c < 2; c++) {
+        double rise = creases[c] / (1 / 0.75 + 1 / 1.25);
         pd_vec3 p[10];
         int n = pts_box(2, 1, 0.5, p);
         p[n++] = v3(-0.25, -0.5, 0.25 + rise);
         p[n++] = v3(-0.25, 0.5, 0.25 + rise);
-        pd_vec3 c = v3(0, 0, 0);
-        pd_part *roof = part_of(convex_mesh(p, n), &c, NULL);
+        pd_vec3 com = v3(0, 0, 0);
+        pd_part *roof = part_of(convex_mesh(p, n), &com, NULL);
         CHECK(roof != NULL);
-        if (roof) {
-            CHECK_INT(roof->hull->nfacets, 7);
-            pd_static_result *r = estimate(roof, NULL);
-            if (r) {
-                CHECK_INT(r->nposes, 6);
-                double top = rect_omega(2, 1, 0.25) / (4 * M_PI);
-                int found = 0;
-                for (int i = 0; i < r->nposes; i++)
-                    if (r->poses[i].normal.z > 0.5) {
-                        found = 1;
-                        CHECK_NEAR(r->poses[i].p_qs, top, 1e-6, "roof of 1e-7 rad");
-                    }
-                CHECK(found);
-            }
-            pd_static_result_free(r);
+        if (!roof)
+            continue;
+        CHECK_INT(roof->hull->nfacets, c == 0 ? 6 : 7);
+        pd_static_result *r = estimate(roof, NULL);
+        if (r) {
+            CHECK_INT(r->nposes, 6);
+            double top = rect_omega(2, 1, 0.25) / (4 * M_PI);
+            int found = 0;
+            for (int i = 0; i < r->nposes; i++)
+                if (r->poses[i].normal.z > 0.5) {
+                    found = 1;
+                    CHECK_NEAR(r->poses[i].p_qs, top, 10 * creases[c], "first order in the crease");
+                }
+            CHECK(found);
         }
+        pd_static_result_free(r);
         pd_part_free(roof);
     }
 
@@ -834,7 +835,8 @@ static void test_hard_cases(void)
         if (h) {
             pd_vec3 c = v3(0.1, -0.05, 0.02);
             pd_part *big = part_of(mesh_of_hull(h), &c, NULL);
-            CHECK(big != NULL && big->hull->nverts == N);
+            /* Near-flat neighbours may merge and drop a few points, rarely. */
+            CHECK(big != NULL && big->hull->nverts > N - N / 1000);
             for (int rule = 0; big && rule < 2; rule++) {
                 pd_static_options o;
                 pd_static_options_default(&o);
