@@ -31,6 +31,7 @@
 #include "posedrop/mass.h"
 #include "posedrop/tolerances.h"
 #include "diag.h"
+#include "mesh_internal.h"
 #include "vec3.h"
 
 /* The accumulated quantities, in this order. */
@@ -59,25 +60,6 @@ static int tri_degenerate(const int t[3])
     return t[0] == t[1] || t[1] == t[2] || t[2] == t[0];
 }
 
-static pd_status check_input(const pd_mesh *m, const pd_mass *mass, pd_diag *diag)
-{
-    if (!m || !mass)
-        return pd_fail(diag, PD_ERR_USAGE, "mass: %s is NULL", m ? "output" : "mesh");
-    if (m->nverts < 0 || m->ntris < 0 || (m->ntris > 0 && !m->tris) || (m->nverts > 0 && !m->verts))
-        return pd_fail(diag, PD_ERR_USAGE, "mass: invalid mesh (%d vertices, %d triangles)",
-                       m->nverts, m->ntris);
-    for (int t = 0; t < m->ntris; t++)
-        for (int c = 0; c < 3; c++)
-            if (m->tris[t][c] < 0 || m->tris[t][c] >= m->nverts)
-                return pd_fail(diag, PD_ERR_RANGE,
-                               "mass: triangle %d: vertex index %d out of range 0..%d", t,
-                               m->tris[t][c], m->nverts - 1);
-    for (int v = 0; v < m->nverts; v++)
-        if (!v3_isfinite(m->verts[v]))
-            return pd_fail(diag, PD_ERR_NONFINITE, "mass: vertex %d is not finite", v);
-    return PD_OK;
-}
-
 /* Bounding box of the vertices the (non-degenerate) triangles use: its centre
  * is the reference point, its diagonal the part's size. Unused vertices are
  * ignored so that a stray far-away vertex cannot move the reference point off
@@ -103,7 +85,9 @@ static int part_box(const pd_mesh *m, pd_vec3 *lo, pd_vec3 *hi)
 
 pd_status pd_mass_compute(const pd_mesh *mesh, pd_mass *mass, pd_diag *diag)
 {
-    pd_status st = check_input(mesh, mass, diag);
+    if (!mass)
+        return pd_fail(diag, PD_ERR_USAGE, "mass: output is NULL");
+    pd_status st = pd_mesh_validate(mesh, "mass", diag);
     if (st != PD_OK)
         return st;
     pd_vec3 lo, hi;

@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include "mesh_internal.h"
 #include "mesh_reader.h"
 #include "posedrop/mesh.h"
 #include "vec3.h"
@@ -242,4 +243,22 @@ void pd_mesh_free(pd_mesh *mesh)
     free(mesh->verts);
     free(mesh->tris);
     free(mesh);
+}
+
+pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag)
+{
+    if (!m)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: mesh is NULL", who);
+    if (m->nverts < 0 || m->ntris < 0 || (m->ntris > 0 && !m->tris) || (m->nverts > 0 && !m->verts))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: invalid mesh (%d vertices, %d triangles)", who,
+                       m->nverts, m->ntris);
+    for (int t = 0; t < m->ntris; t++)
+        for (int c = 0; c < 3; c++)
+            if (m->tris[t][c] < 0 || m->tris[t][c] >= m->nverts)
+                return pd_fail(diag, PD_ERR_RANGE, "%s: triangle %d: vertex index %d out of range 0..%d",
+                               who, t, m->tris[t][c], m->nverts - 1);
+    for (int v = 0; v < m->nverts; v++)
+        if (!v3_isfinite(m->verts[v]))
+            return pd_fail(diag, PD_ERR_NONFINITE, "%s: vertex %d is not finite", who, v);
+    return PD_OK;
 }

@@ -29,6 +29,7 @@
 #include "posedrop/mass.h"
 #include "posedrop/tolerances.h"
 #include "diag.h"
+#include "mesh_internal.h"
 #include "vec3.h"
 
 /* How many points of a component are tried before accepting one whose
@@ -148,25 +149,6 @@ static int nesting_depth(const pd_mesh *m, const component *comps, int ncomps, i
     return first_depth;
 }
 
-static pd_status check_input(const pd_mesh *m, pd_diag *diag)
-{
-    if (!m)
-        return pd_fail(diag, PD_ERR_USAGE, "orient: mesh is NULL");
-    if (m->nverts < 0 || m->ntris < 0 || (m->ntris > 0 && !m->tris) || (m->nverts > 0 && !m->verts))
-        return pd_fail(diag, PD_ERR_USAGE, "orient: invalid mesh (%d vertices, %d triangles)",
-                       m->nverts, m->ntris);
-    for (int t = 0; t < m->ntris; t++)
-        for (int c = 0; c < 3; c++)
-            if (m->tris[t][c] < 0 || m->tris[t][c] >= m->nverts)
-                return pd_fail(diag, PD_ERR_RANGE,
-                               "orient: triangle %d: vertex index %d out of range 0..%d", t,
-                               m->tris[t][c], m->nverts - 1);
-    for (int v = 0; v < m->nverts; v++)
-        if (!v3_isfinite(m->verts[v]))
-            return pd_fail(diag, PD_ERR_NONFINITE, "orient: vertex %d is not finite", v);
-    return PD_OK;
-}
-
 /* Sorts the directed edges and pairs them: nbr[3t+k] is the triangle across
  * the edge starting at corner k of t (-1 for degenerate t), same[3t+k] is 1
  * when that neighbour traverses the edge in the same direction (so exactly one
@@ -215,7 +197,7 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
 
 pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
 {
-    pd_status st = check_input(mesh, diag);
+    pd_status st = pd_mesh_validate(mesh, "orient", diag);
     if (st != PD_OK)
         return st;
     int n = mesh->ntris;
