@@ -40,6 +40,32 @@ double pd_solid_angle_facet(const pd_hull *hull, pd_vec3 com, int f, pd_vec3 nea
  * point of a convex facet containing b and c that is nearest the origin. */
 double pd_solid_angle_from_nearest(pd_vec3 q, pd_vec3 b, pd_vec3 c);
 
+/* The edges leaving each hull vertex, with the facets on either side: the
+ * boundaries of the vertex's normal cone on the sphere of directions. */
+typedef struct pd_star_edge {
+    pd_vec3 u;         /* v - to: the cone's boundary is the plane u . g = 0 */
+    double len;        /* |u| */
+    int to;            /* the other end */
+    int left, right;   /* facet with the edge v -> to in its loop, and the one across */
+} pd_star_edge;
+
+typedef struct pd_star {
+    int *start;        /* nverts + 1: vertex v's edges are edge[start[v] .. start[v+1]) */
+    pd_star_edge *edge;
+} pd_star;
+
+pd_status pd_star_build(const pd_hull *hull, pd_star *star); /* PD_ERR_NOMEM */
+void pd_star_free(pd_star *star);
+
+/* Steepest descent of the centre of mass height from any gravity direction g
+ * (unit, part frame): the facet the part first lands on (whose rest[] then
+ * names the stable pose). hint (may be NULL) is a vertex to start the support
+ * search from and receives the support vertex of g, so that successive calls
+ * with nearby g cost little. PD_ERR_NO_CONVERGENCE or PD_ERR_INTERNAL only on
+ * a bug. */
+pd_status pd_descend(const pd_hull *hull, const pd_star *star, pd_vec3 com, pd_vec3 g,
+                     int *facet, int *hint);
+
 /* The quasi-static successor of every unstable facet: res->facets[f].next,
  * and .rest for all facets. Checks that every link lowers the centre of mass
  * (PD_ERR_INTERNAL otherwise) and that descent ends (PD_ERR_NO_CONVERGENCE). */

@@ -25,20 +25,7 @@
 #include "static_internal.h"
 #include "vec3.h"
 
-/* The edges leaving each hull vertex, with the facets on either side. */
-typedef struct out_edge {
-    pd_vec3 u;         /* v - to: the cone's boundary is the plane u . g = 0 */
-    double len;        /* |u| */
-    int to;            /* the other end */
-    int left, right;   /* facet with the edge v -> to in its loop, and the one across */
-} out_edge;
-
-typedef struct vert_star {
-    int *start;        /* nverts + 1 */
-    out_edge *edge;
-} vert_star;
-
-static pd_status star_build(const pd_hull *h, vert_star *s)
+pd_status pd_star_build(const pd_hull *h, pd_star *s)
 {
     int nloop = h->facet_start[h->nfacets];
     s->start = calloc((size_t)h->nverts + 1, sizeof *s->start);
@@ -58,7 +45,7 @@ static pd_status star_build(const pd_hull *h, vert_star *s)
         int b = h->facet_start[f], n = h->facet_start[f + 1] - b;
         for (int i = 0; i < n; i++) {
             int v = h->facet_vert[b + i];
-            out_edge *e = &s->edge[fill[v]++];
+            pd_star_edge *e = &s->edge[fill[v]++];
             e->to = h->facet_vert[b + (i + 1) % n];
             e->u = v3_sub(h->verts[v], h->verts[e->to]);
             e->len = v3_norm(e->u);
@@ -70,7 +57,7 @@ static pd_status star_build(const pd_hull *h, vert_star *s)
     return PD_OK;
 }
 
-static void star_free(vert_star *s)
+void pd_star_free(pd_star *s)
 {
     free(s->start);
     free(s->edge);
@@ -84,7 +71,7 @@ static pd_vec3 tangential(pd_vec3 x, pd_vec3 g)
 
 /* Rotation about edge (v, w), gravity g on its arc between the normals of
  * facets left and right: the facet at the end the centre of mass descends to. */
-static int roll_about_edge(const pd_hull *h, pd_vec3 com, pd_vec3 v, pd_vec3 w, pd_vec3 g,
+static int roll_abpd_star_edge(const pd_hull *h, pd_vec3 com, pd_vec3 v, pd_vec3 w, pd_vec3 g,
                            int left, int right)
 {
     pd_vec3 tau = v3_unit(v3_cross(v3_sub(w, v), g));
@@ -101,24 +88,24 @@ static int at_normal(pd_vec3 g, pd_vec3 n)
     return v3_dot(d, d) <= PD_TOL_ANGLE * PD_TOL_ANGLE;
 }
 
-/* Steepest descent from facet f whose foot lies nearest its corner v. On a
+/* Steepest descent pivoting about vertex v from gravity direction g in its
+ * cone, moving along the unit tangent d; f (or -1) is the facet it starts
+ * from, which it must not land back on. On a
  * finely tessellated smooth part the walk crosses tens of vertex cones, so
  * each step is kept free of trigonometry: on g(s) = g cos s + d sin s the
  * boundary u . g(s) = A cos s + B sin s (A = u.g >= 0, B = u.d) is reached
  * at the angle of the vector (-B, A), and the first boundary reached is the
  * one whose vector turns least, found by cross products; the exit point is
  * (-B g + A d) / |(A, B)|, a unit vector since g and d are orthonormal. */
-static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, int f, int v,
-                            int *next)
+static pd_status walk(const pd_hull *h, const pd_star *s, pd_vec3 com, int f, int v, pd_vec3 g,
+                     pd_vec3 d, int *next)
 {
-    pd_vec3 g = h->normal[f];
-    pd_vec3 d = v3_unit(tangential(v3_sub(com, h->verts[v]), g));
     int limit = 2 * h->nverts + 8; /* every pivot lowers h, so vertices don't repeat */
     for (int step = 0; step < limit; step++) {
         double bx = 0.0, by = -1.0; /* direction of the best exit so far */
-        const out_edge *exit = NULL;
+        const pd_star_edge *exit = NULL;
         for (int k = s->start[v]; k < s->start[v + 1]; k++) {
-            const out_edge *e = &s->edge[k];
+            const pd_star_edge *e = &s->edge[k];
             double A = v3_dot(e->u, g), B = v3_dot(e->u, d), x = -B, y = A;
             if (A <= PD_TOL_ANGLE * e->len) {
                 if (B > 0.0)
@@ -154,7 +141,7 @@ static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, i
             /* Centre of mass over the segment (lambda > 0 whenever the edge
              * was reached by pivoting about v; round-off below 0 is clamped
              * here too): roll about the edge to the lower end of its arc. */
-            *next = roll_about_edge(h, com, pv, pw, g1, exit->left, exit->right);
+            *next = roll_abpd_star_edge(h, com, pv, pw, g1, exit->left, exit->right);
             return PD_OK;
         }
         /* Beyond w: w takes over as the pivot. */
@@ -163,6 +150,48 @@ static pd_status pivot_walk(const pd_hull *h, const vert_star *s, pd_vec3 com, i
         d = v3_scale(dw, 1.0 / ndw);
     }
     return PD_ERR_NO_CONVERGENCE;
+}
+
+/* The hull vertex farthest along g: hill-climbing over the vertex graph finds
+ * it, because on a convex polytope a vertex no neighbour of which is farther
+ * along g is the farthest of all. */
+static int support_vertex(const pd_hull *h, const pd_star *s, pd_vec3 g, int start)
+{
+    int v = start;
+    double best = v3_dot(h->verts[v], g);
+    for (int moved = 1; moved;) {
+        moved = 0;
+        for (int k = s->start[v]; k < s->start[v + 1]; k++) {
+            double x = v3_dot(h->verts[s->edge[k].to], g);
+            if (x > best) {
+                best = x;
+                v = s->edge[k].to;
+                moved = 1;
+                break;
+            }
+        }
+    }
+    return v;
+}
+
+pd_status pd_descend(const pd_hull *h, const pd_star *s, pd_vec3 com, pd_vec3 g, int *facet,
+                     int *hint)
+{
+    int v = support_vertex(h, s, g, hint && *hint >= 0 && *hint < h->nverts ? *hint : 0);
+    if (hint)
+        *hint = v;
+    /* Resting on a facet already (g at its normal): no motion from there
+     * but the facet's own toppling, which its rest[] records. */
+    for (int k = s->start[v]; k < s->start[v + 1]; k++)
+        if (at_normal(g, h->normal[s->edge[k].left])) {
+            *facet = s->edge[k].left;
+            return PD_OK;
+        }
+    pd_vec3 t = tangential(v3_sub(com, h->verts[v]), g);
+    double nt = v3_norm(t);
+    if (nt == 0.0) /* balanced on the vertex: a maximum; any way down will do */
+        t = tangential(v3_sub(h->verts[s->edge[s->start[v]].to], h->verts[v]), g), nt = v3_norm(t);
+    return walk(h, s, com, -1, v, g, v3_scale(t, 1.0 / nt), facet);
 }
 
 /* Resolves rest[] by following next[] (heights fall along it, so chains are
@@ -190,10 +219,10 @@ static pd_status resolve_rest(pd_static_result *res, pd_diag *diag)
 pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
                           pd_topple_rule rule, pd_static_result *res, pd_diag *diag)
 {
-    vert_star star = {NULL, NULL};
+    pd_star star = {NULL, NULL};
     pd_status st = PD_OK;
     if (rule == PD_TOPPLE_DESCENT)
-        st = star_build(hull, &star);
+        st = pd_star_build(hull, &star);
     for (int f = 0; f < hull->nfacets && st == PD_OK; f++) {
         pd_facet_result *r = &res->facets[f];
         const facet_geom *g = &geom[f];
@@ -206,7 +235,10 @@ pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *ge
         else if (g->near_vertex < 0)
             r->next = hull->facet_adj[base + g->near_edge];
         else
-            st = pivot_walk(hull, &star, com, f, g->near_vertex, &r->next);
+            st = walk(hull, &star, com, f, g->near_vertex, hull->normal[f],
+                      v3_unit(tangential(v3_sub(com, hull->verts[g->near_vertex]),
+                                         hull->normal[f])),
+                      &r->next);
         if (st == PD_ERR_NO_CONVERGENCE)
             st = pd_fail(diag, st, "quasi-static descent from facet %d did not end", f + 1);
         else if (st == PD_ERR_INTERNAL)
@@ -221,7 +253,7 @@ pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *ge
                          "quasi-static link from facet %d to %d raises the centre of mass by %.3g m",
                          f + 1, r->next + 1, rise);
     }
-    star_free(&star);
+    pd_star_free(&star);
     if (st == PD_OK)
         st = resolve_rest(res, diag);
     return st;
