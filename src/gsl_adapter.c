@@ -1,4 +1,5 @@
 /* gsl_adapter.c: GSL behind posedrop's status codes (see gsl_adapter.h). */
+#include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include "gsl_adapter.h"
@@ -37,3 +38,9 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
     *result = value;
     return PD_OK;
 }
+
+/* --- distributions ---------------------------------------------------------- */
+
+double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
+
+double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }

@@ -17,4 +17,8 @@ typedef double (*pd_quad_fn)(double x, void *user);
 pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, double relerr,
                             double *result);
 
+/* Distribution functions (GSL's cdf module). */
+double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
+double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
+
 #endif

@@ -10,6 +10,9 @@
     PD_SUITE(part)   \
     PD_SUITE(static) \
     PD_SUITE(basin)  \
+    PD_SUITE(rng)    \
+    PD_SUITE(stats)  \
+    PD_SUITE(scene)  \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

@@ -1,0 +1,17 @@
+/* stats.h (private): the statistics of Monte Carlo pose counts. */
+#ifndef PD_STATS_H
+#define PD_STATS_H
+
+/* Wilson score interval for k successes in n trials at the confidence whose
+ * two-sided normal quantile is z (1.96 for 95%): better than the normal
+ * interval near 0 and 1, where most pose probabilities of real parts live,
+ * and never outside [0, 1]. n = 0 gives [0, 1]. */
+void pd_wilson(long k, long n, double z, double *lo, double *hi);
+
+/* Drops needed so that every one of k pose probabilities is within delta at
+ * confidence 1 - alpha at once, in the worst case p = 1/2: the paper's eq.
+ * (17) with its missing square restored, (z / (2 delta))^2, and z the
+ * Bonferroni quantile Phi^-1(1 - alpha / (2k)) (READINGS.md). */
+long pd_sample_size(double delta, double alpha, int k);
+
+#endif
