@@ -35,10 +35,10 @@ WARN := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototyp
         -Wvla -Wdouble-promotion
 # -ffp-contract=off: no fused multiply-add, so results are bit-identical across
 # machines and compilers; never -ffast-math.
-CFLAGS_ALL := -std=c11 -g $(CFLAGS_OPT) $(WARN) $(CFLAGS_WERROR) -ffp-contract=off \
+CFLAGS_ALL := -std=c11 -g -pthread $(CFLAGS_OPT) $(WARN) $(CFLAGS_WERROR) -ffp-contract=off \
               -D_DEFAULT_SOURCE -Iinclude -Isrc $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null) \
               $(CFLAGS)
-LDLIBS_LIB := $(shell $(PKG_CONFIG) --libs $(LIB_PKGS) 2>/dev/null) -lm
+LDLIBS_LIB := $(shell $(PKG_CONFIG) --libs $(LIB_PKGS) 2>/dev/null) -lm -pthread
 LDLIBS_TEST := $(shell $(PKG_CONFIG) --libs $(TEST_PKGS) 2>/dev/null)
 CFLAGS_TEST := $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/dev/null)
 

@@ -2,16 +2,19 @@
  *
  * It only parses arguments, calls the library and prints: the results as CSV
  * on stdout, diagnostics on stderr. Exit codes: 0 success, 2 bad usage or
- * input (nothing is printed on stdout), 1 internal failure. */
+ * input (nothing is printed on stdout), 1 internal failure, 130 interrupted
+ * (what was done is printed, marked partial). */
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "posedrop/posedrop.h"
+#include "posedrop/sim.h"
 
-enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
+enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
 
 static const char *prog = "posedrop";
 
@@ -21,21 +24,25 @@ static void usage(FILE *out)
         "usage: %s [options] PART\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
-        "flat surface, by the quasi-static (QS) and perturbed quasi-static (PQS)\n"
-        "estimators, and prints one CSV row per stable pose:\n"
-        "  pose,nx,ny,nz,area,height,p_qs,p_pqs\n"
+        "flat surface and prints one CSV row per stable pose:\n"
+        "  pose,nx,ny,nz,area,height,p_qs,p_pqs[,n,count,p,ci_lo,ci_hi,unsettled,partial]\n"
         "pose: 1 = most probable (QS); nx,ny,nz: outward unit normal of the resting\n"
         "facet in the file's frame (gravity's direction in the part's frame); area:\n"
-        "facet area in m^2; height: centre of mass above the floor in m.\n"
+        "facet area in m^2; height: centre of mass above the floor in m; p_qs, p_pqs:\n"
+        "quasi-static and perturbed quasi-static estimates. With -n or --ci, drops\n"
+        "are simulated too: count of n drops ended in the pose, p = count / n and\n"
+        "its 95%% Wilson interval; unsettled: drops that hit a limit (in no count);\n"
+        "partial: 1 if interrupted before all drops ran.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
         "\n"
-        "options:\n"
+        "part:\n"
         "  --units U          unit of the file's coordinates: m (default), cm, mm, in\n"
         "  --format F         off, stl or obj (default: detect from content and name)\n"
         "  --com X,Y,Z        centre of mass in the file's units (default: computed\n"
         "                     from the mesh, uniform density); required for meshes\n"
         "                     that are not closed\n"
+        "static estimators:\n"
         "  --topple RULE      descent (default): exact quasi-static motion, steepest\n"
         "                     descent of the centre of mass, which may end on a facet\n"
         "                     sharing only a vertex; edge: the paper's graph between\n"
@@ -45,13 +52,31 @@ static void usage(FILE *out)
         "                     probability is lower; qs: compare propagated QS values\n"
         "  --pqs-band B       rect (default): the paper's |a| x epsilon band clipped\n"
         "                     to its triangle; exact: exact spherical band area\n"
+        "dynamic estimator (simulated drops):\n"
+        "  -n N               drops to simulate (default: none)\n"
+        "  --ci DELTA         drop until every pose's 95%% interval is within DELTA\n"
+        "  --seed S           random seed (default 1); same seed, same bytes\n"
+        "  -j THREADS         threads (default: all cores); never changes results\n"
+        "  -h H               drop height in m: lowest point above the floor (0.12)\n"
+        "  -v V               horizontal belt velocity in m/s (0.05)\n"
+        "  --mu MU            friction coefficient (0.3)\n"
+        "  --restitution E    coefficient of restitution (0.3)\n"
+        "  --restitution-law L  poisson (default) or energetic\n"
+        "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
+        "  --initial I        uniform (default) or bootstrap (the paper's belt)\n"
+        "  --scene FILE       'key = value' lines: height, belt_speed, mu, restitution,\n"
+        "                     restitution_law, vibration, initial, gravity; options\n"
+        "                     given after it override it\n"
+        "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
+        "output:\n"
         "  --facets           one row per hull facet instead of per pose, with its\n"
         "                     stability and quasi-static successor\n"
-        "  -v, --verbose      a summary of the part on stderr\n"
+        "  --verbose          a summary of the part (and of the drops) on stderr\n"
         "  --help             this help\n"
         "  --version          version\n"
         "\n"
-        "exit status: 0 success, 2 bad usage or input, 1 internal failure\n",
+        "exit status: 0 success, 2 bad usage or input, 1 internal failure,\n"
+        "130 interrupted (the rows printed are marked partial)\n",
         prog);
 }
 
@@ -72,6 +97,18 @@ static int parse_double(const char *text, double *out)
     if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
         return 0;
     *out = v;
+    return 1;
+}
+
+/* Strict: the whole text one integer in [lo, hi]. */
+static int parse_long(const char *text, long lo, long hi, long *out)
+{
+    char *end;
+    errno = 0;
+    long long v = strtoll(text, &end, 10);
+    if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi)
+        return 0;
+    *out = (long)v;
     return 1;
 }
 
@@ -111,14 +148,19 @@ static double clean(double x)
     return fabs(x) < PD_PRINT_ZERO ? 0.0 : x;
 }
 
-static void print_poses(const pd_static_result *res)
+static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
 {
-    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs\n");
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s\n",
+           sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
     for (int i = 0; i < res->nposes; i++) {
         const pd_pose *p = &res->poses[i];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", i + 1, clean(p->normal.x),
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", i + 1, clean(p->normal.x),
                clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(p->p_qs),
                clean(p->p_pqs));
+        if (sim)
+            printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", sim->n, sim->count[i], sim->p[i],
+                   sim->ci_lo[i], sim->ci_hi[i], sim->unsettled, sim->partial);
+        printf("\n");
     }
 }
 
@@ -140,17 +182,77 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     free(pose_of);
 }
 
+static const char *end_name(pd_drop_end e)
+{
+    switch (e) {
+    case PD_END_SETTLED: return "settled";
+    case PD_END_TIME_LIMIT: return "time_limit";
+    case PD_END_COLLISION_LIMIT: return "collision_limit";
+    default: return "failed";
+    }
+}
+
+static int write_trials(const char *path, const pd_sim_result *sim)
+{
+    FILE *f = fopen(path, "w");
+    if (!f) {
+        fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, strerror(errno));
+        return 0;
+    }
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end\n");
+    for (long i = 0; i < sim->n; i++) {
+        const pd_trial *t = &sim->trials[i];
+        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s\n", i + 1, t->q0[0], t->q0[1],
+                t->q0[2], t->q0[3], t->pose + 1, t->collisions, t->time, end_name(t->end));
+    }
+    int ok = fflush(f) == 0 && !ferror(f);
+    ok &= fclose(f) == 0;
+    if (!ok)
+        fprintf(stderr, "%s: %s: write error\n", prog, path);
+    return ok;
+}
+
 typedef struct {
-    const char *path;
+    const char *path, *trials, *com_text;
     pd_mesh_read_options read;
     pd_part_options part;
-    const char *com_text;
     pd_static_options estimate;
-    int facets, verbose;
+    pd_scene scene;
+    pd_sim_options sim;
+    int dynamic, facets, verbose;
 } cli_args;
 
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
-       OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION };
+       OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
+       OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS };
+
+/* A scene setting given as an option: the library checks it, by the same
+ * names and rules as in scene files. */
+static int scene_option(cli_args *a, const char *option, const char *key, const char *value)
+{
+    pd_diag d;
+    pd_diag_init(&d);
+    if (pd_scene_set(&a->scene, key, value, &d) != PD_OK) {
+        fprintf(stderr, "%s: %s: %s\n%s: see '%s --help'\n", prog, option, d.message, prog, prog);
+        return EXIT_USAGE;
+    }
+    return -1;
+}
+
+static int choose(const char *option, const char *value, const char *const *names, int n,
+                  int *out)
+{
+    for (int i = 0; i < n; i++)
+        if (strcmp(value, names[i]) == 0) {
+            *out = i;
+            return 1;
+        }
+    fprintf(stderr, "%s: %s: expected", prog, option);
+    for (int i = 0; i < n; i++)
+        fprintf(stderr, "%s %s", i ? (i + 1 == n ? " or" : ",") : "", names[i]);
+    fprintf(stderr, ", got '%s'\n%s: see '%s --help'\n", value, prog, prog);
+    return 0;
+}
 
 /* Returns -1 to go on, or an exit code. */
 static int parse_args(int argc, char **argv, cli_args *a)
@@ -163,34 +265,45 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"epsilon", required_argument, 0, OPT_EPSILON},
         {"pqs-compare", required_argument, 0, OPT_PQS_COMPARE},
         {"pqs-band", required_argument, 0, OPT_PQS_BAND},
+        {"ci", required_argument, 0, OPT_CI},
+        {"seed", required_argument, 0, OPT_SEED},
+        {"mu", required_argument, 0, OPT_MU},
+        {"restitution", required_argument, 0, OPT_RESTITUTION},
+        {"restitution-law", required_argument, 0, OPT_LAW},
+        {"vibration", required_argument, 0, OPT_VIBRATION},
+        {"initial", required_argument, 0, OPT_INITIAL},
+        {"scene", required_argument, 0, OPT_SCENE},
+        {"trials", required_argument, 0, OPT_TRIALS},
         {"facets", no_argument, 0, OPT_FACETS},
-        {"verbose", no_argument, 0, 'v'},
+        {"verbose", no_argument, 0, OPT_VERBOSE},
         {"help", no_argument, 0, OPT_HELP},
         {"version", no_argument, 0, OPT_VERSION},
         {0, 0, 0, 0},
     };
+    static const char *const formats[] = {"off", "stl", "obj"};
+    static const char *const topples[] = {"descent", "edge"};
+    static const char *const compares[] = {"raw", "qs"};
+    static const char *const bands[] = {"rect", "exact"};
     memset(a, 0, sizeof *a);
     pd_mesh_read_options_default(&a->read);
     pd_part_options_default(&a->part);
     pd_static_options_default(&a->estimate);
+    pd_scene_default(&a->scene);
+    pd_sim_options_default(&a->sim);
     opterr = 0;
-    int c;
-    double deg;
-    while ((c = getopt_long(argc, argv, ":v", longopts, NULL)) != -1) {
+    int c, code = -1, k;
+    double x;
+    long n;
+    while (code < 0 && (c = getopt_long(argc, argv, ":n:h:v:j:", longopts, NULL)) != -1) {
         switch (c) {
         case OPT_UNITS:
             if (pd_units_parse(optarg, &a->read.units) != PD_OK)
                 return fail_usage("--units: expected m, cm, mm or in, got '%s'", optarg);
             break;
         case OPT_FORMAT:
-            if (strcmp(optarg, "off") == 0)
-                a->read.format = PD_FORMAT_OFF;
-            else if (strcmp(optarg, "stl") == 0)
-                a->read.format = PD_FORMAT_STL;
-            else if (strcmp(optarg, "obj") == 0)
-                a->read.format = PD_FORMAT_OBJ;
-            else
-                return fail_usage("--format: expected off, stl or obj, got '%s'", optarg);
+            if (!choose("--format", optarg, formats, 3, &k))
+                return EXIT_USAGE;
+            a->read.format = (pd_mesh_format)(PD_FORMAT_OFF + k);
             break;
         case OPT_COM:
             if (!parse_vec3(optarg, &a->part.com))
@@ -199,39 +312,73 @@ static int parse_args(int argc, char **argv, cli_args *a)
             a->com_text = optarg;
             break;
         case OPT_TOPPLE:
-            if (strcmp(optarg, "descent") == 0)
-                a->estimate.topple = PD_TOPPLE_DESCENT;
-            else if (strcmp(optarg, "edge") == 0)
-                a->estimate.topple = PD_TOPPLE_EDGE;
-            else
-                return fail_usage("--topple: expected descent or edge, got '%s'", optarg);
+            if (!choose("--topple", optarg, topples, 2, &k))
+                return EXIT_USAGE;
+            a->estimate.topple = (pd_topple_rule)k;
             break;
         case OPT_EPSILON:
-            if (!parse_double(optarg, &deg) || deg < 0.0 || deg > 90.0)
+            if (!parse_double(optarg, &x) || x < 0.0 || x > 90.0)
                 return fail_usage("--epsilon: expected an angle in degrees from 0 to 90, got '%s'",
                                   optarg);
-            a->estimate.epsilon = deg * (M_PI / 180.0);
+            a->estimate.epsilon = x * (M_PI / 180.0);
             break;
         case OPT_PQS_COMPARE:
-            if (strcmp(optarg, "raw") == 0)
-                a->estimate.compare = PD_PQS_COMPARE_RAW;
-            else if (strcmp(optarg, "qs") == 0)
-                a->estimate.compare = PD_PQS_COMPARE_QS;
-            else
-                return fail_usage("--pqs-compare: expected raw or qs, got '%s'", optarg);
+            if (!choose("--pqs-compare", optarg, compares, 2, &k))
+                return EXIT_USAGE;
+            a->estimate.compare = (pd_pqs_compare)k;
             break;
         case OPT_PQS_BAND:
-            if (strcmp(optarg, "rect") == 0)
-                a->estimate.band = PD_PQS_BAND_RECT;
-            else if (strcmp(optarg, "exact") == 0)
-                a->estimate.band = PD_PQS_BAND_EXACT;
-            else
-                return fail_usage("--pqs-band: expected rect or exact, got '%s'", optarg);
+            if (!choose("--pqs-band", optarg, bands, 2, &k))
+                return EXIT_USAGE;
+            a->estimate.band = (pd_pqs_band)k;
+            break;
+        case 'n':
+            if (!parse_long(optarg, 1, 1000000000L, &n))
+                return fail_usage("-n: expected a number of drops from 1 to 10^9, got '%s'", optarg);
+            a->sim.ndrops = n;
+            a->dynamic = 1;
+            break;
+        case OPT_CI:
+            if (!parse_double(optarg, &x) || x <= 0.0 || x >= 0.5)
+                return fail_usage("--ci: expected a half-width between 0 and 0.5, got '%s'", optarg);
+            a->sim.ci_halfwidth = x;
+            a->dynamic = 1;
+            break;
+        case OPT_SEED:
+            if (!parse_long(optarg, 0, 0x7fffffffffffffffL, &n))
+                return fail_usage("--seed: expected a non-negative integer, got '%s'", optarg);
+            a->sim.seed = (uint64_t)n;
+            break;
+        case 'j':
+            if (!parse_long(optarg, 1, 256, &n))
+                return fail_usage("-j: expected a number of threads from 1 to 256, got '%s'", optarg);
+            a->sim.threads = (int)n;
+            break;
+        case 'h': code = scene_option(a, "-h", "height", optarg); break;
+        case 'v': code = scene_option(a, "-v", "belt_speed", optarg); break;
+        case OPT_MU: code = scene_option(a, "--mu", "mu", optarg); break;
+        case OPT_RESTITUTION: code = scene_option(a, "--restitution", "restitution", optarg); break;
+        case OPT_LAW: code = scene_option(a, "--restitution-law", "restitution_law", optarg); break;
+        case OPT_VIBRATION: code = scene_option(a, "--vibration", "vibration", optarg); break;
+        case OPT_INITIAL: code = scene_option(a, "--initial", "initial", optarg); break;
+        case OPT_SCENE: {
+            pd_diag d;
+            pd_diag_init(&d);
+            pd_status st = pd_scene_read(optarg, &a->scene, &d);
+            if (st != PD_OK) {
+                fprintf(stderr, "%s: %s\n", prog, d.message);
+                return pd_status_is_input_error(st) ? EXIT_USAGE : EXIT_INTERNAL;
+            }
+            break;
+        }
+        case OPT_TRIALS:
+            a->trials = optarg;
+            a->sim.keep_trials = 1;
             break;
         case OPT_FACETS:
             a->facets = 1;
             break;
-        case 'v':
+        case OPT_VERBOSE:
             a->verbose = 1;
             break;
         case OPT_HELP:
@@ -246,8 +393,14 @@ static int parse_args(int argc, char **argv, cli_args *a)
             return fail_usage("unknown option '%s'", argv[optind - 1]);
         }
     }
+    if (code >= 0)
+        return code;
     if (optind != argc - 1)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
+    if (a->trials && !a->dynamic)
+        return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
+    if (a->facets && a->dynamic)
+        return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);
@@ -281,6 +434,37 @@ static void print_summary(const cli_args *a, const pd_part *part, const pd_stati
             h->nverts, h->nfacets, res->nposes, res->nknife);
 }
 
+/* What every dynamic run reports, whether or not --verbose: drops that could
+ * not be classified and collisions the law had to correct are never silent. */
+static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
+{
+    if (sim->unsettled)
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit) and "
+                        "are in no count\n", prog, a->path, sim->unsettled, sim->n);
+    if (sim->energy_gain)
+        fprintf(stderr, "%s: %s: %ld collisions would have added kinetic energy under Poisson's "
+                        "law and were resolved by the energetic law\n", prog, a->path,
+                sim->energy_gain);
+    if (sim->bootstrap_rounds)
+        fprintf(stderr, "%s: %s: bootstrap: %d rounds; the last round ended %.3g (total "
+                        "variation) from the distribution it started from%s\n", prog, a->path,
+                sim->bootstrap_rounds, sim->stationarity,
+                sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
+    if (a->verbose && sim->n)
+        fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
+                (double)sim->collisions / (double)sim->n);
+    if (sim->partial)
+        fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
+}
+
+static volatile sig_atomic_t interrupted;
+
+static void on_sigint(int sig)
+{
+    (void)sig;
+    interrupted = 1;
+}
+
 int main(int argc, char **argv)
 {
     cli_args a;
@@ -295,6 +479,7 @@ int main(int argc, char **argv)
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
+    pd_sim_result *sim = NULL;
     pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
@@ -303,20 +488,35 @@ int main(int argc, char **argv)
     st = pd_part_build(mesh, &a.part, &part, &diag);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a.estimate, &res, &diag);
+    if (st == PD_OK && a.dynamic) {
+        struct sigaction sa;
+        memset(&sa, 0, sizeof sa);
+        sa.sa_handler = on_sigint;
+        sigaction(SIGINT, &sa, NULL);
+        a.sim.cancel = &interrupted;
+        st = pd_sim_run(part, res, &a.scene, &a.sim, &sim, &diag);
+    }
     if (st != PD_OK) {
         code = fail_status(st, &diag, a.path);
-    } else {
-        if (a.verbose)
-            print_summary(&a, part, res);
-        if (a.facets)
-            print_facets(part, res);
-        else
-            print_poses(res);
-        code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
-        if (code)
-            fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
+        goto done;
     }
+    if (a.verbose)
+        print_summary(&a, part, res);
+    if (sim)
+        print_sim_summary(&a, sim);
+    if (a.facets)
+        print_facets(part, res);
+    else
+        print_poses(res, sim);
+    code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
+    if (code)
+        fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
+    if (sim && a.trials && !write_trials(a.trials, sim))
+        code = EXIT_INTERNAL;
+    if (code == 0 && sim && sim->partial)
+        code = EXIT_INTERRUPTED;
 done:
+    pd_sim_result_free(sim);
     pd_static_result_free(res);
     pd_part_free(part);
     pd_mesh_free(mesh);

@@ -10,6 +10,7 @@
 #ifndef POSEDROP_SIM_H
 #define POSEDROP_SIM_H
 
+#include <signal.h>
 #include <stdint.h>
 #include "posedrop/diag.h"
 #include "posedrop/part.h"
@@ -54,6 +55,67 @@ pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_d
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
  * what it holds. Errors name the file and line. */
 pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag);
+
+/* How a drop ended. */
+typedef enum pd_drop_end {
+    PD_END_SETTLED = 0,  /* energy below its basin's barrier: outcome final */
+    PD_END_TIME_LIMIT,   /* simulated time ran out: counted, never classified */
+    PD_END_COLLISION_LIMIT, /* too many collisions (a Zeno-like cascade) */
+    PD_END_FAILED        /* the collision solver could not finish (counted) */
+} pd_drop_end;
+
+typedef struct pd_sim_options {
+    long ndrops;            /* drops to run (with ci_halfwidth: at least these); 2000 */
+    uint64_t seed;          /* 1 */
+    int threads;            /* 0: all cores */
+    double ci_halfwidth;    /* > 0: keep dropping until every pose's 95% interval
+                               is at most this wide on each side; 0 */
+    long max_drops;         /* cap for ci_halfwidth runs; 10^7 */
+    double time_limit;      /* s of simulated time per drop; 20 */
+    int max_collisions;     /* per drop; 100000 */
+    int keep_trials;        /* 1: fill result->trials (one record per drop) */
+    volatile sig_atomic_t *cancel; /* may be NULL; set non-zero (e.g. from a SIGINT
+                               handler) to stop early: the result is then marked
+                               partial and holds the first n drops */
+} pd_sim_options;
+
+void pd_sim_options_default(pd_sim_options *options);
+
+/* One drop, for --trials. */
+typedef struct pd_trial {
+    double q0[4];       /* initial orientation, unit quaternion (w, x, y, z), part to world */
+    int pose;           /* index into the static result's poses, -1 if not settled */
+    int collisions;
+    double time;        /* simulated s */
+    pd_drop_end end;
+} pd_trial;
+
+typedef struct pd_sim_result {
+    int nposes;             /* as in the static result */
+    long n;                 /* drops run */
+    long *count;            /* per pose: drops that settled there */
+    double *p, *ci_lo, *ci_hi; /* count / n and its 95% Wilson interval */
+    long unsettled;         /* drops that hit a limit or failed (not in any count) */
+    long energy_gain;       /* collisions that would have added kinetic energy
+                               (Poisson with friction) and were resolved with the
+                               energetic law instead */
+    long collisions;        /* over all drops */
+    int partial;            /* 1 if cancelled before the requested drops ran */
+    int bootstrap_rounds;   /* rounds run (PD_INITIAL_BOOTSTRAP) */
+    double stationarity;    /* bootstrap: total-variation distance between the
+                               last rounds' initial and final distributions */
+    pd_trial *trials;       /* n records when options->keep_trials, else NULL */
+} pd_sim_result;
+
+/* Runs the drops. static_result gives the pose table the outcomes map onto
+ * (same numbering as its poses). options and scene may be NULL (defaults).
+ * Returns PD_ERR_USAGE (bad options), PD_ERR_NOMEM; a cancelled run returns
+ * PD_OK with result->partial set. On success *result is owned by the caller. */
+pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_result,
+                     const pd_scene *scene, const pd_sim_options *options,
+                     pd_sim_result **result, pd_diag *diag);
+
+void pd_sim_result_free(pd_sim_result *result);
 
 #ifdef __cplusplus
 }
