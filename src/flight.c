@@ -170,7 +170,7 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
         F.m = 1.0; /* round-off on the separatrix */
     F.k = sqrt(F.m);
     F.n = (J1 - J2) / (J2 - J3);
-    F.Omega = (J2 > J3 ? 1.0 : -1.0) * F.lambda * sqrt(fabs(J2 - J3) * J1mD);
+    F.Omega = (J2 > J3 ? 1.0 : -1.0) * F.lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
     pd_status st;
     double K = 0.0;
     if (F.m < 1.0) {
