@@ -44,3 +44,56 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
 
 double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }
+
+/* ==== Elliptic functions (flight: torque-free rotation) ======================
+ * See gsl_adapter.h. GSL_PREC_DOUBLE: the flight promises conservation and
+ * phase to ~1e-12 relative, so the full double accuracy is needed. */
+#include <gsl/gsl_sf_ellint.h>
+#include <gsl/gsl_sf_elljac.h>
+
+pd_status pd_elljac(double u, double m, double *sn, double *cn, double *dn)
+{
+    gsl_set_error_handler_off();
+    return gsl_sf_elljac_e(u, m, sn, cn, dn) == GSL_SUCCESS ? PD_OK : PD_ERR_NONFINITE;
+}
+
+pd_status pd_ellint_F(double phi, double k, double *result)
+{
+    gsl_set_error_handler_off();
+    gsl_sf_result r;
+    if (gsl_sf_ellint_F_e(phi, k, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
+        return PD_ERR_NONFINITE;
+    *result = r.val;
+    return PD_OK;
+}
+
+pd_status pd_ellint_P(double phi, double k, double n, double *result)
+{
+    gsl_set_error_handler_off();
+    gsl_sf_result r;
+    if (gsl_sf_ellint_P_e(phi, k, n, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
+        return PD_ERR_NONFINITE;
+    *result = r.val;
+    return PD_OK;
+}
+
+pd_status pd_ellint_Kcomp(double k, double *result)
+{
+    gsl_set_error_handler_off();
+    gsl_sf_result r;
+    if (gsl_sf_ellint_Kcomp_e(k, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
+        return PD_ERR_NONFINITE;
+    *result = r.val;
+    return PD_OK;
+}
+
+pd_status pd_ellint_Pcomp(double k, double n, double *result)
+{
+    gsl_set_error_handler_off();
+    gsl_sf_result r;
+    if (gsl_sf_ellint_Pcomp_e(k, n, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
+        return PD_ERR_NONFINITE;
+    *result = r.val;
+    return PD_OK;
+}
+/* ==== end of elliptic functions ============================================= */

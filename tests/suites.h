@@ -13,6 +13,7 @@
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
     PD_SUITE(scene)  \
+    PD_SUITE(flight) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

@@ -145,8 +145,21 @@ static void test_usage(void)
 
     expect_failure("", 2, "expected one PART file");
     expect_failure("parts/cap.off parts/cap.off", 2, "exactly one PART");
-    /* -h is reserved for the drop height; help is --help only. */
-    expect_failure("-h parts/cap.off", 2, "unknown option");
+    /* -h is the drop height, -v the belt velocity; help is --help only. */
+    expect_failure("-h parts/cap.off", 2, "-h: height");
+    expect_failure("-h -1 -n 10 parts/cap.off", 2, "-h: height");
+    expect_failure("-v fast -n 10 parts/cap.off", 2, "-v: belt_speed");
+    expect_failure("-n 0 parts/cap.off", 2, "-n");
+    expect_failure("-n 12x parts/cap.off", 2, "-n");
+    expect_failure("-j 0 -n 10 parts/cap.off", 2, "-j");
+    expect_failure("--ci 0.7 parts/cap.off", 2, "--ci");
+    expect_failure("--mu -0.1 -n 10 parts/cap.off", 2, "--mu");
+    expect_failure("--restitution 2 -n 10 parts/cap.off", 2, "--restitution");
+    expect_failure("--restitution-law newton -n 10 parts/cap.off", 2, "--restitution-law");
+    expect_failure("--initial sorted -n 10 parts/cap.off", 2, "--initial");
+    expect_failure("--scene /nonexistent/scene -n 10 parts/cap.off", 2, "/nonexistent/scene");
+    expect_failure("--trials /tmp/x.csv parts/cap.off", 2, "--trials");
+    expect_failure("--facets -n 10 parts/cap.off", 2, "--facets");
     expect_failure("--frobnicate parts/cap.off", 2, "unknown option '--frobnicate'");
     expect_failure("--units furlong parts/cap.off", 2, "--units");
     expect_failure("--epsilon 91 parts/cap.off", 2, "--epsilon");

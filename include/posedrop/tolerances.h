@@ -142,6 +142,48 @@
  * other. */
 #define PD_TOL_WINDING 0.25
 
+/* --- dynamics --------------------------------------------------------------- */
+
+/* Principal moments that differ by at most this fraction of the largest are
+ * made exactly equal when the dynamic body model is built, so the flight takes
+ * the closed-form symmetric-top or spherical branch. Why 1e-12: a cube's or a
+ * cylinder's computed moments differ by round-off (~1e-15 relative). Treating a
+ * body of true asymmetry d as symmetric moves it by about d |w| t radians: 1e-10
+ * rad after 2 s at 50 rad/s, far below anything a drop resolves. Smaller:
+ * round-off asymmetry would reach the elliptic branch, whose integral of the
+ * third kind has parameter n = (J1 - J2)/(J2 - J3) up to 1e15 there and loses
+ * digits. Larger (1e-6 and up): genuinely asymmetric parts would lose their
+ * tumbling (tennis-racket) motion. */
+#define PD_TOL_INERTIA_SYM_REL 1e-12
+
+/* The time of impact is found when the lowest hull vertex is within this height
+ * of the floor, approached from above (never below it by more). Why 1e-9: the
+ * flight's positions carry round-off of ~1e-15 L at drop heights of a few L and
+ * its orientation ~1e-14 rad, so heights are known to ~1e-14 L: a margin of 1e5.
+ * The impact time is then known to 1e-9 L / (approach speed). Larger: the
+ * collision is applied with a visible gap (at 1e-5 L a resting part would
+ * hover and re-collide in ever shorter flights). Smaller (below ~1e-13): the
+ * search would chase round-off and stop on its iteration limit. */
+#define PD_TOL_IMPACT_REL 1e-9
+
+/* At impact, every hull vertex within this height of the floor belongs to the
+ * contact set handed to the (multi-contact) collision resolver. Why 1e-6: a
+ * face landing flat touches with all its corners at once, and a face landing
+ * within 1e-6 rad (6e-5 deg) of flat is resolved as flat, instead of as a
+ * cascade of micro-collisions a few 1e-7 s apart that each cost a search.
+ * Must stay above PD_TOL_IMPACT_REL (the lowest vertex itself may sit that
+ * high). Larger (1e-4, i.e. 0.006 deg): corners genuinely apart would be
+ * struck together and the bounce would change. Smaller: the cascade above. */
+#define PD_TOL_CONTACT_REL 1e-6
+
+/* Conservative-advancement steps one impact search may take before it reports
+ * PD_ERR_NO_CONVERGENCE. Each step closes at least the fraction
+ * (true approach speed)/(speed bound) of the remaining gap; a part whose
+ * rotation bound exceeds its approach speed a hundredfold needs ~100 ln(1e9)
+ * ~ 2000 steps to converge to PD_TOL_IMPACT_REL. 100000 is far above any
+ * genuine search and still stops a runaway (NaN-free but stuck) state fast. */
+#define PD_IMPACT_MAX_STEPS 100000
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked

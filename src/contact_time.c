@@ -1,0 +1,130 @@
+/* impact.c: the time of a flight's next contact with the floor (see flight.h).
+ *
+ * Conservative advancement (Mirtich, "Impulse-based dynamic simulation of
+ * rigid body systems", PhD thesis, Berkeley 1996, ch. 2; our formulation).
+ * The support height s(t) = min over hull vertices of their world z can fall
+ * no faster than the com's descent plus the fastest vertex speed about it:
+ *   -ds/dt <= max(0, -vz(t)) + wmax rmax,    vz(t) = vz(t0) - g (t - t0),
+ * so from a sample at t0 with gap s0 > 0 the gap stays positive for
+ *   c D + g D^2 / 2 + W D < s0,  c = max(0, -vz(t0)), W = wmax rmax.
+ * Stepping by the root D of that quadratic never passes the first contact, so
+ * no contact is missed however briefly it dips below the floor, and the
+ * iterates approach the first contact from above. Each step closes at least
+ * the fraction (true approach speed)/(bound) of the gap; a straight fall lands
+ * in one step. */
+#include <math.h>
+#include "flight.h"
+#include "posedrop/tolerances.h"
+#include "vec3.h"
+
+/* Support height at t: the lowest vertex (hill-climbed from *hint) and its z. */
+static pd_status support_at(const pd_body *b, const pd_flight *f, double t, pd_state *s,
+                            int *hint, double *height)
+{
+    pd_status st = pd_flight_eval(f, t, s);
+    if (st != PD_OK)
+        return st;
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    *hint = pd_body_support(b, up, *hint);
+    *height = s->x.z + v3_dot(up, b->verts[*hint]);
+    if (!isfinite(*height))
+        return PD_ERR_NONFINITE;
+    return PD_OK;
+}
+
+/* Vertices within tol of the floor, by breadth-first search from the lowest
+ * one over the edge graph: the vertices of a convex polytope below a plane
+ * form a connected subgraph, so the search finds them all while visiting only
+ * them and their neighbours. The list doubles as the queue; membership is a
+ * linear search, cheap because contact sets are small (a face's corners).
+ * Beyond ncap the set is counted, not listed. */
+static int contact_set(const pd_body *b, const pd_state *s, int lowest, double tol, int *list,
+                       int ncap)
+{
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    if (ncap < 1 || !list)
+        return 1;
+    int n = 0;
+    list[n++] = lowest;
+    for (int head = 0; head < n; head++) {
+        int v = list[head];
+        for (int k = b->adj_start[v]; k < b->adj_start[v + 1]; k++) {
+            int w = b->adj[k];
+            if (s->x.z + v3_dot(up, b->verts[w]) > tol)
+                continue;
+            int seen = 0;
+            for (int i = 0; i < n && !seen; i++)
+                seen = list[i] == w;
+            if (seen)
+                continue;
+            if (n == ncap)
+                return n + 1; /* at least one more than listed */
+            list[n++] = w;
+        }
+    }
+    return n;
+}
+
+pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, int *contacts,
+                           int ncap, pd_impact *out)
+{
+    if (!b || !f || !out || !(t_max >= 0.0) || ncap < 0 || (ncap > 0 && !contacts))
+        return PD_ERR_USAGE;
+    double tol = PD_TOL_IMPACT_REL * b->size;
+    double W = f->wmax * b->rmax;
+    pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
+    pd_state s;
+    int hint = 0;
+    double t = 0.0, h;
+    /* Start from the body's lowest vertex in the initial orientation: the scan
+     * is avoided by hill-climbing from vertex 0. */
+    pd_status st = support_at(b, f, 0.0, &s, &hint, &h);
+    if (st != PD_OK)
+        return st;
+    if (h <= tol) {
+        r.kind = PD_IMPACT_NOW;
+    } else {
+        for (;;) {
+            if (r.steps++ >= PD_IMPACT_MAX_STEPS)
+                return PD_ERR_NO_CONVERGENCE;
+            double vz = f->s0.v.z - f->g * t;
+            double c = (vz < 0.0 ? -vz : 0.0) + W;
+            /* Root of g/2 D^2 + c D = h in the form without cancellation. */
+            double disc = c * c + 2.0 * f->g * h;
+            double D = disc > 0.0 ? 2.0 * h / (c + sqrt(disc)) : HUGE_VAL;
+            if (t + D >= t_max) {
+                /* The bound keeps the gap open up to t_max, but the last
+                 * sample may still close it: look at t_max itself. */
+                double hm;
+                int hm_hint = hint;
+                pd_state sm;
+                if ((st = support_at(b, f, t_max, &sm, &hm_hint, &hm)) != PD_OK)
+                    return st;
+                if (hm > tol) {
+                    r.t = t_max;
+                    r.vertex = hm_hint;
+                    r.height = hm;
+                    *out = r;
+                    return PD_OK;
+                }
+                t = t_max; /* touching at t_max itself, within the tolerance */
+                s = sm;
+                hint = hm_hint;
+                h = hm;
+                break;
+            }
+            t += D;
+            if ((st = support_at(b, f, t, &s, &hint, &h)) != PD_OK)
+                return st;
+            if (h <= tol)
+                break;
+        }
+        r.kind = PD_IMPACT_AT;
+    }
+    r.t = t;
+    r.vertex = hint;
+    r.height = h;
+    r.ncontacts = contact_set(b, &s, hint, PD_TOL_CONTACT_REL * b->size, contacts, ncap);
+    *out = r;
+    return PD_OK;
+}

@@ -1,0 +1,249 @@
+/* flight.c: torque-free flight in closed form (see flight.h).
+ *
+ * Method. The world angular momentum L is constant; u = L/|L| in the body frame
+ * obeys Euler's equations du/dt = |L| u x (J u), J = diag(1/I). Two integrals,
+ * |u| = 1 and u.J u = 2T/|L|^2 = D, make u move on a polhode, solved by Jacobi
+ * elliptic functions (Landau & Lifshitz, Mechanics, sec. 37; our own
+ * derivation in the notation below). In a "chart" frame (a signed permutation
+ * of the principal axes) in which the polhode circles chart axis 3 with
+ * u3 > 0 and D lies between J3 and J2:
+ *   u1 = a1 cn(tau), u2 = a2 sn(tau), u3 = a3 dn(tau), tau = tau0 + Omega t,
+ *   a1^2 = (D-J3)/(J1-J3), a2^2 = (D-J3)/(J2-J3), a3^2 = (J1-D)/(J1-J3),
+ *   m = (J1-J2)(D-J3) / ((J2-J3)(J1-D)),
+ *   Omega = sign(J2-J3) |L| sqrt(|J2-J3| |J1-D|).
+ * The orientation uses Euler angles (z-x-z) about L: chart -> L-frame is
+ * Rz(phi) Rx(theta) Rz(psi), where theta and psi follow from u and
+ *   dphi/dt = |L| (J1 u1^2 + J2 u2^2)/(u1^2 + u2^2)
+ *           = |L| (J3 + (J1-J3)/(1 + n sn^2 tau)),  n = (J1-J2)/(J2-J3),
+ * whose integral is Legendre's incomplete integral of the third kind. Both
+ * forms hold for J1 > J2 > J3 and for J1 < J2 < J3 (all the ratios above are
+ * then positive). Conservation is by construction: the world angular
+ * momentum is R(t) |L| u(t) = Q0 Rz(phi) |L| z = L for any phi, and the energy
+ * is |L|^2 u.J u / 2 = |L|^2 D / 2 since the elliptic functions satisfy
+ * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off. */
+#include <math.h>
+#include "flight.h"
+#include "gsl_adapter.h"
+#include "posedrop/tolerances.h"
+#include "vec3.h"
+
+static const double PI = 3.14159265358979323846;
+
+static pd_vec3 body_L(const pd_body *b, pd_vec3 w)
+{
+    return v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+}
+
+static double comp(pd_vec3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
+
+/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, in the
+ * product form of the three half-angle rotations. */
+static pd_quat euler_zxz(double phi, double theta, double psi)
+{
+    double ct = cos(0.5 * theta), st = sin(0.5 * theta);
+    double sp = 0.5 * (phi + psi), dp = 0.5 * (phi - psi);
+    return quat(ct * cos(sp), st * cos(dp), st * sin(dp), ct * sin(sp));
+}
+
+/* The chart angles of a unit vector u (chart frame): u = Rz(psi)^T Rx(theta)^T z. */
+static void chart_angles(double u1, double u2, double u3, double *theta, double *psi)
+{
+    *theta = atan2(sqrt(u1 * u1 + u2 * u2), u3);
+    *psi = atan2(u1, u2);
+}
+
+/* Elliptic state at argument tau: u in the chart, and the unrolled
+ * P(am tau, k, n) (continuous in tau across periods). */
+static pd_status elliptic_at(const pd_flight *f, double tau, double u[3], double *P)
+{
+    double j = 0.0;
+    if (f->K2 > 0.0)
+        j = nearbyint(tau / f->K2);
+    double tr = tau - j * f->K2; /* in [-K, K]: am(tr) in [-pi/2, pi/2] */
+    double sn, cn, dn, Pr;
+    pd_status st = pd_elljac(tr, f->m, &sn, &cn, &dn);
+    if (st != PD_OK)
+        return st;
+    double am = atan2(sn, cn);
+    if ((st = pd_ellint_P(am, f->k, f->n, &Pr)) != PD_OK)
+        return st;
+    /* sn and cn change sign with each half period 2K; dn does not. */
+    double par = fmod(j, 2.0) != 0.0 ? -1.0 : 1.0;
+    u[0] = f->alpha[0] * cn * par;
+    u[1] = f->alpha[1] * sn * par;
+    u[2] = f->alpha[2] * dn;
+    *P = Pr + 2.0 * j * f->Pc;
+    return PD_OK;
+}
+
+/* Signed permutation taking body axis c (sign s) to chart axis 3, as a proper
+ * rotation: for c = 3 it is the identity or a half turn about x; for c = 1 a
+ * quarter turn about y. */
+static void set_chart(pd_flight *f, int c, double s)
+{
+    double E[3][3] = {{0}};
+    if (c == 2) {
+        f->perm[0] = 0, f->perm[1] = 1, f->perm[2] = 2;
+        f->sgn[0] = 1.0, f->sgn[1] = s, f->sgn[2] = s;
+    } else {
+        f->perm[0] = 2, f->perm[1] = 1, f->perm[2] = 0;
+        f->sgn[0] = -s, f->sgn[1] = 1.0, f->sgn[2] = s;
+    }
+    for (int i = 0; i < 3; i++)
+        E[i][f->perm[i]] = f->sgn[i];
+    f->e = quat_from_matrix(CONST_M3(E));
+}
+
+pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
+{
+    if (!b || !s0 || !f || !(g >= 0.0))
+        return PD_ERR_USAGE;
+    if (!v3_isfinite(s0->x) || !v3_isfinite(s0->v) || !v3_isfinite(s0->w) ||
+        !isfinite(s0->q.w + s0->q.x + s0->q.y + s0->q.z))
+        return PD_ERR_NONFINITE;
+    pd_flight F = {0};
+    F.s0 = *s0;
+    F.s0.q = quat_normalize(s0->q);
+    F.g = g;
+    for (int i = 0; i < 3; i++)
+        F.J0[i] = b->inv_moment[i];
+    pd_vec3 Lb = body_L(b, s0->w);
+    F.lambda = v3_norm(Lb);
+    F.wmax = F.lambda * b->inv_moment[0]; /* |J L| <= max(J) |L| */
+    if (F.lambda == 0.0) {
+        F.kind = PD_FLIGHT_STILL;
+        *f = F;
+        return PD_OK;
+    }
+    pd_vec3 u = v3_scale(Lb, 1.0 / F.lambda);
+    F.lhat = quat_rotate(F.s0.q, u);
+    const double *I = b->moment, *J = b->inv_moment;
+
+    /* Axial cases: equal moments (exact after the body's snapping), or u on a
+     * principal axis (a steady spin, possibly about the unstable middle axis,
+     * which an exact solution keeps). omega = a u + b axis, see flight.h. */
+    int on_axis = -1;
+    if (u.y == 0.0 && u.z == 0.0)
+        on_axis = 0;
+    else if (u.x == 0.0 && u.z == 0.0)
+        on_axis = 1;
+    else if (u.x == 0.0 && u.y == 0.0)
+        on_axis = 2;
+    if (I[0] == I[2] || on_axis >= 0 || I[0] == I[1] || I[1] == I[2]) {
+        F.kind = PD_FLIGHT_AXIAL;
+        if (I[0] == I[2] || on_axis >= 0) {
+            F.a = F.lambda * (on_axis >= 0 ? J[on_axis] : J[0]);
+            F.b = 0.0;
+            F.axis = v3(0.0, 0.0, 1.0);
+        } else {
+            int d = I[0] == I[1] ? 2 : 0; /* the distinct axis */
+            int s = d == 2 ? 0 : 2;       /* one of the equal pair */
+            F.axis = d == 2 ? v3(0.0, 0.0, 1.0) : v3(1.0, 0.0, 0.0);
+            F.a = F.lambda * J[s];
+            F.b = F.lambda * comp(u, d) * (J[d] - J[s]);
+        }
+        *f = F;
+        return PD_OK;
+    }
+
+    /* Asymmetric: D - J2 without cancellation decides which axis the polhode
+     * circles: the largest moment (body axis 3) when D < J2, else axis 1. */
+    double ux = u.x, uz = u.z;
+    double DmJ2 = (J[0] - J[1]) * ux * ux + (J[2] - J[1]) * uz * uz;
+    int c = DmJ2 < 0.0 ? 2 : DmJ2 > 0.0 ? 0 : (fabs(uz) >= fabs(ux) ? 2 : 0);
+    double uc = c == 2 ? uz : ux;
+    set_chart(&F, c, uc > 0.0 ? 1.0 : -1.0);
+    double uch[3];
+    for (int i = 0; i < 3; i++) {
+        uch[i] = F.sgn[i] * comp(u, F.perm[i]);
+        F.J[i] = J[F.perm[i]];
+    }
+    double J1 = F.J[0], J2 = F.J[1], J3 = F.J[2];
+    /* D - J3 and J1 - D from the components: no cancellation near pure spin. */
+    double DmJ3 = (J1 - J3) * uch[0] * uch[0] + (J2 - J3) * uch[1] * uch[1];
+    double J1mD = (J1 - J2) * uch[1] * uch[1] + (J1 - J3) * uch[2] * uch[2];
+    F.alpha[0] = sqrt(DmJ3 / (J1 - J3));
+    F.alpha[1] = sqrt(DmJ3 / (J2 - J3));
+    F.alpha[2] = sqrt(J1mD / (J1 - J3));
+    F.m = (J1 - J2) * DmJ3 / ((J2 - J3) * J1mD);
+    if (F.m > 1.0)
+        F.m = 1.0; /* round-off on the separatrix */
+    F.k = sqrt(F.m);
+    F.n = (J1 - J2) / (J2 - J3);
+    F.Omega = (J2 > J3 ? 1.0 : -1.0) * F.lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
+    pd_status st;
+    double K = 0.0;
+    if (F.m < 1.0) {
+        if ((st = pd_ellint_Kcomp(F.k, &K)) != PD_OK ||
+            (st = pd_ellint_Pcomp(F.k, F.n, &F.Pc)) != PD_OK)
+            return st;
+        F.K2 = 2.0 * K;
+    }
+    /* Initial phase: cn = u1/a1, sn = u2/a2, so am(tau0) = atan2(u2/a2, u1/a1),
+     * then tau0 = F(am) with half periods unrolled (F(am + j pi) = F(am) + 2jK). */
+    double am0 = atan2(uch[1] / F.alpha[1], uch[0] / F.alpha[0]);
+    double j0 = 0.0;
+    if (am0 > 0.5 * PI)
+        j0 = 1.0;
+    else if (am0 < -0.5 * PI)
+        j0 = -1.0;
+    double Fr;
+    if (F.m < 1.0 || j0 == 0.0) {
+        if ((st = pd_ellint_F(am0 - j0 * PI, F.k, &Fr)) != PD_OK)
+            return st;
+    } else {
+        return PD_ERR_NONFINITE; /* unreachable: on the separatrix cn > 0 */
+    }
+    F.tau0 = Fr + j0 * F.K2;
+    double u0[3];
+    if ((st = elliptic_at(&F, F.tau0, u0, &F.P0)) != PD_OK)
+        return st;
+    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
+     * to round-off. */
+    double th, ps;
+    chart_angles(uch[0], uch[1], uch[2], &th, &ps);
+    F.Q0 = quat_mul(quat_mul(F.s0.q, quat_conj(F.e)), quat_conj(euler_zxz(0.0, th, ps)));
+    F.kind = PD_FLIGHT_ELLIPTIC;
+    *f = F;
+    return PD_OK;
+}
+
+pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
+{
+    pd_state s = f->s0;
+    s.x = v3(f->s0.x.x + f->s0.v.x * t, f->s0.x.y + f->s0.v.y * t,
+             f->s0.x.z + f->s0.v.z * t - 0.5 * f->g * t * t);
+    s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
+    if (f->kind == PD_FLIGHT_AXIAL) {
+        /* omega_body(t) = rot(axis, -b t) omega_body(0): for equal moments J
+         * commutes with that rotation (see the derivation in flight.h). */
+        pd_quat back = quat_axis_angle(f->axis, -f->b * t);
+        s.q = quat_mul(quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q),
+                       quat_conj(back));
+        s.w = quat_rotate(back, f->s0.w);
+    } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
+        double u[3], P;
+        pd_status st = elliptic_at(f, f->tau0 + f->Omega * t, u, &P);
+        if (st != PD_OK)
+            return st;
+        double phi = f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
+        double th, ps;
+        chart_angles(u[0], u[1], u[2], &th, &ps);
+        s.q = quat_mul(quat_mul(f->Q0, euler_zxz(phi, th, ps)), f->e);
+        double wb[3] = {0};
+        for (int i = 0; i < 3; i++)
+            wb[f->perm[i]] = f->sgn[i] * f->lambda * f->J[i] * u[i];
+        s.w = v3(wb[0], wb[1], wb[2]);
+    }
+    *out = s;
+    return PD_OK;
+}
+
+pd_status pd_flight_advance(const pd_body *b, pd_state *s, double g, double dt)
+{
+    pd_flight f;
+    pd_status st = pd_flight_plan(b, s, g, &f);
+    if (st != PD_OK)
+        return st;
+    return pd_flight_eval(&f, dt, s);
+}

@@ -1,0 +1,433 @@
+/* test_flight.c: the rigid-body model, torque-free flight and the impact
+ * search. Oracles: closed forms (box moments, free fall, symmetric-top
+ * precession), conservation laws, an independent fine-step RK4 integration of
+ * q and omega, and brute-force scans (all vertices, fine time grids). */
+#include <stdlib.h>
+#include "body.h"
+#include "check.h"
+#include "flight.h"
+#include "posedrop/posedrop.h"
+#include "posedrop/tolerances.h"
+#include "shapes.h"
+#include "suites.h"
+#include "vec3.h"
+
+static const double G = 9.81;
+
+static pd_part *part_of_mesh(pd_mesh *m)
+{
+    pd_part *p = NULL;
+    CHECK_STATUS(pd_part_build(m, NULL, &p, NULL), PD_OK);
+    pd_mesh_free(m);
+    return p;
+}
+
+static pd_body *body_of(const pd_part *p)
+{
+    pd_body *b = NULL;
+    CHECK_STATUS(pd_body_build(p, &b, NULL), PD_OK);
+    return b;
+}
+
+static pd_vec3 world_L(const pd_body *b, const pd_state *s)
+{
+    return quat_rotate(s->q, v3(b->moment[0] * s->w.x, b->moment[1] * s->w.y,
+                                b->moment[2] * s->w.z));
+}
+
+static double energy(const pd_body *b, const pd_state *s)
+{
+    return 0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                  b->moment[2] * s->w.z * s->w.z);
+}
+
+/* Reference: classical RK4 on (q, omega) with q' = q (0, w) / 2 and Euler's
+ * equations, fine fixed steps; shares nothing with the closed form. */
+static void rk4_deriv(const pd_body *b, pd_quat q, pd_vec3 w, pd_quat *dq, pd_vec3 *dw)
+{
+    pd_quat p = quat_mul(q, quat(0.0, w.x, w.y, w.z));
+    *dq = quat(0.5 * p.w, 0.5 * p.x, 0.5 * p.y, 0.5 * p.z);
+    const double *I = b->moment;
+    *dw = v3((I[1] - I[2]) * w.y * w.z / I[0], (I[2] - I[0]) * w.z * w.x / I[1],
+             (I[0] - I[1]) * w.x * w.y / I[2]);
+}
+
+static pd_quat qax(pd_quat q, pd_quat d, double h)
+{
+    return quat(q.w + h * d.w, q.x + h * d.x, q.y + h * d.y, q.z + h * d.z);
+}
+
+static void rk4_rotate(const pd_body *b, pd_quat *q, pd_vec3 *w, double T, int nsteps)
+{
+    double h = T / nsteps;
+    for (int i = 0; i < nsteps; i++) {
+        pd_quat k1q, k2q, k3q, k4q;
+        pd_vec3 k1w, k2w, k3w, k4w;
+        rk4_deriv(b, *q, *w, &k1q, &k1w);
+        rk4_deriv(b, qax(*q, k1q, h / 2), v3_add(*w, v3_scale(k1w, h / 2)), &k2q, &k2w);
+        rk4_deriv(b, qax(*q, k2q, h / 2), v3_add(*w, v3_scale(k2w, h / 2)), &k3q, &k3w);
+        rk4_deriv(b, qax(*q, k3q, h), v3_add(*w, v3_scale(k3w, h)), &k4q, &k4w);
+        *q = quat_normalize(quat(
+            q->w + h / 6 * (k1q.w + 2 * k2q.w + 2 * k3q.w + k4q.w),
+            q->x + h / 6 * (k1q.x + 2 * k2q.x + 2 * k3q.x + k4q.x),
+            q->y + h / 6 * (k1q.y + 2 * k2q.y + 2 * k3q.y + k4q.y),
+            q->z + h / 6 * (k1q.z + 2 * k2q.z + 2 * k3q.z + k4q.z)));
+        *w = v3_add(*w, v3_scale(v3_add(v3_add(k1w, v3_scale(k2w, 2)),
+                                        v3_add(v3_scale(k3w, 2), k4w)), h / 6));
+    }
+}
+
+/* Rotation distance between two orientations, radians. */
+static double quat_angle(pd_quat a, pd_quat b)
+{
+    pd_quat d = quat_mul(quat_conj(a), b);
+    return 2.0 * atan2(sqrt(d.x * d.x + d.y * d.y + d.z * d.z), fabs(d.w));
+}
+
+static void test_eigen(void)
+{
+    /* Box a x b x c: I = V/12 diag(b^2+c^2, a^2+c^2, a^2+b^2). */
+    pd_part *p = part_of_mesh(mesh_box(1.0, 2.0, 3.0));
+    pd_body *b = p ? body_of(p) : NULL;
+    if (b) {
+        CHECK_REL(b->mass, 6.0, 1e-14, "closed form, round-off");
+        CHECK_REL(b->moment[0], 6.0 / 12.0 * (1.0 + 4.0), 1e-13, "closed form, round-off");
+        CHECK_REL(b->moment[1], 6.0 / 12.0 * (1.0 + 9.0), 1e-13, "closed form, round-off");
+        CHECK_REL(b->moment[2], 6.0 / 12.0 * (4.0 + 9.0), 1e-13, "closed form, round-off");
+        double rmax = 0.5 * sqrt(14.0);
+        CHECK_REL(b->rmax, rmax, 1e-14, "half diagonal, round-off");
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+
+    /* Random rotated tensors: R diag R^T reproduces A, eigenvalues match. */
+    test_rng r = {7};
+    double worst_rec = 0.0, worst_eig = 0.0, worst_orth = 0.0;
+    for (int trial = 0; trial < 200; trial++) {
+        double R[3][3], d[3] = {rng_range(&r, 0.1, 3), rng_range(&r, 0.1, 3), rng_range(&r, 0.1, 3)};
+        if (trial % 3 == 0)
+            d[1] = d[0]; /* repeated eigenvalue */
+        rng_rotation(&r, R);
+        double A[3][3], eval[3], V[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++) {
+                A[i][j] = 0.0;
+                for (int k = 0; k < 3; k++)
+                    A[i][j] += R[i][k] * d[k] * R[j][k];
+            }
+        pd_sym_eigen3(CONST_M3(A), eval, V);
+        double ds[3] = {d[0], d[1], d[2]};
+        for (int i = 0; i < 3; i++)
+            for (int j = i + 1; j < 3; j++)
+                if (ds[j] < ds[i]) {
+                    double t = ds[i];
+                    ds[i] = ds[j];
+                    ds[j] = t;
+                }
+        for (int i = 0; i < 3; i++) {
+            double e = fabs(eval[i] - ds[i]) / ds[2];
+            worst_eig = e > worst_eig ? e : worst_eig;
+            for (int j = 0; j < 3; j++) {
+                double a = 0.0, o = 0.0;
+                for (int k = 0; k < 3; k++) {
+                    a += V[i][k] * eval[k] * V[j][k];
+                    o += V[k][i] * V[k][j];
+                }
+                a = fabs(a - A[i][j]) / ds[2];
+                o = fabs(o - (i == j));
+                worst_rec = a > worst_rec ? a : worst_rec;
+                worst_orth = o > worst_orth ? o : worst_orth;
+            }
+        }
+    }
+    CHECK_NEAR(worst_eig, 0.0, 1e-14, "eigenvalues vs construction, round-off");
+    CHECK_NEAR(worst_rec, 0.0, 1e-12, "V diag V^T = A relative to |A|, round-off");
+    CHECK_NEAR(worst_orth, 0.0, 1e-14, "V^T V = 1, round-off");
+}
+
+static pd_state state_at(pd_vec3 x, pd_quat q, pd_vec3 v, pd_vec3 w)
+{
+    pd_state s = {x, q, v, w};
+    return s;
+}
+
+static void check_conservation(const pd_body *b, pd_state s0, double T, const char *what)
+{
+    pd_flight f;
+    CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
+    pd_vec3 L0 = world_L(b, &s0);
+    double E0 = energy(b, &s0), worstE = 0.0, worstL = 0.0;
+    int failed = 0;
+    for (int i = 1; i <= 200; i++) {
+        pd_state s;
+        failed += pd_flight_eval(&f, T * i / 200, &s) != PD_OK;
+        double eE = fabs(energy(b, &s) - E0) / E0;
+        double eL = v3_dist(world_L(b, &s), L0) / v3_norm(L0);
+        worstE = eE > worstE ? eE : worstE;
+        worstL = eL > worstL ? eL : worstL;
+    }
+    CHECK_INT(failed, 0);
+    if (worstE > 1e-10 || worstL > 1e-10)
+        printf("     %s\n", what);
+    CHECK_NEAR(worstE, 0.0, 1e-10, "energy conservation, requirement");
+    CHECK_NEAR(worstL, 0.0, 1e-10, "world angular momentum conservation, requirement");
+}
+
+/* Closed form against fine RK4 after T: RK4 at h = 1e-5 s and |w| h <= 5e-4
+ * has global error ~ (w h)^4 w T ~ 1e-12; 1e-8 rad leaves room. */
+static void check_vs_rk4(const pd_body *b, pd_state s0, double T)
+{
+    pd_flight f;
+    pd_state s;
+    CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
+    CHECK_STATUS(pd_flight_eval(&f, T, &s), PD_OK);
+    pd_quat q = s0.q;
+    pd_vec3 w = s0.w;
+    rk4_rotate(b, &q, &w, T, (int)(T / 1e-5));
+    CHECK_NEAR(quat_angle(q, s.q), 0.0, 1e-8, "RK4 reference, h = 1e-5 s");
+    CHECK_NEAR(v3_dist(w, s.w) / v3_norm(w), 0.0, 1e-8, "RK4 reference, h = 1e-5 s");
+}
+
+static void test_flight(void)
+{
+    pd_part *p = part_of_mesh(mesh_box(0.01, 0.02, 0.03));
+    pd_body *b = p ? body_of(p) : NULL;
+    if (!b) {
+        pd_part_free(p);
+        return;
+    }
+    /* Ballistic com: exact closed form (the same expression up to round-off). */
+    pd_state s0 = state_at(v3(0.1, -0.2, 0.3), quat_identity(), v3(0.5, 0.25, 1.0), v3(0, 0, 0));
+    pd_state s;
+    CHECK_STATUS(pd_flight_advance(b, &(pd_state){s0.x, s0.q, s0.v, s0.w}, G, 0.2), PD_OK);
+    pd_flight f;
+    CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
+    CHECK_STATUS(pd_flight_eval(&f, 0.2, &s), PD_OK);
+    CHECK_NEAR(s.x.x, 0.1 + 0.5 * 0.2, 1e-16, "x + v t, round-off");
+    CHECK_NEAR(s.x.z, 0.3 + 0.2 - 0.5 * G * 0.04, 1e-16, "x + v t - g t^2/2, round-off");
+    CHECK_NEAR(s.v.z, 1.0 - G * 0.2, 1e-15, "v - g t, round-off");
+
+    /* Asymmetric 1:2:3 box, random omega up to 50 rad/s, 2 s. */
+    test_rng r = {11};
+    for (int i = 0; i < 6; i++) {
+        pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 5.0, 50.0));
+        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
+                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        check_conservation(b, state_at(v3(0, 0, 1), q, v3(0, 0, 0), w), 2.0, "random omega");
+        if (i < 2)
+            check_vs_rk4(b, state_at(v3(0, 0, 1), q, v3(0, 0, 0), v3_scale(w, 0.2)), 0.5);
+    }
+    /* Near the unstable middle axis: the tennis-racket flip. omega mostly
+     * along axis 2 with a 1e-3 perturbation: omega_2 reverses within 2 s. */
+    pd_state sr = state_at(v3(0, 0, 1), quat_identity(), v3(0, 0, 0), v3(1e-2, 20.0, 1e-2));
+    check_conservation(b, sr, 2.0, "middle axis");
+    check_vs_rk4(b, sr, 1.0);
+    CHECK_STATUS(pd_flight_plan(b, &sr, G, &f), PD_OK);
+    double wmin = 1e300;
+    for (int i = 1; i <= 400; i++) {
+        CHECK_STATUS(pd_flight_eval(&f, 2.0 * i / 400, &s), PD_OK);
+        wmin = s.w.y < wmin ? s.w.y : wmin;
+    }
+    CHECK(wmin < -19.0); /* flipped: omega_2 near -20 (energy closed form) */
+    /* Exactly on the principal axes: steady spins, also the unstable one. */
+    for (int a = 0; a < 3; a++) {
+        pd_vec3 w = v3(a == 0 ? 30.0 : 0.0, a == 1 ? 30.0 : 0.0, a == 2 ? 30.0 : 0.0);
+        CHECK_STATUS(pd_flight_advance(b, &(pd_state){v3(0, 0, 0), quat_identity(), v3(0, 0, 0), w},
+                                       G, 2.0), PD_OK);
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+
+    /* Symmetric top (1 x 1 x 3 box: I1 = I2 < I3... no: I1 = I2 > I3). The
+     * symmetry axis precesses about L at |L| / I1 (closed form, Landau sec. 33). */
+    p = part_of_mesh(mesh_box(0.01, 0.01, 0.03));
+    b = p ? body_of(p) : NULL;
+    if (b) {
+        int d = b->moment[0] == b->moment[1] ? 2 : 0;
+        CHECK(b->moment[0] == b->moment[1] || b->moment[1] == b->moment[2]);
+        pd_vec3 ax = d == 2 ? v3(0, 0, 1) : v3(1, 0, 0);
+        pd_state st = state_at(v3(0, 0, 0), quat_identity(), v3(0, 0, 0), v3(3.0, 1.0, 7.0));
+        check_conservation(b, st, 2.0, "symmetric top");
+        check_vs_rk4(b, st, 0.5);
+        CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
+        pd_vec3 L = world_L(b, &st), lh = v3_unit(L);
+        double Ieq = b->moment[d == 2 ? 0 : 2];
+        double rate = v3_norm(L) / Ieq, T = 0.3;
+        CHECK_STATUS(pd_flight_eval(&f, T, &s), PD_OK);
+        /* Angle swept by the symmetry axis about L, projected on L's plane. */
+        pd_vec3 a0 = v3_sub(ax, v3_scale(lh, v3_dot(ax, lh)));
+        pd_vec3 a1w = quat_rotate(s.q, ax);
+        pd_vec3 a1 = v3_sub(a1w, v3_scale(lh, v3_dot(a1w, lh)));
+        double ang = atan2(v3_dot(v3_cross(a0, a1), lh), v3_dot(a0, a1));
+        double want = remainder(rate * T, 2.0 * 3.14159265358979323846);
+        CHECK_NEAR(ang, want, 1e-12, "precession |L|/I1, closed form, round-off");
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+
+    /* Spherical top (cube): omega constant, q = q0 exp(w t). */
+    p = part_of_mesh(mesh_box(0.02, 0.02, 0.02));
+    b = p ? body_of(p) : NULL;
+    if (b) {
+        CHECK(b->moment[0] == b->moment[2]);
+        pd_vec3 w = v3(3.0, -4.0, 12.0);
+        pd_state st = state_at(v3(0, 0, 0), quat_axis_angle(v3(0, 1, 0), 0.3), v3(0, 0, 0), w);
+        CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
+        CHECK_STATUS(pd_flight_eval(&f, 1.7, &s), PD_OK);
+        CHECK_NEAR(v3_dist(s.w, w), 0.0, 1e-13, "constant omega, round-off");
+        CHECK_NEAR(quat_angle(s.q, quat_mul(st.q, quat_exp(v3_scale(w, 1.7)))), 0.0, 1e-13,
+                   "q0 exp(w t), round-off");
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+}
+
+/* Lowest vertex height by scanning: the oracle for the impact tests. */
+static double scan_height(const pd_body *b, const pd_flight *f, double t)
+{
+    pd_state s;
+    pd_flight_eval(f, t, &s);
+    double h = 1e300;
+    for (int i = 0; i < b->nverts; i++) {
+        double z = pd_body_vertex_world(b, &s, i).z;
+        h = z < h ? z : h;
+    }
+    return h;
+}
+
+static void test_impact(void)
+{
+    pd_part *p = part_of_mesh(mesh_box(0.01, 0.02, 0.03));
+    pd_body *b = p ? body_of(p) : NULL;
+    if (!b) {
+        pd_part_free(p);
+        return;
+    }
+    double L = b->size, tol = PD_TOL_IMPACT_REL * L;
+    int contacts[16];
+    pd_impact imp;
+    pd_flight f;
+    /* Flat drop: body axis 3 (largest moment, the 0.03 edge... principal
+     * frame) along world z, so a face is horizontal; lowest face at height h. */
+    double hz = fabs(b->verts[pd_body_support_scan(b, v3(0, 0, 1))].z);
+    double h = 0.12;
+    pd_state s0 = {v3(0.0, 0.0, h + hz), quat_identity(), v3(0.05, 0, 0), v3(0, 0, 0)};
+    CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+    CHECK_INT(imp.kind, PD_IMPACT_AT);
+    double tf = sqrt(2.0 * h / G);
+    CHECK_NEAR(imp.t, tf, tol / (G * tf) + 1e-15, "sqrt(2h/g) to the height tolerance / speed");
+    CHECK(imp.t <= tf + 1e-15);
+    CHECK_INT(imp.ncontacts, 4);
+    CHECK(imp.steps <= 3);
+
+    /* Resting on the floor: in contact now. */
+    pd_state rest = {v3(0.0, 0.0, hz), quat_identity(), v3(0, 0, 0), v3(0, 0, 0)};
+    CHECK_STATUS(pd_flight_plan(b, &rest, G, &f), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+    CHECK_INT(imp.kind, PD_IMPACT_NOW);
+    CHECK_INT(imp.ncontacts, 4);
+    /* t_max before the fall ends: no impact. */
+    CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 0.5 * tf, contacts, 16, &imp), PD_OK);
+    CHECK_INT(imp.kind, PD_IMPACT_NONE);
+
+    /* Spinning drops against a fine time scan (dt = 1e-5 s): the search is
+     * never later than the first scanned sample below -tol, and at its time
+     * the lowest vertex is within tol of the floor. */
+    test_rng r = {5};
+    for (int trial = 0; trial < 20; trial++) {
+        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
+                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 5.0, 50.0));
+        pd_state st = {v3(0, 0, rng_range(&r, 0.03, 0.15)), q, v3(0.05, 0, rng_range(&r, -0.5, 0.5)), w};
+        CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+        CHECK_INT(imp.kind, PD_IMPACT_AT);
+        CHECK_NEAR(scan_height(b, &f, imp.t), 0.0, tol, "impact tolerance");
+        double first = 1.0;
+        for (double t = 0.0; t < 1.0; t += 1e-5)
+            if (scan_height(b, &f, t) < -tol) {
+                first = t;
+                break;
+            }
+        CHECK(imp.t <= first);
+        CHECK(imp.t > first - 2e-5 * 10); /* and not early: within a few scan steps */
+    }
+
+    /* Grazing: no gravity, no translation; a corner spinning about a
+     * horizontal axis dips 1e-4 L below the floor and comes back. The search
+     * must find the dip, at the time the scan sees it. */
+    {
+        pd_vec3 w = v3(0.0, 0.0, 10.0); /* about body axis 3, largest moment */
+        pd_quat q = quat_axis_angle(v3(1, 0, 0), 0.5 * 3.14159265358979323846); /* body z -> world -y */
+        pd_state st = {v3(0, 0, 0), q, v3(0, 0, 0), w};
+        CHECK_STATUS(pd_flight_plan(b, &st, 0.0, &f), PD_OK);
+        double lo = 1e300;
+        for (double t = 0.0; t < 0.7; t += 1e-4) {
+            double z = scan_height(b, &f, t);
+            lo = z < lo ? z : lo;
+        }
+        /* Place the com so that the deepest point is 1e-4 L below the floor. */
+        st.x.z = -lo - 1e-4 * L;
+        st.q = quat_mul(quat_axis_angle(v3(1, 0, 0), 0.0), st.q);
+        CHECK_STATUS(pd_flight_plan(b, &st, 0.0, &f), PD_OK);
+        if (scan_height(b, &f, 0.0) > tol) {
+            CHECK_STATUS(pd_flight_impact(b, &f, 0.7, contacts, 16, &imp), PD_OK);
+            CHECK_INT(imp.kind, PD_IMPACT_AT);
+            double first = 0.7;
+            for (double t = 0.0; t < 0.7; t += 1e-6)
+                if (scan_height(b, &f, t) < 0.0) {
+                    first = t;
+                    break;
+                }
+            CHECK(imp.t <= first);
+            CHECK_NEAR(imp.t, first, 2e-6, "scan step 1e-6 s");
+        }
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+}
+
+static void test_support(void)
+{
+    enum { N = 1000 };
+    pd_vec3 *pts = malloc(sizeof *pts * N);
+    test_rng r = {3};
+    for (int i = 0; i < N; i++) {
+        pd_vec3 u = rng_unit_vector(&r);
+        pts[i] = v3(0.03 * u.x, 0.02 * u.y, 0.01 * u.z);
+    }
+    pd_hull *h = NULL;
+    CHECK_STATUS(pd_hull_build(pts, N, &h, NULL), PD_OK);
+    pd_part *p = h ? part_of_mesh(mesh_of_hull(h)) : NULL;
+    pd_body *b = p ? body_of(p) : NULL;
+    if (b) {
+        CHECK(b->nverts > 900);
+        int hint = 0, bad = 0;
+        double worst = 0.0;
+        for (int i = 0; i < 2000; i++) {
+            pd_vec3 d = rng_unit_vector(&r);
+            hint = i % 2 ? hint : (int)(rng_next(&r) % (uint64_t)b->nverts);
+            hint = pd_body_support(b, d, hint);
+            int ref = pd_body_support_scan(b, d);
+            double e = v3_dot(d, b->verts[hint]) - v3_dot(d, b->verts[ref]);
+            worst = e > worst ? e : worst;
+            bad += e > 1e-15 * b->size;
+        }
+        CHECK_NEAR(worst / b->size, 0.0, 1e-15, "hill-climb = scan, round-off");
+        CHECK_INT(bad, 0);
+    }
+    pd_body_free(b);
+    pd_part_free(p);
+    pd_hull_free(h);
+    free(pts);
+}
+
+void suite_flight(void)
+{
+    test_eigen();
+    test_flight();
+    test_impact();
+    test_support();
+}
