@@ -142,6 +142,59 @@
  * other. */
 #define PD_TOL_WINDING 0.25
 
+/* --- collisions (src/impact.c) ---------------------------------------------- *
+ * A collision is solved in units where |u0| = 1 (u0 the pre-impact contact
+ * velocity) and K's mean diagonal is 1, so these are relative to |u0| and the
+ * law stays homogeneous: scaling u0, the masses or the part changes no
+ * decision taken here. */
+
+/* Local error per step asked of the sliding ODE (eq. 14 of the paper), both
+ * absolute (in units of |u0|/K and |u0|^2/K) and relative. Why 1e-11: the
+ * accumulated error over the ~10-30 steps of a collision stays near 1e-10 of
+ * the impulse, far below what any drop statistic can see, while rk8pd still
+ * takes big steps (its cost grows only as tol^(-1/8)). Larger: energy
+ * bookkeeping under the energetic law (which must never gain) and the
+ * homogeneity of the law degrade in step with it, at 1e-6 a "no energy
+ * gain" check needs a 1e-6 allowance. Smaller: below ~1e-13 the controller
+ * chases round-off of p (1e-16 times the condition number of K, up to 1e6)
+ * and steps shrink for nothing. */
+#define PD_TOL_IMPACT_ODE_REL 1e-11
+
+/* Event location: sticking is declared when the tangential contact speed
+ * falls to this fraction of |u0|; maximum compression and the end of an
+ * energetic restitution when the normal velocity (resp. the normal work) is
+ * within this fraction of |u0.z| (resp. of the compression work). Normal
+ * events are relative to |u0.z|, not |u0|, so a grazing impact (|u0.z| =
+ * 1e-12 |u0|) still rebounds with -e u0.z to this relative accuracy instead of
+ * ending with the contact still approaching. Why 1e-9: the events are located
+ * by Newton steps of the integrator, which converge quadratically, so the
+ * cost does not depend on it; it sits two orders above the ODE tolerance so
+ * that integration error cannot fake or hide an event. Larger: a part
+ * declared stuck at 1e-6 |u0| keeps that slip in its state and the impulse
+ * carries a 1e-6 relative error. Smaller: within ~100x of PD_TOL_IMPACT_ODE_REL
+ * the integration noise decides whether a near-miss of the origin sticks. */
+#define PD_TOL_IMPACT_EVENT_REL 1e-9
+
+/* Largest number of integrator steps (accepted or refused for an event) one
+ * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: a collision
+ * takes 5-40 (measured on 1e5 random impacts, worst seen below 100): ~10
+ * smooth steps per phase and ~3-6 Newton steps to land on each of at most
+ * three events (sticking, compression, energetic end). 1000 bounds the cost
+ * of a pathological one to ~100 us, while a real one is never stopped. */
+#define PD_IMPACT_MAX_STEPS 1000
+
+/* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
+ * exceeds this fraction of |p| |u0| (the size of the work terms it is a sum
+ * of). Why 1e-8: the energetic law's own bookkeeping error is the ODE error
+ * (~1e-10); Poisson's genuine gains in 3-D are percent-level. Larger would
+ * hide small genuine gains, smaller would flag integration noise. */
+#define PD_TOL_IMPACT_ENERGY_REL 1e-8
+
+/* K must be symmetric to this fraction of its largest entry: it is assembled
+ * from products of exact quantities, so asymmetry beyond round-off (1e-16)
+ * means a caller's bug, e.g. a transposed inertia. */
+#define PD_TOL_IMPACT_K_SYM_REL 1e-12
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked
