@@ -9,6 +9,7 @@
     PD_SUITE(mass)   \
     PD_SUITE(part)   \
     PD_SUITE(static) \
+    PD_SUITE(impact) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);
