@@ -445,6 +445,10 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: %s: %ld collisions would have added kinetic energy under Poisson's "
                         "law and were resolved by the energetic law\n", prog, a->path,
                 sim->energy_gain);
+    if (sim->fallbacks)
+        fprintf(stderr, "%s: %s: %ld of %ld collisions could not be integrated to the end and "
+                        "were resolved by stopping the contact within the friction cone\n", prog,
+                a->path, sim->fallbacks, sim->collisions);
     if (sim->bootstrap_rounds)
         fprintf(stderr, "%s: %s: bootstrap: %d rounds; the last round ended %.3g (total "
                         "variation) from the distribution it started from%s\n", prog, a->path,

@@ -85,7 +85,7 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, i
         r.kind = PD_IMPACT_NOW;
     } else {
         for (;;) {
-            if (r.steps++ >= PD_IMPACT_MAX_STEPS)
+            if (r.steps++ >= PD_CONTACT_MAX_STEPS)
                 return PD_ERR_NO_CONVERGENCE;
             double vz = f->s0.v.z - f->g * t;
             double c = (vz < 0.0 ? -vz : 0.0) + W;

@@ -24,9 +24,10 @@ void pd_drop_work_free(pd_drop_work *work);
  * comes from that stream. init_cdf (nposes cumulative probabilities) makes it
  * start resting on a pose drawn from it, turned at random about the vertical
  * (the paper's bootstrap); NULL starts from a uniform orientation. *energy_gain
- * counts collisions that would have added energy. */
+ * counts collisions that would have added energy, *fallbacks those the sliding
+ * integrator could not finish (both resolved otherwise, see drop.c). */
 void pd_drop_run(const pd_sim_model *model, pd_drop_work *work, const pd_scene *scene,
                  const pd_sim_options *options, long index, const double *init_cdf,
-                 pd_trial *out, long *energy_gain);
+                 pd_trial *out, long *energy_gain, long *fallbacks);
 
 #endif

@@ -77,7 +77,7 @@ typedef struct pd_impact {
  * contact that dips below the floor by more than the tolerance between
  * samples cannot be stepped over: see flight.c). contacts (capacity ncap, may
  * be NULL with ncap 0) receives the touching vertices, the lowest first.
- * PD_ERR_USAGE, PD_ERR_NO_CONVERGENCE (PD_IMPACT_MAX_STEPS), PD_ERR_NONFINITE. */
+ * PD_ERR_USAGE, PD_ERR_NO_CONVERGENCE (PD_CONTACT_MAX_STEPS), PD_ERR_NONFINITE. */
 pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, int *contacts,
                            int ncap, pd_impact *out);
 

@@ -21,7 +21,7 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
 double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
 
-/* ==== Elliptic functions (flight: torque-free rotation) ======================
+/* ==== Elliptic functions (flight: torque-free rotation) ===============
  * Thin wrappers on GSL's special functions, error handler off, GSL status
  * turned into PD_ERR_NONFINITE (a domain error can only come from a bad
  * argument). k is the modulus, m = k^2 the parameter, as in GSL. */
@@ -39,5 +39,32 @@ pd_status pd_ellint_P(double phi, double k, double n, double *result);
 pd_status pd_ellint_Kcomp(double k, double *result);
 pd_status pd_ellint_Pcomp(double k, double n, double *result);
 /* ==== end of elliptic functions ============================================= */
+/* --- ODE integration (used by impact.c) -------------------------------------
+ * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand
+ * 8(9), with step control on |y|), allocated once and reused: pd_ode_step
+ * allocates nothing, so a per-thread workspace can serve every collision. */
+
+typedef struct pd_ode pd_ode;
+
+/* Right-hand side dy/dt = f(t, y); returns 0 (any other value aborts the
+ * step and pd_ode_step reports PD_ERR_INTERNAL). Same shape as GSL's, so it
+ * is handed to GSL without a trampoline. */
+typedef int (*pd_ode_fn)(double t, const double y[], double dydt[], void *user);
+
+/* An integrator for systems of dim unknowns, each step held to
+ * eps_abs + eps_rel * |y_i| local error. NULL if allocation fails. */
+pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel);
+void pd_ode_free(pd_ode *ode);
+
+/* Forgets the history of the previous integration (call before a new one). */
+void pd_ode_reset(pd_ode *ode);
+
+/* One accepted adaptive step from (*t, y) towards t1 > *t, never past t1
+ * (landing exactly on t1 when it reaches it). *h is the step to try, updated
+ * to the one suggested for the next step. PD_ERR_NO_CONVERGENCE when the step
+ * size falls to round-off of t, PD_ERR_INTERNAL when fn fails; on failure
+ * (*t, y) are those of the start of the step. */
+pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
+                      double y[]);
 
 #endif

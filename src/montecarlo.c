@@ -62,6 +62,7 @@ typedef struct batch {
     pd_trial *out;          /* out[i - first] */
     atomic_long next;
     atomic_long energy_gain;
+    atomic_long fallbacks;
     atomic_int failed;      /* a thread could not get its work area */
 } batch;
 
@@ -75,14 +76,16 @@ static void *worker(void *arg)
         atomic_store(&b->failed, 1);
         return NULL;
     }
-    long gain = 0;
+    long gain = 0, fallbacks = 0;
     for (;;) {
         long i = atomic_fetch_add(&b->next, 1);
         if (i >= b->last || cancelled(b->opt))
             break;
-        pd_drop_run(b->model, w, b->scene, b->opt, i, b->init_cdf, &b->out[i - b->first], &gain);
+        pd_drop_run(b->model, w, b->scene, b->opt, i, b->init_cdf, &b->out[i - b->first], &gain,
+                    &fallbacks);
     }
     atomic_fetch_add(&b->energy_gain, gain);
+    atomic_fetch_add(&b->fallbacks, fallbacks);
     pd_drop_work_free(w);
     return NULL;
 }
@@ -90,10 +93,11 @@ static void *worker(void *arg)
 /* Runs drops [first, last) into out; returns the number completed in index
  * order before any cancellation (a cancelled batch keeps its prefix only, so
  * that a partial result is still the first n drops of the run). */
-static long run_batch(batch *b, int nthreads, long *energy_gain)
+static long run_batch(batch *b, int nthreads, pd_sim_result *r)
 {
     atomic_store(&b->next, b->first);
     atomic_store(&b->energy_gain, 0);
+    atomic_store(&b->fallbacks, 0);
     atomic_store(&b->failed, 0);
     for (long i = 0; i < b->last - b->first; i++)
         b->out[i].end = (pd_drop_end)-1; /* not run */
@@ -105,7 +109,8 @@ static long run_batch(batch *b, int nthreads, long *energy_gain)
     worker(b); /* the calling thread works too */
     for (int t = 0; t < started; t++)
         pthread_join(tid[t], NULL);
-    *energy_gain += atomic_load(&b->energy_gain);
+    r->energy_gain += atomic_load(&b->energy_gain);
+    r->fallbacks += atomic_load(&b->fallbacks);
     long done = 0;
     while (b->first + done < b->last && (int)b->out[done].end >= 0)
         done++;
@@ -212,7 +217,7 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
         batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .first = r->n,
                    .last = r->n + size, .out = buf};
         memcpy(before, r->count, sizeof *before * (size_t)r->nposes);
-        long done = run_batch(&b, nthreads, &r->energy_gain);
+        long done = run_batch(&b, nthreads, r);
         if (done < 0) {
             st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for a thread's work area");
             break;

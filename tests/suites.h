@@ -14,6 +14,7 @@
     PD_SUITE(stats)  \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
+    PD_SUITE(impact) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

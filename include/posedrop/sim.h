@@ -99,6 +99,9 @@ typedef struct pd_sim_result {
     long energy_gain;       /* collisions that would have added kinetic energy
                                (Poisson with friction) and were resolved with the
                                energetic law instead */
+    long fallbacks;         /* collisions whose sliding integration could not
+                               finish (a stiff approach to sticking), resolved
+                               by stopping the contact within the friction cone */
     long collisions;        /* over all drops */
     int partial;            /* 1 if cancelled before the requested drops ran */
     int bootstrap_rounds;   /* rounds run (PD_INITIAL_BOOTSTRAP) */

@@ -182,7 +182,84 @@
  * rotation bound exceeds its approach speed a hundredfold needs ~100 ln(1e9)
  * ~ 2000 steps to converge to PD_TOL_IMPACT_REL. 100000 is far above any
  * genuine search and still stops a runaway (NaN-free but stuck) state fast. */
-#define PD_IMPACT_MAX_STEPS 100000
+#define PD_CONTACT_MAX_STEPS 100000
+
+/* A contact approaching slower than this times sqrt(g L) (the speed of
+ * falling the part's own size) is resting, not colliding: the drop lets it
+ * fall the contact tolerance and meet the floor as a microcollision. Why
+ * 1e-9: velocities after a resolved collision carry round-off of ~1e-16 of
+ * the speeds involved (up to ~10 sqrt(g L) for the paper's drops), so 1e-9
+ * is far above it; a genuine impact after falling even PD_TOL_IMPACT_REL * L
+ * arrives at sqrt(2e-9) ~ 4e-5 sqrt(g L), far above the threshold. Larger:
+ * slow genuine impacts would be ignored; smaller: a contact just resolved
+ * would be "hit" again by its own round-off. */
+#define PD_TOL_APPROACH_REL 1e-9
+
+/* Resting contact is simulated as microcollisions: a vertex pressed on the
+ * floor falls this far (times L), meets it at the speed of that fall and is
+ * stopped dead (e = 0: a resting contact does not bounce, and the Zeno cascade
+ * of ever smaller bounces that e > 0 would start is skipped). Why 1e-4: the
+ * cost of rolling and rocking contact is one collision per fall, so it scales
+ * as 1/sqrt(this) (1e-6 made a 32-gon cap take 5000 collisions a drop); the
+ * part then sinks at most 1e-4 L, an orientation error below 1e-4 rad, and
+ * the energy test adds this depth to the energy so its verdict stays
+ * rigorous. Larger: contact geometry visibly wrong (1e-2 L is a 0.6 deg
+ * tilt); smaller: slower, no more accurate than the mesh itself. */
+#define PD_TOL_REST_FALL_REL 1e-4
+
+/* --- collisions (src/impact.c) ---------------------------------------------- *
+ * A collision is solved in units where |u0| = 1 (u0 the pre-impact contact
+ * velocity) and K's mean diagonal is 1, so these are relative to |u0| and the
+ * law stays homogeneous: scaling u0, the masses or the part changes no
+ * decision taken here. */
+
+/* Local error per step asked of the sliding ODE (eq. 14 of the paper), both
+ * absolute (in units of |u0|/K and |u0|^2/K) and relative. Why 1e-11: the
+ * accumulated error over the ~10-30 steps of a collision stays near 1e-10 of
+ * the impulse, far below what any drop statistic can see, while rk8pd still
+ * takes big steps (its cost grows only as tol^(-1/8)). Larger: energy
+ * bookkeeping under the energetic law (which must never gain) and the
+ * homogeneity of the law degrade in step with it, at 1e-6 a "no energy
+ * gain" check needs a 1e-6 allowance. Smaller: below ~1e-13 the controller
+ * chases round-off of p (1e-16 times the condition number of K, up to 1e6)
+ * and steps shrink for nothing. */
+#define PD_TOL_IMPACT_ODE_REL 1e-11
+
+/* Event location: sticking is declared when the tangential contact speed
+ * falls to this fraction of |u0|; maximum compression and the end of an
+ * energetic restitution when the normal velocity (resp. the normal work) is
+ * within this fraction of |u0.z| (resp. of the compression work). Normal
+ * events are relative to |u0.z|, not |u0|, so a grazing impact (|u0.z| =
+ * 1e-12 |u0|) still rebounds with -e u0.z to this relative accuracy instead of
+ * ending with the contact still approaching. Why 1e-9: the events are located
+ * by Newton steps of the integrator, which converge quadratically, so the
+ * cost does not depend on it; it sits two orders above the ODE tolerance so
+ * that integration error cannot fake or hide an event. Larger: a part
+ * declared stuck at 1e-6 |u0| keeps that slip in its state and the impulse
+ * carries a 1e-6 relative error. Smaller: within ~100x of PD_TOL_IMPACT_ODE_REL
+ * the integration noise decides whether a near-miss of the origin sticks. */
+#define PD_TOL_IMPACT_EVENT_REL 1e-9
+
+/* Largest number of integrator steps (accepted or refused for an event) one
+ * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: measured on
+ * 2e5 random impacts, the mean is ~20 steps and the worst 388; one impact in
+ * 1e5 (a stable stick approached along a slowly closing invariant ray, which
+ * is stiff for an explicit integrator) exceeds 1000. 1000 bounds the cost of
+ * such a collision to ~1 ms; larger buys that rare case at a high price.
+ * Snapping onto incoming rays as onto the diverging one would remove it. */
+#define PD_IMPACT_MAX_STEPS 1000
+
+/* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
+ * exceeds this fraction of |p| |u0| (the size of the work terms it is a sum
+ * of). Why 1e-8: the energetic law's own bookkeeping error is the ODE error
+ * (~1e-10); Poisson's genuine gains in 3-D are percent-level. Larger would
+ * hide small genuine gains, smaller would flag integration noise. */
+#define PD_TOL_IMPACT_ENERGY_REL 1e-8
+
+/* K must be symmetric to this fraction of its largest entry: it is assembled
+ * from products of exact quantities, so asymmetry beyond round-off (1e-16)
+ * means a caller's bug, e.g. a transposed inertia. */
+#define PD_TOL_IMPACT_K_SYM_REL 1e-12
 
 /* --- limits ---------------------------------------------------------------- */
 

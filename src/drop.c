@@ -1,0 +1,390 @@
+/* drop.c: one simulated drop (paper, section 5), from release to the moment
+ * its outcome can no longer change.
+ *
+ * Flight is closed form (flight.c) and the next impact is found by
+ * conservative advancement (contact_time.c), so there is no time step. Each
+ * impact is resolved by the frictional impulse law (impact.c). When several
+ * vertices touch at once (a face or an edge landing), the approaching ones are
+ * resolved as one collision at their centroid weighted by approach speed, and
+ * the set is checked again until no contact approaches: a face landing flat
+ * without spin gets the single impulse through its centre that Poisson's law
+ * gives a flat landing (rebound e times the approach speed, no spurious
+ * rotation), and uneven landings put the impulse nearer the faster contact,
+ * as a sequence of Mirtich's microcollisions would, in one step.
+ *
+ * A drop ends when its energy per unit weight (a height) falls below the
+ * barrier of the basin it is in (basin.c): then no future can leave the
+ * basin, so its stable pose is the outcome. That needs collisions that never
+ * add energy: a Poisson collision that would (possible with friction in 3-D)
+ * is redone by the energetic law, which cannot, and counted. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "basin.h"
+#include "body.h"
+#include "diag.h"
+#include "drop.h"
+#include "flight.h"
+#include "impact.h"
+#include "posedrop/tolerances.h"
+#include "rng.h"
+#include "static_internal.h"
+#include "vec3.h"
+
+/* Contacts considered at once, and resolution rounds per impact. A face of
+ * more corners than MAX_CONTACTS touching at once is resolved through the
+ * lowest MAX_CONTACTS of them, which the rounds then correct. */
+enum { MAX_CONTACTS = 64, MAX_ROUNDS = 64 };
+
+struct pd_sim_model {
+    pd_body *body;
+    const pd_hull *hull;        /* the part's hull, part frame */
+    pd_vec3 com;                /* part frame */
+    pd_static_result *descent;  /* the exact quasi-static rest[] of every facet */
+    double *barrier;            /* per facet: its basin's barrier height, m */
+    pd_star star;
+    int *pose_of;               /* facet -> pose index in the caller's table, or -1 */
+    const pd_static_result *poses;
+    double v_eps;               /* approach speeds below this are contact, not impact */
+    double rest_fall;           /* m: how far resting contact falls between microcollisions */
+    double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
+};
+
+struct pd_drop_work {
+    pd_impact_work *impact;
+    int contacts[MAX_CONTACTS];
+};
+
+void pd_sim_model_free(pd_sim_model *m)
+{
+    if (!m)
+        return;
+    pd_body_free(m->body);
+    pd_static_result_free(m->descent);
+    free(m->barrier);
+    pd_star_free(&m->star);
+    free(m->pose_of);
+    free(m);
+}
+
+pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
+                             const pd_scene *scene, pd_sim_model **model, pd_diag *diag)
+{
+    pd_sim_model *m = calloc(1, sizeof *m);
+    if (!m)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
+    m->hull = part->hull;
+    m->com = part->com;
+    m->poses = poses;
+    /* Basins follow the exact motion whatever rule the static table used;
+     * stability, hence the set of poses, is the same under both rules. */
+    pd_static_options so;
+    pd_static_options_default(&so);
+    so.topple = PD_TOPPLE_DESCENT;
+    so.epsilon = 0.0;
+    pd_status st = pd_body_build(part, &m->body, diag);
+    if (st == PD_OK)
+        st = pd_static_estimate(part, &so, &m->descent, diag);
+    if (st == PD_OK)
+        st = pd_star_build(part->hull, &m->star);
+    int nf = part->hull->nfacets;
+    if (st == PD_OK) {
+        m->barrier = malloc(sizeof *m->barrier * (size_t)nf);
+        m->pose_of = malloc(sizeof *m->pose_of * (size_t)nf);
+        if (!m->barrier || !m->pose_of)
+            st = PD_ERR_NOMEM;
+    }
+    if (st == PD_OK) {
+        pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
+        for (int f = 0; f < nf; f++)
+            m->pose_of[f] = -1;
+        for (int k = 0; k < poses->nposes; k++)
+            m->pose_of[poses->poses[k].facet] = k;
+        /* A speed scale of the part: sqrt(g L), the speed of falling its own
+         * size. Approaches slower by PD_TOL_APPROACH_REL are round-off of a
+         * resolved contact, not a new impact. */
+        m->v_eps = PD_TOL_APPROACH_REL * sqrt(scene->gravity * m->body->size);
+        /* A resting vertex meets the floor at the speed of falling rest_fall;
+         * twice that leaves room for what the part's rotation adds. */
+        m->rest_fall = PD_TOL_REST_FALL_REL * m->body->size;
+        m->v_rest = 2.0 * sqrt(2.0 * scene->gravity * m->rest_fall);
+    }
+    if (st != PD_OK) {
+        if (st == PD_ERR_NOMEM)
+            pd_fail(diag, st, "out of memory for the drop model");
+        pd_sim_model_free(m);
+        return st;
+    }
+    *model = m;
+    return PD_OK;
+}
+
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model)
+{
+    (void)model;
+    pd_drop_work *w = calloc(1, sizeof *w);
+    if (w && !(w->impact = pd_impact_work_alloc())) {
+        free(w);
+        w = NULL;
+    }
+    return w;
+}
+
+void pd_drop_work_free(pd_drop_work *w)
+{
+    if (!w)
+        return;
+    pd_impact_work_free(w->impact);
+    free(w);
+}
+
+/* --- initial state ----------------------------------------------------------- */
+
+/* The rotation turning unit vector a onto unit vector b by the shortest arc. */
+static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
+{
+    pd_vec3 axis = v3_cross(a, b);
+    double s = v3_norm(axis), c = v3_dot(a, b);
+    if (s < 1e-12 * (fabs(c) + 1.0)) { /* parallel or opposite */
+        if (c > 0.0)
+            return quat_identity();
+        pd_vec3 any = fabs(a.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
+        return quat_axis_angle(v3_unit(v3_cross(a, any)), M_PI);
+    }
+    return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
+}
+
+static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
+                          const double *init_cdf, pd_state *s, double q0[4])
+{
+    const pd_body *b = m->body;
+    pd_quat q;
+    if (init_cdf) {
+        /* The paper's belt: resting on a pose drawn from the estimate, turned
+         * at random about the vertical. */
+        double u = pd_rng_uniform(rng);
+        int k = 0;
+        while (k + 1 < m->poses->nposes && u >= init_cdf[k])
+            k++;
+        pd_vec3 n = quat_rotate_inv(b->frame, m->poses->poses[k].normal);
+        pd_quat down = quat_between(n, v3(0, 0, -1));
+        q = quat_mul(quat_axis_angle(v3(0, 0, 1), 2.0 * M_PI * pd_rng_uniform(rng)), down);
+    } else {
+        double r[4];
+        pd_rng_quaternion(rng, r);
+        q = quat(r[0], r[1], r[2], r[3]);
+    }
+    if (sc->vibration > 0.0) {
+        pd_vec3 axis = pd_rng_unit_vector(rng);
+        q = quat_mul(quat_axis_angle(axis, sc->vibration * pd_rng_uniform(rng)), q);
+    }
+    q = quat_normalize(q);
+    s->q = q;
+    s->x = v3(0, 0, 0);
+    s->v = v3(sc->belt_speed, 0, 0);
+    s->w = v3(0, 0, 0);
+    /* Lowest point at the drop height. */
+    int low = pd_body_support(b, quat_rotate_inv(q, v3(0, 0, 1)), 0);
+    s->x.z = sc->height - pd_body_vertex_world(b, s, low).z;
+    /* The orientation of the part's own (file) frame, for --trials. */
+    pd_quat qp = quat_mul(q, quat_conj(b->frame));
+    q0[0] = qp.w;
+    q0[1] = qp.x;
+    q0[2] = qp.y;
+    q0[3] = qp.z;
+}
+
+/* --- collisions ------------------------------------------------------------- */
+
+/* World inverse inertia R diag(1/I) R^T. */
+static void inv_inertia_world(const pd_body *b, pd_quat q, double J[3][3])
+{
+    double R[3][3];
+    quat_to_matrix(q, R);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double s = 0.0;
+            for (int k = 0; k < 3; k++)
+                s += R[i][k] * b->inv_moment[k] * R[j][k];
+            J[i][j] = s;
+        }
+}
+
+static pd_vec3 mat_vec(const double M[3][3], pd_vec3 v)
+{
+    return v3(M[0][0] * v.x + M[0][1] * v.y + M[0][2] * v.z,
+              M[1][0] * v.x + M[1][1] * v.y + M[1][2] * v.z,
+              M[2][0] * v.x + M[2][1] * v.y + M[2][2] * v.z);
+}
+
+/* Solves K p = b for symmetric positive definite K (Cramer's rule: K is
+ * 3 x 3 and well conditioned, its eigenvalues within a few units of 1/m). */
+static pd_vec3 solve3(const double K[3][3], pd_vec3 b)
+{
+    pd_vec3 c0 = v3(K[0][0], K[1][0], K[2][0]), c1 = v3(K[0][1], K[1][1], K[2][1]),
+            c2 = v3(K[0][2], K[1][2], K[2][2]);
+    double det = v3_dot(c0, v3_cross(c1, c2));
+    return v3(v3_dot(b, v3_cross(c1, c2)) / det, v3_dot(c0, v3_cross(b, c2)) / det,
+              v3_dot(c0, v3_cross(c1, b)) / det);
+}
+
+/* The impulse when the sliding integrator cannot finish (a slow approach to
+ * sticking makes eq. 14 stiff; impact.h): stop the contact dead (K p = -u0),
+ * which is inside the friction cone or is projected onto it along its own
+ * tangential direction, then apply restitution to the normal part only.
+ * Kinetic energy cannot rise: if the projection would make it, the normal
+ * inelastic impulse alone is used. Counted, never silent. */
+static pd_vec3 fallback_impulse(const double K[3][3], pd_vec3 u0, double mu, double e)
+{
+    pd_vec3 p = solve3(K, v3_neg(u0));
+    double pt = hypot(p.x, p.y);
+    if (pt > mu * p.z) {
+        double dx = pt > 0 ? p.x / pt : 0, dy = pt > 0 ? p.y / pt : 0;
+        pd_vec3 dir = v3(mu * dx, mu * dy, 1.0); /* on the cone, towards the stick impulse */
+        double kz = K[2][0] * dir.x + K[2][1] * dir.y + K[2][2];
+        p = v3_scale(dir, -u0.z / kz);
+    }
+    p.z *= 1.0 + e;
+    pd_vec3 u1 = v3_add(u0, v3(K[0][0] * p.x + K[0][1] * p.y + K[0][2] * p.z,
+                               K[1][0] * p.x + K[1][1] * p.y + K[1][2] * p.z,
+                               K[2][0] * p.x + K[2][1] * p.y + K[2][2] * p.z));
+    if (v3_dot(p, v3_add(u0, u1)) > 0.0)
+        p = v3(0, 0, -(1.0 + e) * u0.z / K[2][2]);
+    return p;
+}
+
+/* Resolves the touching vertices' collision; *impacts counts collisions
+ * applied, *gain those that Poisson would have made add energy, *fallbacks
+ * those resolved by fallback_impulse. */
+static pd_status resolve(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
+                         pd_state *s, int nc, int *impacts, long *gain, long *fallbacks)
+{
+    const pd_body *b = m->body;
+    double J[3][3];
+    inv_inertia_world(b, s->q, J);
+    pd_impact_law law = sc->law == PD_RESTITUTION_ENERGETIC ? PD_IMPACT_ENERGETIC : PD_IMPACT_POISSON;
+    for (int round = 0; round < MAX_ROUNDS; round++) {
+        pd_vec3 ww = quat_rotate(s->q, s->w), c = v3(0, 0, 0);
+        double wsum = 0.0;
+        for (int i = 0; i < nc; i++) {
+            pd_vec3 r = quat_rotate(s->q, b->verts[w->contacts[i]]);
+            double uz = s->v.z + v3_cross(ww, r).z;
+            if (uz < -m->v_eps) {
+                c = v3_add(c, v3_scale(r, -uz));
+                wsum -= uz;
+            }
+        }
+        if (wsum == 0.0)
+            return PD_OK;
+        c = v3_scale(c, 1.0 / wsum);
+        pd_vec3 u0 = v3_add(s->v, v3_cross(ww, c));
+        double e = -u0.z <= m->v_rest ? 0.0 : sc->restitution;
+        double K[3][3];
+        pd_impact_K(1.0 / b->mass, CONST_M3(J), c, K);
+        pd_impact_result res;
+        pd_status st = pd_impact_solve(w->impact, CONST_M3(K), u0, sc->mu, e, law, &res);
+        if (st == PD_OK && res.energy_gain && law == PD_IMPACT_POISSON) {
+            (*gain)++;
+            st = pd_impact_solve(w->impact, CONST_M3(K), u0, sc->mu, e, PD_IMPACT_ENERGETIC, &res);
+        }
+        if (st == PD_ERR_NO_CONVERGENCE) {
+            (*fallbacks)++;
+            res.p = fallback_impulse(CONST_M3(K), u0, sc->mu, e);
+        } else if (st != PD_OK) {
+            return st;
+        }
+        s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
+        ww = v3_add(ww, mat_vec(CONST_M3(J), v3_cross(c, res.p)));
+        s->w = quat_rotate_inv(s->q, ww);
+        (*impacts)++;
+    }
+    return PD_OK;
+}
+
+/* --- the drop ----------------------------------------------------------------- */
+
+/* Energy per unit weight: the height the part could reach, m. */
+static double energy_height(const pd_body *b, const pd_state *s, double g)
+{
+    double rot = b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                 b->moment[2] * s->w.z * s->w.z;
+    return s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
+}
+
+/* 1 and the pose if the outcome is decided, 0 if not yet, -1 on failure. */
+static int decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
+{
+    pd_vec3 down = quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
+    int f;
+    if (pd_descend(m->hull, &m->star, m->com, down, &f, hint) != PD_OK)
+        return -1;
+    /* A resting vertex may be up to rest_fall below the floor, so the part's
+     * potential energy may read that much low: count it. */
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier[f]))
+        return 0;
+    *pose = m->pose_of[m->descent->facets[f].rest];
+    return *pose >= 0 ? 1 : -1;
+}
+
+void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
+                 const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
+                 long *energy_gain, long *fallbacks)
+{
+    pd_rng rng;
+    pd_rng_init(&rng, o->seed, (uint64_t)index);
+    pd_state s;
+    initial_state(m, sc, &rng, init_cdf, &s, out->q0);
+    out->pose = -1;
+    out->collisions = 0;
+    out->end = PD_END_FAILED;
+    double t = 0.0, g = sc->gravity;
+    /* Resting contact advances by the time to fall rest_fall, so that a
+     * vertex pressed on the floor by gravity meets it again with the speed
+     * that fall gives (a microcollision) rather than at speed 0. */
+    double dt_rest = sqrt(2.0 * m->rest_fall / g);
+    int hint = 0;
+    for (;;) {
+        int pose, d = decided(m, &s, g, &hint, &pose);
+        if (d < 0)
+            break;
+        if (d > 0) {
+            out->pose = pose;
+            out->end = PD_END_SETTLED;
+            break;
+        }
+        if (out->collisions >= o->max_collisions) {
+            out->end = PD_END_COLLISION_LIMIT;
+            break;
+        }
+        pd_flight f;
+        pd_impact imp;
+        if (pd_flight_plan(m->body, &s, g, &f) != PD_OK ||
+            pd_flight_impact(m->body, &f, o->time_limit - t, w->contacts, MAX_CONTACTS, &imp) != PD_OK)
+            break;
+        if (imp.kind == PD_IMPACT_NONE) {
+            t = o->time_limit;
+            out->end = PD_END_TIME_LIMIT;
+            break;
+        }
+        if (imp.kind == PD_IMPACT_AT) {
+            if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
+                break;
+            t += imp.t;
+        }
+        int nc = imp.ncontacts < MAX_CONTACTS ? imp.ncontacts : MAX_CONTACTS;
+        int before = out->collisions;
+        if (resolve(m, w, sc, &s, nc, &out->collisions, energy_gain, fallbacks) != PD_OK)
+            break;
+        if (out->collisions == before) {
+            /* Touching but not approaching: separating, or resting. */
+            if (pd_flight_plan(m->body, &s, g, &f) != PD_OK || pd_flight_eval(&f, dt_rest, &s) != PD_OK)
+                break;
+            t += dt_rest;
+            if (t >= o->time_limit) {
+                out->end = PD_END_TIME_LIMIT;
+                break;
+            }
+        }
+    }
+    out->time = t;
+}
