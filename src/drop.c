@@ -119,6 +119,8 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
     return PD_OK;
 }
 
+const pd_body *pd_sim_model_body(const pd_sim_model *model) { return model->body; }
+
 pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model)
 {
     (void)model;
@@ -253,11 +255,9 @@ static pd_vec3 fallback_impulse(const double K[3][3], pd_vec3 u0, double mu, dou
     return p;
 }
 
-/* Resolves the touching vertices' collision; *impacts counts collisions
- * applied, *gain those that Poisson would have made add energy, *fallbacks
- * those resolved by fallback_impulse. */
-static pd_status resolve(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
-                         pd_state *s, int nc, int *impacts, long *gain, long *fallbacks)
+pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
+                          pd_state *s, const int *contacts, int nc, int *impacts, long *gain,
+                          long *fallbacks)
 {
     const pd_body *b = m->body;
     double J[3][3];
@@ -267,7 +267,7 @@ static pd_status resolve(const pd_sim_model *m, pd_drop_work *w, const pd_scene 
         pd_vec3 ww = quat_rotate(s->q, s->w), c = v3(0, 0, 0);
         double wsum = 0.0;
         for (int i = 0; i < nc; i++) {
-            pd_vec3 r = quat_rotate(s->q, b->verts[w->contacts[i]]);
+            pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
             double uz = s->v.z + v3_cross(ww, r).z;
             if (uz < -m->v_eps) {
                 c = v3_add(c, v3_scale(r, -uz));
@@ -373,7 +373,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         int nc = imp.ncontacts < MAX_CONTACTS ? imp.ncontacts : MAX_CONTACTS;
         int before = out->collisions;
-        if (resolve(m, w, sc, &s, nc, &out->collisions, energy_gain, fallbacks) != PD_OK)
+        if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
+            PD_OK)
             break;
         if (out->collisions == before) {
             /* Touching but not approaching: separating, or resting. */

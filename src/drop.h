@@ -8,6 +8,7 @@
 #define PD_DROP_H
 
 #include <stdint.h>
+#include "body.h"
 #include "posedrop/sim.h"
 
 typedef struct pd_sim_model pd_sim_model;
@@ -29,5 +30,18 @@ void pd_drop_work_free(pd_drop_work *work);
 void pd_drop_run(const pd_sim_model *model, pd_drop_work *work, const pd_scene *scene,
                  const pd_sim_options *options, long index, const double *init_cdf,
                  pd_trial *out, long *energy_gain, long *fallbacks);
+
+/* Resolves a collision of the part in state s with the floor at the body
+ * vertices contacts[0..nc): approaching contacts are resolved as one impact at
+ * their centroid weighted by approach speed, repeatedly until none approaches
+ * (see drop.c). Updates s's velocities; *impacts counts impulses applied,
+ * *gain and *fallbacks as for pd_drop_run. The model's body gives the vertex
+ * numbering (pd_sim_model_body). */
+pd_status pd_drop_collide(const pd_sim_model *model, pd_drop_work *work, const pd_scene *scene,
+                          pd_state *s, const int *contacts, int nc, int *impacts, long *gain,
+                          long *fallbacks);
+
+/* The model's rigid body (principal frame, hull vertices). */
+const pd_body *pd_sim_model_body(const pd_sim_model *model);
 
 #endif

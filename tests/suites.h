@@ -15,6 +15,8 @@
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \
+    PD_SUITE(drop)   \
+    PD_SUITE(sim)    \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

@@ -264,6 +264,49 @@ static void test_results(void)
     free(err);
 }
 
+static void test_dynamic(void)
+{
+    char *out, *err, *out2, *err2, args[512], path[160];
+    /* The headline command, small: static and dynamic columns together, and
+     * the same bytes for one thread or two. */
+    CHECK_INT(run("-n 60 -j 1 --units mm parts/block.stl", &out, &err), 0);
+    CHECK_INT(run("-n 60 -j 2 --units mm parts/block.stl", &out2, &err2), 0);
+    CHECK(strncmp(out, "pose,nx,ny,nz,area,height,p_qs,p_pqs,n,count,p,ci_lo,ci_hi,unsettled,partial\n",
+                  77) == 0);
+    CHECK(strcmp(out, out2) == 0);
+    CHECK(strstr(out, ",60,") != NULL);
+    free(out);
+    free(err);
+    free(out2);
+    free(err2);
+
+    /* --trials writes one row per drop; a scene file sets the scene, and
+     * options after it override it. */
+    snprintf(path, sizeof path, "%s/scene.txt", tmpdir);
+    write_file(path, "# a low drop\nheight = 0.01\nmu = 0.5\n");
+    char trials[160];
+    snprintf(trials, sizeof trials, "%s/trials.csv", tmpdir);
+    snprintf(args, sizeof args, "--scene %s --mu 0.2 -n 25 --trials %s --units mm parts/block.stl",
+             path, trials);
+    CHECK_INT(run(args, &out, &err), 0);
+    char *t = slurp(trials);
+    int rows = 0;
+    for (char *c = t; c && *c; c++)
+        rows += *c == '\n';
+    CHECK_INT(rows, 26);
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end\n", 42) == 0);
+    free(t);
+    free(out);
+    free(err);
+
+    /* A bad scene file names its line and prints nothing. */
+    write_file(path, "height = 0.01\nfriction = 2\n");
+    snprintf(args, sizeof args, "--scene %s -n 5 parts/cap.off", path);
+    char where[200];
+    snprintf(where, sizeof where, "%s:2:", path);
+    expect_failure(args, 2, where);
+}
+
 static void test_scripts(void)
 {
     char cmd[512], *out, *err;
@@ -313,6 +356,7 @@ void suite_cli(void)
     test_usage();
     test_bad_input();
     test_results();
+    test_dynamic();
     test_scripts();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
