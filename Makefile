@@ -98,7 +98,7 @@ check: deps
 
 demo: deps
 	@$(MAKE) --no-print-directory all
-	$(CLI) $(DEMO_PART)
+	$(CLI) -n 2000 -h 0.12 $(DEMO_PART)
 
 bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
@@ -123,7 +123,7 @@ clean:
 
 help:
 	@echo "make            build libposedrop.a and the posedrop command ($(BUILD)/)"
-	@echo "make demo       install missing packages, build, run posedrop on $(DEMO_PART)"
+	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make bench      speed figures, as ratios against reference runs"
