@@ -12,7 +12,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "posedrop/posedrop.h"
-#include "posedrop/sim.h"
 
 enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
 

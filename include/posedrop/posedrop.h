@@ -7,6 +7,8 @@
  *   pd_part_build(mesh, NULL, &part, &diag);
  *   pd_static_estimate(part, NULL, &res, &diag);
  *   ... res->poses[i].p_qs, res->poses[i].p_pqs ...
+ *   pd_sim_run(part, res, NULL, NULL, &sim, &diag);   (2000 drops, the paper's scene)
+ *   ... sim->p[i], sim->ci_lo[i], sim->ci_hi[i] ...
  * each call returning a pd_status to check (PD_OK == 0). */
 #ifndef POSEDROP_POSEDROP_H
 #define POSEDROP_POSEDROP_H
@@ -21,6 +23,7 @@
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"
 #include "posedrop/part.h"
+#include "posedrop/sim.h"
 #include "posedrop/static.h"
 #include "posedrop/status.h"
 #include "posedrop/tolerances.h"
