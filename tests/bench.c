@@ -1,14 +1,20 @@
 /* bench.c: speed figures for `make bench`.
  *
  * Every figure is a ratio against a reference run in the same process on the
- * same data (qhull's hull of the same points), so it means the same on a slow
- * and a fast machine; absolute times are printed beside them for context only.
- * Nothing here passes or fails. */
+ * same data (qhull's hull of the same points; for the drops, the plain scene
+ * and the one-thread run), so it means the same on a slow and a fast machine;
+ * absolute times are printed beside them for context only. The drops' cost is
+ * also set against the issue's fixed target of 50 us per drop. Nothing here
+ * passes or fails. `bench_posedrop static hull dynamic` runs only the parts
+ * named. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include "drop.h"
 #include "posedrop/posedrop.h"
+#include "posedrop/sim.h"
 #include "qhull_ref.h"
 #include "shapes.h"
 #include "vec3.h"
@@ -20,20 +26,27 @@ static double now(void)
     return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+static double cpu_now(void)
+{
+    struct timespec t;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
 /* Best of several runs: the least disturbed by the rest of the machine. */
 #define BEST_OF 5
 
-static double time_pd_hull(const pd_vec3 *p, int n, int reps, int *nfacets)
+/* A failing build is reported (diag->message) and timed no further: returns
+ * a negative time. */
+static double time_pd_hull(const pd_vec3 *p, int n, int reps, int *nfacets, pd_diag *diag)
 {
     double best = 1e300;
     for (int r = 0; r < BEST_OF; r++) {
         double t0 = now();
         for (int k = 0; k < reps; k++) {
             pd_hull *h = NULL;
-            if (pd_hull_build(p, n, &h, NULL) != PD_OK) {
-                fprintf(stderr, "bench: pd_hull_build failed\n");
-                exit(1);
-            }
+            if (pd_hull_build(p, n, &h, diag) != PD_OK)
+                return -1.0;
             *nfacets = h->nfacets;
             pd_hull_free(h);
         }
@@ -88,8 +101,15 @@ static void bench_hull(void)
         else
             points_sphere(&rng, p, N);
         int nf_pd = 0, nf_q = 0;
-        double t_pd = time_pd_hull(p, N, 1, &nf_pd);
+        pd_diag diag;
+        pd_diag_init(&diag);
+        double t_pd = time_pd_hull(p, N, 1, &nf_pd, &diag);
         double t_q = time_qhull(p, N, 1, &nf_q);
+        if (t_pd < 0) {
+            printf("%-22s %12s %12.1f %10d   pd_hull_build FAILED: %s\n",
+                   c == 0 ? "uniform in a cube" : "on a sphere", "-", 1e3 * t_q, nf_q, diag.message);
+            continue;
+        }
         printf("%-22s %12.1f %12.1f %10d %9.2fx%s\n", c == 0 ? "uniform in a cube" : "on a sphere",
                1e3 * t_pd, 1e3 * t_q, nf_pd, t_pd / t_q, nf_pd == nf_q ? "" : "  (facet counts differ!)");
     }
@@ -174,10 +194,270 @@ static void bench_static(void)
     }
 }
 
-int main(void)
+/* --- the dynamic estimator ------------------------------------------------------ *
+ * Drops of small parts in the paper's scene (pd_scene_default: 0.12 m, belt,
+ * friction, vibration). The reference for the per-drop cost is the issue's
+ * target of 50 us per drop; for the scene's effects, the plain scene; for the
+ * threads, one thread. Drop counts keep this part under about a minute on two
+ * cores. */
+
+enum { DYN_DROPS = 400 };       /* per timed run */
+/* The drops are the same in every repeat (seeded), so repeats only filter
+ * out the rest of the machine: fewer than BEST_OF keep this part short. */
+enum { DYN_BEST_OF = 3 };
+#define DROP_TARGET_US 50.0
+
+typedef struct dyn_part {
+    const char *name;
+    pd_part *part;
+    pd_static_result *poses;
+} dyn_part;
+
+static dyn_part dyn_part_make(const char *name, pd_mesh *m)
+{
+    dyn_part d = {name, NULL, NULL};
+    if (!m || pd_part_build(m, NULL, &d.part, NULL) != PD_OK ||
+        pd_static_estimate(d.part, NULL, &d.poses, NULL) != PD_OK) {
+        fprintf(stderr, "bench: cannot build the part %s\n", name);
+        exit(1);
+    }
+    pd_mesh_free(m);
+    return d;
+}
+
+static void dyn_part_free(dyn_part *d)
+{
+    pd_static_result_free(d->poses);
+    pd_part_free(d->part);
+}
+
+static pd_sim_result *sim_run(const dyn_part *d, const pd_scene *sc, long n, int threads,
+                              int keep_trials)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = n;
+    o.threads = threads;
+    o.keep_trials = keep_trials;
+    pd_sim_result *r = NULL;
+    if (pd_sim_run(d->part, d->poses, sc, &o, &r, NULL) != PD_OK) {
+        fprintf(stderr, "bench: pd_sim_run failed on %s\n", d->name);
+        exit(1);
+    }
+    return r;
+}
+
+/* Mean wall seconds per drop of pd_sim_run (model build included), best of
+ * DYN_BEST_OF runs; *cpu gets that run's process CPU seconds per drop (all
+ * threads), *last the last run's result. */
+static double time_sim(const dyn_part *d, const pd_scene *sc, long n, int threads,
+                       int keep_trials, pd_sim_result **last, double *cpu)
+{
+    double best = 1e300;
+    for (int r = 0; r < DYN_BEST_OF; r++) {
+        pd_sim_result_free(*last);
+        double c0 = cpu_now(), t0 = now();
+        *last = sim_run(d, sc, n, threads, keep_trials);
+        double t = (now() - t0) / (double)n, c = (cpu_now() - c0) / (double)n;
+        if (t < best) {
+            best = t;
+            if (cpu)
+                *cpu = c;
+        }
+    }
+    return best;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+typedef struct drop_times {
+    double median, p90, max; /* s */
+} drop_times;
+
+/* Seconds of one drop: drops 0..n-1 of the run (seed 1, the same drops as
+ * pd_sim_run's), each timed alone through the internal drop API (drop.h),
+ * the model built once outside. */
+static drop_times single_drops(const dyn_part *d, const pd_scene *sc, long n)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    pd_sim_model *model = NULL;
+    pd_drop_work *w = NULL;
+    if (pd_sim_model_build(d->part, d->poses, sc, &model, NULL) != PD_OK ||
+        !(w = pd_drop_work_alloc(model))) {
+        fprintf(stderr, "bench: no drop model for %s\n", d->name);
+        exit(1);
+    }
+    double *t = malloc(sizeof *t * (size_t)n);
+    long gain = 0, fallbacks = 0;
+    for (long i = 0; i < n; i++) {
+        pd_trial out;
+        double t0 = now();
+        pd_drop_run(model, w, sc, &o, i, NULL, &out, &gain, &fallbacks);
+        t[i] = now() - t0;
+    }
+    qsort(t, (size_t)n, sizeof *t, cmp_double);
+    drop_times dt = {n % 2 ? t[n / 2] : 0.5 * (t[n / 2 - 1] + t[n / 2]), t[(9 * n) / 10],
+                     t[n - 1]};
+    free(t);
+    pd_drop_work_free(w);
+    pd_sim_model_free(model);
+    return dt;
+}
+
+static void bench_drop_cost(dyn_part *parts, int nparts)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    printf("\ndynamic estimator, one thread: cost per drop, paper's scene (pd_scene_default, %.2f m)\n",
+           sc.height);
+    printf("median: %d drops each timed alone through pd_drop_run (drop.h), model built outside\n",
+           DYN_DROPS);
+    printf("mean: pd_sim_run, threads = 1, the same %d drops, total / n (model build included),\n"
+           "best of %d; drops/s = 1 / mean\n", DYN_DROPS, DYN_BEST_OF);
+    printf("reference: the issue's target of %.0f us per drop\n", DROP_TARGET_US);
+    printf("%-16s %5s %9s %9s %9s %9s %8s %9s %6s  %s\n", "part", "poses", "median us", "p90 us",
+           "max us", "mean us", "drops/s", "coll/drop", "unset", "vs target (median; mean)");
+    for (int k = 0; k < nparts; k++) {
+        const dyn_part *d = &parts[k];
+        drop_times dt = single_drops(d, &sc, DYN_DROPS);
+        pd_sim_result *r = NULL;
+        double mean = time_sim(d, &sc, DYN_DROPS, 1, 0, &r, NULL);
+        printf("%-16s %5d %9.1f %9.1f %9.0f %9.1f %8.0f %9.1f %6ld  %.2fx; %.2fx of the %.0f us target\n",
+               d->name, d->poses->nposes, 1e6 * dt.median, 1e6 * dt.p90, 1e6 * dt.max, 1e6 * mean,
+               1.0 / mean, (double)r->collisions / (double)r->n, r->unsettled,
+               1e6 * dt.median / DROP_TARGET_US, 1e6 * mean / DROP_TARGET_US, DROP_TARGET_US);
+        pd_sim_result_free(r);
+    }
+}
+
+static void bench_effects(const dyn_part *d)
+{
+    pd_scene plain;
+    pd_scene_default(&plain);
+    plain.mu = 0.0;
+    plain.vibration = 0.0;
+    plain.belt_speed = 0.0;
+    plain.initial = PD_INITIAL_UNIFORM;
+    printf("\nsimulate only the effects a scene calls for: %s, one thread, %d drops, best of %d\n",
+           d->name, DYN_DROPS, DYN_BEST_OF);
+    printf("reference: the plain scene (mu 0, vibration 0, belt 0, uniform initial), same process\n");
+    printf("%-28s %10s %9s %9s %10s\n", "scene", "mean us", "coll/drop", "unsettled", "ratio");
+    double t_ref = 0.0;
+    for (int e = 0; e < 6; e++) {
+        pd_scene sc = plain;
+        const char *name = "plain (reference)";
+        if (e == 1 || e == 5) {
+            sc.mu = 0.3;
+            name = "mu 0.3";
+        }
+        if (e == 2 || e == 5) {
+            sc.vibration = 1.5 * M_PI / 180.0;
+            name = "vibration 1.5 deg";
+        }
+        if (e == 3 || e == 5) {
+            sc.belt_speed = 0.05;
+            name = "belt 0.05 m/s";
+        }
+        if (e == 4 || e == 5) {
+            sc.initial = PD_INITIAL_BOOTSTRAP;
+            name = "bootstrap initial";
+        }
+        if (e == 5)
+            name = "all together";
+        pd_sim_result *r = NULL;
+        double t = time_sim(d, &sc, DYN_DROPS, 1, 0, &r, NULL);
+        if (e == 0)
+            t_ref = t;
+        printf("%-28s %10.1f %9.1f %9ld %9.2fx\n", name, 1e6 * t,
+               (double)r->collisions / (double)r->n, r->unsettled, t / t_ref);
+        pd_sim_result_free(r);
+    }
+}
+
+/* Same outcome, drop by drop: counts and every trial record's fields. */
+static int same_result(const pd_sim_result *a, const pd_sim_result *b)
+{
+    if (a->n != b->n || a->nposes != b->nposes || a->unsettled != b->unsettled ||
+        a->collisions != b->collisions || a->energy_gain != b->energy_gain ||
+        a->fallbacks != b->fallbacks)
+        return 0;
+    for (int k = 0; k < a->nposes; k++)
+        if (a->count[k] != b->count[k])
+            return 0;
+    for (long i = 0; i < a->n; i++) {
+        const pd_trial *x = &a->trials[i], *y = &b->trials[i];
+        if (memcmp(x->q0, y->q0, sizeof x->q0) != 0 || x->pose != y->pose ||
+            x->collisions != y->collisions || x->time != y->time || x->end != y->end)
+            return 0;
+    }
+    return 1;
+}
+
+static void bench_threads(const dyn_part *d)
+{
+    enum { N = 2 * DYN_DROPS };
+    pd_scene sc;
+    pd_scene_default(&sc);
+    printf("\nparallel speed-up: %s, paper's scene, %d drops, best of %d\n", d->name, N, DYN_BEST_OF);
+    printf("reference: the same run on one thread, same process\n");
+    printf("(cpu/wall: cores the process actually got; below the thread count, the machine is busy)\n");
+    printf("%-8s %10s %10s %10s %9s %9s\n", "threads", "wall ms", "cpu ms", "mean us", "cpu/wall",
+           "speed-up");
+    double t1 = 0.0;
+    pd_sim_result *r[2] = {NULL, NULL};
+    for (int k = 0; k < 2; k++) {
+        double cpu = 0.0, t = time_sim(d, &sc, N, k + 1, 1, &r[k], &cpu);
+        if (k == 0)
+            t1 = t;
+        printf("%-8d %10.1f %10.1f %10.1f %9.2f %8.2fx\n", k + 1, 1e3 * t * N, 1e3 * cpu * N,
+               1e6 * t, cpu / t, t1 / t);
+    }
+    printf("determinism, threads 1 vs 2 (counts, collisions, every trial record): %s\n",
+           same_result(r[0], r[1]) ? "identical" : "DIFFERENT");
+    pd_sim_result_free(r[0]);
+    pd_sim_result_free(r[1]);
+}
+
+static void bench_dynamic(void)
+{
+    dyn_part parts[3] = {
+        dyn_part_make("cube 1 cm", mesh_box(0.01, 0.01, 0.01)),
+        dyn_part_make("box 1 x 2 x 3 cm", mesh_box(0.01, 0.02, 0.03)),
+        dyn_part_make("coin 32-gon", mesh_prism(32, 0.01, 0.01)),
+    };
+    double t0 = now();
+    bench_drop_cost(parts, 3);
+    bench_effects(&parts[1]);
+    bench_threads(&parts[1]);
+    printf("(dynamic part: %.1f s)\n", now() - t0);
+    for (int k = 0; k < 3; k++)
+        dyn_part_free(&parts[k]);
+}
+
+/* Arguments pick parts (static, hull, dynamic); none runs them all. */
+static int wanted(int argc, char **argv, const char *name)
+{
+    if (argc < 2)
+        return 1;
+    for (int i = 1; i < argc; i++)
+        if (strcmp(argv[i], name) == 0)
+            return 1;
+    return 0;
+}
+
+int main(int argc, char **argv)
 {
     printf("posedrop %s benchmark (best of %d runs each)\n", PD_VERSION_STRING, BEST_OF);
-    bench_static();
-    bench_hull();
+    if (wanted(argc, argv, "static"))
+        bench_static();
+    if (wanted(argc, argv, "hull"))
+        bench_hull();
+    if (wanted(argc, argv, "dynamic"))
+        bench_dynamic();
     return 0;
 }
