@@ -564,6 +564,76 @@ static int parabolic_strips(pd_vec3 *p, int nstrips, double c)
     return n;
 }
 
+/* A shallow paraboloid cap z = -c r^2 (r <= 1) on a polar grid of nrings
+ * rings of m points (alternate rings turned by half a step) and a centre,
+ * over a disc of m points at z = -1. Where the cap's curvature is a few
+ * tolerances over its width, region growing finds rings of triangles within
+ * the tolerance of one plane around a centre that bulges out of it. */
+static int paraboloid_cap(pd_vec3 *p, int nrings, int m, double c)
+{
+    int n = 0;
+    p[n++] = v3(0, 0, 0);
+    for (int i = 1; i <= nrings; i++) {
+        double r = (double)i / nrings;
+        for (int j = 0; j < m; j++) {
+            double t = 2.0 * M_PI * (j + 0.5 * (i % 2)) / m;
+            p[n++] = v3(r * cos(t), r * sin(t), -c * r * r);
+        }
+    }
+    for (int j = 0; j < m; j++) {
+        double t = 2.0 * M_PI * j / m;
+        p[n++] = v3(cos(t), sin(t), -1);
+    }
+    return n;
+}
+
+/* The merge's repairs, on inputs where the plane test alone fails: before
+ * the disc rule, the first cap grew a facet that was not a disc (an
+ * annulus, PD_ERR_INTERNAL), and the second left a facet with two corners
+ * (PD_ERR_COPLANAR). Each must now reach its repair (the counters say so),
+ * give a hull that passes pd_hull_check, and keep qhull's volume. */
+static void test_merge_repair(void)
+{
+    pd_vec3 *p = malloc(sizeof *p * 1000);
+    const struct { int nrings, m; double c; int disc, dissolve; } cap[] = {
+        {8, 48, 1.6e-6, 1, 0},
+        {8, 24, 8e-7, 0, 1},
+    };
+    for (int k = 0; k < 2; k++) {
+        int n = paraboloid_cap(p, cap[k].nrings, cap[k].m, cap[k].c);
+        pd_hull *h = NULL;
+        pd_hull_merge_stats ms;
+        memset(&ms, 0, sizeof ms);
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_status st = pd_hull_build_stats(p, n, &h, &ms, &d);
+        CHECK_STATUS(st, PD_OK);
+        if (st != PD_OK) {
+            printf("     pd_hull_build: %s (cap %d)\n", d.message, k);
+            continue;
+        }
+        CHECK_STATUS(pd_hull_check(h, p, n, &d), PD_OK);
+        if (cap[k].disc)
+            CHECK(ms.disc_rejects > 0);
+        if (cap[k].dissolve)
+            CHECK(ms.dissolved_regions > 0 && ms.repair_passes > 0);
+        /* the cap must still be merged, not left as its triangles */
+        int top = 0;
+        for (int f = 0; f < h->nfacets; f++)
+            top += h->normal[f].z > 0.5;
+        CHECK(top < 2 * cap[k].nrings * cap[k].m);
+        qhull_ref q;
+        if (qhull_ref_build(p, n, &q) == 0) {
+            CHECK_REL(h->volume, q.volume, VOLUME_REL, "sum of tetrahedra of the exact triangulation");
+            qhull_ref_free(&q);
+        } else {
+            CHECK(0);
+        }
+        pd_hull_free(h);
+    }
+    free(p);
+}
+
 static void test_merging(void)
 {
     enum { MAXP = 20000 };
@@ -743,6 +813,7 @@ void suite_hull(void)
     test_vs_qhull_degenerate();
     test_invariance();
     test_merging();
+    test_merge_repair();
     test_degenerate_status();
     test_large_and_deterministic();
 }
