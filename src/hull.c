@@ -98,6 +98,12 @@ static pd_status classify(const pd_vec3 *p, int n, int seed[4], double *size, pd
 
 pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *diag)
 {
+    return pd_hull_build_stats(pts, npts, hull, NULL, diag);
+}
+
+pd_status pd_hull_build_stats(const pd_vec3 *pts, int npts, pd_hull **hull, pd_hull_merge_stats *stats,
+                              pd_diag *diag)
+{
     if (!hull || (!pts && npts > 0) || npts < 0)
         return pd_fail(diag, PD_ERR_USAGE, "pd_hull_build: NULL argument or negative count");
     int seed[4];
@@ -115,7 +121,7 @@ pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *d
         return pd_fail(diag, PD_ERR_NOMEM, "convex hull: out of memory");
     }
     h->size = size;
-    st = pd_hull_merge(pts, &th, h, diag);
+    st = pd_hull_merge(pts, &th, h, stats, diag);
     pd_trihull_free(&th);
 #ifdef PD_DEBUG
     if (st == PD_OK)

@@ -21,7 +21,25 @@ pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_t
                            pd_diag *diag);
 void pd_trihull_free(pd_trihull *th);
 
-/* Merges the triangles of th into the facets of hull (whose size is set). */
-pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *hull, pd_diag *diag);
+/* What the merge had to repair (hull_merge.c): how often the plane test
+ * accepted a triangle that would have made its region other than a disc, and
+ * how many regions of two or more triangles were dissolved into single
+ * triangles to give every facet three corners. Lets the tests see that they
+ * reach those paths. */
+typedef struct {
+    long disc_rejects;
+    long dissolved_regions;
+    long dissolved_triangles;
+    int repair_passes;
+} pd_hull_merge_stats;
+
+/* Merges the triangles of th into the facets of hull (whose size is set);
+ * stats may be NULL. */
+pd_status pd_hull_merge(const pd_vec3 *pts, const pd_trihull *th, pd_hull *hull, pd_hull_merge_stats *stats,
+                        pd_diag *diag);
+
+/* pd_hull_build that also reports the merge's repairs (stats may be NULL). */
+pd_status pd_hull_build_stats(const pd_vec3 *pts, int npts, pd_hull **hull, pd_hull_merge_stats *stats,
+                              pd_diag *diag);
 
 #endif
