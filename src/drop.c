@@ -147,7 +147,7 @@ static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
 {
     pd_vec3 axis = v3_cross(a, b);
     double s = v3_norm(axis), c = v3_dot(a, b);
-    if (s < 1e-12 * (fabs(c) + 1.0)) { /* parallel or opposite */
+    if (s < PD_TOL_ANGLE) { /* parallel or opposite within round-off */
         if (c > 0.0)
             return quat_identity();
         pd_vec3 any = fabs(a.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);

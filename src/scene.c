@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "diag.h"
+#include "mesh_reader.h"
 #include "posedrop/sim.h"
 
 void pd_scene_default(pd_scene *s)
@@ -18,18 +19,6 @@ void pd_scene_default(pd_scene *s)
     s->vibration = 1.5 * M_PI / 180.0;
     s->initial = PD_INITIAL_UNIFORM;
     s->gravity = 9.81;
-}
-
-/* The whole text one finite number. */
-static int number(const char *text, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
 }
 
 typedef struct {
@@ -58,7 +47,7 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
         if (strcmp(key, keys[i].key) != 0)
             continue;
         double v;
-        if (!number(value, &v))
+        if (pd_parse_double(value, strlen(value), &v) != PD_NUM_OK)
             return pd_fail(diag, PD_ERR_PARSE, "%s: expected %s, got '%s'", key, keys[i].what, value);
         if (v < keys[i].lo || v > keys[i].hi)
             return pd_fail(diag, PD_ERR_RANGE, "%s: expected %s, got %s", key, keys[i].what, value);
