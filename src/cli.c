@@ -53,6 +53,9 @@ static void usage(FILE *out)
         "                     to its triangle; exact: exact spherical band area\n"
         "dynamic estimator (simulated drops):\n"
         "  -n N               drops to simulate (default: none)\n"
+        "  --engine E         impulse (default): posedrop's own simulator; ode or\n"
+        "                     bullet: the same drops on a stepping engine, to cross-check\n"
+        "  --dt S             time step of ode (default 0.001) or bullet (1/960)\n"
         "  --ci DELTA         drop until every pose's 95%% interval is within DELTA\n"
         "  --seed S           random seed (default 1); same seed, same bytes\n"
         "  -j THREADS         threads (default: all cores); never changes results\n"
@@ -223,7 +226,8 @@ typedef struct {
 
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
-       OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS };
+       OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
+       OPT_ENGINE, OPT_DT };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -273,6 +277,8 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"initial", required_argument, 0, OPT_INITIAL},
         {"scene", required_argument, 0, OPT_SCENE},
         {"trials", required_argument, 0, OPT_TRIALS},
+        {"engine", required_argument, 0, OPT_ENGINE},
+        {"dt", required_argument, 0, OPT_DT},
         {"facets", no_argument, 0, OPT_FACETS},
         {"verbose", no_argument, 0, OPT_VERBOSE},
         {"help", no_argument, 0, OPT_HELP},
@@ -283,6 +289,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
     static const char *const topples[] = {"descent", "edge"};
     static const char *const compares[] = {"raw", "qs"};
     static const char *const bands[] = {"rect", "exact"};
+    static const char *const engines[] = {"impulse", "ode", "bullet"};
     memset(a, 0, sizeof *a);
     pd_mesh_read_options_default(&a->read);
     pd_part_options_default(&a->part);
@@ -370,6 +377,17 @@ static int parse_args(int argc, char **argv, cli_args *a)
             }
             break;
         }
+        case OPT_ENGINE:
+            if (!choose("--engine", optarg, engines, 3, &k))
+                return EXIT_USAGE;
+            a->sim.engine = (pd_engine_kind)k;
+            break;
+        case OPT_DT:
+            if (!parse_double(optarg, &x) || x <= 0.0 || x > 0.01)
+                return fail_usage("--dt: expected a time step in s, above 0 and at most 0.01, got '%s'",
+                                  optarg);
+            a->sim.dt = x;
+            break;
         case OPT_TRIALS:
             a->trials = optarg;
             a->sim.keep_trials = 1;

@@ -23,7 +23,7 @@
 #include "basin.h"
 #include "body.h"
 #include "diag.h"
-#include "drop.h"
+#include "drop_internal.h"
 #include "flight.h"
 #include "impact.h"
 #include "posedrop/tolerances.h"
@@ -31,29 +31,6 @@
 #include "static_internal.h"
 #include "vec3.h"
 
-/* Contacts considered at once, and resolution rounds per impact. A face of
- * more corners than MAX_CONTACTS touching at once is resolved through the
- * lowest MAX_CONTACTS of them, which the rounds then correct. */
-enum { MAX_CONTACTS = 64, MAX_ROUNDS = 64 };
-
-struct pd_sim_model {
-    pd_body *body;
-    const pd_hull *hull;        /* the part's hull, part frame */
-    pd_vec3 com;                /* part frame */
-    pd_static_result *descent;  /* the exact quasi-static rest[] of every facet */
-    double *barrier;            /* per facet: its basin's barrier height, m */
-    pd_star star;
-    int *pose_of;               /* facet -> pose index in the caller's table, or -1 */
-    const pd_static_result *poses;
-    double v_eps;               /* approach speeds below this are contact, not impact */
-    double rest_fall;           /* m: how far resting contact falls between microcollisions */
-    double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
-};
-
-struct pd_drop_work {
-    pd_impact_work *impact;
-    int contacts[MAX_CONTACTS];
-};
 
 void pd_sim_model_free(pd_sim_model *m)
 {
@@ -68,11 +45,21 @@ void pd_sim_model_free(pd_sim_model *m)
 }
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
-                             const pd_scene *scene, pd_sim_model **model, pd_diag *diag)
+                             const pd_scene *scene, const pd_sim_options *options,
+                             pd_sim_model **model, pd_diag *diag)
 {
     pd_sim_model *m = calloc(1, sizeof *m);
     if (!m)
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
+    /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
+     * frame cut into 16 substeps. */
+    if (options->engine == PD_ENGINE_ODE) {
+        m->engine = &pd_engine_ode;
+        m->dt = options->dt > 0 ? options->dt : 1e-3;
+    } else if (options->engine == PD_ENGINE_BULLET) {
+        m->engine = &pd_engine_bullet;
+        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    }
     m->hull = part->hull;
     m->com = part->com;
     m->poses = poses;
@@ -121,14 +108,20 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
 
 const pd_body *pd_sim_model_body(const pd_sim_model *model) { return model->body; }
 
-pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model)
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene)
 {
-    (void)model;
     pd_drop_work *w = calloc(1, sizeof *w);
-    if (w && !(w->impact = pd_impact_work_alloc())) {
+    if (!w)
+        return NULL;
+    if (model->engine)
+        w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
+    else
+        w->impact = pd_impact_work_alloc();
+    if (!w->impact && !w->world) {
         free(w);
-        w = NULL;
+        return NULL;
     }
+    w->engine = model->engine;
     return w;
 }
 
@@ -137,6 +130,8 @@ void pd_drop_work_free(pd_drop_work *w)
     if (!w)
         return;
     pd_impact_work_free(w->impact);
+    if (w->world)
+        w->engine->world_free(w->world);
     free(w);
 }
 
@@ -156,8 +151,8 @@ static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
     return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
 }
 
-static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
-                          const double *init_cdf, pd_state *s, double q0[4])
+void pd_drop_initial(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
+                     const double *init_cdf, pd_state *s, double q0[4])
 {
     const pd_body *b = m->body;
     pd_quat q;
@@ -263,7 +258,7 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
     double J[3][3];
     inv_inertia_world(b, s->q, J);
     pd_impact_law law = sc->law == PD_RESTITUTION_ENERGETIC ? PD_IMPACT_ENERGETIC : PD_IMPACT_POISSON;
-    for (int round = 0; round < MAX_ROUNDS; round++) {
+    for (int round = 0; round < PD_MAX_ROUNDS; round++) {
         pd_vec3 ww = quat_rotate(s->q, s->w), c = v3(0, 0, 0);
         double wsum = 0.0;
         for (int i = 0; i < nc; i++) {
@@ -311,8 +306,7 @@ static double energy_height(const pd_body *b, const pd_state *s, double g)
     return s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
 }
 
-/* 1 and the pose if the outcome is decided, 0 if not yet, -1 on failure. */
-static int decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
+int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
 {
     pd_vec3 down = quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
     int f;
@@ -326,14 +320,24 @@ static int decided(const pd_sim_model *m, const pd_state *s, double g, int *hint
     return *pose >= 0 ? 1 : -1;
 }
 
+double pd_drop_tilt(const pd_sim_model *m, const pd_state *s, int pose)
+{
+    pd_vec3 down = quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
+    return v3_angle(down, m->poses->poses[pose].normal);
+}
+
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
 {
+    if (m->engine) {
+        pd_drop_run_stepping(m, w, sc, o, index, init_cdf, out);
+        return;
+    }
     pd_rng rng;
     pd_rng_init(&rng, o->seed, (uint64_t)index);
     pd_state s;
-    initial_state(m, sc, &rng, init_cdf, &s, out->q0);
+    pd_drop_initial(m, sc, &rng, init_cdf, &s, out->q0);
     out->pose = -1;
     out->collisions = 0;
     out->end = PD_END_FAILED;
@@ -344,7 +348,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     double dt_rest = sqrt(2.0 * m->rest_fall / g);
     int hint = 0;
     for (;;) {
-        int pose, d = decided(m, &s, g, &hint, &pose);
+        int pose, d = pd_drop_decided(m, &s, g, &hint, &pose);
         if (d < 0)
             break;
         if (d > 0) {
@@ -359,7 +363,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         pd_flight f;
         pd_impact imp;
         if (pd_flight_plan(m->body, &s, g, &f) != PD_OK ||
-            pd_flight_impact(m->body, &f, o->time_limit - t, w->contacts, MAX_CONTACTS, &imp) != PD_OK)
+            pd_flight_impact(m->body, &f, o->time_limit - t, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
             break;
         if (imp.kind == PD_IMPACT_NONE) {
             t = o->time_limit;
@@ -371,7 +375,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 break;
             t += imp.t;
         }
-        int nc = imp.ncontacts < MAX_CONTACTS ? imp.ncontacts : MAX_CONTACTS;
+        int nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
         int before = out->collisions;
         if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
             PD_OK)

@@ -9,16 +9,18 @@
 
 #include <stdint.h>
 #include "body.h"
+#include "rng.h"
 #include "posedrop/sim.h"
 
 typedef struct pd_sim_model pd_sim_model;
 typedef struct pd_drop_work pd_drop_work;
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
-                             const pd_scene *scene, pd_sim_model **model, pd_diag *diag);
+                             const pd_scene *scene, const pd_sim_options *options,
+                             pd_sim_model **model, pd_diag *diag);
 void pd_sim_model_free(pd_sim_model *model);
 
-pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model);
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene);
 void pd_drop_work_free(pd_drop_work *work);
 
 /* Drop number `index` of a run seeded `seed`: everything random about it
@@ -40,6 +42,31 @@ void pd_drop_run(const pd_sim_model *model, pd_drop_work *work, const pd_scene *
 pd_status pd_drop_collide(const pd_sim_model *model, pd_drop_work *work, const pd_scene *scene,
                           pd_state *s, const int *contacts, int nc, int *impacts, long *gain,
                           long *fallbacks);
+
+/* The release state of drop `index` (uniform or bootstrap pose, vibration,
+ * belt velocity, lowest point at the drop height), drawn from rng; q0 gets the
+ * part frame's orientation for --trials. Shared by every engine, so engines
+ * can be compared drop by drop. */
+void pd_drop_initial(const pd_sim_model *model, const pd_scene *scene, pd_rng *rng,
+                     const double *init_cdf, pd_state *s, double q0[4]);
+
+/* 1 and the pose index if the outcome of state s is decided (energy below its
+ * basin's barrier, see drop.c), 0 if not yet, -1 on failure. hint speeds up
+ * successive calls. */
+int pd_drop_decided(const pd_sim_model *model, const pd_state *s, double gravity, int *hint,
+                    int *pose);
+
+/* The part's tilt in state s from the facet of the basin it would rest in:
+ * the angle between gravity and that facet's normal, rad. */
+double pd_drop_tilt(const pd_sim_model *model, const pd_state *s, int pose);
+
+/* The stepping engines' drop (drop_step.c): the same release, then fixed
+ * steps of the engine in work until it lies on a facet (tilt below
+ * PD_TOL_REST_TILT) with its energy below its basin's barrier, or the time
+ * limit. */
+void pd_drop_run_stepping(const pd_sim_model *model, pd_drop_work *work, const pd_scene *scene,
+                          const pd_sim_options *options, long index, const double *init_cdf,
+                          pd_trial *out);
 
 /* The model's rigid body (principal frame, hull vertices). */
 const pd_body *pd_sim_model_body(const pd_sim_model *model);

@@ -30,6 +30,8 @@ static const double Z95 = 1.959963984540054;
 void pd_sim_options_default(pd_sim_options *o)
 {
     memset(o, 0, sizeof *o);
+    o->engine = PD_ENGINE_IMPULSE;
+    o->dt = 0.0;
     o->ndrops = 2000;
     o->seed = 1;
     o->threads = 0;
@@ -71,7 +73,7 @@ static int cancelled(const pd_sim_options *o) { return o->cancel && *o->cancel; 
 static void *worker(void *arg)
 {
     batch *b = arg;
-    pd_drop_work *w = pd_drop_work_alloc(b->model);
+    pd_drop_work *w = pd_drop_work_alloc(b->model, b->scene);
     if (!w) {
         atomic_store(&b->failed, 1);
         return NULL;
@@ -181,13 +183,13 @@ static double round_distance(const double *cdf, const long *before, const long *
 /* Size of the next batch: the bootstrap's rounds, --ci's checks, or what is
  * left of -n; never past the cap. */
 static long next_batch(const pd_sim_result *r, const pd_scene *scene, const pd_sim_options *o,
-                       long cap)
+                       long want, long cap)
 {
-    long size = o->ci_halfwidth > 0 ? CI_BATCH : o->ndrops - r->n;
+    long size = r->n < want ? want - r->n : CI_BATCH;
     if (scene->initial == PD_INITIAL_BOOTSTRAP)
         size = r->n < BOOTSTRAP_FIRST ? BOOTSTRAP_FIRST - r->n : BOOTSTRAP_ROUND;
-    if (o->ci_halfwidth <= 0 && size > o->ndrops - r->n)
-        size = o->ndrops - r->n;
+    if (o->ci_halfwidth <= 0 && size > want - r->n)
+        size = want - r->n;
     if (size > cap - r->n)
         size = cap - r->n;
     return size > BATCH_MAX ? BATCH_MAX : size;
@@ -197,8 +199,15 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
                        pd_sim_result *r, pd_diag *diag)
 {
     int nthreads = o->threads > 0 ? (o->threads > 256 ? 256 : o->threads) : default_threads();
-    long cap = o->ci_halfwidth > 0 ? (o->max_drops > o->ndrops ? o->max_drops : o->ndrops)
-                                   : o->ndrops;
+    /* --ci starts from the drops that guarantee the half-width for every pose
+     * at once in the worst case (p = 1/2, Bonferroni over the poses: the
+     * corrected eq. 17), then adds batches while an interval is still wider. */
+    long want = o->ndrops;
+    if (o->ci_halfwidth > 0) {
+        long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
+        want = bound > want ? bound : want;
+    }
+    long cap = o->ci_halfwidth > 0 ? (o->max_drops > want ? o->max_drops : want) : want;
     pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
     double *cdf = malloc(sizeof *cdf * (size_t)r->nposes);
     long *before = malloc(sizeof *before * (size_t)r->nposes);
@@ -206,9 +215,9 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     if (!buf || !cdf || !before)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
     while (st == PD_OK && r->n < cap && !r->partial) {
-        if (r->n >= o->ndrops && (o->ci_halfwidth <= 0 || ci_reached(r, o->ci_halfwidth)))
+        if (r->n >= want && (o->ci_halfwidth <= 0 || ci_reached(r, o->ci_halfwidth)))
             break;
-        long size = next_batch(r, scene, o, cap);
+        long size = next_batch(r, scene, o, want, cap);
         const double *init = NULL;
         if (scene->initial == PD_INITIAL_BOOTSTRAP && r->n >= BOOTSTRAP_FIRST) {
             estimate_cdf(r, cdf);
@@ -261,12 +270,13 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     if (!part || !poses || !result)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL argument");
     if (o.ndrops < 0 || o.max_drops < 0 || !(o.ci_halfwidth >= 0) || !(o.time_limit > 0) ||
-        o.max_collisions < 1)
+        o.max_collisions < 1 || !(o.dt >= 0 && o.dt < 1) ||
+        (unsigned)o.engine > (unsigned)PD_ENGINE_BULLET)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
     if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
     pd_sim_model *model = NULL;
-    pd_status st = pd_sim_model_build(part, poses, &sc, &model, diag);
+    pd_status st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
     if (st != PD_OK)
         return st;
     pd_sim_result *r = calloc(1, sizeof *r);

@@ -287,8 +287,8 @@ static drop_times single_drops(const dyn_part *d, const pd_scene *sc, long n)
     pd_sim_options_default(&o);
     pd_sim_model *model = NULL;
     pd_drop_work *w = NULL;
-    if (pd_sim_model_build(d->part, d->poses, sc, &model, NULL) != PD_OK ||
-        !(w = pd_drop_work_alloc(model))) {
+    if (pd_sim_model_build(d->part, d->poses, sc, &o, &model, NULL) != PD_OK ||
+        !(w = pd_drop_work_alloc(model, sc))) {
         fprintf(stderr, "bench: no drop model for %s\n", d->name);
         exit(1);
     }

@@ -20,10 +20,12 @@ typedef struct {
 static int setup(fixture *fx, pd_mesh *mesh, const pd_scene *sc)
 {
     memset(fx, 0, sizeof *fx);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
     int ok = pd_part_build(mesh, NULL, &fx->part, NULL) == PD_OK &&
              pd_static_estimate(fx->part, NULL, &fx->poses, NULL) == PD_OK &&
-             pd_sim_model_build(fx->part, fx->poses, sc, &fx->model, NULL) == PD_OK &&
-             (fx->work = pd_drop_work_alloc(fx->model)) != NULL;
+             pd_sim_model_build(fx->part, fx->poses, sc, &o, &fx->model, NULL) == PD_OK &&
+             (fx->work = pd_drop_work_alloc(fx->model, sc)) != NULL;
     pd_mesh_free(mesh);
     CHECK(ok);
     return ok;

@@ -64,7 +64,16 @@ typedef enum pd_drop_end {
     PD_END_FAILED        /* the collision solver could not finish (counted) */
 } pd_drop_end;
 
+typedef enum pd_engine_kind {
+    PD_ENGINE_IMPULSE = 0, /* posedrop's own: closed-form flight, frictional impulses */
+    PD_ENGINE_ODE,         /* the Open Dynamics Engine, fixed step */
+    PD_ENGINE_BULLET       /* Bullet Physics, fixed step */
+} pd_engine_kind;
+
 typedef struct pd_sim_options {
+    pd_engine_kind engine;  /* PD_ENGINE_IMPULSE */
+    double dt;              /* s, fixed step of ODE and Bullet; 0 picks each engine's
+                               default (ODE 1 ms, Bullet 1/960 s) */
     long ndrops;            /* drops to run (with ci_halfwidth: at least these); 2000 */
     uint64_t seed;          /* 1 */
     int threads;            /* 0: all cores */
@@ -85,7 +94,7 @@ void pd_sim_options_default(pd_sim_options *options);
 typedef struct pd_trial {
     double q0[4];       /* initial orientation, unit quaternion (w, x, y, z), part to world */
     int pose;           /* index into the static result's poses, -1 if not settled */
-    int collisions;
+    int collisions;     /* impulses applied (impulse engine; 0 for stepping engines) */
     double time;        /* simulated s */
     pd_drop_end end;
 } pd_trial;

@@ -272,4 +272,15 @@
 /* Largest polygon a mesh face may have (vertex count of one OFF/OBJ face). */
 #define PD_MAX_FACE_VERTICES 65536
 
+/* --- stepping engines (ODE, Bullet) ---------------------------------------- */
+
+/* A stepping engine's drop ends only when the part lies on the facet of its
+ * basin, tilted less than this from it (and its energy is below the basin's
+ * barrier). Why 1 degree (0.0175 rad): soft contacts let a resting part sink
+ * and rock by a fraction of a degree, so much less would wait for settling
+ * that never comes; the energy test already rules out leaving the basin, and
+ * 1 degree is far below any tilt at which a part could still be on its way
+ * to another pose. */
+#define PD_TOL_REST_TILT 0.0174532925199432958
+
 #endif
