@@ -17,11 +17,9 @@
 #include "posedrop/part.h"
 #include "posedrop/status.h"
 #include "posedrop/types.h"
+#include "mat3.h"
 #include "quat.h"
 
-/* C before C23 will not pass a double[3][3] where a const one is expected
- * without a cast. */
-#define CONST_M3(m) ((const double(*)[3])(m))
 
 typedef struct pd_body {
     double mass;          /* kg, at density 1 kg/m^3: the volume, m^3 */

@@ -207,13 +207,6 @@ static void inv_inertia_world(const pd_body *b, pd_quat q, double J[3][3])
         }
 }
 
-static pd_vec3 mat_vec(const double M[3][3], pd_vec3 v)
-{
-    return v3(M[0][0] * v.x + M[0][1] * v.y + M[0][2] * v.z,
-              M[1][0] * v.x + M[1][1] * v.y + M[1][2] * v.z,
-              M[2][0] * v.x + M[2][1] * v.y + M[2][2] * v.z);
-}
-
 /* Solves K p = b for symmetric positive definite K (Cramer's rule: K is
  * 3 x 3 and well conditioned, its eigenvalues within a few units of 1/m). */
 static pd_vec3 solve3(const double K[3][3], pd_vec3 b)
@@ -289,7 +282,7 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
             return st;
         }
         s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
-        ww = v3_add(ww, mat_vec(CONST_M3(J), v3_cross(c, res.p)));
+        ww = v3_add(ww, m3_vec(CONST_M3(J), v3_cross(c, res.p)));
         s->w = quat_rotate_inv(s->q, ww);
         (*impacts)++;
     }

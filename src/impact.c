@@ -17,14 +17,11 @@
 #include "gsl_adapter.h"
 #include "impact.h"
 #include "posedrop/tolerances.h"
+#include "mat3.h"
 #include "vec3.h"
 
 /* State of the sliding ODE: the impulse so far, and the normal work W. */
 enum { PX, PY, PW, PZ, NSTATE };
-
-/* C before C23 will not pass a double[3][3] where a const one is expected
- * without a cast. */
-#define CK(m) ((const double(*)[3])(m))
 
 struct pd_impact_work {
     pd_ode *ode;
@@ -51,12 +48,6 @@ void pd_impact_work_free(pd_impact_work *w)
     free(w);
 }
 
-static pd_vec3 mat_vec(const double K[3][3], pd_vec3 p)
-{
-    return v3(K[0][0] * p.x + K[0][1] * p.y + K[0][2] * p.z,
-              K[1][0] * p.x + K[1][1] * p.y + K[1][2] * p.z,
-              K[2][0] * p.x + K[2][1] * p.y + K[2][2] * p.z);
-}
 
 void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3][3])
 {
@@ -143,7 +134,7 @@ typedef struct {
 
 static pd_vec3 coll_u(const collision *c, const double y[])
 {
-    return v3_add(c->u0, mat_vec(c->K, v3(y[PX], y[PY], y[PZ])));
+    return v3_add(c->u0, m3_vec(c->K, v3(y[PX], y[PY], y[PZ])));
 }
 
 /* Eq. 14 in a rescaled parameter tau with dpz/dtau = |u_t|: the state
@@ -200,7 +191,7 @@ static void linear_advance(collision *c, pd_vec3 d, double q, double uz, double 
  * v = (-mu t, 1), since t.a > mu t'Bt there. */
 static void linear_phase(collision *c, pd_vec3 d)
 {
-    double q = mat_vec(CK(c->K), d).z;
+    double q = m3_vec(CONST_M3(c->K), d).z;
     if (!(q > 0.0))
         return; /* cannot happen for SPD K (above); the caller's output check stops it */
     if (!c->compressed) {
@@ -291,7 +282,7 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
         /* Newton predictions of the next events, from the slopes in tau:
          * d/dtau = |u_t| d/dpz, and in pz, u' = K (-mu t, 1). */
         double tx = u.x / s, ty = u.y / s;
-        pd_vec3 du = mat_vec(CK(c->K), v3(-c->mu * tx, -c->mu * ty, 1.0));
+        pd_vec3 du = m3_vec(CONST_M3(c->K), v3(-c->mu * tx, -c->mu * ty, 1.0));
         double hlim = INFINITY;
         int ev = EV_NONE;
         if (!c->compressed && du.z > 0.0 && -u.z / (s * du.z) < hlim) {
@@ -444,7 +435,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
     } else {
         pd_status st = PD_OK;
         double th;
-        if (pd_impact_diverging_ray(CK(c.K), mu, &th) == PD_OK) {
+        if (pd_impact_diverging_ray(CONST_M3(c.K), mu, &th) == PD_OK) {
             c.have_ray = 1;
             c.rtx = cos(th);
             c.rty = sin(th);
@@ -456,7 +447,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         if (!c.done) {
             pd_vec3 d;
             r.stuck = !c.on_ray;
-            if (!c.on_ray && stick_direction(CK(c.K), mu, &d)) {
+            if (!c.on_ray && stick_direction(CONST_M3(c.K), mu, &d)) {
                 r.stick_stable = 1;
             } else {
                 if (!c.have_ray)
@@ -471,7 +462,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
 
     double pscale = uscale / kscale;
     r.p = v3_scale(v3(c.y[PX], c.y[PY], c.y[PZ]), pscale);
-    r.u1 = v3_add(u0, mat_vec(K, r.p));
+    r.u1 = v3_add(u0, m3_vec(K, r.p));
     r.pz_c = c.pz_c * pscale;
     r.dke = 0.5 * v3_dot(r.p, v3_add(u0, r.u1));
     r.energy_gain = r.dke > PD_TOL_IMPACT_ENERGY_REL * v3_norm(r.p) * uscale;
