@@ -40,6 +40,7 @@ struct pd_engine_world {
     dBodyID body;
     dGeomID convex, plane;
     dJointGroupID contacts;
+    dThreadingImplementationID threading;
     /* dCreateConvex keeps pointers to these: they live as long as the geom. */
     dReal *planes;
     dReal *points;
@@ -92,6 +93,8 @@ static void world_free(pd_engine_world *w)
         dSpaceDestroy(w->space);
     if (w->world)
         dWorldDestroy(w->world); /* also destroys the body */
+    if (w->threading)
+        dThreadingFreeImplementation(w->threading);
     free(w->planes);
     free(w->points);
     free(w->polygons);
@@ -180,8 +183,15 @@ static pd_engine_world *world_alloc(const pd_body *body, const pd_hull *hull,
     w->world = dWorldCreate();
     w->space = w->world ? dSimpleSpaceCreate(0) : NULL;
     w->contacts = w->space ? dJointGroupCreate(0) : NULL;
-    if (!w->contacts)
+    /* Without one of its own, a world steps on ODE's process-wide default
+     * threading object, whose fake locks assert when two threads step at
+     * once (measured: "assertion failed in WaitWakeup"). One self-threaded
+     * implementation per world keeps the worlds independent. */
+    w->threading = w->contacts ? dThreadingAllocateSelfThreadedImplementation() : NULL;
+    if (!w->threading)
         goto fail;
+    dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
+                                         w->threading);
     dWorldSetGravity(w->world, 0.0, 0.0, -scene->gravity);
     /* The contacts carry their own erp/cfm; these only matter if a joint
      * without them were ever added. */

@@ -1,6 +1,7 @@
 /* test_engine_ode.c: the ODE backend, step by step: free flight against the
  * closed form, a box resting and landing on each face, toppling off an edge
  * to the side its centre of mass leans to, reset and determinism. */
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 #include "body.h"
@@ -348,6 +349,90 @@ static void test_reset_and_determinism(void)
     teardown(&fx);
 }
 
+/* The contact softness scales with the part: a 1 m box and a 32-gon coin
+ * (32 corners on its big facets, of which PD_ODE_MAX_CONTACTS are kept) rest
+ * flat at the facet's height less at most the sink, like the 1 x 2 x 3 cm
+ * box, and land flat from a drop of a fifth of their size. */
+static void test_scale_and_many_corners(void)
+{
+    pd_mesh *meshes[2] = {mesh_box(1.0, 2.0, 3.0), mesh_prism(32, 0.01, 0.004)};
+    for (int k = 0; k < 2; k++) {
+        fixture fx;
+        if (!setup(&fx, meshes[k]))
+            continue;
+        pd_engine_world *w = world(&fx);
+        const pd_body *b = fx.body;
+        for (int f = 0; w && f < fx.part->hull->nfacets; f++) {
+            double d;
+            pd_vec3 n = facet_normal(&fx, f, &d);
+            /* The box's six faces; the coin's two round faces (normal along
+             * its axis, the principal axis of the largest moment). */
+            if (k == 1 && fabs(n.z) < 0.5)
+                continue;
+            for (int lift = 0; lift <= 1; lift++) {
+                pd_state s = on_facet(&fx, f, lift * 0.2 * b->size);
+                CHECK_STATUS(pd_engine_ode.reset(w, &s), PD_OK);
+                CHECK_STATUS(run(w, &s, 1500), PD_OK);
+                double ct;
+                CHECK_INT(facet_down(&fx, &s, &ct), f);
+                CHECK_NEAR(ct, 1.0, 1e-5, "flat within the sink over the width");
+                CHECK_NEAR(s.x.z, d, PD_ODE_SINK_REL * b->size, "resting height, contact sink");
+                CHECK(s.x.z <= d + 1e-12 * b->size);
+            }
+        }
+        pd_engine_ode.world_free(w);
+        teardown(&fx);
+    }
+}
+
+/* One world per thread: drops stepped in two threads at once give the bytes
+ * the same drop gives alone in this thread. */
+typedef struct {
+    const fixture *fx;
+    pd_state s;
+    pd_status st;
+} thread_job;
+
+static void *thread_drop(void *arg)
+{
+    thread_job *job = arg;
+    job->st = PD_ERR_NOMEM;
+    pd_engine_world *w = pd_engine_ode.world_alloc(job->fx->body, job->fx->part->hull,
+                                                   &job->fx->scene, DT);
+    if (!w)
+        return NULL;
+    job->st = pd_engine_ode.reset(w, &job->s);
+    if (job->st == PD_OK)
+        job->st = run(w, &job->s, 1000);
+    pd_engine_ode.world_free(w);
+    return NULL;
+}
+
+static void test_threads(void)
+{
+    fixture fx;
+    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    pd_state s0 = {v3(0, 0, 0.08), quat_normalize(quat(0.6, -0.2, 0.5, 0.3)), v3(0.05, 0.01, 0),
+                   v3(-4.0, 12.0, 2.0)};
+    thread_job ref = {&fx, s0, PD_OK}, jobs[2] = {{&fx, s0, PD_OK}, {&fx, s0, PD_OK}};
+    thread_drop(&ref);
+    CHECK_STATUS(ref.st, PD_OK);
+    pthread_t t[2];
+    int started[2];
+    for (int i = 0; i < 2; i++)
+        started[i] = pthread_create(&t[i], NULL, thread_drop, &jobs[i]) == 0;
+    for (int i = 0; i < 2; i++) {
+        CHECK(started[i]);
+        if (!started[i])
+            continue;
+        pthread_join(t[i], NULL);
+        CHECK_STATUS(jobs[i].st, PD_OK);
+        CHECK(memcmp(&jobs[i].s, &ref.s, sizeof ref.s) == 0);
+    }
+    teardown(&fx);
+}
+
 void suite_engine_ode(void)
 {
     test_free_fall();
@@ -355,4 +440,6 @@ void suite_engine_ode(void)
     test_flat_release();
     test_topple();
     test_reset_and_determinism();
+    test_scale_and_many_corners();
+    test_threads();
 }
