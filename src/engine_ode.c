@@ -21,6 +21,7 @@
  * diagonally, sees the pyramid's up to sqrt(2) larger corner. */
 #include <math.h>
 #include <pthread.h>
+#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <ode/ode.h>
@@ -31,8 +32,15 @@
 /* Candidate contacts asked of dCollide, from which PD_ODE_MAX_CONTACTS are
  * chosen: ODE's convex-plane test reports the hull vertices under the floor
  * in index order and stops at the buffer's size, so a small buffer would keep
- * the first corners of a facet, not a spread of them. */
+ * the first corners of a facet, not a spread of them. A facet with more than
+ * 64 corners is still spread over only its first 64 (in hull order). */
 enum { ODE_CANDIDATES = 64 };
+
+/* libode-dev is built in double precision (dGetConfiguration reports
+ * ODE_double_precision); the states cross over without conversion and the
+ * tests' round-off bounds assume it. A single-precision ODE would need its
+ * own tolerances, so it is refused at compile time. */
+_Static_assert(sizeof(dReal) == sizeof(double), "ODE must be built with dDOUBLE");
 
 struct pd_engine_world {
     dWorldID world;
