@@ -11,7 +11,7 @@ PKG_CONFIG ?= pkg-config
 # Libraries the project links through pkg-config. Only GSL is used so far;
 # ODE, libccd and Bullet arrive with the dynamic backends. qhull_r is for the
 # tests' and the benchmark's reference hull only, never for libposedrop.
-LIB_PKGS  := gsl
+LIB_PKGS  := gsl ode ccd
 TEST_PKGS := qhull_r
 
 CONFIG := opt
