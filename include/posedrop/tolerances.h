@@ -261,6 +261,31 @@
  * means a caller's bug, e.g. a transposed inertia. */
 #define PD_TOL_IMPACT_K_SYM_REL 1e-12
 
+/* --- engines (the stepping backends that cross-check the simulator) -------- */
+
+/* Bullet's collision margin, times L: its convex shapes are the hull inflated
+ * by a sphere of this radius (Bullet's default, 0.04 m absolute, is four times
+ * a 1 cm part). The adapter lowers the floor plane by the margin, so heights
+ * against the floor are exact whatever its value; what it still moves is the
+ * contact point, m below the true corner, so friction acts on a lever arm off
+ * by m. Why 1e-3: that lever-arm error (1e-3 of the part's size) is far below
+ * the uncertainty of mu itself, while the margin stays ~1e4 times above the
+ * single-precision round-off of Bullet's coordinates (6e-8 L). Larger: friction
+ * torques visibly wrong (1e-1 L is a tenth of the arm); smaller than ~1e-5:
+ * within a few hundred ulps of float coordinates. */
+#define PD_BULLET_MARGIN_REL 1e-3
+
+/* Bullet contacts approaching slower than this many steps of gravity (g dt) do
+ * not bounce (Bullet's restitution velocity threshold, by default 0.2 m/s
+ * absolute, which is 2/3 of the speed of falling a 1 cm part's own size). A
+ * resting contact closes at g dt per step, the velocity one step of gravity
+ * adds; restitution on it would make the part chatter on the floor. Why 2: it
+ * stays clear of that resting speed (and of the solver's residue on it),
+ * while a genuine bounce kept has fallen at least (2 g dt)^2 / 2g = 2 g dt^2,
+ * 2e-5 m at the default 1/960 s. Larger: real low bounces are killed;
+ * smaller: resting contacts chatter. */
+#define PD_BULLET_BOUNCE_STEPS 2.0
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked
