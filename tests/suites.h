@@ -17,6 +17,7 @@
     PD_SUITE(impact) \
     PD_SUITE(drop)   \
     PD_SUITE(sim)    \
+    PD_SUITE(engine_bullet) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);
