@@ -5,13 +5,15 @@
 # own directory under build/, so switching never mixes objects.
 
 CC      ?= cc
+CXX     ?= g++
 PREFIX  ?= /usr/local
 PKG_CONFIG ?= pkg-config
 
-# Libraries the project links through pkg-config. Only GSL is used so far;
-# ODE, libccd and Bullet arrive with the dynamic backends. qhull_r is for the
+# Libraries the project links through pkg-config: GSL (quadrature, ODE
+# stepping, special functions), ODE with libccd and Bullet for the stepping
+# backends (src/engine_ode.c, src/engine_bullet.cpp). qhull_r is for the
 # tests' and the benchmark's reference hull only, never for libposedrop.
-LIB_PKGS  := gsl ode ccd
+LIB_PKGS  := gsl ode ccd bullet
 TEST_PKGS := qhull_r
 
 CONFIG := opt
@@ -38,12 +40,18 @@ WARN := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototyp
 CFLAGS_ALL := -std=c11 -g -pthread $(CFLAGS_OPT) $(WARN) $(CFLAGS_WERROR) -ffp-contract=off \
               -D_DEFAULT_SOURCE -Iinclude -Isrc $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null) \
               $(CFLAGS)
+# The one C++ file (the Bullet adapter). Bullet's headers come in as system
+# headers (-isystem) so their own warnings do not trip WERROR=1.
+CXXFLAGS_ALL := -std=c++17 -g -pthread $(CFLAGS_OPT) -Wall -Wextra $(CFLAGS_WERROR) -ffp-contract=off \
+                -Iinclude -Isrc $(patsubst -I%,-isystem %,$(shell $(PKG_CONFIG) --cflags bullet 2>/dev/null)) \
+                $(CXXFLAGS)
 LDLIBS_LIB := $(shell $(PKG_CONFIG) --libs $(LIB_PKGS) 2>/dev/null) -lm -pthread
 LDLIBS_TEST := $(shell $(PKG_CONFIG) --libs $(TEST_PKGS) 2>/dev/null)
 CFLAGS_TEST := $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/dev/null)
 
 LIB_SRCS   := $(filter-out src/cli.c,$(wildcard src/*.c))
-LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o)
+LIB_CXX_SRCS := $(wildcard src/*.cpp)
+LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 LIB        := $(BUILD)/libposedrop.a
 CLI        := $(BUILD)/posedrop
 TEST_SRCS  := $(filter-out tests/bench.c,$(wildcard tests/*.c))
@@ -63,6 +71,10 @@ $(BUILD)/%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 
+$(BUILD)/src/%.o: src/%.cpp
+	@mkdir -p $(dir $@)
+	$(CXX) $(CXXFLAGS_ALL) -MMD -MP -c $< -o $@
+
 $(BUILD)/tests/%.o: tests/%.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -DPD_CLI_PATH='"$(CLI)"' -MMD -MP -c $< -o $@
@@ -71,18 +83,20 @@ $(BUILD)/bench-%.o: %.c
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -MMD -MP -c $< -o $@
 
+# Binaries link with $(CXX): the archive holds the Bullet adapter, which needs
+# the C++ runtime.
 $(LIB): $(LIB_OBJS)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
 $(CLI): $(BUILD)/src/cli.o $(LIB)
-	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
 
 $(TEST_BIN): $(TEST_OBJS) $(LIB)
-	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
 
 $(BENCH_BIN): $(BENCH_OBJS) $(LIB)
-	$(CC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
 
 # Installs the Debian packages when pkg-config cannot find them (quick no-op
 # otherwise). The targets a new user runs first go through it; their real work

@@ -101,6 +101,8 @@ static long run_batch(batch *b, int nthreads, pd_sim_result *r)
     atomic_store(&b->energy_gain, 0);
     atomic_store(&b->fallbacks, 0);
     atomic_store(&b->failed, 0);
+    /* Zeroed first, padding included, so records compare byte for byte. */
+    memset(b->out, 0, sizeof *b->out * (size_t)(b->last - b->first));
     for (long i = 0; i < b->last - b->first; i++)
         b->out[i].end = (pd_drop_end)-1; /* not run */
     pthread_t tid[256];

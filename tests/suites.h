@@ -19,6 +19,7 @@
     PD_SUITE(sim)    \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
+    PD_SUITE(engine_bullet) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

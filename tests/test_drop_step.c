@@ -56,7 +56,17 @@ static void run_solid(pd_engine_kind engine, int (*solid)(pd_vec3 *), long drops
          * they are counted, and nearly all settle. */
         CHECK(a->unsettled <= drops / 50);
         CHECK(memcmp(a->count, b->count, sizeof *a->count * (size_t)a->nposes) == 0);
-        CHECK(memcmp(a->trials, b->trials, sizeof *a->trials * (size_t)a->n) == 0);
+        /* Field by field: the record's padding is not part of the result. */
+        long differ = 0;
+        for (long i = 0; i < a->n; i++) {
+            const pd_trial *x = &a->trials[i], *y = &b->trials[i];
+            differ += memcmp(x->q0, y->q0, sizeof x->q0) != 0 || x->pose != y->pose ||
+                      x->collisions != y->collisions || x->time != y->time || x->end != y->end;
+        }
+        if (differ)
+            printf("     engine %d: %ld of %ld records differ between 1 and 2 threads\n",
+                   (int)engine, differ, a->n);
+        CHECK_INT(differ, 0);
     }
     pd_sim_result_free(a);
     pd_sim_result_free(b);

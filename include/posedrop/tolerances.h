@@ -261,10 +261,19 @@
  * means a caller's bug, e.g. a transposed inertia. */
 #define PD_TOL_IMPACT_K_SYM_REL 1e-12
 
-/* --- engines (src/engine_ode.c) ------------------------------------------- *
+/* --- engines (src/engine_ode.c, src/engine_bullet.cpp, src/drop_step.c) -- *
  * The stepping engines that cross-check the impulse simulator. Their contacts
  * are soft (a penetration spring) and resolved once per fixed time step, so
  * they need guards the event-driven simulator does not. */
+
+/* A stepping engine's drop ends only when the part lies on the facet of its
+ * basin, tilted less than this from it (and its energy is below the basin's
+ * barrier). Why 1 degree (0.0175 rad): soft contacts let a resting part sink
+ * and rock by a fraction of a degree, so much less would wait for settling
+ * that never comes; the energy test already rules out leaving the basin, and
+ * 1 degree is far below any tilt at which a part could still be on its way
+ * to another pose. */
+#define PD_TOL_REST_TILT 0.0174532925199432958
 
 /* ODE contact points: at most this many per step go to the solver. Three
  * already fix a resting facet; eight spread over the facet (chosen by farthest
@@ -303,6 +312,29 @@
  * spring oscillation on top. */
 #define PD_ODE_DAMPING_RATIO 1.0
 
+/* Bullet's collision margin, times L: its convex shapes are the hull inflated
+ * by a sphere of this radius (Bullet's default, 0.04 m absolute, is four times
+ * a 1 cm part). The adapter lowers the floor plane by the margin, so heights
+ * against the floor are exact whatever its value; what it still moves is the
+ * contact point, m below the true corner, so friction acts on a lever arm off
+ * by m. Why 1e-3: that lever-arm error (1e-3 of the part's size) is far below
+ * the uncertainty of mu itself, while the margin stays ~1e4 times above the
+ * single-precision round-off of Bullet's coordinates (6e-8 L). Larger: friction
+ * torques visibly wrong (1e-1 L is a tenth of the arm); smaller than ~1e-5:
+ * within a few hundred ulps of float coordinates. */
+#define PD_BULLET_MARGIN_REL 1e-3
+
+/* Bullet contacts approaching slower than this many steps of gravity (g dt) do
+ * not bounce (Bullet's restitution velocity threshold, by default 0.2 m/s
+ * absolute, which is 2/3 of the speed of falling a 1 cm part's own size). A
+ * resting contact closes at g dt per step, the velocity one step of gravity
+ * adds; restitution on it would make the part chatter on the floor. Why 2: it
+ * stays clear of that resting speed (and of the solver's residue on it),
+ * while a genuine bounce kept has fallen at least (2 g dt)^2 / 2g = 2 g dt^2,
+ * 2e-5 m at the default 1/960 s. Larger: real low bounces are killed;
+ * smaller: resting contacts chatter. */
+#define PD_BULLET_BOUNCE_STEPS 2.0
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked
@@ -313,16 +345,5 @@
 
 /* Largest polygon a mesh face may have (vertex count of one OFF/OBJ face). */
 #define PD_MAX_FACE_VERTICES 65536
-
-/* --- stepping engines (ODE, Bullet) ---------------------------------------- */
-
-/* A stepping engine's drop ends only when the part lies on the facet of its
- * basin, tilted less than this from it (and its energy is below the basin's
- * barrier). Why 1 degree (0.0175 rad): soft contacts let a resting part sink
- * and rock by a fraction of a degree, so much less would wait for settling
- * that never comes; the energy test already rules out leaving the basin, and
- * 1 degree is far below any tilt at which a part could still be on its way
- * to another pose. */
-#define PD_TOL_REST_TILT 0.0174532925199432958
 
 #endif
