@@ -6,6 +6,7 @@
 # For each part, runs posedrop with the same scene, seed and drops on the three
 # engines and writes DIR/crosscheck.csv with one row per part, pose and engine:
 #   part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled
+# (ms_per_drop: wall-clock time of the whole run on all cores, divided by n).
 # and prints a summary: for each pair of engines the total-variation distance
 # between their distributions and a chi-square test of homogeneity (is the
 # difference larger than sampling noise explains?), and the fraction of

@@ -299,6 +299,35 @@ static void test_dynamic(void)
     free(out);
     free(err);
 
+    /* The stepping engines: same columns, same scene; bad choices refused. */
+    CHECK_INT(run("-n 40 --engine ode --units mm parts/block.stl", &out, &err), 0);
+    const char *cols = "pose,nx,ny,nz,area,height,p_qs,p_pqs,n,count,p,";
+    CHECK(strncmp(out, cols, strlen(cols)) == 0);
+    free(out);
+    free(err);
+    CHECK_INT(run("-n 40 --engine bullet --dt 0.002 --units mm parts/block.stl", &out, &err), 0);
+    CHECK(strstr(out, ",40,") != NULL);
+    free(out);
+    free(err);
+    expect_failure("--engine warp -n 10 parts/cap.off", 2, "--engine");
+    expect_failure("--dt 0 -n 10 --engine ode parts/cap.off", 2, "--dt");
+
+    /* The cross-check script: one CSV for the three engines, a verdict per
+     * pair, drop-by-drop agreement. */
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "scripts/crosscheck.sh -n 40 -o %s/xc -- --units mm parts/block.stl",
+             tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    CHECK(strstr(out, "impulse vs ode: total variation") != NULL);
+    CHECK(strstr(out, "ode vs bullet:") != NULL && strstr(out, "same pose") != NULL);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/xc/crosscheck.csv", tmpdir);
+    char *x = slurp(path);
+    CHECK(x && strncmp(x, "part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled\n", 55) == 0);
+    CHECK(x && strstr(x, "\nblock,1,bullet,40,") != NULL);
+    free(x);
+
     /* A bad scene file names its line and prints nothing. */
     write_file(path, "height = 0.01\nfriction = 2\n");
     snprintf(args, sizeof args, "--scene %s -n 5 parts/cap.off", path);
