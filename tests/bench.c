@@ -5,8 +5,8 @@
  * and the one-thread run), so it means the same on a slow and a fast machine;
  * absolute times are printed beside them for context only. The drops' cost is
  * also set against the issue's fixed target of 50 us per drop. Nothing here
- * passes or fails. `bench_posedrop static hull dynamic` runs only the parts
- * named. */
+ * passes or fails. `bench_posedrop static hull dynamic engines` runs only the
+ * parts named. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -439,7 +439,134 @@ static void bench_dynamic(void)
         dyn_part_free(&parts[k]);
 }
 
-/* Arguments pick parts (static, hull, dynamic); none runs them all. */
+/* --- the engines ----------------------------------------------------------------- *
+ * The issue's last paragraph: ms per drop of each engine on the same parts
+ * (reference: the impulse engine on that part, same process), and how the
+ * distribution moves when the stepping engines' dt is divided by 4. */
+
+enum { ENG_DROPS = 300, CONV_DROPS = 600 };
+static const char *const eng_name[] = {"impulse", "ode", "bullet"};
+static const double eng_dt[] = {0.0, 1e-3, 1.0 / 960.0}; /* drop.c's defaults */
+
+/* One run of engine e at step dt (0: its default), seed 1; *wall and *cpu get
+ * seconds per drop. */
+static pd_sim_result *eng_run(const dyn_part *d, int e, double dt, long n, int threads,
+                              double *wall, double *cpu)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.engine = (pd_engine_kind)e;
+    o.dt = dt;
+    o.ndrops = n;
+    o.seed = 1;
+    o.threads = threads;
+    o.keep_trials = 1;
+    pd_sim_result *r = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    double c0 = cpu_now(), t0 = now();
+    if (pd_sim_run(d->part, d->poses, &sc, &o, &r, &diag) != PD_OK) {
+        fprintf(stderr, "bench: %s on %s failed: %s\n", eng_name[e], d->name, diag.message);
+        exit(1);
+    }
+    *wall = (now() - t0) / (double)n;
+    *cpu = (cpu_now() - c0) / (double)n;
+    return r;
+}
+
+static double half_width(const pd_sim_result *r, int k)
+{
+    return fmax(r->ci_hi[k] - r->p[k], r->p[k] - r->ci_lo[k]);
+}
+
+static void bench_engine_cost(dyn_part *parts, int nparts)
+{
+    printf("\nengines, one thread: ms per drop, paper's scene, %d drops, seed 1, best of %d\n",
+           ENG_DROPS, DYN_BEST_OF);
+    printf("reference: the impulse engine on the same part, same process "
+           "(ode dt %g s, bullet dt 1/960 s)\n", eng_dt[1]);
+    printf("%-16s %-8s %10s %9s %10s\n", "part", "engine", "ms/drop", "unsettled", "vs impulse");
+    for (int k = 0; k < nparts; k++) {
+        double t_ref = 0.0;
+        for (int e = 0; e < 3; e++) {
+            double t = 1e300, w, cpu;
+            pd_sim_result *r = NULL;
+            for (int rep = 0; rep < DYN_BEST_OF; rep++) {
+                pd_sim_result_free(r);
+                r = eng_run(&parts[k], e, 0.0, ENG_DROPS, 1, &w, &cpu);
+                t = w < t ? w : t;
+            }
+            t_ref = e == 0 ? t : t_ref;
+            printf("%-16s %-8s %10.3f %9ld %9.2fx\n", e == 0 ? parts[k].name : "",
+                   eng_name[e], 1e3 * t, r->unsettled, t / t_ref);
+            pd_sim_result_free(r);
+        }
+    }
+}
+
+/* Same seed and drops at dt and dt/4 (two threads: outcomes do not depend on
+ * them; the cost ratio is of process CPU time). A pose "moved" if |p(dt/4) -
+ * p(dt)| exceeds the larger 95% half-width of the two runs. */
+static void bench_engine_dt(const dyn_part *d)
+{
+    printf("\nconvergence in dt: %s, paper's scene, %d drops, seed 1, dt vs dt/4\n", d->name,
+           CONV_DROPS);
+    printf("half: the larger 95%% half-width (Wilson, either side) of the two runs\n");
+    for (int e = 1; e < 3; e++) {
+        double w[2], c[2];
+        pd_sim_result *r[2];
+        for (int j = 0; j < 2; j++)
+            r[j] = eng_run(d, e, j ? eng_dt[e] / 4 : 0.0, CONV_DROPS, 2, &w[j], &c[j]);
+        printf("%s: dt %.4g s vs %.4g s (unsettled %ld, %ld)\n", eng_name[e], eng_dt[e],
+               eng_dt[e] / 4, r[0]->unsettled, r[1]->unsettled);
+        printf("  %4s %8s %8s %8s %8s\n", "pose", "p(dt)", "p(dt/4)", "diff", "half");
+        double tv = 0.0, worst = 0.0, worst_h = 0.0;
+        int bad = -1;
+        for (int k = 0; k < d->poses->nposes; k++) {
+            double diff = r[1]->p[k] - r[0]->p[k], h = fmax(half_width(r[0], k), half_width(r[1], k));
+            tv += 0.5 * fabs(diff);
+            printf("  %4d %8.4f %8.4f %+8.4f %8.4f%s\n", k, r[0]->p[k], r[1]->p[k], diff, h,
+                   fabs(diff) > h ? "  moved" : "");
+            if (fabs(diff) > h && fabs(diff) - h > worst - worst_h) {
+                bad = k;
+                worst = fabs(diff);
+                worst_h = h;
+            }
+        }
+        long changed = 0;
+        for (long i = 0; i < r[0]->n; i++)
+            changed += r[0]->trials[i].pose != r[1]->trials[i].pose;
+        printf("  total variation %.4f; drops ending elsewhere %ld of %ld; cost dt/4 vs dt %.2fx "
+               "(cpu %.2f vs %.2f ms/drop)\n", tv, changed, r[0]->n, c[1] / c[0], 1e3 * c[1],
+               1e3 * c[0]);
+        if (bad < 0)
+            printf("  %s: converged (every pose moved less than its interval)\n", eng_name[e]);
+        else
+            printf("  %s: NOT converged: pose %d moved by %.4f, more than its interval %.4f\n",
+                   eng_name[e], bad, worst, worst_h);
+        pd_sim_result_free(r[0]);
+        pd_sim_result_free(r[1]);
+    }
+}
+
+static void bench_engines(void)
+{
+    dyn_part parts[3] = {
+        dyn_part_make("cube 1 cm", mesh_box(0.01, 0.01, 0.01)),
+        dyn_part_make("box 1 x 2 x 3 cm", mesh_box(0.01, 0.02, 0.03)),
+        dyn_part_make("coin 32-gon", mesh_prism(32, 0.01, 0.01)),
+    };
+    double t0 = now();
+    bench_engine_cost(parts, 3);
+    bench_engine_dt(&parts[1]);
+    printf("(engines part: %.1f s)\n", now() - t0);
+    for (int k = 0; k < 3; k++)
+        dyn_part_free(&parts[k]);
+}
+
+/* Arguments pick parts (static, hull, dynamic, engines); none runs them all. */
 static int wanted(int argc, char **argv, const char *name)
 {
     if (argc < 2)
@@ -459,5 +586,7 @@ int main(int argc, char **argv)
         bench_hull();
     if (wanted(argc, argv, "dynamic"))
         bench_dynamic();
+    if (wanted(argc, argv, "engines"))
+        bench_engines();
     return 0;
 }
