@@ -62,7 +62,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo install uninstall clean help deps
+.PHONY: all check test bench demo paper install uninstall clean help deps
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI)
@@ -114,6 +114,11 @@ demo: deps
 	@$(MAKE) --no-print-directory all
 	$(CLI) -n 2000 -h 0.12 $(DEMO_PART)
 
+# The paper's Tables 1-4 with posedrop's columns beside them (results/).
+paper: deps
+	@$(MAKE) --no-print-directory all
+	scripts/paper.sh
+
 bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
 	$(BENCH_BIN)
@@ -140,6 +145,7 @@ help:
 	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
+	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"

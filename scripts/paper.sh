@@ -1,0 +1,128 @@
+#!/usr/bin/env bash
+# paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
+# columns beside the paper's.
+#
+#   scripts/paper.sh [-n DROPS] [-o DIR] [-d PAPER_TABLES_CSV]
+#
+# For each of the paper's four parts (parts/<name>.off, rebuilt from the
+# paper's photographs; parts/README.md), runs posedrop's QS and PQS and the
+# three engines with the paper's scene (2000 drops from 0.12 m, belt 0.05 m/s,
+# mu = restitution = 0.3, vibration 1.5 degrees, bootstrapped initial poses),
+# grouped into pose classes as the paper counts them, writes the CSVs under DIR
+# (default results/) and prints each table: the paper's QS, PQS, dynamic and
+# physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
+# eq. (16) error of every column against the physical tests and the total
+# variation distance beside it (eq. 16 weights by the measured p, so mass on
+# poses never observed costs nothing there; total variation counts it).
+# posedrop's classes are matched to the paper's pose numbers by rank of their
+# QS probability, the column the parts were fitted on.
+set -u
+n=2000
+outdir=results
+tables=""
+while [ $# -gt 0 ]; do
+    case "$1" in
+        -n) n=$2; shift 2 ;;
+        -o) outdir=$2; shift 2 ;;
+        -d) tables=$2; shift 2 ;;
+        --help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        *) echo "paper.sh: unknown argument '$1'" >&2; exit 2 ;;
+    esac
+done
+here=$(cd "$(dirname "$0")/.." && pwd)
+bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
+[ -n "$bin" ] || { echo "paper.sh: posedrop not built (run make)" >&2; exit 2; }
+if [ -z "$tables" ]; then
+    for t in "$here/../shared/data/paper-tables.csv" "$here/parts/paper-tables.csv"; do
+        [ -f "$t" ] && { tables=$t; break; }
+    done
+fi
+[ -f "$tables" ] || { echo "paper.sh: the paper's measured tables not found (give -d FILE)" >&2; exit 2; }
+mkdir -p "$outdir" || exit 2
+status=0
+for part in insulator_cap white_button rect_black_button square_black_button; do
+    file="$here/parts/$part.off"
+    [ -f "$file" ] || { echo "paper.sh: $file missing" >&2; status=1; continue; }
+    "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
+    for engine in impulse ode bullet; do
+        start=$(date +%s.%N)
+        "$bin" --group -n "$n" --initial bootstrap --engine "$engine" "$file" \
+            > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
+        end=$(date +%s.%N)
+        awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f\n", b - a }' > "$outdir/$part.$engine.seconds"
+    done
+    # One table: paper columns by pose number, posedrop's by class rank in QS.
+    awk -F, -v part="$part" -v outdir="$outdir" '
+        function load(file, key,    line, i, c, k) {
+            k = 0
+            while ((getline line < file) > 0) {
+                split(line, f, ",")
+                if (!c["pose"]) { for (i = 1; i in f; i++) c[f[i]] = i; continue }
+                k++
+                qs[key, k] = f[c["p_qs"]]; pqs[key, k] = f[c["p_pqs"]]
+                dyn[key, k] = ("p" in c) ? f[c["p"]] : ""
+            }
+            close(file); delete c
+            return k
+        }
+        # Ranks of the classes by descending QS (ties by class number).
+        function rank(key, k,    i, j, t) {
+            for (i = 1; i <= k; i++) order[key, i] = i
+            for (i = 1; i <= k; i++) for (j = i + 1; j <= k; j++)
+                if (qs[key, order[key, j]] > qs[key, order[key, i]]) {
+                    t = order[key, i]; order[key, i] = order[key, j]; order[key, j] = t }
+        }
+        BEGIN {
+            ks = load(outdir "/" part ".static.csv", "s"); rank("s", ks)
+            split("impulse ode bullet", eng, " ")
+            for (e = 1; e <= 3; e++) { ke[e] = load(outdir "/" part "." eng[e] ".csv", eng[e]); rank(eng[e], ke[e]) }
+        }
+        NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
+        $col["part"] == part {
+            np++; p = $col["pose"]
+            paper[p, 1] = $col["p_qs"] / 100; paper[p, 2] = $col["p_pqs"] / 100
+            paper[p, 3] = $col["p_dynamic"] / 100; phys[p] = $col["p_physical"] / 100
+            trials = $col["physical_trials"]
+        }
+        END {
+            printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d)\n", part, trials, ks, np
+            printf "%4s | %6s %6s %6s %6s | %6s %6s %7s %6s %6s\n", "pose", "QS", "PQS", "Dyn", "Phys",
+                   "QS", "PQS", "impulse", "ODE", "Bullet"
+            for (p = 1; p <= np; p++) {
+                ours[p, 1] = p <= ks ? qs["s", order["s", p]] : 0
+                ours[p, 2] = p <= ks ? pqs["s", order["s", p]] : 0
+                # The engines rank their own classes by QS too: same order.
+                for (e = 1; e <= 3; e++) ours[p, 2 + e] = p <= ke[e] ? dyn[eng[e], order[eng[e], p]] : 0
+                printf "%4d | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f %7.1f %6.1f %6.1f\n", p,
+                       100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p],
+                       100 * ours[p, 1], 100 * ours[p, 2], 100 * ours[p, 3], 100 * ours[p, 4], 100 * ours[p, 5]
+            }
+            # Mass posedrop puts on classes beyond the paper count goes to TV.
+            for (c = 1; c <= 5; c++) { extra[c] = 0 }
+            for (p = np + 1; p <= ks; p++) {
+                extra[1] += qs["s", order["s", p]]; extra[2] += pqs["s", order["s", p]]
+                for (e = 1; e <= 3; e++) if (p <= ke[e]) extra[2 + e] += dyn[eng[e], order[eng[e], p]]
+            }
+            printf "%4s |", "e16"
+            for (c = 1; c <= 3; c++) printf " %6.1f", err16(paper, c, np)
+            printf " %6s |", "-"
+            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), err16(ours, c, np)
+            printf "\n%4s |", "TV"
+            for (c = 1; c <= 3; c++) printf " %6.1f", tv(paper, c, np, 0)
+            printf " %6s |", "-"
+            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), tv(ours, c, np, extra[c])
+            printf "\n"
+        }
+        function err16(a, c, n,    p, s) { s = 0; for (p = 1; p <= n; p++) s += phys[p] * abs(a[p, c] - phys[p]); return 100 * s }
+        function tv(a, c, n, rest,    p, s) { s = rest; for (p = 1; p <= n; p++) s += abs(a[p, c] - phys[p]); return 50 * s }
+        function abs(x) { return x < 0 ? -x : x }
+    ' "$tables" | tee "$outdir/$part.table.txt"
+done
+printf '\nseconds per run (%d drops):' "$n"
+for part in insulator_cap white_button rect_black_button square_black_button; do
+    for engine in impulse ode bullet; do
+        [ -f "$outdir/$part.$engine.seconds" ] && printf ' %s/%s %s' "$part" "$engine" "$(cat "$outdir/$part.$engine.seconds")"
+    done
+done
+printf '\n'
+exit $status
