@@ -1,6 +1,7 @@
 #!/bin/sh
 # Installs the Debian packages posedrop builds and tests with, when pkg-config
-# (or, for the reference hull, the qhull command) cannot find them.
+# (or, for the reference hull, the qhull command) cannot find them, and any
+# further packages named as arguments that are not installed.
 # Quiet and quick when everything is present. Uses sudo only when not root.
 set -eu
 
@@ -17,6 +18,10 @@ check_pc ccd libccd-dev
 check_pc bullet libbullet-dev
 check_pc qhull_r libqhull-dev
 command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
+# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart).
+for pkg in "$@"; do
+    dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
+done
 
 [ -z "$missing" ] && exit 0
 

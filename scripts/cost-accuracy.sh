@@ -1,0 +1,101 @@
+#!/usr/bin/env bash
+# cost-accuracy.sh: what accuracy costs in time, per estimator, on the paper's
+# four parts.
+#
+#   scripts/cost-accuracy.sh [-o DIR] [-s SEEDS] [-d PAPER_TABLES_CSV]
+#
+# Runs QS and PQS, the impulse simulator at n = 50 ... 5000 drops with SEEDS
+# seeds (default 3), and ODE and Bullet at three time steps (1000 drops), all
+# with the paper's scene and bootstrapped initial poses, grouped into pose
+# classes; records CPU seconds (user + system, all threads) and the eq. (16)
+# error (and total variation) against the physical tests in
+# DIR/cost-accuracy.csv (default results/), and draws error against time on a
+# log axis, one series per estimator, error bars over seeds, in
+# DIR/cost-accuracy.png and .svg (gnuplot; installed if missing).
+set -u
+outdir=results
+seeds=3
+tables=""
+while [ $# -gt 0 ]; do
+    case "$1" in
+        -o) outdir=$2; shift 2 ;;
+        -s) seeds=$2; shift 2 ;;
+        -d) tables=$2; shift 2 ;;
+        --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        *) echo "cost-accuracy.sh: unknown argument '$1'" >&2; exit 2 ;;
+    esac
+done
+here=$(cd "$(dirname "$0")/.." && pwd)
+bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
+[ -n "$bin" ] || { echo "cost-accuracy.sh: posedrop not built (run make)" >&2; exit 2; }
+if [ -z "$tables" ]; then
+    for t in "$here/../shared/data/paper-tables.csv" "$here/parts/paper-tables.csv"; do
+        [ -f "$t" ] && { tables=$t; break; }
+    done
+fi
+[ -f "$tables" ] || { echo "cost-accuracy.sh: the paper's tables not found (give -d FILE)" >&2; exit 2; }
+mkdir -p "$outdir" || exit 2
+csv="$outdir/cost-accuracy.csv"
+tmp="$outdir/.cost-run.csv"
+echo "part,estimator,budget,seed,cpu_s,e16,tv" > "$csv"
+TIMEFORMAT='%3U %3S'
+
+# run PART ESTIMATOR BUDGET SEED COLUMN POSEDROP-ARGS...: one row of the CSV.
+run() {
+    local part=$1 est=$2 budget=$3 seed=$4 column=$5; shift 5
+    local t
+    t=$( { time "$bin" --group "$@" "$here/parts/$part.off" > "$tmp" 2>/dev/null; } 2>&1 ) || return 1
+    local cpu; cpu=$(echo "$t" | awk '{ print $1 + $2 }')
+    local err; err=$(awk -F, -v part="$part" -v column="$column" -f "$here/scripts/eq16.awk" "$tables" "$tmp")
+    echo "$part,$est,$budget,$seed,$cpu,${err% *},${err#* }" >> "$csv"
+}
+
+for part in insulator_cap white_button rect_black_button square_black_button; do
+    run "$part" QS 0 1 p_qs || continue
+    run "$part" PQS 0 1 p_pqs
+    for n in 50 100 200 500 1000 2000 5000; do
+        for s in $(seq 1 "$seeds"); do
+            run "$part" impulse "$n" "$s" p -n "$n" --seed "$s" --initial bootstrap
+        done
+    done
+    for dt in 0.002 0.001 0.0005; do
+        run "$part" ODE "$dt" 1 p -n 1000 --engine ode --dt "$dt" --initial bootstrap
+    done
+    for dt in 0.0021 0.00104 0.00052; do
+        run "$part" Bullet "$dt" 1 p -n 1000 --engine bullet --dt "$dt" --initial bootstrap
+    done
+    echo "cost-accuracy.sh: $part done" >&2
+done
+rm -f "$tmp"
+
+# Mean and spread over seeds per (part, estimator, budget), then the chart.
+awk -F, 'NR > 1 { k = $1 FS $2 FS $3; n[k]++; t[k] += $5; e[k] += $6; e2[k] += $6 * $6 }
+    END { for (k in n) { m = e[k] / n[k]; v = e2[k] / n[k] - m * m
+          printf "%s,%.6g,%.6g,%.6g\n", k, t[k] / n[k], m, sqrt(v > 0 ? v : 0) } }' "$csv" |
+    sort -t, -k1,1 -k2,2 -k4,4g > "$outdir/cost-accuracy-mean.csv"
+command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||
+    { echo "cost-accuracy.sh: gnuplot missing; $csv written, no chart" >&2; exit 1; }
+for term in png svg; do
+    gnuplot <<GP
+set datafile separator ","
+set terminal ${term} size 1100,800 $( [ "$term" = png ] && echo "font ',10'" )
+set output "$outdir/cost-accuracy.${term}"
+set multiplot layout 2,2 title "What accuracy costs: eq. (16) error against the physical tests vs CPU time (paper's four parts)"
+set logscale x
+set format x "10^{%T}"
+set xlabel "CPU seconds (all threads)"
+set ylabel "eq. (16) error, %"
+set key top right
+set grid
+do for [p in "insulator_cap white_button rect_black_button square_black_button"] {
+    set title p
+    plot "< grep '^".p.",QS,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 7 ps 1.5 title "QS", \
+         "< grep '^".p.",PQS,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 5 ps 1.5 title "PQS", \
+         "< grep '^".p.",impulse,' $outdir/cost-accuracy-mean.csv" using 4:5:6 with yerrorlines pt 9 title "impulse (n = 50..5000, +-1 sd over seeds)", \
+         "< grep '^".p.",ODE,' $outdir/cost-accuracy-mean.csv" using 4:5 with linespoints pt 11 title "ODE (dt 2, 1, 0.5 ms)", \
+         "< grep '^".p.",Bullet,' $outdir/cost-accuracy-mean.csv" using 4:5 with linespoints pt 13 title "Bullet (dt 2.1, 1.04, 0.52 ms)"
+}
+unset multiplot
+GP
+done
+echo "wrote $csv, $outdir/cost-accuracy.png and .svg" >&2
