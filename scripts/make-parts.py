@@ -12,14 +12,16 @@ from a few named dimensions (millimetres; the OFF files are written in metres):
 
 Usage:
   scripts/make-parts.py                 write the four OFF files from DIMS below
-  scripts/make-parts.py --set cap.H=14  change a dimension for this run
+  scripts/make-parts.py --set insulator_cap.H=14 change a dimension for this run
   scripts/make-parts.py --report        also print posedrop's QS per pose class
                                         against the paper's QS column
-  scripts/make-parts.py --fit [PART..]  search the FIT dimensions of each part
+  scripts/make-parts.py --fit [PART..] [--save]
+                                        search the FIT dimensions of each part
                                         (coarse grid, then Nelder-Mead) so that
                                         posedrop's grouped QS column matches the
                                         paper's; prints the fitted DIMS and writes
-                                        the OFF files from them
+                                        the OFF files from them; --save also
+                                        writes them into DIMS below
 
 Only the QS column is used for fitting (QS depends only on the hull and the
 centre of mass); PQS and the dynamic columns stay out-of-sample predictions.
@@ -32,6 +34,7 @@ import io
 import itertools
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -64,19 +67,19 @@ PAPER_PQS = {
 DIMS = {
     "insulator_cap": {
         "R": 10.0,    # outer radius of the cup body
-        "H": 14.0,    # overall height (closed top at z = H, open end at z = 0)
-        "RL": 11.5,   # radius of the lip at the open end
-        "t": 3.0,     # height of the lip
-        "c": 1.0,     # 45-degree chamfer on the closed end's outer edge
+        "H": 17.035,    # overall height (closed top at z = H, open end at z = 0)
+        "RL": 12.929,   # radius of the lip at the open end
+        "t": 5.488,     # height of the lip
+        "c": 4.897,     # 45-degree chamfer on the closed end's outer edge
         "w": 1.5,     # wall thickness (bore radius R - w)
         "tt": 2.0,    # thickness of the closed end
     },
     "white_button": {
         "R": 10.0,    # cap radius
-        "hc": 6.0,    # cap height
+        "hc": 4.994,    # cap height
         "c": 1.0,     # chamfer on the cap's top edge
-        "rs": 4.0,    # stem radius
-        "hs": 6.0,    # stem length below the cap
+        "rs": 4.789,    # stem radius
+        "hs": 7.816,    # stem length below the cap
     },
     "rect_black_button": {
         "a": 16.0,    # cap length (x)
@@ -104,8 +107,8 @@ DIMS = {
 
 FIT = {
     "insulator_cap": [("H", 8.0, 30.0), ("RL", 10.3, 14.0), ("t", 0.5, 12.0),
-                      ("c", 0.2, 4.0)],
-    "white_button": [("hc", 2.0, 14.0), ("rs", 1.5, 8.0), ("hs", 2.0, 16.0)],
+                      ("c", 0.2, 6.0)],
+    "white_button": [("hc", 2.0, 14.0), ("rs", 1.5, 5.0), ("hs", 2.0, 16.0)],
     "rect_black_button": [("b", 5.0, 15.0), ("hc", 2.0, 10.0),
                           ("hs", 2.0, 12.0), ("ht", 0.5, 4.0)],
     "square_black_button": [("k", 0.5, 4.0), ("hc", 2.0, 10.0),
@@ -509,15 +512,39 @@ def report(name, d, tmpdir):
     print()
 
 
+def save_dims(dims):
+    """Rewrite the values of the DIMS block of this script (comments kept)."""
+    path = os.path.abspath(__file__)
+    out, part, inside = [], None, False
+    with open(path) as fp:
+        for line in fp:
+            if line.startswith("DIMS = {"):
+                inside = True
+            elif inside and line.startswith("}"):
+                inside = False
+            elif inside:
+                m = re.match(r'    "(\w+)": \{', line)
+                if m:
+                    part = m.group(1)
+                m = re.match(r'(        "(\w+)": )([-0-9.e]+)(,.*)$', line, re.S)
+                if m and part in dims:
+                    line = "%s%r%s" % (m.group(1), dims[part][m.group(2)], m.group(4))
+            out.append(line)
+    with open(path, "w") as fp:
+        fp.write("".join(out))
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--fit", nargs="*", metavar="PART",
                     help="fit these parts (all when none is named)")
     ap.add_argument("--set", action="append", default=[], metavar="PART.DIM=MM",
                     help="override a dimension, e.g. insulator_cap.H=14")
+    ap.add_argument("--save", action="store_true",
+                    help="with --fit: write the fitted values into DIMS in this script")
     ap.add_argument("--report", action="store_true",
                     help="print posedrop's grouped QS against the paper's")
-    ap.add_argument("--grid", type=int, default=6, help="grid points per dimension (6)")
+    ap.add_argument("--grid", type=int, default=8, help="grid points per dimension (8)")
     ap.add_argument("--starts", type=int, default=3,
                     help="Nelder-Mead starts from the best grid points (3)")
     ap.add_argument("--outdir", default=os.path.join(ROOT, "parts"))
@@ -543,6 +570,8 @@ def main():
             for name in DIMS:
                 print('    "%s": %r,' % (name, dims[name]))
             print("}")
+            if args.save:
+                save_dims(dims)
         for name in DIMS:
             make(name, dims[name], os.path.join(args.outdir, name + ".off"))
         if args.report or args.fit is not None:
