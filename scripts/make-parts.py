@@ -83,14 +83,14 @@ DIMS = {
     },
     "rect_black_button": {
         "a": 16.0,    # cap length (x)
-        "b": 8.0,     # cap width (y)
-        "hc": 4.0,    # cap height
+        "b": 10.347,     # cap width (y)
+        "hc": 8.743,    # cap height
         "sa": 6.0,    # stem length (x)
         "sb": 4.0,    # stem width (y)
-        "hs": 5.0,    # stem height below the cap
+        "hs": 2.241,    # stem height below the cap
         "ta": 12.0,   # raised top (step) length (x)
         "tb": 6.0,    # raised top width (y)
-        "ht": 1.0,    # raised top height
+        "ht": 1.19,    # raised top height
     },
     "square_black_button": {
         "a": 12.0,    # cap side (x and y)
