@@ -94,14 +94,14 @@ DIMS = {
     },
     "square_black_button": {
         "a": 12.0,    # cap side (x and y)
-        "k": 2.0,     # corner chamfer of the cap (octagonal outline)
-        "hc": 5.0,    # cap height
-        "sa": 6.0,    # stem length (x)
-        "sb": 4.0,    # stem width (y)
-        "hs": 6.0,    # stem height below the flange
-        "fa": 9.0,    # flange length (x) between stem and cap
-        "fb": 7.0,    # flange width (y)
-        "hf": 1.0,    # flange thickness
+        "k": 3.673,     # corner chamfer of the cap (octagonal outline)
+        "hc": 2.189,    # cap height
+        "sa": 5.5,    # stem length (x)
+        "sb": 3.2,    # stem width (y)
+        "hs": 3.617,    # stem height below the flange
+        "fa": 7.7,    # flange length (x) between stem and cap
+        "fb": 8.2,    # flange width (y)
+        "hf": 0.721,    # flange thickness
     },
 }
 
