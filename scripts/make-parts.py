@@ -67,10 +67,10 @@ PAPER_PQS = {
 DIMS = {
     "insulator_cap": {
         "R": 10.0,    # outer radius of the cup body
-        "H": 17.035,    # overall height (closed top at z = H, open end at z = 0)
-        "RL": 12.929,   # radius of the lip at the open end
-        "t": 5.488,     # height of the lip
-        "c": 4.897,     # 45-degree chamfer on the closed end's outer edge
+        "H": 17.113,    # overall height (closed top at z = H, open end at z = 0)
+        "RL": 10.432,   # radius of the lip at the open end
+        "t": 9.412,     # height of the lip
+        "c": 5.965,     # 45-degree chamfer on the closed end's outer edge
         "w": 1.5,     # wall thickness (bore radius R - w)
         "tt": 2.0,    # thickness of the closed end
     },
@@ -224,14 +224,43 @@ def check_nested(outer, inner, what):
 # the dimensions do not make a valid shape.
 
 
+def inside_profile(outer, r, z, margin):
+    """(r, z) lies inside the closed (r, z) polygon outer (closed through the
+    axis), at least margin from each of its edges."""
+    poly = outer + [(0.0, outer[-1][1]), outer[0]]
+    crossings = 0
+    for (r0, z0), (r1, z1) in zip(poly, poly[1:]):
+        if (z0 > z) != (z1 > z) and r < r0 + (z - z0) * (r1 - r0) / (z1 - z0):
+            crossings += 1
+        dr, dz = r1 - r0, z1 - z0
+        L2 = dr * dr + dz * dz
+        u = 0.0 if L2 == 0 else max(0.0, min(1.0, ((r - r0) * dr + (z - z0) * dz) / L2))
+        if math.hypot(r - r0 - u * dr, z - z0 - u * dz) < margin and r0 + r1 > 0:
+            return False
+    return crossings % 2 == 1
+
+
 def build_insulator_cap(d):
     R, H, RL, t, c, w, tt = (d[k] for k in ("R", "H", "RL", "t", "c", "w", "tt"))
-    if not (0 < c < R - w and RL > R and 0 < t < H - c and tt < H - 0.5
+    if not (0 < c < R and RL > R and 0 < t < H - c and 0 < tt < H - 1.0
             and 0 < w < R):
         raise ValueError("insulator_cap: inconsistent dimensions")
-    profile = [(0.0, H), (R - c, H), (R, H - c), (R, t), (RL, t), (RL, 0.0),
-               (R - w, 0.0), (R - w, H - tt), (0.0, H - tt)]
-    return revolve(profile)
+    outer = [(0.0, H), (R - c, H), (R, H - c), (R, t), (RL, t), (RL, 0.0)]
+    # the bore: radius R - w, its closed end tt below the top; where the
+    # chamfer comes closer than the wall, the bore's corner is chamfered
+    # parallel to it (a 45-degree line w inside the chamfer)
+    rb, zb = R - w, H - tt
+    k = R + H - c - w * math.sqrt(2.0)  # inner chamfer line r + z = k
+    if rb + zb > k:
+        inner = [(rb, 0.0), (rb, k - rb), (k - zb, zb), (0.0, zb)]
+    else:
+        inner = [(rb, 0.0), (rb, zb), (0.0, zb)]
+    for r, z in inner[1:]:
+        if r > 0 and not inside_profile(outer, r, z, 0.5 * w):
+            raise ValueError("insulator_cap: the bore breaks through the wall")
+    if inner[-2][0] <= 0 or k - rb <= 0:
+        raise ValueError("insulator_cap: the bore breaks through the wall")
+    return revolve(outer + inner)
 
 
 def build_white_button(d):
@@ -289,8 +318,8 @@ BUILDERS = {
 }
 
 DESCRIPTION = {
-    "insulator_cap": "insulator cap: closed-end cylindrical cup (hollow), chamfered "
-                     "closed end, lip at the open end; %d-sided solid of revolution" % NSEG,
+    "insulator_cap": "insulator cap: closed-end cylindrical cup (hollow, wall w), "
+                     "chamfered closed end, lip at the open end; %d-sided solid of revolution" % NSEG,
     "white_button": "large white stereo pushbutton: solid round cap with a chamfered "
                     "top edge on a smaller round stem; %d-sided solid of revolution" % NSEG,
     "rect_black_button": "rectangular black stereo button: rectangular cap with a "
