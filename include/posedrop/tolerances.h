@@ -109,6 +109,23 @@
  * transfers, above what GSL's 21-point rule reaches on smooth integrands. */
 #define PD_TOL_BAND_QUAD_REL 1e-10
 
+/* Pose classes (src/symmetry.c): a rotation about the centre of mass maps the
+ * hull onto itself when every vertex lands within this distance (times L) of
+ * a vertex; the candidate rotations are found by matching distances from the
+ * centre and between two reference vertices to the same accuracy, and two
+ * poses of one class must rest at heights this close. Why 1e-5: a symmetric
+ * part read from a file carries the file's print noise, up to 5e-7 L per
+ * coordinate for 6 significant digits (see PD_TOL_PROB_TIE_REL), and its
+ * computed centre of mass a similar amount; distances between two such points
+ * and the rotation they define add a few of these, and a reference pair that
+ * is close to collinear with the centre amplifies them a few times more: 1e-5
+ * leaves a margin of ~5 over that. A genuine asymmetry of 1e-5 L (1 um on a
+ * 10 cm part) is below what is manufactured or what any drop could tell
+ * apart. Larger: features that differ by a hundredth of a millimetre would be
+ * merged as symmetric. Smaller: 6-digit files of symmetric parts would lose
+ * their symmetry. */
+#define PD_TOL_SYMMETRY_REL 1e-5
+
 /* --- output ----------------------------------------------------------------- */
 
 /* Printed unit-normal components and probabilities smaller than this in
@@ -342,6 +359,17 @@
  * fails with a parse error, not an out-of-memory. 2^26 = 67M elements is ten
  * times the largest CAD meshes users feed to a pose estimator. */
 #define PD_MAX_ELEMENTS (1 << 26)
+
+/* The symmetry search tries every image of a reference pair of hull vertices
+ * among the vertices at the same distances from the centre of mass: |A| x |B|
+ * pairs, each then checked in time ~ the vertex count. Past this many pairs the
+ * search is skipped with a warning and poses are not grouped (only the
+ * identity). Why 2^26 (67M): a 2000-gon prism, whose 4000 vertices all sit at
+ * one radius, needs 1.6e7, a fraction of a second of distance tests; a
+ * finely tessellated sphere of 10^4 vertices at one radius (1e8 pairs, and
+ * thousands of near-matches to check) would take minutes for a symmetry it
+ * almost certainly lacks. */
+#define PD_SYMMETRY_MAX_PAIRS (1L << 26)
 
 /* Largest polygon a mesh face may have (vertex count of one OFF/OBJ face). */
 #define PD_MAX_FACE_VERTICES 65536
