@@ -8,6 +8,7 @@
  * kept if it sends every vertex onto a distinct vertex. Both frames are built
  * right-handed, so only proper rotations come out: a mirror image of the part
  * is a different part on the floor. */
+#include <limits.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,10 +19,11 @@
 #include "vec3.h"
 
 /* --- vertex lookup ------------------------------------------------------------ *
- * A hash of grid cells of side 2 tol: a vertex within tol of a point lies in
- * the point's cell or one of its 26 neighbours. Coordinates are relative to
- * the centre and at most the size L, so cell indices stay below L / (2 tol) =
- * 5e4, well inside the 21 bits each gets in the key. */
+ * A hash of grid cells of side 4 tol; a lookup visits the cells that meet the
+ * cube of half-side tol around the point, 1.5 per axis on average (3.4 in
+ * all, against 27 for cells of side tol). Coordinates are relative to the
+ * centre and at most the size L, so cell indices stay below L / (4 tol) =
+ * 2.5e4, well inside the 21 bits each gets in the key. */
 
 enum { KEY_BITS = 21 };
 
@@ -80,7 +82,7 @@ static void vgrid_free(vgrid *g)
 static int vgrid_build(vgrid *g, const pd_vec3 *w, int n, double tol)
 {
     memset(g, 0, sizeof *g);
-    g->cell = 2.0 * tol;
+    g->cell = 4.0 * tol;
     g->n = n;
     g->w = w;
     size_t nslots = 16;
@@ -123,13 +125,16 @@ static int vgrid_build(vgrid *g, const pd_vec3 *w, int n, double tol)
 /* The vertex nearest to x within tol, or -1. */
 static int vgrid_nearest(const vgrid *g, pd_vec3 x, double tol)
 {
-    int64_t ci = cell_of(x.x, g->cell), cj = cell_of(x.y, g->cell), ck = cell_of(x.z, g->cell);
+    int64_t lo[3] = {cell_of(x.x - tol, g->cell), cell_of(x.y - tol, g->cell),
+                     cell_of(x.z - tol, g->cell)};
+    int64_t hi[3] = {cell_of(x.x + tol, g->cell), cell_of(x.y + tol, g->cell),
+                     cell_of(x.z + tol, g->cell)};
     int best = -1;
     double best_d = tol;
-    for (int di = -1; di <= 1; di++)
-        for (int dj = -1; dj <= 1; dj++)
-            for (int dk = -1; dk <= 1; dk++) {
-                uint64_t k = pack(ci + di, cj + dj, ck + dk);
+    for (int64_t ci = lo[0]; ci <= hi[0]; ci++)
+        for (int64_t cj = lo[1]; cj <= hi[1]; cj++)
+            for (int64_t ck = lo[2]; ck <= hi[2]; ck++) {
+                uint64_t k = pack(ci, cj, ck);
                 size_t s = slot_of(k, g->mask);
                 int p = -1;
                 for (; g->slot_first[s] >= 0; s = (s + 1) & g->mask)
@@ -218,7 +223,9 @@ typedef struct {
     double *r;         /* their distances from it */
     int *order;        /* vertex indices by r */
     vgrid grid;
-    int *perm, *used;  /* scratch of the check */
+    int *perm, *used;  /* scratch of the check: used[v] == token marks a vertex
+                          taken by the current candidate, so no clearing */
+    int token;
     double tol;
 } search_ctx;
 
@@ -243,7 +250,7 @@ static int ctx_init(search_ctx *c, const pd_part *part)
     c->r = malloc(sizeof *c->r * n);
     c->order = malloc(sizeof *c->order * n);
     c->perm = malloc(sizeof *c->perm * n);
-    c->used = malloc(sizeof *c->used * n);
+    c->used = calloc(n ? n : 1, sizeof *c->used);
     ranked *tmp = malloc(sizeof *tmp * n);
     if (!c->w || !c->r || !c->order || !c->perm || !c->used || !tmp) {
         free(tmp);
@@ -265,13 +272,16 @@ static int ctx_init(search_ctx *c, const pd_part *part)
 /* Does R send every vertex within tol of a distinct vertex? Fills c->perm. */
 static int check_rotation(search_ctx *c, const double R[3][3])
 {
-    for (int i = 0; i < c->n; i++)
-        c->used[i] = 0;
+    if (c->token == INT_MAX) {
+        memset(c->used, 0, sizeof *c->used * (size_t)c->n);
+        c->token = 0;
+    }
+    int token = ++c->token;
     for (int i = 0; i < c->n; i++) {
         int j = vgrid_nearest(&c->grid, rotate(R, c->w[i]), c->tol);
-        if (j < 0 || c->used[j])
+        if (j < 0 || c->used[j] == token)
             return 0;
-        c->used[j] = 1;
+        c->used[j] = token;
         c->perm[i] = j;
     }
     return 1;
@@ -331,11 +341,11 @@ static int search(search_ctx *c, rotation_fn found, void *user, int *capped, pd_
             b_perp = d;
         }
     }
-    if (b < 0 || (long)a_count * (long)b_count > PD_SYMMETRY_MAX_PAIRS) {
+    if (b < 0 || (long long)a_count * b_count > PD_SYMMETRY_MAX_PAIRS) {
         *capped = 1;
-        pd_warn(diag, "symmetry search skipped: %ld candidate images of the reference vertices "
+        pd_warn(diag, "symmetry search skipped: %lld candidate images of the reference vertices "
                       "exceed the limit of %ld; poses are not grouped",
-                (long)a_count * (long)b_count, (long)PD_SYMMETRY_MAX_PAIRS);
+                (long long)a_count * b_count, (long)PD_SYMMETRY_MAX_PAIRS);
         return 1;
     }
 
@@ -450,6 +460,10 @@ static int image_facet(class_ctx *k, int f, const int *perm)
 {
     const pd_hull *h = k->hull;
     int s = h->facet_start[f], e = h->facet_start[f + 1];
+    if (k->token == INT_MAX) {
+        memset(k->stamp, 0, sizeof *k->stamp * (size_t)h->nverts);
+        k->token = 0;
+    }
     int token = ++k->token;
     for (int i = s; i < e; i++)
         k->stamp[perm[h->facet_vert[i]]] = token;
@@ -526,7 +540,7 @@ pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int 
             k.vf_start[h->facet_vert[q] + 1]++;
         for (size_t v = 0; v < nv; v++)
             k.vf_start[v + 1] += k.vf_start[v];
-        int *fill = c.used; /* scratch, reset by every check */
+        int *fill = c.perm; /* scratch until the search starts */
         memcpy(fill, k.vf_start, sizeof *fill * nv);
         for (int f = 0; f < h->nfacets; f++)
             for (int q = h->facet_start[f]; q < h->facet_start[f + 1]; q++)
