@@ -21,9 +21,9 @@
 /* --- vertex lookup ------------------------------------------------------------ *
  * A hash of grid cells of side 4 tol; a lookup visits the cells that meet the
  * cube of half-side tol around the point, 1.5 per axis on average (3.4 in
- * all, against 27 for cells of side tol). Coordinates are relative to the
- * centre and at most the size L, so cell indices stay below L / (4 tol) =
- * 2.5e4, well inside the 21 bits each gets in the key. */
+ * all, against 27 for a cell and all its neighbours). Coordinates are
+ * relative to the centre and at most the size L, so cell indices stay below
+ * L / (4 tol) = 2.5e4, well inside the 21 bits each gets in the key. */
 
 enum { KEY_BITS = 21 };
 
