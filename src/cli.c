@@ -73,6 +73,12 @@ static void usage(FILE *out)
         "output:\n"
         "  --facets           one row per hull facet instead of per pose, with its\n"
         "                     stability and quasi-static successor\n"
+        "  --group            one row per class of poses that a rotation of the part\n"
+        "                     about its centre of mass maps onto each other (a prism's\n"
+        "                     sides; mirror images stay apart): pose = class number,\n"
+        "                     geometry of its first member, p_qs, p_pqs, count and p\n"
+        "                     summed, the class's own interval, and a last column\n"
+        "                     members: the member poses' numbers, space-separated\n"
         "  --verbose          a summary of the part (and of the drops) on stderr\n"
         "  --help             this help\n"
         "  --version          version\n"
@@ -166,6 +172,40 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
     }
 }
 
+/* One row per class: the columns of print_poses, the first member's geometry,
+ * probabilities summed (gsim holds the library's grouped counts and
+ * intervals), and the members' pose numbers. */
+static void print_classes(const pd_static_result *res, const pd_sim_result *gsim,
+                          const int *class_of, int nclasses)
+{
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s,members\n",
+           gsim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    for (int c = 0; c < nclasses; c++) {
+        int first = -1;
+        double qs = 0.0, pqs = 0.0;
+        for (int i = 0; i < res->nposes; i++)
+            if (class_of[i] == c) {
+                if (first < 0)
+                    first = i;
+                qs += res->poses[i].p_qs;
+                pqs += res->poses[i].p_pqs;
+            }
+        const pd_pose *p = &res->poses[first];
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", c + 1, clean(p->normal.x),
+               clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(qs), clean(pqs));
+        if (gsim)
+            printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", gsim->n, gsim->count[c], gsim->p[c],
+                   gsim->ci_lo[c], gsim->ci_hi[c], gsim->unsettled, gsim->partial);
+        printf(",");
+        for (int i = first, sep = 0; i < res->nposes; i++)
+            if (class_of[i] == c) {
+                printf(sep ? " %d" : "%d", i + 1);
+                sep = 1;
+            }
+        printf("\n");
+    }
+}
+
 static void print_facets(const pd_part *part, const pd_static_result *res)
 {
     /* Facets are numbered from 1 here, like poses; 0 means "none". */
@@ -221,13 +261,13 @@ typedef struct {
     pd_static_options estimate;
     pd_scene scene;
     pd_sim_options sim;
-    int dynamic, facets, verbose;
+    int dynamic, facets, group, verbose;
 } cli_args;
 
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT };
+       OPT_ENGINE, OPT_DT, OPT_GROUP };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -280,6 +320,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"engine", required_argument, 0, OPT_ENGINE},
         {"dt", required_argument, 0, OPT_DT},
         {"facets", no_argument, 0, OPT_FACETS},
+        {"group", no_argument, 0, OPT_GROUP},
         {"verbose", no_argument, 0, OPT_VERBOSE},
         {"help", no_argument, 0, OPT_HELP},
         {"version", no_argument, 0, OPT_VERSION},
@@ -395,6 +436,9 @@ static int parse_args(int argc, char **argv, cli_args *a)
         case OPT_FACETS:
             a->facets = 1;
             break;
+        case OPT_GROUP:
+            a->group = 1;
+            break;
         case OPT_VERBOSE:
             a->verbose = 1;
             break;
@@ -418,6 +462,8 @@ static int parse_args(int argc, char **argv, cli_args *a)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
+    if (a->facets && a->group)
+        return fail_usage("%s", "--facets lists hull facets; it does not go with --group");
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);
@@ -500,7 +546,8 @@ int main(int argc, char **argv)
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
-    pd_sim_result *sim = NULL;
+    pd_sim_result *sim = NULL, *gsim = NULL;
+    int *class_of = NULL, nclasses = 0;
     pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
@@ -517,6 +564,12 @@ int main(int argc, char **argv)
         a.sim.cancel = &interrupted;
         st = pd_sim_run(part, res, &a.scene, &a.sim, &sim, &diag);
     }
+    if (st == PD_OK && a.group) {
+        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
+        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
+        if (st == PD_OK && sim)
+            st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+    }
     if (st != PD_OK) {
         code = fail_status(st, &diag, a.path);
         goto done;
@@ -527,6 +580,8 @@ int main(int argc, char **argv)
         print_sim_summary(&a, sim);
     if (a.facets)
         print_facets(part, res);
+    else if (a.group)
+        print_classes(res, gsim, class_of, nclasses);
     else
         print_poses(res, sim);
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
@@ -537,6 +592,8 @@ int main(int argc, char **argv)
     if (code == 0 && sim && sim->partial)
         code = EXIT_INTERRUPTED;
 done:
+    free(class_of);
+    pd_sim_result_free(gsim);
     pd_sim_result_free(sim);
     pd_static_result_free(res);
     pd_part_free(part);

@@ -25,7 +25,7 @@ enum { BOOTSTRAP_FIRST = 20, BOOTSTRAP_ROUND = 100 };
  * of at most BATCH_MAX, so the outcome buffer stays small for any -n. */
 enum { CI_BATCH = 1000, BATCH_MAX = 65536 };
 /* Two-sided 95% normal quantile for the Wilson intervals. */
-static const double Z95 = 1.959963984540054;
+static const double Z95 = PD_Z95;
 
 void pd_sim_options_default(pd_sim_options *o)
 {

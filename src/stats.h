@@ -2,6 +2,10 @@
 #ifndef PD_STATS_H
 #define PD_STATS_H
 
+/* The two-sided normal quantile of 95% confidence, Phi^-1(0.975): every
+ * interval the library reports uses it. */
+#define PD_Z95 1.959963984540054
+
 /* Wilson score interval for k successes in n trials at the confidence whose
  * two-sided normal quantile is z (1.96 for 95%): better than the normal
  * interval near 0 and 1, where most pose probabilities of real parts live,

@@ -20,6 +20,7 @@
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
+    PD_SUITE(symmetry) \
     PD_SUITE(cli)
 
 #define PD_SUITE(name) void suite_##name(void);

@@ -1,6 +1,7 @@
 /* test_cli.c: the posedrop command as a user runs it: exit codes, CSV on
  * stdout only on success, clear messages on stderr, determinism, and the batch
  * scripts. Runs the built binary (PD_CLI_PATH) from the repository root. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -370,6 +371,94 @@ static void test_scripts(void)
     free(all);
 }
 
+/* Column k (from 0) of a CSV row, as a number; the row is the line starting
+ * at p. */
+static double column(const char *p, int k)
+{
+    for (int i = 0; i < k && p; i++) {
+        p = strchr(p, ',');
+        p = p ? p + 1 : NULL;
+    }
+    return p ? strtod(p, NULL) : nan("");
+}
+
+/* --group: the cap's 32 sides are one class. Its row sums the ungrouped rows
+ * of poses 3..34, for the static columns and (same seed, same drops) for the
+ * drop counts. */
+static void test_group(void)
+{
+    char *out, *err, *ref, *err2;
+    csv_summary s;
+    CHECK_INT(run("--group parts/cap.off", &out, &err), 0);
+    const char *head = "pose,nx,ny,nz,area,height,p_qs,p_pqs,members\n";
+    CHECK(strncmp(out, head, strlen(head)) == 0);
+    CHECK(summarise(out, &s));
+    CHECK_INT(s.nrows, 3);
+    CHECK(s.numbered);
+    CHECK_NEAR(s.p_qs_sum, 1.0, 1e-9, "10 printed digits per row");
+    CHECK_NEAR(s.p_pqs_sum, 1.0, 1e-9, "10 printed digits per row");
+    CHECK(strstr(out, ",1\n2,") != NULL); /* the caps: classes of one */
+    char members[256] = "";
+    for (int i = 3; i <= 34; i++)
+        snprintf(members + strlen(members), sizeof members - strlen(members), "%s%d",
+                 i > 3 ? " " : ",", i);
+    strcat(members, "\n");
+    CHECK(strstr(out, members) != NULL);
+    CHECK_INT(run("parts/cap.off", &ref, &err2), 0);
+    const char *row3 = strstr(out, "\n3,");
+    double qs = 0.0, pqs = 0.0;
+    int rows = 0;
+    for (const char *p = strchr(ref, '\n') + 1; *p; p = strchr(p, '\n') + 1, rows++)
+        if (rows >= 2) {
+            qs += column(p, 6);
+            pqs += column(p, 7);
+        }
+    CHECK_INT(rows, 34);
+    CHECK(row3 != NULL);
+    if (row3) {
+        CHECK_NEAR(column(row3 + 1, 6), qs, 1e-9, "10 printed digits per row");
+        CHECK_NEAR(column(row3 + 1, 7), pqs, 1e-9, "10 printed digits per row");
+    }
+    free(out);
+    free(err);
+    free(ref);
+    free(err2);
+
+    CHECK_INT(run("--group -n 50 parts/cap.off", &out, &err), 0);
+    CHECK_INT(run("-n 50 parts/cap.off", &ref, &err2), 0);
+    const char *cols =
+        "pose,nx,ny,nz,area,height,p_qs,p_pqs,n,count,p,ci_lo,ci_hi,unsettled,partial,members\n";
+    CHECK(strncmp(out, cols, strlen(cols)) == 0);
+    long count = 0, total = 0, side_count = 0;
+    rows = 0;
+    for (const char *p = strchr(out, '\n') + 1; *p; p = strchr(p, '\n') + 1, rows++)
+        total += (long)column(p, 9);
+    CHECK_INT(rows, 3);
+    for (const char *p = strchr(ref, '\n') + 1; *p; p = strchr(p, '\n') + 1, count++)
+        if (count >= 2)
+            side_count += (long)column(p, 9);
+    row3 = strstr(out, "\n3,");
+    CHECK(row3 != NULL);
+    if (row3) {
+        CHECK_INT((long)column(row3 + 1, 9), side_count);
+        CHECK_NEAR(column(row3 + 1, 10), side_count / 50.0, 1e-10, "10 printed digits");
+        /* The class's own Wilson interval holds its p. */
+        CHECK(column(row3 + 1, 11) < column(row3 + 1, 10));
+        CHECK(column(row3 + 1, 12) > column(row3 + 1, 10));
+    }
+    CHECK_INT(total + (long)column(strchr(out, '\n') + 1, 13), 50);
+    free(out);
+    free(err);
+    free(ref);
+    free(err2);
+
+    CHECK_INT(run("--help", &out, &err), 0);
+    CHECK(strstr(out, "--group") != NULL);
+    free(out);
+    free(err);
+    expect_failure("--group --facets parts/cap.off", 2, "--group");
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -387,6 +476,7 @@ void suite_cli(void)
     test_results();
     test_dynamic();
     test_scripts();
+    test_group();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

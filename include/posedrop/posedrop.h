@@ -26,6 +26,7 @@
 #include "posedrop/sim.h"
 #include "posedrop/static.h"
 #include "posedrop/status.h"
+#include "posedrop/symmetry.h"
 #include "posedrop/tolerances.h"
 #include "posedrop/types.h"
 

@@ -109,6 +109,23 @@
  * transfers, above what GSL's 21-point rule reaches on smooth integrands. */
 #define PD_TOL_BAND_QUAD_REL 1e-10
 
+/* Pose classes (src/symmetry.c): a rotation about the centre of mass maps the
+ * hull onto itself when every vertex lands within this distance (times L) of
+ * a vertex; the candidate rotations are found by matching distances from the
+ * centre and between two reference vertices to the same accuracy, and two
+ * poses of one class must rest at heights this close. Why 1e-5: a symmetric
+ * part read from a file carries the file's print noise, up to 5e-7 L per
+ * coordinate for 6 significant digits (see PD_TOL_PROB_TIE_REL), and its
+ * computed centre of mass a similar amount; distances between two such points
+ * and the rotation they define add a few of these, and a reference pair that
+ * is close to collinear with the centre amplifies them a few times more: 1e-5
+ * leaves a margin of ~5 over that. A genuine asymmetry of 1e-5 L (1 um on a
+ * 10 cm part) is below what is manufactured or what any drop could tell
+ * apart. Larger: features that differ by a hundredth of a millimetre would be
+ * merged as symmetric. Smaller: 6-digit files of symmetric parts would lose
+ * their symmetry. */
+#define PD_TOL_SYMMETRY_REL 1e-5
+
 /* --- output ----------------------------------------------------------------- */
 
 /* Printed unit-normal components and probabilities smaller than this in
@@ -342,6 +359,21 @@
  * fails with a parse error, not an out-of-memory. 2^26 = 67M elements is ten
  * times the largest CAD meshes users feed to a pose estimator. */
 #define PD_MAX_ELEMENTS (1 << 26)
+
+/* The symmetry search tries every image of a reference pair of hull vertices
+ * among the vertices at the same distances from the centre of mass: |A| x |B|
+ * pairs, and checks each pair that also matches their distance apart on all
+ * vertices. Past this many pairs the search is skipped with a warning and the
+ * poses are not grouped (only the identity). The worst case within the limit
+ * is a regular polygon prism, all of whose vertices sit at one radius: a
+ * 4000-gon (8000 vertices, 6.4e7 pairs, 8000 rotations each checked on every
+ * vertex) takes 5 s for the rotations and 7.5 s for the pose classes on this
+ * project's machine (2026-11-23), and the cost grows as the square of the
+ * vertex count; an asymmetric 8000-vertex sphere, also at one radius, takes
+ * 0.3 s. Larger: the search could run for minutes on a finely tessellated
+ * body of revolution. Smaller: such parts of a few thousand vertices would
+ * lose their grouping for no need. */
+#define PD_SYMMETRY_MAX_PAIRS (1L << 26)
 
 /* Largest polygon a mesh face may have (vertex count of one OFF/OBJ face). */
 #define PD_MAX_FACE_VERTICES 65536
