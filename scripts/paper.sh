@@ -14,8 +14,9 @@
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
 # poses never observed costs nothing there; total variation counts it).
-# posedrop's classes are matched to the paper's pose numbers by rank of their
-# QS probability, the column the parts were fitted on.
+# posedrop's classes are matched to the paper's poses by rank of their QS
+# probability on both sides, the column the parts were fitted on (the paper
+# numbers its poses by physical frequency).
 set -u
 n=2000
 outdir=results
@@ -85,14 +86,21 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             trials = $col["physical_trials"]
         }
         END {
+            # The paper numbers its poses by physical frequency: pair its QS
+            # ranks with ours (the pairing the QS fit was made under).
+            for (i = 1; i <= np; i++) prank[i] = i
+            for (i = 1; i <= np; i++) for (j = i + 1; j <= np; j++)
+                if (paper[prank[j], 1] > paper[prank[i], 1]) { t = prank[i]; prank[i] = prank[j]; prank[j] = t }
+            for (r = 1; r <= np; r++) rank_of[prank[r]] = r
             printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d)\n", part, trials, ks, np
             printf "%4s | %6s %6s %6s %6s | %6s %6s %7s %6s %6s\n", "pose", "QS", "PQS", "Dyn", "Phys",
                    "QS", "PQS", "impulse", "ODE", "Bullet"
             for (p = 1; p <= np; p++) {
-                ours[p, 1] = p <= ks ? qs["s", order["s", p]] : 0
-                ours[p, 2] = p <= ks ? pqs["s", order["s", p]] : 0
+                r = rank_of[p]
+                ours[p, 1] = r <= ks ? qs["s", order["s", r]] : 0
+                ours[p, 2] = r <= ks ? pqs["s", order["s", r]] : 0
                 # The engines rank their own classes by QS too: same order.
-                for (e = 1; e <= 3; e++) ours[p, 2 + e] = p <= ke[e] ? dyn[eng[e], order[eng[e], p]] : 0
+                for (e = 1; e <= 3; e++) ours[p, 2 + e] = r <= ke[e] ? dyn[eng[e], order[eng[e], r]] : 0
                 printf "%4d | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f %7.1f %6.1f %6.1f\n", p,
                        100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p],
                        100 * ours[p, 1], 100 * ours[p, 2], 100 * ours[p, 3], 100 * ours[p, 4], 100 * ours[p, 5]

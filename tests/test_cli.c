@@ -337,6 +337,30 @@ static void test_dynamic(void)
     expect_failure(args, 2, where);
 }
 
+/* eq16.awk, fed the paper's own columns, must reproduce the errors the paper
+ * publishes (Table 1, the cap: QS 10.1, PQS 1.2, dynamic 4.0; Table 4, the
+ * square button: 17.2, 10.7, 4.8), to the tables' 0.05 rounding. */
+static void test_eq16(void)
+{
+    const char *parts[] = {"insulator_cap", "square_black_button"};
+    const double want[2][3] = {{10.1, 1.2, 4.0}, {17.2, 10.7, 4.8}};
+    const char *cols[] = {"p_qs", "p_pqs", "p"};
+    for (int i = 0; i < 2; i++)
+        for (int c = 0; c < 3; c++) {
+            char cmd[512], *out, *err;
+            snprintf(cmd, sizeof cmd,
+                     "awk -F, -v part=%s 'NR == 1 { print \"pose,p_qs,p_pqs,p\" } $1 == part "
+                     "{ print $2 \",\" $3 / 100 \",\" $4 / 100 \",\" $5 / 100 }' "
+                     "parts/paper-tables.csv > %s/own.csv && awk -F, -v part=%s -v column=%s "
+                     "-f scripts/eq16.awk parts/paper-tables.csv %s/own.csv",
+                     parts[i], tmpdir, parts[i], cols[c], tmpdir);
+            CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+            CHECK_NEAR(strtod(out, NULL), want[i][c], 0.05, "the paper's tables print one decimal");
+            free(out);
+            free(err);
+        }
+}
+
 static void test_scripts(void)
 {
     char cmd[512], *out, *err;
@@ -475,6 +499,7 @@ void suite_cli(void)
     test_bad_input();
     test_results();
     test_dynamic();
+    test_eq16();
     test_scripts();
     test_group();
     char cmd[128];
