@@ -227,6 +227,15 @@ static void test_results(void)
         free(err);
     }
 
+    /* Every canonical and paper part: closed, oriented, no warning, a table. */
+    CHECK_INT(run_cmd("for f in parts/canonical/*.off parts/insulator_cap.off parts/white_button.off "
+                      "parts/rect_black_button.off parts/square_black_button.off; do " PD_CLI_PATH
+                      " --group \"$f\" > /dev/null || echo \"$f failed\"; done", 1, &out, &err), 0);
+    CHECK_INT((int)strlen(out), 0);
+    CHECK(strstr(err, "warning") == NULL);
+    free(out);
+    free(err);
+
     /* Same input, same bytes. */
     CHECK_INT(run("--topple edge parts/cap.off", &out, &err), 0);
     CHECK_INT(run("--topple edge parts/cap.off", &out2, &err2), 0);
