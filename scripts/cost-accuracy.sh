@@ -78,11 +78,11 @@ command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-no
 for term in png svg; do
     gnuplot <<GP
 set datafile separator ","
-set terminal ${term} size 1100,800 $( [ "$term" = png ] && echo "font ',10'" )
+set terminal ${term} size 1100,800 noenhanced $( [ "$term" = png ] && echo "font ',10'" )
 set output "$outdir/cost-accuracy.${term}"
 set multiplot layout 2,2 title "What accuracy costs: eq. (16) error against the physical tests vs CPU time (paper's four parts)"
 set logscale x
-set format x "10^{%T}"
+set format x "%g"
 set xlabel "CPU seconds (all threads)"
 set ylabel "eq. (16) error, %"
 set key top right

@@ -53,23 +53,23 @@ poses=$(awk -F, 'NR > 1 { print $3 }' "$csv" | sort -n -u | tr '\n' ' ')
 for term in png svg; do
     gnuplot <<GP
 set datafile separator ","
-set terminal ${term} size 1100,800 $( [ "$term" = png ] && echo "font ',10'" )
+set terminal ${term} size 1100,800 noenhanced $( [ "$term" = png ] && echo "font ',10'" )
 set output "$outdir/$name-sensitivity.${term}"
 set multiplot layout 2,2 title "$name: pose probabilities against the scene (95% bands; pose classes)"
 set ylabel "probability"
 set yrange [0:1]
 set grid
 set key top right
-array label[4] = ["friction mu (1000 drops each)", "restitution e", "drop height, m", "PQS epsilon, degrees"]
+array label[4] = ["friction mu ($n drops each)", "restitution e", "drop height, m", "PQS epsilon, degrees"]
 array key[4] = ["mu", "restitution", "height", "epsilon"]
 do for [k = 1:4] {
     set title label[k]
     set xlabel label[k]
     if (k == 3) { set logscale x } else { unset logscale x }
     plot for [p in "$poses"] "< grep '^".key[k].",' $csv | awk -F, '\$3 == ".p."'" \
-         using 2:5:6 with filledcurves fs transparent solid 0.15 notitle, \
+         using 2:5:6 with filledcurves fs transparent solid 0.15 lc (p+0) notitle, \
          for [p in "$poses"] "< grep '^".key[k].",' $csv | awk -F, '\$3 == ".p."'" \
-         using 2:4 with linespoints title "pose ".p
+         using 2:4 with linespoints lc (p+0) title "pose ".p
 }
 unset multiplot
 GP
