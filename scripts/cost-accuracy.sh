@@ -2,7 +2,7 @@
 # cost-accuracy.sh: what accuracy costs in time, per estimator, on the paper's
 # four parts.
 #
-#   scripts/cost-accuracy.sh [-o DIR] [-s SEEDS] [-d PAPER_TABLES_CSV]
+#   scripts/cost-accuracy.sh [-o DIR] [-s SEEDS] [-d PAPER_TABLES_CSV] [--chart-only]
 #
 # Runs QS and PQS, the impulse simulator at n = 50 ... 5000 drops with SEEDS
 # seeds (default 3), and ODE and Bullet at three time steps (1000 drops), all
@@ -11,17 +11,22 @@
 # error (and total variation) against the physical tests in
 # DIR/cost-accuracy.csv (default results/), and draws error against time on a
 # log axis, one series per estimator, error bars over seeds, in
-# DIR/cost-accuracy.png and .svg (gnuplot; installed if missing).
+# DIR/cost-accuracy.png and .svg (gnuplot; installed if missing), beside the
+# paper's own points (its errors at its reported times on a SPARC20: QS and
+# PQS "less than a second", dynamic simulation "approximately two hours").
+# --chart-only redraws from an existing DIR/cost-accuracy.csv.
 set -u
 outdir=results
 seeds=3
 tables=""
+chart_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
         -o) outdir=$2; shift 2 ;;
         -s) seeds=$2; shift 2 ;;
         -d) tables=$2; shift 2 ;;
-        --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --chart-only) chart_only=1; shift ;;
+        --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "cost-accuracy.sh: unknown argument '$1'" >&2; exit 2 ;;
     esac
 done
@@ -37,7 +42,6 @@ fi
 mkdir -p "$outdir" || exit 2
 csv="$outdir/cost-accuracy.csv"
 tmp="$outdir/.cost-run.csv"
-echo "part,estimator,budget,seed,cpu_s,e16,tv" > "$csv"
 TIMEFORMAT='%3U %3S'
 
 # run PART ESTIMATOR BUDGET SEED COLUMN POSEDROP-ARGS...: one row of the CSV.
@@ -50,7 +54,9 @@ run() {
     echo "$part,$est,$budget,$seed,$cpu,${err% *},${err#* }" >> "$csv"
 }
 
+[ "$chart_only" = 1 ] || echo "part,estimator,budget,seed,cpu_s,e16,tv" > "$csv"
 for part in insulator_cap white_button rect_black_button square_black_button; do
+    [ "$chart_only" = 1 ] && break
     run "$part" QS 0 1 p_qs || continue
     run "$part" PQS 0 1 p_pqs
     for n in 50 100 200 500 1000 2000 5000; do
@@ -73,19 +79,30 @@ awk -F, 'NR > 1 { k = $1 FS $2 FS $3; n[k]++; t[k] += $5; e[k] += $6; e2[k] += $
     END { for (k in n) { m = e[k] / n[k]; v = e2[k] / n[k] - m * m
           printf "%s,%.6g,%.6g,%.6g\n", k, t[k] / n[k], m, sqrt(v > 0 ? v : 0) } }' "$csv" |
     sort -t, -k1,1 -k2,2 -k4,4g > "$outdir/cost-accuracy-mean.csv"
+# The paper's own points: its columns' eq. (16) errors at its reported times.
+for part in insulator_cap white_button rect_black_button square_black_button; do
+    awk -F, -v part="$part" 'NR == 1 { print "pose,p_qs,p_pqs,p" }
+        $1 == part { print $2 "," $3 / 100 "," $4 / 100 "," $5 / 100 }' "$tables" > "$tmp"
+    for c in "p_qs paper_QS 1" "p_pqs paper_PQS 1" "p paper_dynamic 7200"; do
+        set -- $c
+        e=$(awk -F, -v part="$part" -v column="$1" -f "$here/scripts/eq16.awk" "$tables" "$tmp")
+        echo "$part,$2,0,$3,${e% *},0" >> "$outdir/cost-accuracy-mean.csv"
+    done
+done
+rm -f "$tmp"
 command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||
     { echo "cost-accuracy.sh: gnuplot missing; $csv written, no chart" >&2; exit 1; }
 for term in png svg; do
     gnuplot <<GP
 set datafile separator ","
-set terminal ${term} size 1100,800 noenhanced $( [ "$term" = png ] && echo "font ',10'" )
+set terminal ${term} size 1300,1000 noenhanced $( [ "$term" = png ] && echo "font ',10'" )
 set output "$outdir/cost-accuracy.${term}"
 set multiplot layout 2,2 title "What accuracy costs: eq. (16) error against the physical tests vs CPU time (paper's four parts)"
 set logscale x
 set format x "%g"
 set xlabel "CPU seconds (all threads)"
 set ylabel "eq. (16) error, %"
-set key top right
+set key below horizontal maxcols 4 font ',8' spacing 0.9
 set grid
 do for [p in "insulator_cap white_button rect_black_button square_black_button"] {
     set title p
@@ -93,7 +110,10 @@ do for [p in "insulator_cap white_button rect_black_button square_black_button"]
          "< grep '^".p.",PQS,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 5 ps 1.5 title "PQS", \
          "< grep '^".p.",impulse,' $outdir/cost-accuracy-mean.csv" using 4:5:6 with yerrorlines pt 9 title "impulse (n = 50..5000, +-1 sd over seeds)", \
          "< grep '^".p.",ODE,' $outdir/cost-accuracy-mean.csv" using 4:5 with linespoints pt 11 title "ODE (dt 2, 1, 0.5 ms)", \
-         "< grep '^".p.",Bullet,' $outdir/cost-accuracy-mean.csv" using 4:5 with linespoints pt 13 title "Bullet (dt 2.1, 1.04, 0.52 ms)"
+         "< grep '^".p.",Bullet,' $outdir/cost-accuracy-mean.csv" using 4:5 with linespoints pt 13 title "Bullet (dt 2.1, 1.04, 0.52 ms)", \
+         "< grep '^".p.",paper_QS,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 6 ps 2 lc rgb "black" title "paper QS (<1 s, SPARC20)", \
+         "< grep '^".p.",paper_PQS,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 4 ps 2 lc rgb "black" title "paper PQS (<1 s)", \
+         "< grep '^".p.",paper_dynamic,' $outdir/cost-accuracy-mean.csv" using 4:5 with points pt 8 ps 2 lc rgb "black" title "paper dynamic (~2 h)"
 }
 unset multiplot
 GP
