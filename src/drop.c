@@ -151,8 +151,8 @@ static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
     return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
 }
 
-void pd_drop_initial(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
-                     const double *init_cdf, pd_state *s, double q0[4])
+static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
+                          const double *init_cdf, pd_state *s, double q0[4])
 {
     const pd_body *b = m->body;
     pd_quat q;
@@ -189,6 +189,18 @@ void pd_drop_initial(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
     q0[1] = qp.x;
     q0[2] = qp.y;
     q0[3] = qp.z;
+}
+
+void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_options *o,
+                     long index, const double *init_cdf, pd_state *s, pd_trial *out)
+{
+    pd_rng rng;
+    pd_rng_init(&rng, o->seed, (uint64_t)index);
+    initial_state(m, sc, &rng, init_cdf, s, out->q0);
+    out->pose = -1;
+    out->collisions = 0;
+    out->end = PD_END_FAILED;
+    out->time = 0.0;
 }
 
 /* --- collisions ------------------------------------------------------------- */
@@ -299,9 +311,15 @@ static double energy_height(const pd_body *b, const pd_state *s, double g)
     return s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
 }
 
+/* Gravity's direction in the part's (file) frame. */
+static pd_vec3 gravity_in_part(const pd_sim_model *m, const pd_state *s)
+{
+    return quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
+}
+
 int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
 {
-    pd_vec3 down = quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
+    pd_vec3 down = gravity_in_part(m, s);
     int f;
     if (pd_descend(m->hull, &m->star, m->com, down, &f, hint) != PD_OK)
         return -1;
@@ -315,8 +333,7 @@ int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hin
 
 double pd_drop_tilt(const pd_sim_model *m, const pd_state *s, int pose)
 {
-    pd_vec3 down = quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
-    return v3_angle(down, m->poses->poses[pose].normal);
+    return v3_angle(gravity_in_part(m, s), m->poses->poses[pose].normal);
 }
 
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
@@ -327,13 +344,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         pd_drop_run_stepping(m, w, sc, o, index, init_cdf, out);
         return;
     }
-    pd_rng rng;
-    pd_rng_init(&rng, o->seed, (uint64_t)index);
     pd_state s;
-    pd_drop_initial(m, sc, &rng, init_cdf, &s, out->q0);
-    out->pose = -1;
-    out->collisions = 0;
-    out->end = PD_END_FAILED;
+    pd_drop_release(m, sc, o, index, init_cdf, &s, out);
     double t = 0.0, g = sc->gravity;
     /* Resting contact advances by the time to fall rest_fall, so that a
      * vertex pressed on the floor by gravity meets it again with the speed

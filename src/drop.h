@@ -43,12 +43,14 @@ pd_status pd_drop_collide(const pd_sim_model *model, pd_drop_work *work, const p
                           pd_state *s, const int *contacts, int nc, int *impacts, long *gain,
                           long *fallbacks);
 
-/* The release state of drop `index` (uniform or bootstrap pose, vibration,
- * belt velocity, lowest point at the drop height), drawn from rng; q0 gets the
- * part frame's orientation for --trials. Shared by every engine, so engines
+/* The release of drop `index`: its state (uniform or bootstrap pose,
+ * vibration, belt velocity, lowest point at the drop height) drawn from the
+ * drop's own stream (options->seed, index), and its record reset (out->q0 the
+ * part frame's orientation, no pose yet). Shared by every engine, so engines
  * can be compared drop by drop. */
-void pd_drop_initial(const pd_sim_model *model, const pd_scene *scene, pd_rng *rng,
-                     const double *init_cdf, pd_state *s, double q0[4]);
+void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
+                     const pd_sim_options *options, long index, const double *init_cdf,
+                     pd_state *s, pd_trial *out);
 
 /* 1 and the pose index if the outcome of state s is decided (energy below its
  * basin's barrier, see drop.c), 0 if not yet, -1 on failure. hint speeds up

@@ -1,6 +1,6 @@
 /* drop_step.c: a drop on a stepping engine (ODE, Bullet), for the
  * cross-check. Same release as the impulse simulator's drop of the same index
- * (pd_drop_initial), fixed steps of the engine, and the same decision of
+ * (pd_drop_release), fixed steps of the engine, and the same decision of
  * where it ends. A stepping engine's contacts are soft and can feed energy
  * back, so the energy test alone is not trusted: the part must also lie on
  * the facet of its basin, tilted less than PD_TOL_REST_TILT. */
@@ -12,14 +12,8 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
                           const pd_sim_options *o, long index, const double *init_cdf,
                           pd_trial *out)
 {
-    pd_rng rng;
-    pd_rng_init(&rng, o->seed, (uint64_t)index);
     pd_state s;
-    pd_drop_initial(m, sc, &rng, init_cdf, &s, out->q0);
-    out->pose = -1;
-    out->collisions = 0;
-    out->end = PD_END_FAILED;
-    out->time = 0.0;
+    pd_drop_release(m, sc, o, index, init_cdf, &s, out);
     if (m->engine->reset(w->world, &s) != PD_OK)
         return;
     long steps = (long)(o->time_limit / m->dt) + 1;

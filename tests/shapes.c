@@ -2,7 +2,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include "gsl_adapter.h"
 #include "posedrop/hull.h"
+#include "posedrop/sim.h"
 #include "shapes.h"
 #include "vec3.h"
 
@@ -283,4 +285,15 @@ pd_mesh *mesh_of_hull(const pd_hull *h)
         }
     }
     return m;
+}
+
+double uniform_p_value(const pd_sim_result *r)
+{
+    long settled = 0;
+    for (int k = 0; k < r->nposes; k++)
+        settled += r->count[k];
+    double expect = (double)settled / r->nposes, x2 = 0.0;
+    for (int k = 0; k < r->nposes; k++)
+        x2 += (r->count[k] - expect) * (r->count[k] - expect) / expect;
+    return pd_gsl_chisq_q(x2, r->nposes - 1);
 }

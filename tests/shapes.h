@@ -51,6 +51,11 @@ int pts_icosahedron(pd_vec3 *out);
 struct pd_hull;
 pd_mesh *mesh_of_hull(const struct pd_hull *h);
 
+/* Chi-square test that a Monte Carlo result is uniform over its poses:
+ * P(X > statistic) with nposes - 1 degrees of freedom. */
+struct pd_sim_result;
+double uniform_p_value(const struct pd_sim_result *r);
+
 /* Convenience: convex_mesh of the points above. */
 pd_mesh *mesh_box(double ax, double ay, double az);
 pd_mesh *mesh_prism(int nsides, double radius, double height);

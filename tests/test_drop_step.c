@@ -10,17 +10,6 @@
 #include "suites.h"
 #include "vec3.h"
 
-static double uniform_p_value(const pd_sim_result *r)
-{
-    long settled = 0;
-    for (int k = 0; k < r->nposes; k++)
-        settled += r->count[k];
-    double expect = (double)settled / r->nposes, x2 = 0.0;
-    for (int k = 0; k < r->nposes; k++)
-        x2 += (r->count[k] - expect) * (r->count[k] - expect) / expect;
-    return pd_gsl_chisq_q(x2, r->nposes - 1);
-}
-
 static void run_solid(pd_engine_kind engine, int (*solid)(pd_vec3 *), long drops)
 {
     pd_vec3 p[64];

@@ -39,18 +39,6 @@ static pd_mesh *scaled(pd_mesh *m, double s)
     return m;
 }
 
-/* Chi-square test of uniformity over the poses: P(X > statistic). */
-static double uniform_p_value(const pd_sim_result *r)
-{
-    long settled = 0;
-    for (int k = 0; k < r->nposes; k++)
-        settled += r->count[k];
-    double expect = (double)settled / r->nposes, x2 = 0.0;
-    for (int k = 0; k < r->nposes; k++)
-        x2 += (r->count[k] - expect) * (r->count[k] - expect) / expect;
-    return pd_gsl_chisq_q(x2, r->nposes - 1);
-}
-
 static pd_sim_result *run(const part_fixture *f, const pd_scene *sc, const pd_sim_options *o)
 {
     pd_sim_result *r = NULL;
