@@ -1,9 +1,11 @@
 /* shapes.c: test fixtures (see shapes.h). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "gsl_adapter.h"
 #include "posedrop/hull.h"
+#include "posedrop/part.h"
 #include "posedrop/sim.h"
 #include "shapes.h"
 #include "vec3.h"
@@ -296,4 +298,20 @@ double uniform_p_value(const pd_sim_result *r)
     for (int k = 0; k < r->nposes; k++)
         x2 += (r->count[k] - expect) * (r->count[k] - expect) / expect;
     return pd_gsl_chisq_q(x2, r->nposes - 1);
+}
+
+pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
+{
+    pd_part_options po;
+    pd_part_options_default(&po);
+    if (com) {
+        po.com_given = 1;
+        po.com = *com;
+    }
+    pd_part *part = NULL;
+    pd_status st = m ? pd_part_build(m, &po, &part, diag) : PD_ERR_INTERNAL;
+    pd_mesh_free(m);
+    if (st != PD_OK)
+        printf("     part_of: %s (%s)\n", pd_status_str(st), diag ? diag->message : "");
+    return st == PD_OK ? part : NULL;
 }

@@ -51,6 +51,13 @@ int pts_icosahedron(pd_vec3 *out);
 struct pd_hull;
 pd_mesh *mesh_of_hull(const struct pd_hull *h);
 
+/* A part built from mesh m (consumed; NULL gives NULL), with its centre of
+ * mass given if com is not NULL; NULL on failure, which is printed with the
+ * library's message. */
+struct pd_part;
+struct pd_diag;
+struct pd_part *part_of(pd_mesh *m, const pd_vec3 *com, struct pd_diag *diag);
+
 /* Chi-square test that a Monte Carlo result is uniform over its poses:
  * P(X > statistic) with nposes - 1 degrees of freedom. */
 struct pd_sim_result;

@@ -10,20 +10,6 @@
 #include "suites.h"
 #include "vec3.h"
 
-static pd_part *build(pd_mesh *m, const pd_vec3 *com)
-{
-    pd_part_options po;
-    pd_part_options_default(&po);
-    if (com) {
-        po.com_given = 1;
-        po.com = *com;
-    }
-    pd_part *p = NULL;
-    pd_part_build(m, &po, &p, NULL);
-    pd_mesh_free(m);
-    return p;
-}
-
 static pd_static_result *descent_result(const pd_part *p)
 {
     pd_static_options o;
@@ -51,7 +37,7 @@ static void test_box(void)
     const double dims[][3] = {{1, 1, 1}, {1, 2, 3}, {0.3, 1, 0.05}};
     for (int t = 0; t < 3; t++) {
         const double *d = dims[t];
-        pd_part *p = build(mesh_box(d[0], d[1], d[2]), NULL);
+        pd_part *p = part_of(mesh_box(d[0], d[1], d[2]), NULL, NULL);
         pd_static_result *r = p ? descent_result(p) : NULL;
         CHECK(r != NULL);
         if (!r) {
@@ -119,7 +105,7 @@ static void test_random(void)
             pts[i] = v3(u.x, 0.7 * u.y, 0.5 * u.z);
         }
         pd_vec3 com = v3(rng_range(&rng, -0.2, 0.2), rng_range(&rng, -0.15, 0.15), 0.0);
-        pd_part *p = build(convex_mesh(pts, 20), &com);
+        pd_part *p = part_of(convex_mesh(pts, 20), &com, NULL);
         pd_static_result *r = p ? descent_result(p) : NULL;
         if (!r) {
             pd_part_free(p);

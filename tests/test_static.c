@@ -11,23 +11,6 @@
 
 /* --- helpers ----------------------------------------------------------------- */
 
-/* Builds a part from a mesh (consumed), with com if given. */
-static pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
-{
-    pd_part_options po;
-    pd_part_options_default(&po);
-    if (com) {
-        po.com_given = 1;
-        po.com = *com;
-    }
-    pd_part *part = NULL;
-    pd_status st = pd_part_build(m, &po, &part, diag);
-    pd_mesh_free(m);
-    if (st != PD_OK)
-        printf("     part_of: %s (%s)\n", pd_status_str(st), diag ? diag->message : "");
-    return st == PD_OK ? part : NULL;
-}
-
 static pd_static_result *estimate(const pd_part *part, const pd_static_options *o)
 {
     pd_static_result *r = NULL;

@@ -11,23 +11,6 @@
 #include "suites.h"
 #include "vec3.h"
 
-/* Builds a part from a mesh (consumed), with com if given. */
-static pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
-{
-    pd_part_options po;
-    pd_part_options_default(&po);
-    if (com) {
-        po.com_given = 1;
-        po.com = *com;
-    }
-    pd_part *part = NULL;
-    pd_status st = m ? pd_part_build(m, &po, &part, diag) : PD_ERR_INTERNAL;
-    pd_mesh_free(m);
-    if (st != PD_OK)
-        printf("     part_of: %s (%s)\n", pd_status_str(st), diag ? diag->message : "");
-    return st == PD_OK ? part : NULL;
-}
-
 /* Every rotation found is orthonormal with determinant +1 (round-off of a
  * product of two orthonormal frames: a few 1e-16 per entry; 1e-12 leaves a
  * wide margin), the first is the identity, and each sends every hull vertex
