@@ -46,6 +46,18 @@ static pd_engine_world *world(const fixture *fx)
     return w;
 }
 
+/* The 1 x 2 x 3 cm box most tests drop, with a world for it; NULL (and
+ * nothing left to free) if either cannot be had. */
+static pd_engine_world *box_world(fixture *fx)
+{
+    if (!setup(fx, mesh_box(0.01, 0.02, 0.03)))
+        return NULL;
+    pd_engine_world *w = world(fx);
+    if (!w)
+        teardown(fx);
+    return w;
+}
+
 /* Steps n times; returns the first failure's status. */
 static pd_status run(pd_engine_world *w, pd_state *s, int n)
 {
@@ -122,13 +134,9 @@ static pd_state on_facet(const fixture *fx, int f, double lift)
 static void test_free_fall(void)
 {
     fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+    pd_engine_world *w = box_world(&fx);
+    if (!w)
         return;
-    pd_engine_world *w = world(&fx);
-    if (!w) {
-        teardown(&fx);
-        return;
-    }
     /* A tumble about no principal axis, far above the floor. */
     pd_state s0 = {v3(0.1, -0.2, 1.0), quat_normalize(quat(0.9, 0.1, -0.3, 0.2)),
                    v3(0.3, -0.1, 0.5), v3(7.0, 20.0, -4.0)};
@@ -163,13 +171,9 @@ static void test_free_fall(void)
 static void test_rest_on_faces(void)
 {
     fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+    pd_engine_world *w = box_world(&fx);
+    if (!w)
         return;
-    pd_engine_world *w = world(&fx);
-    if (!w) {
-        teardown(&fx);
-        return;
-    }
     const pd_body *b = fx.body;
     double g = fx.scene.gravity;
     CHECK_INT(fx.part->hull->nfacets, 6);
@@ -201,13 +205,9 @@ static void test_rest_on_faces(void)
 static void test_flat_release(void)
 {
     fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+    pd_engine_world *w = box_world(&fx);
+    if (!w)
         return;
-    pd_engine_world *w = world(&fx);
-    if (!w) {
-        teardown(&fx);
-        return;
-    }
     const pd_body *b = fx.body;
     for (int f = 0; f < fx.part->hull->nfacets; f++) {
         double d;
@@ -239,13 +239,9 @@ static int shared_corner(const pd_hull *h, int f0, int f1)
 static void test_topple(void)
 {
     fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+    pd_engine_world *w = box_world(&fx);
+    if (!w)
         return;
-    pd_engine_world *w = world(&fx);
-    if (!w) {
-        teardown(&fx);
-        return;
-    }
     const pd_body *b = fx.body;
     const pd_hull *h = fx.part->hull;
     const double lean = 2.0 * M_PI / 180.0;
