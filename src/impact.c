@@ -82,36 +82,56 @@ void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3
  * unique"); Mirtich's thesis, which the paper follows, was corrected on
  * resumed sliding by R. Baber (2011), whose note we could not consult, so the
  * construction here is derived directly from eq. 14 rather than taken from it.
- * phi is monotone on a known bracket, so plain bisection finds lambda to
- * round-off in a fixed number of cheap steps, with no trigonometry. */
+ * Newton's method on psi(lambda) = 1/sqrt(phi) - 1 finds it: 1/|t(lambda)|
+ * is concave and increasing in lambda (the secular function of trust-region
+ * methods; it is exactly linear when a is an eigenvector of B), so Newton
+ * from lambda = 0, where psi < 0, climbs monotonically to the root without
+ * overshoot and converges quadratically: 4-6 steps, no bracket to keep, no
+ * trigonometry. (Bisection took ~50 steps, 10% of a whole drop.) */
 
-enum { RAY_BISECT = 200 };
+enum { RAY_NEWTON = 100 };
 
-static double ray_phi(const double K[3][3], double mu, double lam, double *tx, double *ty)
+/* t = M^-1 a, M = mu B + lam I, and t' M^-1 t (for the derivative). */
+static double ray_phi(const double K[3][3], double mu, double lam, double *tx, double *ty,
+                      double *tMt)
 {
     double m00 = mu * K[0][0] + lam, m01 = mu * K[0][1], m11 = mu * K[1][1] + lam;
     double det = m00 * m11 - m01 * m01;
     *tx = (m11 * K[0][2] - m01 * K[1][2]) / det;
     *ty = (m00 * K[1][2] - m01 * K[0][2]) / det;
+    double sx = (m11 * *tx - m01 * *ty) / det, sy = (m00 * *ty - m01 * *tx) / det;
+    *tMt = *tx * sx + *ty * sy;
     return *tx * *tx + *ty * *ty;
+}
+
+/* The ray's unit direction (tx, ty), or 0 when sticking is stable. */
+static int diverging_ray(const double K[3][3], double mu, double *rx, double *ry)
+{
+    double tx, ty, tMt, lam = 0.0;
+    double phi = mu > 0.0 ? ray_phi(K, mu, 0.0, &tx, &ty, &tMt) : 0.0;
+    if (!(phi > 1.0))
+        return 0;
+    for (int i = 0; i < RAY_NEWTON; i++) {
+        double r = sqrt(phi);
+        /* psi = 1/r - 1, psi' = tMt / r^3. */
+        double step = (r - 1.0) * r * r / tMt;
+        if (!(step > 4.0 * DBL_EPSILON * lam))
+            break; /* at the root to round-off (r <= 1 cannot give step > 0) */
+        lam += step;
+        phi = ray_phi(K, mu, lam, &tx, &ty, &tMt);
+    }
+    double n = sqrt(phi);
+    *rx = tx / n;
+    *ry = ty / n;
+    return 1;
 }
 
 pd_status pd_impact_diverging_ray(const double K[3][3], double mu, double *theta)
 {
-    double tx, ty;
-    if (!(mu > 0.0) || !(ray_phi(K, mu, 0.0, &tx, &ty) > 1.0))
+    double rx, ry;
+    if (!diverging_ray(K, mu, &rx, &ry))
         return PD_ERR_NO_CONVERGENCE;
-    /* phi(|a|) < 1: |(mu B + lam I)^-1 a| <= |a| / lam. */
-    double lo = 0.0, hi = hypot(K[0][2], K[1][2]);
-    for (int i = 0; i < RAY_BISECT && hi - lo > 2.0 * DBL_EPSILON * hi; i++) {
-        double mid = 0.5 * (lo + hi);
-        if (ray_phi(K, mu, mid, &tx, &ty) > 1.0)
-            lo = mid;
-        else
-            hi = mid;
-    }
-    (void)ray_phi(K, mu, 0.5 * (lo + hi), &tx, &ty);
-    *theta = atan2(ty, tx);
+    *theta = atan2(ry, rx);
     return PD_OK;
 }
 
@@ -152,7 +172,7 @@ static int slide_rhs(double tau, const double y[], double dydt[], void *user)
     (void)tau;
     const collision *c = user;
     pd_vec3 u = coll_u(c, y);
-    double s = hypot(u.x, u.y);
+    double s = sqrt(u.x * u.x + u.y * u.y); /* |u| <~ 1 here: no overflow for hypot to guard */
     dydt[PX] = -c->mu * u.x;
     dydt[PY] = -c->mu * u.y;
     dydt[PW] = u.z * s;
@@ -240,7 +260,7 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
     pd_ode_reset(ode);
     for (;;) {
         pd_vec3 u = coll_u(c, c->y);
-        double s = hypot(u.x, u.y);
+        double s = sqrt(u.x * u.x + u.y * u.y);
         double tolw = PD_TOL_IMPACT_EVENT_REL * fabs(c->W_c);
         double tolp = PD_TOL_IMPACT_EVENT_REL * c->pz_end;
         if (!c->compressed && u.z >= -tolz)
@@ -434,12 +454,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         linear_phase(&c, v3(0.0, 0.0, 1.0));
     } else {
         pd_status st = PD_OK;
-        double th;
-        if (pd_impact_diverging_ray(CONST_M3(c.K), mu, &th) == PD_OK) {
-            c.have_ray = 1;
-            c.rtx = cos(th);
-            c.rty = sin(th);
-        }
+        c.have_ray = diverging_ray(CONST_M3(c.K), mu, &c.rtx, &c.rty);
         if (hypot(c.u0.x, c.u0.y) > PD_TOL_IMPACT_EVENT_REL)
             st = slide(&c, w->ode, &r.nsteps);
         if (st != PD_OK)
@@ -453,7 +468,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
                 if (!c.have_ray)
                     return PD_ERR_INTERNAL; /* unstable sticking always has its ray */
                 r.resumed = 1;
-                r.theta_e = th;
+                r.theta_e = atan2(c.rty, c.rtx);
                 d = v3(-mu * c.rtx, -mu * c.rty, 1.0);
             }
             linear_phase(&c, d);
