@@ -386,8 +386,10 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             PD_OK)
             break;
         if (out->collisions == before) {
-            /* Touching but not approaching: separating, or resting. */
-            if (pd_flight_plan(m->body, &s, g, &f) != PD_OK || pd_flight_eval(&f, dt_rest, &s) != PD_OK)
+            /* Touching but not approaching: separating, or resting. An
+             * impact found at once left s as planned: f still holds. */
+            if ((imp.kind != PD_IMPACT_NOW && pd_flight_plan(m->body, &s, g, &f) != PD_OK) ||
+                pd_flight_eval(&f, dt_rest, &s) != PD_OK)
                 break;
             t += dt_rest;
             if (t >= o->time_limit) {

@@ -211,6 +211,11 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
 {
     pd_state s = f->s0;
+    if (t == 0.0) {
+        /* The start itself: exact, and free (impact searches begin here). */
+        *out = s;
+        return PD_OK;
+    }
     s.x = v3(f->s0.x.x + f->s0.v.x * t, f->s0.x.y + f->s0.v.y * t,
              f->s0.x.z + f->s0.v.z * t - 0.5 * f->g * t * t);
     s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
