@@ -22,6 +22,7 @@
 #include <string.h>
 #include "basin.h"
 #include "body.h"
+#include "contact_phase.h"
 #include "diag.h"
 #include "drop_internal.h"
 #include "flight.h"
@@ -95,6 +96,7 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
          * twice that leaves room for what the part's rotation adds. */
         m->rest_fall = PD_TOL_REST_FALL_REL * m->body->size;
         m->v_rest = 2.0 * sqrt(2.0 * scene->gravity * m->rest_fall);
+        m->phases = 1;
     }
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
@@ -115,9 +117,13 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
         return NULL;
     if (model->engine)
         w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
-    else
+    else {
         w->impact = pd_impact_work_alloc();
-    if (!w->impact && !w->world) {
+        w->phase = pd_contact_phase_ode_alloc();
+    }
+    if ((!w->impact || !w->phase) && !w->world) {
+        pd_impact_work_free(w->impact);
+        pd_ode_free(w->phase);
         free(w);
         return NULL;
     }
@@ -130,6 +136,7 @@ void pd_drop_work_free(pd_drop_work *w)
     if (!w)
         return;
     pd_impact_work_free(w->impact);
+    pd_ode_free(w->phase);
     if (w->world)
         w->engine->world_free(w->world);
     free(w);
@@ -351,7 +358,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * vertex pressed on the floor by gravity meets it again with the speed
      * that fall gives (a microcollision) rather than at speed 0. */
     double dt_rest = sqrt(2.0 * m->rest_fall / g);
-    int hint = 0;
+    int hint = 0, phase_ok = 1;
     for (;;) {
         int pose, d = pd_drop_decided(m, &s, g, &hint, &pose);
         if (d < 0)
@@ -385,9 +392,27 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
             PD_OK)
             break;
+        if (out->collisions == before && phase_ok && m->phases &&
+            pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
+            /* Sliding on a vertex or an edge: the exact continuous motion.
+             * It ends at an event the microcollisions must resolve, so the
+             * next rest step is theirs (no phase can start and stop at once
+             * forever). */
+            double dt;
+            if (pd_contact_phase(m, w->phase, sc, &s, w->contacts, nc, o->time_limit - t, &dt) != PD_OK)
+                break;
+            t += dt;
+            phase_ok = 0;
+            if (t >= o->time_limit) {
+                out->end = PD_END_TIME_LIMIT;
+                break;
+            }
+            continue;
+        }
         if (out->collisions == before) {
             /* Touching but not approaching: separating, or resting. An
              * impact found at once left s as planned: f still holds. */
+            phase_ok = 1;
             if ((imp.kind != PD_IMPACT_NOW && pd_flight_plan(m->body, &s, g, &f) != PD_OK) ||
                 pd_flight_eval(&f, dt_rest, &s) != PD_OK)
                 break;

@@ -7,6 +7,7 @@
 #include "basin.h"
 #include "drop.h"
 #include "engine.h"
+#include "gsl_adapter.h"
 #include "impact.h"
 #include "static_internal.h"
 
@@ -29,10 +30,12 @@ struct pd_sim_model {
     double v_eps;               /* approach speeds below this are contact, not impact */
     double rest_fall;           /* m: how far resting contact falls between microcollisions */
     double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
+    int phases;                 /* 1: sliding contact as continuous phases (contact_phase.c) */
 };
 
 struct pd_drop_work {
     pd_impact_work *impact;
+    pd_ode *phase;              /* the sliding phases' integrator */
     pd_engine_world *world;     /* the stepping engine's, or NULL */
     const pd_engine *engine;
     int contacts[PD_MAX_CONTACTS];

@@ -226,6 +226,37 @@
  * Larger: more damping and sinking; smaller: slower, still biased. */
 #define PD_TOL_REST_FALL_REL 1e-4
 
+/* --- sliding contact phases (src/contact_phase.c) --------------------------- *
+ * One vertex or edge sliding on the floor is integrated as an ODE in units
+ * of the part: length L, time sqrt(L/g), speed sqrt(g L). */
+
+/* Local error per step asked of the phase's integrator (rk8pd), absolute and
+ * relative in those units. Why 1e-10: the energy the integration error can
+ * add over a phase of ~100 steps stays near 1e-8 L, far inside the rest-fall
+ * margin (1e-4 L) the energy test allows for, so the test stays sound;
+ * rk8pd's cost grows only as tol^(-1/8). Larger: that margin would have to
+ * grow. Smaller: steps shrink towards round-off of the state. */
+#define PD_TOL_PHASE_ODE_REL 1e-10
+
+/* A phase ends when a contact's slip falls below this times sqrt(g L): near
+ * zero slip friction's direction turns ever faster (the ODE stiffens) and the
+ * contact may stick, which the collision law decides. Why 1e-3: at that slip
+ * the part moves 1e-3 L per unit time, so handing over costs a few
+ * microcollisions; smaller would make the phase chase the stiff turn. A phase
+ * starts only at twice this, so it cannot start and end at once. */
+#define PD_TOL_PHASE_SLIP_REL 1e-3
+
+/* An event inside a phase step (lift-off, sticking, a new contact) is
+ * approached by halving the step until it is this short, in units of
+ * sqrt(L/g). Why 1e-6: the state is then within ~1e-6 L of the event, the
+ * same order as the contact tolerance; ~20 halvings from a unit step. */
+#define PD_TOL_PHASE_EVENT_REL 1e-6
+
+/* Integrator steps one phase may take: bounded work per phase. Why 10000: a
+ * sliding phase takes tens of steps; a phase that reaches this ends and the
+ * microcollisions go on, so nothing is lost but time. */
+#define PD_PHASE_MAX_STEPS 10000
+
 /* --- collisions (src/impact.c) ---------------------------------------------- *
  * A collision is solved in units where |u0| = 1 (u0 the pre-impact contact
  * velocity) and K's mean diagonal is 1, so these are relative to |u0| and the

@@ -1,0 +1,28 @@
+/* contact_phase.h (private): one vertex or one edge sliding on the floor,
+ * integrated as a continuous motion instead of microcollisions (see
+ * contact_phase.c for the model and when it hands back). */
+#ifndef PD_CONTACT_PHASE_H
+#define PD_CONTACT_PHASE_H
+
+#include "drop.h"
+#include "gsl_adapter.h"
+
+/* The phase's integrator (13 unknowns), one per thread. NULL if out of memory. */
+pd_ode *pd_contact_phase_ode_alloc(void);
+
+/* 1 if state s, touching the floor at body vertices contacts[0..nc), is a
+ * sliding contact the phase can take: one or two contacts moving normally
+ * no faster than the microcollisions' rest speed, all sliding, pressed by
+ * positive forces, no other vertex down. Then s's normal contact speeds are
+ * zeroed, without adding energy, for the phase to start from; otherwise s is
+ * left alone. */
+int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_state *s,
+                           const int *contacts, int nc);
+
+/* Runs the phase from s for at most t_max seconds, or until the energy test
+ * decides the drop; s becomes the state where it ended and *t_used the time
+ * it took. */
+pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, const pd_scene *scene,
+                           pd_state *s, const int *contacts, int nc, double t_max, double *t_used);
+
+#endif
