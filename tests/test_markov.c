@@ -1,10 +1,12 @@
 /* test_markov.c: the long-run distribution of a pose-to-pose chain against
- * closed forms, and its resampling intervals. */
+ * closed forms, its resampling intervals, and --initial stationary end to end
+ * on the cube. */
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
 #include "gsl_adapter.h"
 #include "markov.h"
+#include "posedrop/posedrop.h"
 #include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "suites.h"
@@ -235,10 +237,122 @@ static void test_coverage(void)
         CHECK(held[j] >= 0.90 * REPS);
 }
 
+/* --- end to end ----------------------------------------------------------- */
+
+static pd_sim_result *run_stationary(const pd_part *part, const pd_static_result *poses,
+                                     long n, int threads)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.initial = PD_INITIAL_STATIONARY;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = n;
+    o.threads = threads;
+    o.seed = 11;
+    pd_sim_result *r = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_status st = pd_sim_run(part, poses, &sc, &o, &r, &d);
+    if (st != PD_OK)
+        printf("     pd_sim_run: %s (%s)\n", pd_status_str(st), d.message);
+    return r;
+}
+
+static void test_cube(void)
+{
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_mesh *m = NULL;
+    pd_part *part = NULL;
+    pd_static_result *poses = NULL;
+    CHECK_STATUS(pd_mesh_read("parts/canonical/cube.off", NULL, &m, &d), PD_OK);
+    part = part_of(m, NULL, &d);
+    if (!part || pd_static_estimate(part, NULL, &poses, &d) != PD_OK) {
+        CHECK(0);
+        pd_part_free(part);
+        return;
+    }
+    CHECK_INT(poses->nposes, 6);
+    /* 700 drops: 100 uniform, 100 resting on each face. */
+    pd_sim_result *a = run_stationary(part, poses, 700, 1);
+    pd_sim_result *b = run_stationary(part, poses, 700, 2);
+    CHECK(a && b);
+    if (a && b) {
+        CHECK_INT(a->n, 700);
+        CHECK_INT(a->first_drops, 100);
+        CHECK_INT(a->pose_drops, 100);
+        CHECK_INT(a->unsettled, 0);
+        /* Every drop of phase 2 is one transition (none unsettled). */
+        long moves = 0, firsts = 0;
+        for (int i = 0; i < 36; i++)
+            moves += a->transitions[i];
+        for (int i = 0; i < 6; i++)
+            firsts += a->first_count[i];
+        CHECK_INT(moves, 600);
+        CHECK_INT(firsts, 100);
+        CHECK(a->closed_classes >= 1);
+        /* Threads change no byte. */
+        CHECK(memcmp(a->p, b->p, 6 * sizeof *a->p) == 0);
+        CHECK(memcmp(a->ci_lo, b->ci_lo, 6 * sizeof *a->ci_lo) == 0);
+        CHECK(memcmp(a->ci_hi, b->ci_hi, 6 * sizeof *a->ci_hi) == 0);
+        CHECK(memcmp(a->transitions, b->transitions, 36 * sizeof *a->transitions) == 0);
+        /* The counts over both phases are uniform within the 99.9%
+         * chi-square bound: each phase-2 row is a permutation of one
+         * distribution, which makes the test conservative. */
+        CHECK(uniform_p_value(a) > 1e-3);
+        /* pi uniform: each pose's deviation from 1/6 over its resampled
+         * standard error (the 95% half-width / 1.96), squared and summed,
+         * within the 99.9% bound of chi-square with 6 degrees of freedom
+         * (conservative: the sum to one takes one away). */
+        double x2 = 0, sum = 0;
+        for (int k = 0; k < 6; k++) {
+            double se = (a->ci_hi[k] - a->ci_lo[k]) / (2 * 1.959963984540054);
+            x2 += (a->p[k] - 1.0 / 6) * (a->p[k] - 1.0 / 6) / (se * se);
+            sum += a->p[k];
+        }
+        CHECK(pd_gsl_chisq_q(x2, 6) > 1e-3);
+        CHECK_NEAR(sum, 1.0, 1e-15, "a distribution, round-off");
+    }
+    pd_sim_result_free(a);
+    pd_sim_result_free(b);
+
+    /* Too few drops for the poses: refused with the minimum named. */
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.initial = PD_INITIAL_STATIONARY;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 7 * PD_STATIONARY_MIN_POSE_DROPS - 1;
+    pd_sim_result *r = NULL;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+    CHECK(r == NULL && strstr(d.message, "70") != NULL);
+    /* --ci has no meaning for a split fixed in advance. */
+    o.ndrops = 700;
+    o.ci_halfwidth = 0.05;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+
+    /* Cancelled before the first drop: partial, raw counts, no NaN. */
+    pd_sim_options_default(&o);
+    o.ndrops = 700;
+    volatile sig_atomic_t stop = 1;
+    o.cancel = &stop;
+    r = NULL;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_OK);
+    CHECK(r && r->partial && r->n == 0 && r->closed_classes == 0);
+    if (r)
+        for (int k = 0; k < 6; k++)
+            CHECK(r->p[k] == 0 && r->ci_lo[k] == 0 && r->ci_hi[k] == 1);
+    pd_sim_result_free(r);
+    pd_static_result_free(poses);
+    pd_part_free(part);
+}
+
 void suite_markov(void)
 {
     test_closed_forms();
     test_random_chains();
     test_estimate();
     test_coverage();
+    test_cube();
 }
