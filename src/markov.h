@@ -61,7 +61,7 @@ typedef struct pd_markov_summary {
  * empty. The intervals are a parametric bootstrap (see markov.c):
  * PD_STATIONARY_RESAMPLES chains redrawn from the counts, on streams derived
  * from seed that no drop uses, so the same counts and seed give the same
- * bytes. PD_ERR_RANGE for a row of more than UINT_MAX drops, PD_ERR_NOMEM,
+ * bytes; each interval holds its p. PD_ERR_RANGE for a row of more than UINT_MAX drops, PD_ERR_NOMEM,
  * PD_ERR_INTERNAL. */
 pd_status pd_markov_estimate(const pd_markov_counts *counts, const int *class_of, int nclasses,
                              uint64_t seed, pd_markov_summary *out);

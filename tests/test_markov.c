@@ -215,7 +215,7 @@ static void test_coverage(void)
     int nc;
     CHECK_STATUS(limit(3, P, mu0, pi, &nc), PD_OK);
     enum { REPS = 200, M = 20 };
-    int held[3] = {0}, defined = 0;
+    int held[3] = {0}, defined = 0, holds_p = 1;
     test_rng r = {2024};
     for (int rep = 0; rep < REPS; rep++) {
         long first[3] = {0}, C[9] = {0};
@@ -229,12 +229,15 @@ static void test_coverage(void)
         pd_markov_summary s = {p, lo, hi, 0, 0};
         CHECK_STATUS(pd_markov_estimate(&counts, NULL, 3, (uint64_t)rep, &s), PD_OK);
         defined += s.nclosed > 0;
-        for (int j = 0; s.nclosed > 0 && j < 3; j++)
+        for (int j = 0; s.nclosed > 0 && j < 3; j++) {
             held[j] += lo[j] <= pi[j] && pi[j] <= hi[j];
+            holds_p &= lo[j] <= p[j] && p[j] <= hi[j];
+        }
     }
     CHECK_INT(defined, REPS);
     for (int j = 0; j < 3; j++)
         CHECK(held[j] >= 0.90 * REPS);
+    CHECK(holds_p);
 }
 
 /* --- end to end ----------------------------------------------------------- */
@@ -312,6 +315,8 @@ static void test_cube(void)
             sum += a->p[k];
         }
         CHECK(pd_gsl_chisq_q(x2, 6) > 1e-3);
+        for (int k = 0; k < 6; k++)
+            CHECK(a->ci_lo[k] <= a->p[k] && a->p[k] <= a->ci_hi[k]);
         CHECK_NEAR(sum, 1.0, 1e-15, "a distribution, round-off");
     }
     pd_sim_result_free(a);

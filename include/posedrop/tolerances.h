@@ -387,8 +387,8 @@
  * drop is Jeffreys's prior on "does it ever leave" (a Beta(1/2, 1/2) gives
  * each outcome half a pseudo-count). Larger: intervals widen everywhere for
  * no gain in coverage (1: 95-100% at m = 20); smaller: traps return. It
- * moves only the intervals; p is the long-run distribution of the counts
- * themselves. */
+ * moves only the intervals (which are then stretched to hold p, markov.c);
+ * p is the long-run distribution of the counts themselves. */
 #define PD_STATIONARY_PSEUDO_DROPS 0.5
 
 /* --- limits ---------------------------------------------------------------- */
