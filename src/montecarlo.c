@@ -65,8 +65,9 @@ typedef struct batch {
     const pd_scene *scene;
     const pd_sim_options *opt;
     const double *init_cdf;
-    const double *pose_cdfs; /* not NULL: drop i starts on pose (i - pose_first) mod
-                               nposes, whose point-mass cdf is row that of pose_cdfs */
+    const double *pose_cdfs; /* not NULL: drop i starts resting on pose
+                               (i - pose_first) mod nposes, whose point-mass cdf
+                               is that row of pose_cdfs (instead of init_cdf) */
     long pose_first;
     int nposes;
     long first, last;       /* drop indices [first, last) */
