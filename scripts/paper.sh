@@ -2,12 +2,14 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-o DIR] [-d PAPER_TABLES_CSV]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-o DIR] [-d PAPER_TABLES_CSV]
 #
 # For each of the paper's four parts (parts/<name>.off, rebuilt from the
 # paper's photographs; parts/README.md), runs posedrop's QS and PQS and the
 # three engines with the paper's scene (2000 drops from 0.12 m, belt 0.05 m/s,
-# mu = restitution = 0.3, vibration 1.5 degrees, bootstrapped initial poses),
+# mu = restitution = 0.3, vibration 1.5 degrees, the belt's initial poses:
+# INITIAL is stationary by default, the long run of the estimated pose-to-pose
+# chain, or bootstrap, the paper's own running estimate, for comparison),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
 # (default results/) and prints each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
@@ -19,14 +21,16 @@
 # numbers its poses by physical frequency).
 set -u
 n=2000
+initial=stationary
 outdir=results
 tables=""
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) n=$2; shift 2 ;;
+        -i) initial=$2; shift 2 ;;
         -o) outdir=$2; shift 2 ;;
         -d) tables=$2; shift 2 ;;
-        --help) sed -n '2,20p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,21p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) echo "paper.sh: unknown argument '$1'" >&2; exit 2 ;;
     esac
 done
@@ -47,13 +51,13 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
         start=$(date +%s.%N)
-        "$bin" --group -n "$n" --initial bootstrap --engine "$engine" "$file" \
+        "$bin" --group -n "$n" --initial "$initial" --engine "$engine" "$file" \
             > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
         end=$(date +%s.%N)
         awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f\n", b - a }' > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
-    awk -F, -v part="$part" -v outdir="$outdir" '
+    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" '
         function load(file, key,    line, i, c, k) {
             k = 0
             while ((getline line < file) > 0) {
@@ -92,7 +96,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             for (i = 1; i <= np; i++) for (j = i + 1; j <= np; j++)
                 if (paper[prank[j], 1] > paper[prank[i], 1]) { t = prank[i]; prank[i] = prank[j]; prank[j] = t }
             for (r = 1; r <= np; r++) rank_of[prank[r]] = r
-            printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d)\n", part, trials, ks, np
+            printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d; initial %s)\n", part, trials, ks, np, initial
             printf "%4s | %6s %6s %6s %6s | %6s %6s %7s %6s %6s\n", "pose", "QS", "PQS", "Dyn", "Phys",
                    "QS", "PQS", "impulse", "ODE", "Bullet"
             for (p = 1; p <= np; p++) {

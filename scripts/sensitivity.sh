@@ -6,7 +6,9 @@
 #   scripts/sensitivity.sh [-n DROPS] [-o DIR] [-- POSEDROP-OPTIONS...] PART
 #
 # Sweeps mu, restitution and drop height around the paper's scene with the
-# impulse simulator (DROPS drops each, default 1000, pose classes grouped),
+# impulse simulator (DROPS drops each, default 1000, pose classes grouped;
+# initial poses the belt's long run, --initial stationary, which needs at
+# least 10 (k + 1) drops for k stable poses),
 # and epsilon with PQS; writes DIR/<part>-sensitivity.csv (parameter, value,
 # pose, p, ci_lo, ci_hi) and a chart DIR/<part>-sensitivity.png and .svg:
 # one panel per parameter, one line per pose class with its 95% band.
@@ -20,7 +22,7 @@ while [ $# -gt 0 ]; do
         -n) n=$2; shift 2 ;;
         -o) outdir=$2; shift 2 ;;
         --) shift; while [ $# -gt 1 ]; do opts+=("$1"); shift; done ;;
-        --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) part=$1; shift ;;
     esac
 done
@@ -42,9 +44,9 @@ point() {
         { lo = ("ci_lo" in c) ? $c["ci_lo"] : $c[column]; hi = ("ci_hi" in c) ? $c["ci_hi"] : $c[column]
           print param, value, $c["pose"], $c[column], lo, hi }' >> "$csv"
 }
-for v in 0 0.1 0.2 0.3 0.5 0.8 1.2; do point mu "$v" p -n "$n" --initial bootstrap --mu "$v"; done
-for v in 0 0.1 0.3 0.5 0.7 0.9; do point restitution "$v" p -n "$n" --initial bootstrap --restitution "$v"; done
-for v in 0.01 0.03 0.06 0.12 0.25 0.5; do point height "$v" p -n "$n" --initial bootstrap -h "$v"; done
+for v in 0 0.1 0.2 0.3 0.5 0.8 1.2; do point mu "$v" p -n "$n" --initial stationary --mu "$v"; done
+for v in 0 0.1 0.3 0.5 0.7 0.9; do point restitution "$v" p -n "$n" --initial stationary --restitution "$v"; done
+for v in 0.01 0.03 0.06 0.12 0.25 0.5; do point height "$v" p -n "$n" --initial stationary -h "$v"; done
 for v in 0 5 10 15 20 30 45; do point epsilon "$v" p_pqs --epsilon "$v"; done
 
 command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||

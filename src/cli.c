@@ -31,7 +31,9 @@ static void usage(FILE *out)
         "quasi-static and perturbed quasi-static estimates. With -n or --ci, drops\n"
         "are simulated too: count of n drops ended in the pose, p = count / n and\n"
         "its 95%% Wilson interval; unsettled: drops that hit a limit (in no count);\n"
-        "partial: 1 if interrupted before all drops ran.\n"
+        "partial: 1 if interrupted before all drops ran. With --initial stationary,\n"
+        "p is the long-run probability of the estimated pose-to-pose chain and\n"
+        "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
         "\n"
@@ -51,7 +53,9 @@ static void usage(FILE *out)
         "                     probability is lower; qs: compare propagated QS values\n"
         "  --pqs-band B       rect (default): the paper's |a| x epsilon band clipped\n"
         "                     to its triangle; exact: exact spherical band area\n"
-        "dynamic estimator (simulated drops):\n"
+        "dynamic estimator (simulated drops):\n", prog);
+    /* Two strings: C11 compilers need only take 4095 characters in one. */
+    fprintf(out,
         "  -n N               drops to simulate (default: none)\n"
         "  --engine E         impulse (default): posedrop's own simulator; ode or\n"
         "                     bullet: the same drops on a stepping engine, to cross-check\n"
@@ -65,11 +69,26 @@ static void usage(FILE *out)
         "  --restitution E    coefficient of restitution (0.3)\n"
         "  --restitution-law L  poisson (default) or energetic\n"
         "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
-        "  --initial I        uniform (default) or bootstrap (the paper's belt)\n"
+        "  --initial I        uniform (default): orientations uniform at random;\n"
+        "                     bootstrap: the paper's belt, drops resting on poses drawn\n"
+        "                     from the running estimate, rounds of 100 after 20 uniform;\n"
+        "                     stationary: the belt's long run: of N drops, N/(k+1)\n"
+        "                     start resting on each of the k poses and estimate the\n"
+        "                     pose-to-pose transition matrix P, the rest (at least as\n"
+        "                     many) start uniform and give the first drop's outcome mu0;\n"
+        "                     p = lim (1/T) sum_{t<T} mu0 P^t, solved exactly, with 95%%\n"
+        "                     intervals from 1000 multinomial redraws of mu0 and P.\n"
+        "                     Needs N >= 10 (k+1); does not go with --ci\n"
         "  --scene FILE       'key = value' lines: height, belt_speed, mu, restitution,\n"
         "                     restitution_law, vibration, initial, gravity; options\n"
         "                     given after it override it\n"
         "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
+        "  --transitions FILE with --initial stationary, the estimated chain as CSV:\n"
+        "                     from_pose,to_pose,count,p, one row per pair of poses\n"
+        "                     (numbered as in the output, classes with --group);\n"
+        "                     count: drops started resting on from_pose that settled\n"
+        "                     in to_pose, p: count over the row's settled drops (P);\n"
+        "                     from_pose 0: the uniform drops (mu0)\n"
         "output:\n"
         "  --facets           one row per hull facet instead of per pose, with its\n"
         "                     stability and quasi-static successor\n"
@@ -84,8 +103,7 @@ static void usage(FILE *out)
         "  --version          version\n"
         "\n"
         "exit status: 0 success, 2 bad usage or input, 1 internal failure,\n"
-        "130 interrupted (the rows printed are marked partial)\n",
-        prog);
+        "130 interrupted (the rows printed are marked partial)\n");
 }
 
 static int fail_usage(const char *fmt, const char *arg)
@@ -234,19 +252,18 @@ static const char *end_name(pd_drop_end e)
     }
 }
 
-static int write_trials(const char *path, const pd_sim_result *sim)
+/* The side files (--trials, --transitions): opened with a message on
+ * failure, closed with every write error caught. */
+static FILE *open_output(const char *path)
 {
     FILE *f = fopen(path, "w");
-    if (!f) {
+    if (!f)
         fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, strerror(errno));
-        return 0;
-    }
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end\n");
-    for (long i = 0; i < sim->n; i++) {
-        const pd_trial *t = &sim->trials[i];
-        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s\n", i + 1, t->q0[0], t->q0[1],
-                t->q0[2], t->q0[3], t->pose + 1, t->collisions, t->time, end_name(t->end));
-    }
+    return f;
+}
+
+static int close_output(FILE *f, const char *path)
+{
     int ok = fflush(f) == 0 && !ferror(f);
     ok &= fclose(f) == 0;
     if (!ok)
@@ -254,8 +271,44 @@ static int write_trials(const char *path, const pd_sim_result *sim)
     return ok;
 }
 
+static int write_trials(const char *path, const pd_sim_result *sim)
+{
+    FILE *f = open_output(path);
+    if (!f)
+        return 0;
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end\n");
+    for (long i = 0; i < sim->n; i++) {
+        const pd_trial *t = &sim->trials[i];
+        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s\n", i + 1, t->q0[0], t->q0[1],
+                t->q0[2], t->q0[3], t->pose + 1, t->collisions, t->time, end_name(t->end));
+    }
+    return close_output(f, path);
+}
+
+/* The stationary estimator's chain in long format: row 0 is the uniform
+ * drops (mu0), rows 1..k the poses (P); every pair is written, zeros
+ * included, so the file is the whole matrix. */
+static int write_transitions(const char *path, const pd_sim_result *sim)
+{
+    FILE *f = open_output(path);
+    if (!f)
+        return 0;
+    int k = sim->nposes;
+    fprintf(f, "from_pose,to_pose,count,p\n");
+    for (int i = 0; i <= k; i++) {
+        const long *row = i == 0 ? sim->first_count : sim->transitions + (size_t)(i - 1) * (size_t)k;
+        long total = 0;
+        for (int j = 0; j < k; j++)
+            total += row[j];
+        for (int j = 0; j < k; j++)
+            fprintf(f, "%d,%d,%ld,%.10g\n", i, j + 1, row[j],
+                    total ? (double)row[j] / (double)total : 0.0);
+    }
+    return close_output(f, path);
+}
+
 typedef struct {
-    const char *path, *trials, *com_text;
+    const char *path, *trials, *transitions, *com_text;
     pd_mesh_read_options read;
     pd_part_options part;
     pd_static_options estimate;
@@ -267,7 +320,7 @@ typedef struct {
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -317,6 +370,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"initial", required_argument, 0, OPT_INITIAL},
         {"scene", required_argument, 0, OPT_SCENE},
         {"trials", required_argument, 0, OPT_TRIALS},
+        {"transitions", required_argument, 0, OPT_TRANSITIONS},
         {"engine", required_argument, 0, OPT_ENGINE},
         {"dt", required_argument, 0, OPT_DT},
         {"facets", no_argument, 0, OPT_FACETS},
@@ -433,6 +487,9 @@ static int parse_args(int argc, char **argv, cli_args *a)
             a->trials = optarg;
             a->sim.keep_trials = 1;
             break;
+        case OPT_TRANSITIONS:
+            a->transitions = optarg;
+            break;
         case OPT_FACETS:
             a->facets = 1;
             break;
@@ -460,6 +517,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
+    int stationary = a->scene.initial == PD_INITIAL_STATIONARY;
+    if (a->transitions && (!stationary || !a->dynamic))
+        return fail_usage("%s", "--transitions needs the drops of --initial stationary and -n");
+    if (stationary && a->sim.ci_halfwidth > 0)
+        return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
+                          "number of drops over the poses in advance: give -n");
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
@@ -497,6 +560,40 @@ static void print_summary(const cli_args *a, const pd_part *part, const pd_stati
             h->nverts, h->nfacets, res->nposes, res->nknife);
 }
 
+/* --initial stationary: whether p is the chain's limit (always said when it
+ * is not), and with --verbose how the chain came out: its closed classes, and
+ * how far the long run moved from the first drops (mu0 against pi's
+ * intervals, which carry mu0's noise too). */
+static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim)
+{
+    if (sim->closed_classes == 0) {
+        fprintf(stderr, "%s: %s: the drops run do not define the pose-to-pose chain (a pose it "
+                        "reaches has no settled drop started on it, or no uniform drop "
+                        "settled): p is count / n\n", prog, a->path);
+        return;
+    }
+    if (!a->verbose)
+        return;
+    long settled = 0;
+    for (int i = 0; i < sim->nposes; i++)
+        settled += sim->first_count[i];
+    int outside = 0;
+    for (int i = 0; i < sim->nposes; i++) {
+        double mu0 = (double)sim->first_count[i] / (double)settled;
+        outside += mu0 < sim->ci_lo[i] || mu0 > sim->ci_hi[i];
+    }
+    fprintf(stderr, "%s: stationary: %ld uniform drops, %ld resting on each of %d poses; the "
+                    "chain has %d closed class%s reached from the uniform drops%s\n", a->path,
+            sim->first_drops, sim->pose_drops, sim->nposes, sim->closed_classes,
+            sim->closed_classes == 1 ? "" : "es",
+            sim->closed_classes == 1 ? " (pi is its unique stationary distribution)"
+                                     : " (pi weighs them by absorption from mu0)");
+    fprintf(stderr, "%s: stationary: the first drops (mu0) and the long run (pi) differ by %.3g "
+                    "in total variation; mu0 is outside pi's 95%% interval on %d of %d poses%s\n",
+            a->path, sim->stationary_shift, outside, sim->nposes,
+            outside ? "" : " (no sign that they differ)");
+}
+
 /* What every dynamic run reports, whether or not --verbose: drops that could
  * not be classified and collisions the law had to correct are never silent. */
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
@@ -517,6 +614,8 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
                         "variation) from the distribution it started from%s\n", prog, a->path,
                 sim->bootstrap_rounds, sim->stationarity,
                 sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
+    if (sim->transitions)
+        print_stationary_summary(a, sim);
     if (a->verbose && sim->n)
         fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
                 (double)sim->collisions / (double)sim->n);
@@ -588,6 +687,8 @@ int main(int argc, char **argv)
     if (code)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
     if (sim && a.trials && !write_trials(a.trials, sim))
+        code = EXIT_INTERNAL;
+    if (sim && a.transitions && !write_transitions(a.transitions, gsim ? gsim : sim))
         code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
         code = EXIT_INTERRUPTED;

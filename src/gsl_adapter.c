@@ -3,6 +3,8 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_randist.h>
+#include <gsl/gsl_rng.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_elljac.h>
 #include <stdlib.h>
@@ -48,6 +50,29 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
 
 double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }
+
+/* GSL's samplers draw through a gsl_rng; this type makes one of posedrop's
+ * streams that gsl_rng, so no GSL generator (and no GSL seeding convention)
+ * enters the results. get gives the top 32 bits, get_double the same 53-bit
+ * uniform as pd_rng_uniform. set is never called: the state is the caller's. */
+static void stream_set(void *state, unsigned long seed)
+{
+    (void)state;
+    (void)seed;
+}
+
+static unsigned long stream_get(void *state) { return (unsigned long)(pd_rng_u64(state) >> 32); }
+
+static double stream_get_double(void *state) { return pd_rng_uniform(state); }
+
+static const gsl_rng_type stream_type = {"posedrop-stream", 0xffffffffUL, 0, sizeof(pd_rng),
+                                         stream_set, stream_get, stream_get_double};
+
+void pd_gsl_multinomial(pd_rng *rng, int k, unsigned total, const double *w, unsigned *out)
+{
+    gsl_rng r = {&stream_type, rng};
+    gsl_ran_multinomial(&r, (size_t)k, total, w, out);
+}
 
 /* ==== Elliptic functions (flight: torque-free rotation) ===============
  * See gsl_adapter.h. GSL_PREC_DOUBLE: the flight promises conservation and

@@ -7,6 +7,7 @@
 #define PD_GSL_ADAPTER_H
 
 #include "posedrop/status.h"
+#include "rng.h"
 
 typedef double (*pd_quad_fn)(double x, void *user);
 
@@ -20,6 +21,12 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 /* Distribution functions (GSL's cdf module). */
 double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
 double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
+
+/* One multinomial draw: out[0..k) counts of `total` trials over k categories
+ * of weights w[0..k) (non-negative, not all zero, normalised by GSL), drawn
+ * from rng, one of posedrop's own streams, so the draw is as reproducible as
+ * a drop. GSL's conditional binomials: O(k) whatever total is. */
+void pd_gsl_multinomial(pd_rng *rng, int k, unsigned total, const double *w, unsigned *out);
 
 /* ==== Elliptic functions (flight: torque-free rotation) ===============
  * Thin wrappers on GSL's special functions, error handler off, GSL status

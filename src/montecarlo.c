@@ -6,7 +6,8 @@
  * randomness comes from its own stream (seed, index), so neither the thread
  * count nor the scheduling can change a byte of the result. What depends on
  * earlier outcomes (the bootstrap's initial distribution, the --ci stopping
- * rule) is decided between batches, on tallies of whole batches only. */
+ * rule) is decided between batches, on tallies of whole batches only; the
+ * stationary estimator's phases depend on nothing but the drop index. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -15,6 +16,8 @@
 #include <unistd.h>
 #include "diag.h"
 #include "drop.h"
+#include "markov.h"
+#include "posedrop/tolerances.h"
 #include "stats.h"
 
 /* The paper's bootstrap: 20 uniform drops, then drops resting on poses drawn
@@ -52,6 +55,8 @@ void pd_sim_result_free(pd_sim_result *r)
     free(r->ci_lo);
     free(r->ci_hi);
     free(r->trials);
+    free(r->first_count);
+    free(r->transitions);
     free(r);
 }
 
@@ -60,6 +65,11 @@ typedef struct batch {
     const pd_scene *scene;
     const pd_sim_options *opt;
     const double *init_cdf;
+    const double *pose_cdfs; /* not NULL: drop i starts resting on pose
+                               (i - pose_first) mod nposes, whose point-mass cdf
+                               is that row of pose_cdfs (instead of init_cdf) */
+    long pose_first;
+    int nposes;
     long first, last;       /* drop indices [first, last) */
     pd_trial *out;          /* out[i - first] */
     atomic_long next;
@@ -83,7 +93,10 @@ static void *worker(void *arg)
         long i = atomic_fetch_add(&b->next, 1);
         if (i >= b->last || cancelled(b->opt))
             break;
-        pd_drop_run(b->model, w, b->scene, b->opt, i, b->init_cdf, &b->out[i - b->first], &gain,
+        const double *cdf = b->init_cdf;
+        if (b->pose_cdfs)
+            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((i - b->pose_first) % b->nposes);
+        pd_drop_run(b->model, w, b->scene, b->opt, i, cdf, &b->out[i - b->first], &gain,
                     &fallbacks);
     }
     atomic_fetch_add(&b->energy_gain, gain);
@@ -121,14 +134,25 @@ static long run_batch(batch *b, int nthreads, pd_sim_result *r)
     return atomic_load(&b->failed) && done < b->last - b->first ? -1 : done;
 }
 
+/* Counts drops r->n .. r->n + n - 1, whose records are t[0..n). The
+ * stationary estimator also files each settled drop under its phase: mu0's
+ * counts, or the row of the pose it started on. */
 static void tally(pd_sim_result *r, const pd_trial *t, long n)
 {
     for (long i = 0; i < n; i++) {
         r->collisions += t[i].collisions;
-        if (t[i].end == PD_END_SETTLED && t[i].pose >= 0)
-            r->count[t[i].pose]++;
-        else
+        if (t[i].end != PD_END_SETTLED || t[i].pose < 0) {
             r->unsettled++;
+            continue;
+        }
+        r->count[t[i].pose]++;
+        if (!r->transitions)
+            continue;
+        long phase2 = r->n + i - r->first_drops;
+        if (phase2 < 0)
+            r->first_count[t[i].pose]++;
+        else
+            r->transitions[(size_t)(phase2 % r->nposes) * (size_t)r->nposes + (size_t)t[i].pose]++;
     }
     r->n += n;
 }
@@ -197,10 +221,41 @@ static long next_batch(const pd_sim_result *r, const pd_scene *scene, const pd_s
     return size > BATCH_MAX ? BATCH_MAX : size;
 }
 
+/* Runs batch b, appends its records to r->trials when they are kept, and
+ * tallies them (a batch cut short by cancellation marks r partial). Returns
+ * the drops done, or -1 with *st set. */
+static long run_recorded(batch *b, int nthreads, const pd_sim_options *o, pd_sim_result *r,
+                         pd_status *st, pd_diag *diag)
+{
+    long done = run_batch(b, nthreads, r);
+    if (done < 0) {
+        *st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for a thread's work area");
+        return -1;
+    }
+    if (o->keep_trials && done > 0) {
+        pd_trial *t = realloc(r->trials, sizeof *t * (size_t)(r->n + done));
+        if (!t) {
+            *st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for %ld trial records", r->n + done);
+            return -1;
+        }
+        memcpy(t + r->n, b->out, sizeof *t * (size_t)done);
+        r->trials = t;
+    }
+    tally(r, b->out, done);
+    if (done < b->last - b->first)
+        r->partial = 1;
+    return done;
+}
+
+static int thread_count(const pd_sim_options *o)
+{
+    return o->threads > 0 ? (o->threads > 256 ? 256 : o->threads) : default_threads();
+}
+
 static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const pd_sim_options *o,
                        pd_sim_result *r, pd_diag *diag)
 {
-    int nthreads = o->threads > 0 ? (o->threads > 256 ? 256 : o->threads) : default_threads();
+    int nthreads = thread_count(o);
     /* --ci starts from the drops that guarantee the half-width for every pose
      * at once in the worst case (p = 1/2, Bonferroni over the poses: the
      * corrected eq. 17), then adds batches while an interval is still wider. */
@@ -228,32 +283,85 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
         batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .first = r->n,
                    .last = r->n + size, .out = buf};
         memcpy(before, r->count, sizeof *before * (size_t)r->nposes);
-        long done = run_batch(&b, nthreads, r);
-        if (done < 0) {
-            st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for a thread's work area");
+        if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
-        }
-        if (o->keep_trials && done > 0) {
-            pd_trial *t = realloc(r->trials, sizeof *t * (size_t)(r->n + done));
-            if (!t) {
-                st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for %ld trial records", r->n + done);
-                break;
-            }
-            memcpy(t + r->n, buf, sizeof *t * (size_t)done);
-            r->trials = t;
-        }
-        tally(r, buf, done);
         if (init) {
             r->bootstrap_rounds++;
             r->stationarity = round_distance(init, before, r->count, r->nposes);
         }
-        if (done < size)
-            r->partial = 1;
     }
     free(buf);
     free(cdf);
     free(before);
     return st;
+}
+
+/* --initial stationary: drops [0, first_drops) from uniform orientations,
+ * then the rest resting on the poses in turn. Interleaved rather than pose
+ * after pose, so that a run stopped early has drops from every pose and can
+ * still give pi. */
+static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
+                                  const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)
+{
+    int k = r->nposes;
+    size_t K = (size_t)k;
+    pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
+    /* Row i: the cumulative distribution of a point mass on pose i, so the
+     * bootstrap's own release (drop.c) starts the drop resting on pose i. */
+    double *point = malloc(sizeof *point * K * K);
+    pd_status st = PD_OK;
+    if (!buf || !point)
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
+    for (size_t i = 0; point && i < K; i++)
+        for (size_t j = 0; j < K; j++)
+            point[i * K + j] = j >= i ? 1.0 : 0.0;
+    int nthreads = thread_count(o);
+    while (st == PD_OK && r->n < o->ndrops && !r->partial) {
+        int resting = r->n >= r->first_drops;
+        long end = resting ? o->ndrops : r->first_drops;
+        long size = end - r->n > BATCH_MAX ? BATCH_MAX : end - r->n;
+        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = resting ? point : NULL,
+                   .pose_first = r->first_drops, .nposes = k, .first = r->n,
+                   .last = r->n + size, .out = buf};
+        if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
+            break;
+    }
+    free(buf);
+    free(point);
+    return st;
+}
+
+/* p and its intervals become pi of the estimated chain and its resampled
+ * intervals, when the counts define the chain; otherwise they stay count / n
+ * and Wilson's (closed_classes 0 says which). */
+static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
+{
+    pd_markov_counts c = {r->nposes, r->first_count, r->transitions};
+    pd_markov_summary s = {r->p, r->ci_lo, r->ci_hi, 0, 0.0};
+    pd_status st = pd_markov_estimate(&c, NULL, r->nposes, r->seed, &s);
+    if (st != PD_OK)
+        return pd_fail(diag, st, "the long-run distribution of the pose chain: %s",
+                       pd_status_str(st));
+    r->closed_classes = s.nclosed;
+    r->stationary_shift = s.shift;
+    return PD_OK;
+}
+
+/* The stationary estimator's split of the drops, refused when it cannot
+ * give every pose its minimum or --ci asks for a stopping rule. */
+static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
+{
+    if (o->ci_halfwidth > 0)
+        return pd_fail(diag, PD_ERR_USAGE, "initial stationary splits a fixed number of drops "
+                       "over the poses in advance; it does not go with a confidence half-width "
+                       "(give the number of drops)");
+    long need = (long)(k + 1) * PD_STATIONARY_MIN_POSE_DROPS;
+    if (o->ndrops < need)
+        return pd_fail(diag, PD_ERR_USAGE, "initial stationary: %ld drops are too few for %d "
+                       "stable poses: each pose needs %d drops started resting on it and the "
+                       "uniform start as many, at least %ld drops in all", o->ndrops, k,
+                       PD_STATIONARY_MIN_POSE_DROPS, need);
+    return PD_OK;
 }
 
 pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const pd_scene *scene,
@@ -277,6 +385,9 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
     if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
+    int stationary = sc.initial == PD_INITIAL_STATIONARY;
+    if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
+        return PD_ERR_USAGE;
     pd_sim_model *model = NULL;
     pd_status st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
     if (st != PD_OK)
@@ -289,9 +400,19 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         r->p = calloc((size_t)k, sizeof *r->p);
         r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
         r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
+        r->seed = o.seed;
+        if (stationary) {
+            r->first_count = calloc((size_t)k, sizeof *r->first_count);
+            r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
+            r->pose_drops = o.ndrops / (k + 1);
+            r->first_drops = o.ndrops - k * r->pose_drops;
+        }
     }
-    if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi)
+    if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi ||
+        (stationary && (!r->first_count || !r->transitions)))
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the results");
+    else if (stationary)
+        st = drive_stationary(model, &sc, &o, r, diag);
     else
         st = drive(model, &sc, &o, r, diag);
     pd_sim_model_free(model);
@@ -302,6 +423,10 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     for (int i = 0; i < k; i++) {
         r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
         pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
+    }
+    if (stationary && (st = finish_stationary(r, diag)) != PD_OK) {
+        pd_sim_result_free(r);
+        return st;
     }
     *result = r;
     return PD_OK;

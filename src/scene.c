@@ -69,9 +69,11 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
             s->initial = PD_INITIAL_UNIFORM;
         else if (strcmp(value, "bootstrap") == 0)
             s->initial = PD_INITIAL_BOOTSTRAP;
+        else if (strcmp(value, "stationary") == 0)
+            s->initial = PD_INITIAL_STATIONARY;
         else
-            return pd_fail(diag, PD_ERR_PARSE, "%s: expected uniform or bootstrap, got '%s'", key,
-                           value);
+            return pd_fail(diag, PD_ERR_PARSE, "%s: expected uniform, bootstrap or stationary, "
+                           "got '%s'", key, value);
         return PD_OK;
     }
     return pd_fail(diag, PD_ERR_USAGE,

@@ -17,6 +17,7 @@
     PD_SUITE(impact) \
     PD_SUITE(drop)   \
     PD_SUITE(sim)    \
+    PD_SUITE(markov) \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \

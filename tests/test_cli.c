@@ -492,6 +492,83 @@ static void test_group(void)
     expect_failure("--group --facets parts/cap.off", 2, "--group");
 }
 
+/* Sums column k (0-based) of every data row of a CSV text. */
+static double column_sum(const char *csv, int k, int *rows)
+{
+    double sum = 0.0;
+    *rows = 0;
+    for (const char *p = strchr(csv, '\n'); p && p[1]; p = strchr(p + 1, '\n'), ++*rows)
+        sum += column(p + 1, k);
+    return sum;
+}
+
+/* --initial stationary: the same columns with p the chain's long run, the
+ * same bytes for any thread count, the matrix in --transitions, classes
+ * summed by --group, and the combinations it refuses. */
+static void test_stationary(void)
+{
+    char *out, *err, *out2, *err2, args[512], path[160];
+    int rows;
+    /* The cube, 140 drops: 20 uniform, 20 resting on each of its 6 faces. */
+    snprintf(path, sizeof path, "%s/transitions.csv", tmpdir);
+    snprintf(args, sizeof args,
+             "-n 140 -j 1 --initial stationary --verbose --transitions %s parts/canonical/cube.off",
+             path);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK_INT(run("-n 140 -j 2 --initial stationary parts/canonical/cube.off", &out2, &err2), 0);
+    const char *cols = "pose,nx,ny,nz,area,height,p_qs,p_pqs,n,count,p,ci_lo,ci_hi,unsettled,partial\n";
+    CHECK(strncmp(out, cols, strlen(cols)) == 0);
+    CHECK(strcmp(out, out2) == 0);
+    CHECK_NEAR(column_sum(out, 10, &rows), 1.0, 6e-10, "10 printed digits on 6 rows");
+    CHECK_INT(rows, 6);
+    CHECK_NEAR(column_sum(out, 9, &rows), 140 - column(strchr(out, '\n') + 1, 13), 0.0,
+               "every settled drop counted once");
+    CHECK(strstr(err, "20 uniform drops, 20 resting on each of 6 poses") != NULL);
+    CHECK(strstr(err, "closed class") != NULL && strstr(err, "total variation") != NULL);
+    char *t = slurp(path);
+    CHECK(t && strncmp(t, "from_pose,to_pose,count,p\n", 26) == 0);
+    if (t) {
+        /* 7 rows of 6: the uniform drops' outcomes, then each face's; the
+         * faces' rows hold the 120 drops started on them (none unsettled
+         * on a cube), each row's p sums to 1. */
+        CHECK_NEAR(column_sum(t, 2, &rows), 140, 0.0, "all drops settle on a cube");
+        CHECK_INT(rows, 42);
+        CHECK_NEAR(column_sum(t, 3, &rows), 7.0, 7 * 6e-10, "10 printed digits, 7 rows of P");
+        CHECK(strstr(t, "\n0,1,") != NULL && strstr(t, "\n6,6,") != NULL);
+    }
+    free(t);
+    free(out);
+    free(err);
+    free(out2);
+    free(err2);
+
+    /* --group on a 1 x 1 x 2 box (ends and sides): each class's p is the sum
+     * of its poses' p, the matrix is between classes. */
+    snprintf(args, sizeof args,
+             "-n 140 --initial stationary --group --transitions %s parts/canonical/box_1x1x2.off",
+             path);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK_INT(run("-n 140 --initial stationary parts/canonical/box_1x1x2.off", &out2, &err2), 0);
+    double grouped = column_sum(out, 10, &rows);
+    CHECK_INT(rows, 2);
+    CHECK_NEAR(grouped, column_sum(out2, 10, &rows), 1e-9, "10 printed digits per row");
+    t = slurp(path);
+    CHECK(t != NULL);
+    if (t) {
+        column_sum(t, 2, &rows);
+        CHECK_INT(rows, 6);
+    }
+    free(t);
+    free(out);
+    free(err);
+    free(out2);
+    free(err2);
+
+    expect_failure("--initial stationary --ci 0.05 parts/cap.off", 2, "--ci");
+    expect_failure("--transitions /tmp/x.csv -n 10 parts/cap.off", 2, "--transitions");
+    expect_failure("--initial stationary -n 300 parts/cap.off", 2, "at least 350 drops");
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -511,6 +588,7 @@ void suite_cli(void)
     test_eq16();
     test_scripts();
     test_group();
+    test_stationary();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

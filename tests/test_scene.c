@@ -25,6 +25,8 @@ void suite_scene(void)
     CHECK(s.law == PD_RESTITUTION_ENERGETIC);
     CHECK_STATUS(pd_scene_set(&s, "initial", "bootstrap", &d), PD_OK);
     CHECK(s.initial == PD_INITIAL_BOOTSTRAP);
+    CHECK_STATUS(pd_scene_set(&s, "initial", "stationary", &d), PD_OK);
+    CHECK(s.initial == PD_INITIAL_STATIONARY);
     pd_scene before = s;
     CHECK_STATUS(pd_scene_set(&s, "restitution", "1.5", &d), PD_ERR_RANGE);
     CHECK_STATUS(pd_scene_set(&s, "mu", "nan", &d), PD_ERR_PARSE);

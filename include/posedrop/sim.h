@@ -28,7 +28,9 @@ typedef enum pd_restitution_law {
 
 typedef enum pd_initial {
     PD_INITIAL_UNIFORM = 0, /* orientation uniform over SO(3) */
-    PD_INITIAL_BOOTSTRAP    /* the paper's: resting poses drawn from the running estimate */
+    PD_INITIAL_BOOTSTRAP,   /* the paper's: resting poses drawn from the running estimate */
+    PD_INITIAL_STATIONARY   /* the long-run distribution of the estimated pose-to-pose
+                               chain (see pd_sim_run) */
 } pd_initial;
 
 /* What a drop is made of. Filled by pd_scene_default, then edited. */
@@ -47,8 +49,8 @@ void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed (or v), mu, restitution, restitution_law
- * (poisson|energetic), vibration (degrees), initial (uniform|bootstrap),
- * gravity. PD_ERR_USAGE for an unknown key, PD_ERR_PARSE for a bad value,
+ * (poisson|energetic), vibration (degrees), initial
+ * (uniform|bootstrap|stationary), gravity. PD_ERR_USAGE for an unknown key, PD_ERR_PARSE for a bad value,
  * PD_ERR_RANGE for a value out of range; the scene is unchanged on failure. */
 pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
 
@@ -117,10 +119,42 @@ typedef struct pd_sim_result {
     double stationarity;    /* bootstrap: total-variation distance between the
                                last rounds' initial and final distributions */
     pd_trial *trials;       /* n records when options->keep_trials, else NULL */
+    /* PD_INITIAL_STATIONARY only (otherwise 0 and NULL): */
+    long first_drops;       /* drops 0 .. first_drops-1 start from uniform orientations */
+    long pose_drops;        /* then this many start resting on each pose, interleaved:
+                               drop first_drops + t rests on pose t mod nposes */
+    long *first_count;      /* nposes: uniform drops that settled in each pose (mu0's counts) */
+    long *transitions;      /* nposes * nposes, row-major: [i * nposes + j] = drops started
+                               resting on pose i that settled in pose j */
+    int closed_classes;     /* closed communicating classes of the estimated chain that
+                               mu0 reaches (1: pi is its unique stationary distribution);
+                               0: p is count / n with Wilson intervals, because the counts
+                               do not define the chain (a cancelled run, or a pose the
+                               chain reaches without one settled drop started on it) */
+    double stationary_shift; /* total variation between mu0 and pi */
+    uint64_t seed;          /* the run's seed (options->seed) */
 } pd_sim_result;
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
  * (same numbering as its poses). options and scene may be NULL (defaults).
+ *
+ * PD_INITIAL_STATIONARY estimates the belt's pose-to-pose chain: with k
+ * poses, m = ndrops / (k + 1) drops start resting on each pose (on its facet,
+ * turned at random about the vertical, with the scene's vibration, as the
+ * bootstrap starts them) and give the rows of the transition matrix P; the
+ * other ndrops - k m drops (at least m) start from uniform orientations and
+ * give mu0, the distribution of a first drop. p is then the long-run
+ * distribution pi = lim (1/T) sum_{t<T} mu0 P^t, exact (closed classes,
+ * their stationary distributions, absorption from mu0), and ci_lo, ci_hi its
+ * 95% parametric-bootstrap percentile interval (PD_STATIONARY_RESAMPLES
+ * redraws of mu0 and every row of P, each multinomial from its own counts);
+ * count and n still count the drops, over both phases. Even drops for every
+ * pose because every row of P enters pi; uniform drops as many because mu0
+ * matters only when P has several closed classes. m must be at least
+ * PD_STATIONARY_MIN_POSE_DROPS, and ci_halfwidth 0 (the split is fixed in
+ * advance): PD_ERR_USAGE otherwise. A cancelled run gives pi of the drops run
+ * when they define the chain, else count / n (closed_classes = 0).
+ *
  * Returns PD_ERR_USAGE (bad options), PD_ERR_NOMEM; a cancelled run returns
  * PD_OK with result->partial set. On success *result is owned by the caller. */
 pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_result,

@@ -52,7 +52,12 @@ pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int 
  * count[c] the sum over the class's poses, p = count / n and the 95% Wilson
  * interval recomputed for the class (an interval is not the sum of its
  * members'). n, unsettled, partial and the other run totals are copied;
- * trials is NULL. class_of has sim->nposes entries in [0, nclasses).
+ * trials is NULL. A PD_INITIAL_STATIONARY result whose p is the chain's
+ * long-run pi gets pi summed over each class and the class's own resampled
+ * interval (the same redraws, summed before the percentiles are taken), and
+ * its first_count and transitions summed over classes (row and column);
+ * stationary_shift is then measured between the classes. class_of has
+ * sim->nposes entries in [0, nclasses).
  * Free with pd_sim_result_free. PD_ERR_USAGE, PD_ERR_NOMEM. */
 pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
                                 pd_sim_result **grouped, pd_diag *diag);

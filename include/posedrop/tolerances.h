@@ -385,6 +385,45 @@
  * smaller: resting contacts chatter. */
 #define PD_BULLET_BOUNCE_STEPS 2.0
 
+/* --- initial stationary (src/montecarlo.c, src/markov.c) ----------------- */
+
+/* Fewest drops started resting on each stable pose. Each row of the
+ * estimated transition matrix rests on this many drops, and a transition the
+ * drops never show is taken to be impossible: one of probability 0.2 is
+ * missed with probability 0.8^m, 11% at m = 10 and 33% at m = 5, and a missed
+ * transition can split the chain into closed classes that do not exist
+ * (wrongly trapping the long-run mass). Below 10 a row is little more than a
+ * guess; larger would refuse -n 2000 on parts of more than ~200 stable poses
+ * (the paper's insulator cap has 98, so it gets 20 drops per pose). */
+#define PD_STATIONARY_MIN_POSE_DROPS 10
+
+/* Redrawn chains behind each stationary 95% interval (a percentile
+ * interval: its ends are the 2.5% and 97.5% points of the redrawn long-run
+ * probabilities). Why 1000: the usual minimum for percentile intervals
+ * (Efron and Tibshirani 1993, ch. 13); each end then sits on ~25 draws, and
+ * for a normal spread its own Monte Carlo error is 0.085 standard errors,
+ * 4% of the interval's half-width. More costs time linearly: each redraw
+ * solves the chain, O(k^3) for k poses. */
+#define PD_STATIONARY_RESAMPLES 1000
+
+/* Pseudo-drops spread evenly over the poses (those with drops started on
+ * them) before each row of the transition matrix, and mu0, is redrawn for
+ * the stationary intervals. Why: redrawn from the counts alone, a transition
+ * no drop made never appears in a redraw, so a pose that kept every one of
+ * its m drops is a trap in every redrawn chain and its long-run probability
+ * gets an interval of zero width, although the data allow it to be left
+ * with probability up to ~3/m. Measured on known chains with m = 20 drops
+ * per row (400 repetitions each): a pose kept 97% of the time, coverage of
+ * the nominal 95% intervals 47% without pseudo-drops, 98% with 0.5, 98%
+ * with 1; a sparse 5-pose chain 65-90% without, 94-100% with 0.5; a dense
+ * one 93-95% either way; at m = 100, 0.5 gives 92-98% everywhere. Half a
+ * drop is Jeffreys's prior on "does it ever leave" (a Beta(1/2, 1/2) gives
+ * each outcome half a pseudo-count). Larger: intervals widen everywhere for
+ * no gain in coverage (1: 95-100% at m = 20); smaller: traps return. It
+ * moves only the intervals (which are then stretched to hold p, markov.c);
+ * p is the long-run distribution of the counts themselves. */
+#define PD_STATIONARY_PSEUDO_DROPS 0.5
+
 /* --- limits ---------------------------------------------------------------- */
 
 /* Largest vertex or face count a file may declare. Counts are also checked
