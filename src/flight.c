@@ -122,12 +122,13 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
     /* Axial cases: equal moments (exact after the body's snapping), or u on a
      * principal axis (a steady spin, possibly about the unstable middle axis,
      * which an exact solution keeps). omega = a u + b axis, see flight.h. */
+    const double ax = PD_TOL_FLIGHT_AXIS_REL; /* |u| = 1 */
     int on_axis = -1;
-    if (u.y == 0.0 && u.z == 0.0)
+    if (fabs(u.y) <= ax && fabs(u.z) <= ax)
         on_axis = 0;
-    else if (u.x == 0.0 && u.z == 0.0)
+    else if (fabs(u.x) <= ax && fabs(u.z) <= ax)
         on_axis = 1;
-    else if (u.x == 0.0 && u.y == 0.0)
+    else if (fabs(u.x) <= ax && fabs(u.y) <= ax)
         on_axis = 2;
     if (I[0] == I[2] || on_axis >= 0 || I[0] == I[1] || I[1] == I[2]) {
         F.kind = PD_FLIGHT_AXIAL;

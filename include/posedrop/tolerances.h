@@ -173,6 +173,17 @@
  * tumbling (tennis-racket) motion. */
 #define PD_TOL_INERTIA_SYM_REL 1e-12
 
+/* An angular momentum whose direction is within this (unit vector
+ * components) of a principal axis is a steady spin about that axis, taken in
+ * closed form. Why 1e-12: a contact phase rotating a part about an edge along
+ * a principal axis ends with off-axis components of round-off (~1e-14); about
+ * the middle axis that is the elliptic solution's separatrix, where the
+ * phase's integral F(am, 1) = atanh(sin am) needs sin am = 1 - 1e-28 and
+ * overflows. Snapping keeps the unstable spin steady: a 1e-12 perturbation
+ * would grow at most e^(|w| t), to 1e-8 rad after 2 s at 10 rad/s. Smaller:
+ * the overflow; larger: genuine wobbles would be dropped. */
+#define PD_TOL_FLIGHT_AXIS_REL 1e-12
+
 /* The time of impact is found when the lowest hull vertex is within this height
  * of the floor, approached from above (never below it by more). Why 1e-9: the
  * flight's positions carry round-off of ~1e-15 L at drop heights of a few L and
