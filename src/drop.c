@@ -12,6 +12,14 @@
  * rotation), and uneven landings put the impulse nearer the faster contact,
  * as a sequence of Mirtich's microcollisions would, in one step.
  *
+ * Contact that lasts is simulated two ways. One vertex or one edge on the
+ * floor, sliding or sticking, is a contact phase (contact_phase.c): the
+ * exact continuous motion under its contact forces, until a contact lifts,
+ * slips, sticks or another vertex lands. Everything else (faces, contacts
+ * that chatter too much to enter a phase losslessly, hand-overs) is
+ * microcollisions: the contact falls a rest fall and is stopped, which sinks
+ * and damps the part slightly per step (README: "Known limit").
+ *
  * A drop ends when its energy per unit weight (a height) falls below the
  * barrier of the basin it is in (basin.c): then no future can leave the
  * basin, so its stable pose is the outcome. That needs collisions that never

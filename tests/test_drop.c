@@ -4,60 +4,12 @@
 #include <string.h>
 #include "check.h"
 #include "drop.h"
+#include "drop_fixture.h"
 #include "posedrop/posedrop.h"
 #include "quat.h"
 #include "shapes.h"
 #include "suites.h"
 #include "vec3.h"
-
-typedef struct {
-    pd_part *part;
-    pd_static_result *poses;
-    pd_sim_model *model;
-    pd_drop_work *work;
-} fixture;
-
-static int setup(fixture *fx, pd_mesh *mesh, const pd_scene *sc)
-{
-    memset(fx, 0, sizeof *fx);
-    pd_sim_options o;
-    pd_sim_options_default(&o);
-    int ok = pd_part_build(mesh, NULL, &fx->part, NULL) == PD_OK &&
-             pd_static_estimate(fx->part, NULL, &fx->poses, NULL) == PD_OK &&
-             pd_sim_model_build(fx->part, fx->poses, sc, &o, &fx->model, NULL) == PD_OK &&
-             (fx->work = pd_drop_work_alloc(fx->model, sc)) != NULL;
-    pd_mesh_free(mesh);
-    CHECK(ok);
-    return ok;
-}
-
-static void teardown(fixture *fx)
-{
-    pd_drop_work_free(fx->work);
-    pd_sim_model_free(fx->model);
-    pd_static_result_free(fx->poses);
-    pd_part_free(fx->part);
-}
-
-/* The body vertices within 1e-12 of the lowest, with the body turned by q. */
-static int lowest(const pd_body *b, pd_quat q, int *out)
-{
-    double zmin = 1e300;
-    for (int i = 0; i < b->nverts; i++)
-        zmin = fmin(zmin, quat_rotate(q, b->verts[i]).z);
-    int n = 0;
-    for (int i = 0; i < b->nverts; i++)
-        if (quat_rotate(q, b->verts[i]).z < zmin + 1e-12)
-            out[n++] = i;
-    return n;
-}
-
-static double kinetic(const pd_body *b, const pd_state *s)
-{
-    return 0.5 * b->mass * v3_dot(s->v, s->v) +
-           0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
-                  b->moment[2] * s->w.z * s->w.z);
-}
 
 static void test_flat_landing(void)
 {
@@ -66,14 +18,12 @@ static void test_flat_landing(void)
      * rebounds at e times the approach speed and does not turn. With friction
      * and a sideways speed it turns, but the normal rebound is the same. */
     pd_scene sc;
-    pd_scene_default(&sc);
-    sc.mu = 0.0;
-    fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.0);
+    if (!b)
         return;
-    const pd_body *b = pd_sim_model_body(fx.model);
     int contacts[64];
-    int nc = lowest(b, quat_identity(), contacts);
+    int nc = lowest_vertices(b, quat_identity(), contacts);
     CHECK_INT(nc, 4);
     const double es[] = {0.0, 0.3, 1.0};
     for (int i = 0; i < 3; i++) {
@@ -90,7 +40,7 @@ static void test_flat_landing(void)
     sc.mu = 0.3;
     sc.restitution = 0.3;
     pd_state s = {v3(0, 0, 0.1), quat_identity(), v3(0.4, 0, -1.5), v3(0, 0, 0)};
-    double k0 = kinetic(b, &s);
+    double k0 = kinetic_energy(b, &s);
     int impacts = 0;
     long gain = 0, fb = 0;
     CHECK_STATUS(pd_drop_collide(fx.model, fx.work, &sc, &s, contacts, nc, &impacts, &gain, &fb),
@@ -101,8 +51,8 @@ static void test_flat_landing(void)
     for (int i = 0; i < nc; i++)
         worst = fmin(worst, s.v.z + v3_cross(ww, quat_rotate(s.q, b->verts[contacts[i]])).z);
     CHECK(worst >= -1e-9);
-    CHECK(kinetic(b, &s) <= k0);
-    teardown(&fx);
+    CHECK(kinetic_energy(b, &s) <= k0);
+    drop_teardown(&fx);
 }
 
 static void test_energy_never_gained(void)
@@ -110,11 +60,10 @@ static void test_energy_never_gained(void)
     /* 2000 random single-vertex impacts of an asymmetric box: kinetic energy
      * never rises (the energetic law stands in for Poisson's where it would). */
     pd_scene sc;
-    pd_scene_default(&sc);
-    fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
         return;
-    const pd_body *b = pd_sim_model_body(fx.model);
     test_rng rng = {2718};
     int rises = 0, applied = 0;
     long gain = 0, fb = 0;
@@ -122,22 +71,22 @@ static void test_energy_never_gained(void)
         double r[3][3];
         rng_rotation(&rng, r);
         pd_quat q = quat_normalize(quat_from_matrix(CR(r)));
-        int contacts[64], nc = lowest(b, q, contacts);
+        int contacts[64], nc = lowest_vertices(b, q, contacts);
         sc.mu = rng_range(&rng, 0.0, 2.0);
         sc.restitution = rng_range(&rng, 0.0, 1.0);
         pd_state s = {v3(0, 0, 0.1), q, v3_scale(rng_unit_vector(&rng), 2.0),
                       v3_scale(rng_unit_vector(&rng), 50.0)};
         s.v.z = -fabs(s.v.z) - 0.1;
-        double k0 = kinetic(b, &s);
+        double k0 = kinetic_energy(b, &s);
         int impacts = 0;
         if (pd_drop_collide(fx.model, fx.work, &sc, &s, contacts, nc, &impacts, &gain, &fb) != PD_OK)
             continue;
         applied += impacts > 0;
-        rises += kinetic(b, &s) > k0 * (1 + 1e-12);
+        rises += kinetic_energy(b, &s) > k0 * (1 + 1e-12);
     }
     CHECK(applied > 1000);
     CHECK_INT(rises, 0);
-    teardown(&fx);
+    drop_teardown(&fx);
 }
 
 static void test_resting_drops(void)
@@ -149,8 +98,8 @@ static void test_resting_drops(void)
     sc.height = 1e-3;
     sc.vibration = 0.0;
     sc.belt_speed = 0.0;
-    fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
+    drop_fixture fx;
+    if (!drop_setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
         return;
     pd_sim_options o;
     pd_sim_options_default(&o);
@@ -177,7 +126,7 @@ static void test_resting_drops(void)
     double first[6] = {1, 1, 1, 1, 1, 1};
     pd_drop_run(fx.model, fx.work, &sc, &o, 0, first, &t, &gain, &fb);
     CHECK(t.end == PD_END_SETTLED && t.pose == 0);
-    teardown(&fx);
+    drop_teardown(&fx);
 }
 
 static void test_limits(void)
@@ -188,8 +137,8 @@ static void test_limits(void)
     pd_scene_default(&sc);
     sc.mu = 0.0;
     sc.restitution = 1.0;
-    fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
+    drop_fixture fx;
+    if (!drop_setup(&fx, mesh_box(0.01, 0.02, 0.03), &sc))
         return;
     pd_sim_options o;
     pd_sim_options_default(&o);
@@ -203,7 +152,7 @@ static void test_limits(void)
         CHECK(t.end == PD_END_TIME_LIMIT || t.end == PD_END_COLLISION_LIMIT);
     }
     CHECK_INT(classified, 0);
-    teardown(&fx);
+    drop_teardown(&fx);
 }
 
 void suite_drop(void)

@@ -231,10 +231,11 @@
  * as 1/sqrt(this) (1e-6 made a 32-gon cap take 5000 collisions a drop); the
  * energy test adds this depth to the energy. Caveat, measured: each step is
  * stopped where it ended, so sustained contact sinks about this much per
- * step (mean depth at collisions 1-3e-3 L, maximum 2-6e-2 L with spin), and
- * stopping the fall damps the motion artificially; the cap's pose 3 reads
- * 32.7, 37.2, 42.3, 45.6, 47.1% at 3e-3 ... 3e-5 (README: "Known limit").
- * Larger: more damping and sinking; smaller: slower, still biased. */
+ * step (mean depth at collisions 1-2e-3 L, maximum 2-6e-2 L with spin), and
+ * stopping the fall damps the motion artificially; with the contact phases
+ * taking vertex and edge contact, the cap's pose 3 reads 39.0, 45.7, 48.9,
+ * 49.9% at 1e-3, 3e-4, 1e-4, 1e-5 (README: "Known limit"). Larger: more
+ * damping and sinking; smaller: slower for a point or less. */
 #define PD_TOL_REST_FALL_REL 1e-4
 
 /* --- sliding contact phases (src/contact_phase.c) --------------------------- *
@@ -248,6 +249,18 @@
  * rk8pd's cost grows only as tol^(-1/8). Larger: that margin would have to
  * grow. Smaller: steps shrink towards round-off of the state. */
 #define PD_TOL_PHASE_ODE_REL 1e-10
+
+/* A phase starts from microcollision chatter by projecting the velocities
+ * onto the contact constraints, an inelastic impulse; it is admitted only if
+ * it takes at most this times m g L of kinetic energy. Why 1e-7: chatter
+ * moves at up to the rest speed, so an unrestricted entry costs up to about
+ * m g rest_fall = 1e-4 m g L, the damping of a microcollision, at every
+ * entry; measured on the paper's cap (4000 drops, rest fall 1e-4) that moved
+ * its most likely pose from 48.9% to 38.5%, against 48-50% in the limit of
+ * small rest falls. At 1e-7 only contacts already at rest up to round-off or
+ * nearly so enter (1e-9 gives the same distribution). Larger: the damping
+ * above; smaller: no change, then fewer phases. */
+#define PD_TOL_PHASE_ENTRY_REL 1e-7
 
 /* A phase ends when a contact's slip falls below this times sqrt(g L): near
  * zero slip friction's direction turns ever faster (the ODE stiffens) and the

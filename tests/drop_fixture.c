@@ -1,0 +1,58 @@
+/* drop_fixture.c: see drop_fixture.h. */
+#include <math.h>
+#include <string.h>
+#include "check.h"
+#include "drop_fixture.h"
+#include "quat.h"
+#include "shapes.h"
+#include "vec3.h"
+
+int drop_setup(drop_fixture *fx, pd_mesh *mesh, const pd_scene *sc)
+{
+    memset(fx, 0, sizeof *fx);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    int ok = pd_part_build(mesh, NULL, &fx->part, NULL) == PD_OK &&
+             pd_static_estimate(fx->part, NULL, &fx->poses, NULL) == PD_OK &&
+             pd_sim_model_build(fx->part, fx->poses, sc, &o, &fx->model, NULL) == PD_OK &&
+             (fx->work = pd_drop_work_alloc(fx->model, sc)) != NULL;
+    pd_mesh_free(mesh);
+    CHECK(ok);
+    return ok;
+}
+
+const pd_body *drop_setup_box(drop_fixture *fx, pd_scene *sc, double mu)
+{
+    pd_scene_default(sc);
+    sc->mu = mu;
+    if (!drop_setup(fx, mesh_box(0.01, 0.02, 0.03), sc))
+        return NULL;
+    return pd_sim_model_body(fx->model);
+}
+
+void drop_teardown(drop_fixture *fx)
+{
+    pd_drop_work_free(fx->work);
+    pd_sim_model_free(fx->model);
+    pd_static_result_free(fx->poses);
+    pd_part_free(fx->part);
+}
+
+int lowest_vertices(const pd_body *b, pd_quat q, int *out)
+{
+    double zmin = 1e300;
+    for (int i = 0; i < b->nverts; i++)
+        zmin = fmin(zmin, quat_rotate(q, b->verts[i]).z);
+    int n = 0;
+    for (int i = 0; i < b->nverts; i++)
+        if (quat_rotate(q, b->verts[i]).z < zmin + 1e-12)
+            out[n++] = i;
+    return n;
+}
+
+double kinetic_energy(const pd_body *b, const pd_state *s)
+{
+    return 0.5 * b->mass * v3_dot(s->v, s->v) +
+           0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                  b->moment[2] * s->w.z * s->w.z);
+}

@@ -1,0 +1,30 @@
+/* drop_fixture.h: a part with its pose table, drop model and work area, for
+ * tests that call the drop simulator's internals (drop.h) directly. */
+#ifndef PD_TEST_DROP_FIXTURE_H
+#define PD_TEST_DROP_FIXTURE_H
+
+#include "drop.h"
+#include "posedrop/posedrop.h"
+
+typedef struct {
+    pd_part *part;
+    pd_static_result *poses;
+    pd_sim_model *model;
+    pd_drop_work *work;
+} drop_fixture;
+
+/* Builds everything from mesh (consumed) for scene sc; counts a check and
+ * returns 0 if any step fails. */
+int drop_setup(drop_fixture *fx, pd_mesh *mesh, const pd_scene *sc);
+void drop_teardown(drop_fixture *fx);
+
+/* The fixture of the 1 x 2 x 3 cm box in the default scene with friction mu
+ * (sc is filled in); its body, or NULL (a check counted) on failure. */
+const pd_body *drop_setup_box(drop_fixture *fx, pd_scene *sc, double mu);
+
+/* The body vertices within 1e-12 of the lowest with the body turned by q. */
+int lowest_vertices(const pd_body *b, pd_quat q, int *out);
+
+double kinetic_energy(const pd_body *b, const pd_state *s);
+
+#endif

@@ -1,0 +1,176 @@
+/* test_contact_phase.c: sustained contact as a continuous motion: closed
+ * forms for a box sliding along an edge and toppling about one, energy that
+ * never rises, and a hand-over that leaves no vertex below the floor. */
+#include <math.h>
+#include "check.h"
+#include "contact_phase.h"
+#include "drop_fixture.h"
+#include "quat.h"
+#include "shapes.h"
+#include "suites.h"
+#include "vec3.h"
+
+static const double G = 9.81;
+
+/* Body-frame half extents of a box body. */
+static pd_vec3 half_extents(const pd_body *b)
+{
+    pd_vec3 e = v3(0, 0, 0);
+    for (int i = 0; i < b->nverts; i++)
+        e = v3(fmax(e.x, fabs(b->verts[i].x)), fmax(e.y, fabs(b->verts[i].y)),
+               fmax(e.z, fabs(b->verts[i].z)));
+    return e;
+}
+
+/* The box standing on its edge along body x at (y, z) = (-Y, -Z), turned
+ * about x so that the arm from the edge to the centre of mass leans `tilt`
+ * rad past the vertical, the edge on the floor, at rest. */
+static pd_state on_edge(const pd_body *b, double tilt, int *contacts, int *nc)
+{
+    pd_vec3 h = half_extents(b);
+    double a = atan2(h.y, h.z) + tilt;
+    pd_state s = {v3(0, 0, 0), quat_axis_angle(v3(1, 0, 0), a), v3(0, 0, 0), v3(0, 0, 0)};
+    *nc = lowest_vertices(b, s.q, contacts);
+    s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
+    return s;
+}
+
+static double energy(const pd_body *b, const pd_state *s)
+{
+    return kinetic_energy(b, s) + b->mass * G * s->x.z;
+}
+
+/* Sliding along the edge, balanced over it: friction mu m g brakes the box
+ * along x and its pitching moment is carried by the two ends' normal forces
+ * (mu h < X, so both stay positive); nothing turns. Closed form until the
+ * slip falls to the phase's end threshold: v = v0 - mu g t,
+ * x = v0 t - mu g t^2 / 2. */
+static void test_edge_slide(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    int contacts[8], nc;
+    pd_state s = on_edge(b, 0.0, contacts, &nc);
+    CHECK_INT(nc, 2);
+    double v0 = 0.2, z0 = s.x.z, L = b->size;
+    s.v = v3(v0, 0, 0);
+    CHECK(pd_contact_phase_start(fx.model, &sc, &s, contacts, nc));
+    pd_ode *ode = pd_contact_phase_ode_alloc();
+    double t = 0.0;
+    CHECK_STATUS(pd_contact_phase(fx.model, ode, &sc, &s, contacts, nc, 1.0, &t), PD_OK);
+    double stop = v0 / (sc.mu * G);
+    CHECK(t > 0.99 * stop && t < stop);
+    CHECK_NEAR(s.v.x, v0 - sc.mu * G * t, 1e-8 * v0, "closed form; ODE tolerance 1e-10 per step");
+    CHECK_NEAR(s.x.x, v0 * t - 0.5 * sc.mu * G * t * t, 1e-9 * L, "closed form; ODE tolerance");
+    CHECK_NEAR(s.x.z, z0, 1e-9 * L, "balanced over the edge: the height holds");
+    CHECK_NEAR(v3_norm(s.w), 0.0, 1e-6, "no turn, up to the unstable balance's growth of round-off");
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* Toppling about the edge: started 0.05 rad short of balance and turning
+ * towards it with 1.5 times the energy it needs to pass, so the outcome is
+ * open (a part leaning past balance from rest is decided at once, which ends
+ * a phase), and friction enough to hold the edge. A rotation about a fixed
+ * axis: the reaction does no work, the energy is conserved, the edge does not
+ * move, the next face comes down, and then the box turns about the edge at
+ * w = sqrt(w0^2 + 2 m g dh / I_e). */
+static void test_edge_topple(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 1.0);
+    if (!b)
+        return;
+    int contacts[8], nc;
+    pd_state s = on_edge(b, -0.05, contacts, &nc);
+    CHECK_INT(nc, 2);
+    pd_vec3 h = half_extents(b);
+    double Ie = b->moment[0] + b->mass * (h.y * h.y + h.z * h.z), L = b->size;
+    double w0 = sqrt(1.5 * 2.0 * b->mass * G * (hypot(h.y, h.z) - s.x.z) / Ie);
+    pd_vec3 e0 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    s.w = v3(w0, 0, 0);
+    s.v = v3_cross(quat_rotate(s.q, s.w), v3_sub(s.x, e0)); /* the edge at rest */
+    double E0 = energy(b, &s), z0 = s.x.z;
+    CHECK(pd_contact_phase_start(fx.model, &sc, &s, contacts, nc));
+    CHECK_NEAR(energy(b, &s), E0, 1e-12 * E0, "already on the constraint: the start changes nothing");
+    pd_ode *ode = pd_contact_phase_ode_alloc();
+    double t = 0.0;
+    CHECK_STATUS(pd_contact_phase(fx.model, ode, &sc, &s, contacts, nc, 1.0, &t), PD_OK);
+    CHECK(t > 0.0);
+    CHECK_NEAR(energy(b, &s), E0, 1e-8 * b->mass * G * L, "conservation; ODE tolerance 1e-10 per step");
+    pd_vec3 e1 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    CHECK_NEAR(v3_norm(v3_sub(e1, e0)), 0.0, 1e-8 * L, "a sticking contact stays put; ODE tolerance");
+    /* It ends as the next face lands: some other vertex at the floor. */
+    double low = 1e300;
+    for (int i = 0; i < b->nverts; i++)
+        if (i != contacts[0] && i != contacts[1])
+            low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
+    CHECK_NEAR(low, 0.0, 1e-5 * L, "event located to 1e-6 sqrt(L/g) at speeds ~ sqrt(g L)");
+    double w = sqrt(w0 * w0 + 2.0 * b->mass * G * (z0 - s.x.z) / Ie);
+    CHECK_NEAR(fabs(s.w.x), w, 1e-7 * w, "energy about a fixed axis; ODE tolerance");
+    CHECK_NEAR(hypot(s.w.y, s.w.z), 0.0, 1e-7 * w, "the axis is the edge");
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* Random phases of a box on a vertex or an edge, sliding and spinning: the
+ * start (a projection) and the phase never add energy beyond the
+ * integration error, and the hand-over leaves every other vertex above the
+ * contacts. */
+static void test_random_phases(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    double L = b->size, mgL = b->mass * G * L;
+    pd_ode *ode = pd_contact_phase_ode_alloc();
+    test_rng rng = {31};
+    int started = 0, rises = 0, below = 0;
+    for (int k = 0; k < 300; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        sc.mu = rng_range(&rng, 0.1, 1.0);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                      v3(rng_range(&rng, -0.5, 0.5), rng_range(&rng, -0.5, 0.5), 0.0),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 20.0))};
+        int contacts[8], nc = lowest_vertices(b, s.q, contacts);
+        s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
+        /* Contact moving along the floor, not into or out of it. */
+        s.v.z = -v3_cross(quat_rotate(s.q, s.w), quat_rotate(s.q, b->verts[contacts[0]])).z;
+        double E0 = energy(b, &s);
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc))
+            continue;
+        started++;
+        double E1 = energy(b, &s), t;
+        rises += E1 > E0 + 1e-14 * mgL;
+        if (pd_contact_phase(fx.model, ode, &sc, &s, contacts, nc, 0.5, &t) != PD_OK)
+            continue;
+        rises += energy(b, &s) > E1 + 1e-8 * mgL;
+        double floor_z = 1e300, low = 1e300;
+        for (int i = 0; i < nc; i++)
+            floor_z = fmin(floor_z, s.x.z + quat_rotate(s.q, b->verts[contacts[i]]).z);
+        for (int i = 0; i < b->nverts; i++)
+            if (i != contacts[0] && (nc < 2 || i != contacts[1]))
+                low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
+        below += low < floor_z - 1e-12 * L;
+    }
+    CHECK(started >= 100);
+    CHECK_INT(rises, 0);
+    CHECK_INT(below, 0);
+    printf("contact_phase: %d of 300 random sliding or spinning contacts started a phase\n", started);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+void suite_contact_phase(void)
+{
+    test_edge_slide();
+    test_edge_topple();
+    test_random_phases();
+}
