@@ -94,6 +94,101 @@ static void set_chart(pd_flight *f, int c, double s)
     f->e = quat_from_matrix(CONST_M3(E));
 }
 
+/* The principal axis u lies on within tol (its other components), or -1. */
+static int principal_axis(pd_vec3 u, double tol)
+{
+    if (fabs(u.y) <= tol && fabs(u.z) <= tol)
+        return 0;
+    if (fabs(u.x) <= tol && fabs(u.z) <= tol)
+        return 1;
+    if (fabs(u.x) <= tol && fabs(u.y) <= tol)
+        return 2;
+    return -1;
+}
+
+/* omega = a u + b axis (flight.h): a spherical top or a spin about a
+ * principal axis (on_axis >= 0) turns about L alone; a symmetric top also
+ * about its distinct axis. */
+static void set_axial(pd_flight *F, const double *I, const double *J, pd_vec3 u, int on_axis)
+{
+    F->kind = PD_FLIGHT_AXIAL;
+    if (I[0] == I[2] || on_axis >= 0) {
+        F->a = F->lambda * (on_axis >= 0 ? J[on_axis] : J[0]);
+        F->b = 0.0;
+        F->axis = v3(0.0, 0.0, 1.0);
+    } else {
+        int d = I[0] == I[1] ? 2 : 0; /* the distinct axis */
+        int s = d == 2 ? 0 : 2;       /* one of the equal pair */
+        F->axis = d == 2 ? v3(0.0, 0.0, 1.0) : v3(1.0, 0.0, 0.0);
+        F->a = F->lambda * J[s];
+        F->b = F->lambda * comp(u, d) * (J[d] - J[s]);
+    }
+}
+
+/* The asymmetric top in closed form (header), u = L/|L| in the body frame. */
+static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
+{
+    /* Asymmetric: D - J2 without cancellation decides which axis the polhode
+     * circles: the largest moment (body axis 3) when D < J2, else axis 1. */
+    double ux = u.x, uz = u.z;
+    double DmJ2 = (J[0] - J[1]) * ux * ux + (J[2] - J[1]) * uz * uz;
+    int c = DmJ2 < 0.0 ? 2 : DmJ2 > 0.0 ? 0 : (fabs(uz) >= fabs(ux) ? 2 : 0);
+    double uc = c == 2 ? uz : ux;
+    set_chart(F, c, uc > 0.0 ? 1.0 : -1.0);
+    double uch[3];
+    for (int i = 0; i < 3; i++) {
+        uch[i] = F->sgn[i] * comp(u, F->perm[i]);
+        F->J[i] = J[F->perm[i]];
+    }
+    double J1 = F->J[0], J2 = F->J[1], J3 = F->J[2];
+    /* D - J3 and J1 - D from the components: no cancellation near pure spin. */
+    double DmJ3 = (J1 - J3) * uch[0] * uch[0] + (J2 - J3) * uch[1] * uch[1];
+    double J1mD = (J1 - J2) * uch[1] * uch[1] + (J1 - J3) * uch[2] * uch[2];
+    F->alpha[0] = sqrt(DmJ3 / (J1 - J3));
+    F->alpha[1] = sqrt(DmJ3 / (J2 - J3));
+    F->alpha[2] = sqrt(J1mD / (J1 - J3));
+    F->m = (J1 - J2) * DmJ3 / ((J2 - J3) * J1mD);
+    if (F->m > 1.0)
+        F->m = 1.0; /* round-off on the separatrix */
+    F->k = sqrt(F->m);
+    F->n = (J1 - J2) / (J2 - J3);
+    F->Omega = (J2 > J3 ? 1.0 : -1.0) * F->lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
+    pd_status st;
+    double K = 0.0;
+    if (F->m < 1.0) {
+        if ((st = pd_ellint_Kcomp(F->k, &K)) != PD_OK ||
+            (st = pd_ellint_Pcomp(F->k, F->n, &F->Pc)) != PD_OK)
+            return st;
+        F->K2 = 2.0 * K;
+    }
+    /* Initial phase: cn = u1/a1, sn = u2/a2, so am(tau0) = atan2(u2/a2, u1/a1),
+     * then tau0 = F(am) with half periods unrolled (F(am + j pi) = F(am) + 2jK). */
+    double am0 = atan2(uch[1] / F->alpha[1], uch[0] / F->alpha[0]);
+    double j0 = 0.0;
+    if (am0 > 0.5 * PI)
+        j0 = 1.0;
+    else if (am0 < -0.5 * PI)
+        j0 = -1.0;
+    double Fr;
+    if (F->m < 1.0 || j0 == 0.0) {
+        if ((st = pd_ellint_F(am0 - j0 * PI, F->k, &Fr)) != PD_OK)
+            return st;
+    } else {
+        return PD_ERR_NONFINITE; /* unreachable: on the separatrix cn > 0 */
+    }
+    F->tau0 = Fr + j0 * F->K2;
+    double u0[3];
+    if ((st = elliptic_at(F, F->tau0, u0, &F->P0)) != PD_OK)
+        return st;
+    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
+     * to round-off. */
+    double th, ps;
+    chart_angles(uch[0], uch[1], uch[2], &th, &ps);
+    F->Q0 = quat_mul(quat_mul(F->s0.q, quat_conj(F->e)), quat_conj(euler_zxz(0.0, th, ps)));
+    F->kind = PD_FLIGHT_ELLIPTIC;
+    return PD_OK;
+}
+
 pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
 {
     if (!b || !s0 || !f || !(g >= 0.0))
@@ -121,93 +216,26 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
 
     /* Axial cases: equal moments (exact after the body's snapping), or u on a
      * principal axis (a steady spin, possibly about the unstable middle axis,
-     * which an exact solution keeps). omega = a u + b axis, see flight.h. */
-    const double ax = PD_TOL_FLIGHT_AXIS_REL; /* |u| = 1 */
-    int on_axis = -1;
-    if (fabs(u.y) <= ax && fabs(u.z) <= ax)
-        on_axis = 0;
-    else if (fabs(u.x) <= ax && fabs(u.z) <= ax)
-        on_axis = 1;
-    else if (fabs(u.x) <= ax && fabs(u.y) <= ax)
-        on_axis = 2;
+     * which an exact solution keeps). */
+    int on_axis = principal_axis(u, PD_TOL_FLIGHT_AXIS_REL);
     if (I[0] == I[2] || on_axis >= 0 || I[0] == I[1] || I[1] == I[2]) {
-        F.kind = PD_FLIGHT_AXIAL;
-        if (I[0] == I[2] || on_axis >= 0) {
-            F.a = F.lambda * (on_axis >= 0 ? J[on_axis] : J[0]);
-            F.b = 0.0;
-            F.axis = v3(0.0, 0.0, 1.0);
-        } else {
-            int d = I[0] == I[1] ? 2 : 0; /* the distinct axis */
-            int s = d == 2 ? 0 : 2;       /* one of the equal pair */
-            F.axis = d == 2 ? v3(0.0, 0.0, 1.0) : v3(1.0, 0.0, 0.0);
-            F.a = F.lambda * J[s];
-            F.b = F.lambda * comp(u, d) * (J[d] - J[s]);
-        }
+        set_axial(&F, I, J, u, on_axis);
         *f = F;
         return PD_OK;
     }
-
-    /* Asymmetric: D - J2 without cancellation decides which axis the polhode
-     * circles: the largest moment (body axis 3) when D < J2, else axis 1. */
-    double ux = u.x, uz = u.z;
-    double DmJ2 = (J[0] - J[1]) * ux * ux + (J[2] - J[1]) * uz * uz;
-    int c = DmJ2 < 0.0 ? 2 : DmJ2 > 0.0 ? 0 : (fabs(uz) >= fabs(ux) ? 2 : 0);
-    double uc = c == 2 ? uz : ux;
-    set_chart(&F, c, uc > 0.0 ? 1.0 : -1.0);
-    double uch[3];
-    for (int i = 0; i < 3; i++) {
-        uch[i] = F.sgn[i] * comp(u, F.perm[i]);
-        F.J[i] = J[F.perm[i]];
-    }
-    double J1 = F.J[0], J2 = F.J[1], J3 = F.J[2];
-    /* D - J3 and J1 - D from the components: no cancellation near pure spin. */
-    double DmJ3 = (J1 - J3) * uch[0] * uch[0] + (J2 - J3) * uch[1] * uch[1];
-    double J1mD = (J1 - J2) * uch[1] * uch[1] + (J1 - J3) * uch[2] * uch[2];
-    F.alpha[0] = sqrt(DmJ3 / (J1 - J3));
-    F.alpha[1] = sqrt(DmJ3 / (J2 - J3));
-    F.alpha[2] = sqrt(J1mD / (J1 - J3));
-    F.m = (J1 - J2) * DmJ3 / ((J2 - J3) * J1mD);
-    if (F.m > 1.0)
-        F.m = 1.0; /* round-off on the separatrix */
-    F.k = sqrt(F.m);
-    F.n = (J1 - J2) / (J2 - J3);
-    F.Omega = (J2 > J3 ? 1.0 : -1.0) * F.lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
-    pd_status st;
-    double K = 0.0;
-    if (F.m < 1.0) {
-        if ((st = pd_ellint_Kcomp(F.k, &K)) != PD_OK ||
-            (st = pd_ellint_Pcomp(F.k, F.n, &F.Pc)) != PD_OK)
+    pd_status st = plan_elliptic(&F, u, J);
+    if (st != PD_OK) {
+        /* Within PD_TOL_FLIGHT_NEAR_AXIS_REL of the separatrix's end, the
+         * middle axis, the elliptic phase can overflow: a steady spin. */
+        int near = principal_axis(u, PD_TOL_FLIGHT_NEAR_AXIS_REL);
+        if (near < 0)
             return st;
-        F.K2 = 2.0 * K;
+        set_axial(&F, I, J, u, near);
     }
-    /* Initial phase: cn = u1/a1, sn = u2/a2, so am(tau0) = atan2(u2/a2, u1/a1),
-     * then tau0 = F(am) with half periods unrolled (F(am + j pi) = F(am) + 2jK). */
-    double am0 = atan2(uch[1] / F.alpha[1], uch[0] / F.alpha[0]);
-    double j0 = 0.0;
-    if (am0 > 0.5 * PI)
-        j0 = 1.0;
-    else if (am0 < -0.5 * PI)
-        j0 = -1.0;
-    double Fr;
-    if (F.m < 1.0 || j0 == 0.0) {
-        if ((st = pd_ellint_F(am0 - j0 * PI, F.k, &Fr)) != PD_OK)
-            return st;
-    } else {
-        return PD_ERR_NONFINITE; /* unreachable: on the separatrix cn > 0 */
-    }
-    F.tau0 = Fr + j0 * F.K2;
-    double u0[3];
-    if ((st = elliptic_at(&F, F.tau0, u0, &F.P0)) != PD_OK)
-        return st;
-    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
-     * to round-off. */
-    double th, ps;
-    chart_angles(uch[0], uch[1], uch[2], &th, &ps);
-    F.Q0 = quat_mul(quat_mul(F.s0.q, quat_conj(F.e)), quat_conj(euler_zxz(0.0, th, ps)));
-    F.kind = PD_FLIGHT_ELLIPTIC;
     *f = F;
     return PD_OK;
 }
+
 
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
 {

@@ -184,6 +184,17 @@
  * the overflow; larger: genuine wobbles would be dropped. */
 #define PD_TOL_FLIGHT_AXIS_REL 1e-12
 
+/* Where the closed form fails near the separatrix (the elliptic phase of a
+ * state within round-off of its end, the middle axis, overflows), a spin
+ * whose L is within this of a principal axis is taken as steady instead.
+ * Why 1e-6: contact phases that rotate a part about an edge along its middle
+ * axis leave off-axis components of their integration error, ~1e-8; the
+ * steady spin then errs by 1e-6 e^(lambda t), lambda <~ |w| the growth rate
+ * of the middle axis's instability: 1.6e-6 rad after a 0.1 s flight at 10
+ * rad/s (flights after a contact are that short). Only used where the
+ * exact form has failed; larger would hide genuine tumbling. */
+#define PD_TOL_FLIGHT_NEAR_AXIS_REL 1e-6
+
 /* The time of impact is found when the lowest hull vertex is within this height
  * of the floor, approached from above (never below it by more). Why 1e-9: the
  * flight's positions carry round-off of ~1e-15 L at drop heights of a few L and
