@@ -69,6 +69,10 @@ static void usage(FILE *out)
         "  --restitution E    coefficient of restitution (0.3)\n"
         "  --restitution-law L  poisson (default) or energetic\n"
         "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
+        "  --impact-time S    contacts that would reach the floor within S seconds of\n"
+        "                     the first are struck with it as one impact (the impact's\n"
+        "                     duration, a material property; default 0: rigid, the\n"
+        "                     paper's model; impulse engine only)\n"
         "  --initial I        uniform (default): orientations uniform at random;\n"
         "                     bootstrap: the paper's belt, drops resting on poses drawn\n"
         "                     from the running estimate, rounds of 100 after 20 uniform;\n"
@@ -80,8 +84,8 @@ static void usage(FILE *out)
         "                     intervals from 1000 multinomial redraws of mu0 and P.\n"
         "                     Needs N >= 10 (k+1); does not go with --ci\n"
         "  --scene FILE       'key = value' lines: height, belt_speed, mu, restitution,\n"
-        "                     restitution_law, vibration, initial, gravity; options\n"
-        "                     given after it override it\n"
+        "                     restitution_law, vibration, initial, gravity,\n"
+        "                     impact_time; options given after it override it\n"
         "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
         "  --transitions FILE with --initial stationary, the estimated chain as CSV:\n"
         "                     from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -320,7 +324,7 @@ typedef struct {
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_IMPACT_TIME };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -367,6 +371,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"restitution", required_argument, 0, OPT_RESTITUTION},
         {"restitution-law", required_argument, 0, OPT_LAW},
         {"vibration", required_argument, 0, OPT_VIBRATION},
+        {"impact-time", required_argument, 0, OPT_IMPACT_TIME},
         {"initial", required_argument, 0, OPT_INITIAL},
         {"scene", required_argument, 0, OPT_SCENE},
         {"trials", required_argument, 0, OPT_TRIALS},
@@ -461,6 +466,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         case OPT_RESTITUTION: code = scene_option(a, "--restitution", "restitution", optarg); break;
         case OPT_LAW: code = scene_option(a, "--restitution-law", "restitution_law", optarg); break;
         case OPT_VIBRATION: code = scene_option(a, "--vibration", "vibration", optarg); break;
+        case OPT_IMPACT_TIME: code = scene_option(a, "--impact-time", "impact_time", optarg); break;
         case OPT_INITIAL: code = scene_option(a, "--initial", "initial", optarg); break;
         case OPT_SCENE: {
             pd_diag d;

@@ -71,16 +71,22 @@ static double vertex_step(const pd_body *b, const pd_state *s, double B, int low
     return best > 0.0 ? best : 0.0;
 }
 
-/* Vertices within tol of the floor, by breadth-first search from the lowest
- * one over the edge graph: the vertices of a convex polytope below a plane
- * form a connected subgraph, so the search finds them all while visiting only
- * them and their neighbours. The list doubles as the queue; membership is a
- * linear search, cheap because contact sets are small (a face's corners).
- * Beyond ncap the set is counted, not listed. */
-static int contact_set(const pd_body *b, const pd_state *s, int lowest, double tol, int *list,
-                       int ncap)
+/* The contact set: vertices within tol of the floor, or that would reach it
+ * within window (s) at their present velocity (a vertex's extrapolated
+ * height z + z' window). Found by breadth-first search from the lowest one
+ * over the edge graph: the vertices of a convex polytope below a plane form
+ * a connected subgraph, and so do those of its image under the rigid motion
+ * extrapolated linearly (an affine map, which keeps the polytope's edges);
+ * both sets hold the lowest vertex, which is approaching, so their union is
+ * connected too and the search finds it all while visiting only it and its
+ * neighbours. The list doubles as the queue; membership is a linear search,
+ * cheap because contact sets are small (a face's corners). Beyond ncap the
+ * set is counted, not listed. */
+static int contact_set(const pd_body *b, const pd_state *s, int lowest, double tol, double window,
+                       int *list, int ncap)
 {
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    pd_vec3 a = v3_cross(up, s->w); /* z_v' = v_z + b_v . (up x w), body frame */
     if (ncap < 1 || !list)
         return 1;
     int n = 0;
@@ -89,7 +95,9 @@ static int contact_set(const pd_body *b, const pd_state *s, int lowest, double t
         int v = list[head];
         for (int k = b->adj_start[v]; k < b->adj_start[v + 1]; k++) {
             int w = b->adj[k];
-            if (s->x.z + v3_dot(up, b->verts[w]) > tol)
+            double z = s->x.z + v3_dot(up, b->verts[w]);
+            double zw = z + window * (s->v.z + v3_dot(a, b->verts[w]));
+            if (z > tol && zw > tol)
                 continue;
             int seen = 0;
             for (int i = 0; i < n && !seen; i++)
@@ -104,10 +112,10 @@ static int contact_set(const pd_body *b, const pd_state *s, int lowest, double t
     return n;
 }
 
-pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, int *contacts,
-                           int ncap, pd_impact *out)
+pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
+                           int *contacts, int ncap, pd_impact *out)
 {
-    if (!b || !f || !out || !(t_max >= 0.0) || ncap < 0 || (ncap > 0 && !contacts))
+    if (!b || !f || !out || !(t_max >= 0.0) || !(window >= 0.0) || ncap < 0 || (ncap > 0 && !contacts))
         return PD_ERR_USAGE;
     double tol = PD_TOL_IMPACT_REL * b->size;
     double W = f->wmax * b->rmax;
@@ -169,7 +177,7 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, i
     r.t = t;
     r.vertex = hint;
     r.height = h;
-    r.ncontacts = contact_set(b, &s, hint, PD_TOL_CONTACT_REL * b->size, contacts, ncap);
+    r.ncontacts = contact_set(b, &s, hint, PD_TOL_CONTACT_REL * b->size, window, contacts, ncap);
     *out = r;
     return PD_OK;
 }

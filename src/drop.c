@@ -10,7 +10,10 @@
  * without spin gets the single impulse through its centre that Poisson's law
  * gives a flat landing (rebound e times the approach speed, no spurious
  * rotation), and uneven landings put the impulse nearer the faster contact,
- * as a sequence of Mirtich's microcollisions would, in one step.
+ * as a sequence of Mirtich's microcollisions would, in one step. The scene's
+ * impact_time widens "at once" to the contacts that would arrive within it
+ * (contact_time.c): a stand-in for the compliance that makes a nearly flat
+ * landing strike its face as a whole.
  *
  * Contact that lasts is simulated two ways. One vertex or one edge on the
  * floor, sliding or sticking, is a contact phase (contact_phase.c): the
@@ -383,7 +386,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         pd_flight f;
         pd_impact imp;
         if (pd_flight_plan(m->body, &s, g, &f) != PD_OK ||
-            pd_flight_impact(m->body, &f, o->time_limit - t, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+            pd_flight_impact(m->body, &f, o->time_limit - t, sc->impact_time, w->contacts,
+                             PD_MAX_CONTACTS, &imp) != PD_OK)
             break;
         if (imp.kind == PD_IMPACT_NONE) {
             t = o->time_limit;

@@ -67,7 +67,7 @@ typedef struct pd_impact {
     double t;       /* time of contact, s (t_max for NONE) */
     int vertex;     /* lowest hull vertex at t (body index) */
     double height;  /* its height above the floor at t, m, in [-tol, tol] on contact */
-    int ncontacts;  /* vertices within PD_TOL_CONTACT_REL * L of the floor at t;
+    int ncontacts;  /* vertices in contact at t (pd_flight_impact);
                        may exceed the capacity given, then only that many are listed */
     int steps;      /* conservative-advancement steps taken */
 } pd_impact;
@@ -76,9 +76,11 @@ typedef struct pd_impact {
  * to within PD_TOL_IMPACT_REL * L, never after the true first contact (a
  * contact that dips below the floor by more than the tolerance between
  * samples cannot be stepped over: see flight.c). contacts (capacity ncap, may
- * be NULL with ncap 0) receives the touching vertices, the lowest first.
+ * be NULL with ncap 0) receives the touching vertices, the lowest first:
+ * those within PD_TOL_CONTACT_REL * L of the floor and, with window > 0 (s),
+ * those that would reach it within window at their present velocity.
  * PD_ERR_USAGE, PD_ERR_NO_CONVERGENCE (PD_CONTACT_MAX_STEPS), PD_ERR_NONFINITE. */
-pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, int *contacts,
-                           int ncap, pd_impact *out);
+pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
+                           int *contacts, int ncap, pd_impact *out);
 
 #endif

@@ -324,7 +324,7 @@ static void test_impact(void)
     double h = 0.12;
     pd_state s0 = {v3(0.0, 0.0, h + hz), quat_identity(), v3(0.05, 0, 0), v3(0, 0, 0)};
     CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
-    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, 0.0, contacts, 16, &imp), PD_OK);
     CHECK_INT(imp.kind, PD_IMPACT_AT);
     double tf = sqrt(2.0 * h / G);
     CHECK_NEAR(imp.t, tf, tol / (G * tf) + 1e-15, "sqrt(2h/g) to the height tolerance / speed");
@@ -335,12 +335,12 @@ static void test_impact(void)
     /* Resting on the floor: in contact now. */
     pd_state rest = {v3(0.0, 0.0, hz), quat_identity(), v3(0, 0, 0), v3(0, 0, 0)};
     CHECK_STATUS(pd_flight_plan(b, &rest, G, &f), PD_OK);
-    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 1.0, 0.0, contacts, 16, &imp), PD_OK);
     CHECK_INT(imp.kind, PD_IMPACT_NOW);
     CHECK_INT(imp.ncontacts, 4);
     /* t_max before the fall ends: no impact. */
     CHECK_STATUS(pd_flight_plan(b, &s0, G, &f), PD_OK);
-    CHECK_STATUS(pd_flight_impact(b, &f, 0.5 * tf, contacts, 16, &imp), PD_OK);
+    CHECK_STATUS(pd_flight_impact(b, &f, 0.5 * tf, 0.0, contacts, 16, &imp), PD_OK);
     CHECK_INT(imp.kind, PD_IMPACT_NONE);
 
     /* Spinning drops against a fine time scan (dt = 1e-5 s): the search is
@@ -353,7 +353,7 @@ static void test_impact(void)
         pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 5.0, 50.0));
         pd_state st = {v3(0, 0, rng_range(&r, 0.03, 0.15)), q, v3(0.05, 0, rng_range(&r, -0.5, 0.5)), w};
         CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
-        CHECK_STATUS(pd_flight_impact(b, &f, 1.0, contacts, 16, &imp), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &f, 1.0, 0.0, contacts, 16, &imp), PD_OK);
         CHECK_INT(imp.kind, PD_IMPACT_AT);
         CHECK_NEAR(scan_height(b, &f, imp.t), 0.0, tol, "impact tolerance");
         double first = 1.0;
@@ -381,7 +381,7 @@ static void test_impact(void)
         int low = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
         st.x.z = -pd_body_vertex_world(b, &st, low).z + L * pow(10.0, rng_range(&r, -5.0, -2.0));
         CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
-        CHECK_STATUS(pd_flight_impact(b, &f, 0.5, contacts, 16, &imp), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &f, 0.5, 0.0, contacts, 16, &imp), PD_OK);
         if (imp.kind != PD_IMPACT_AT)
             continue;
         ntrials++;
@@ -398,6 +398,36 @@ static void test_impact(void)
     CHECK(ntrials > 40);
     printf("flight: skimming impact search: %.1f steps on average over %d spinning starts\n",
            ntrials ? (double)steps / ntrials : 0.0, ntrials);
+
+    /* The simultaneity window: the box falling nearly flat (turned 0.5 deg
+     * about a diagonal-ish axis) at 1.5 m/s, no spin. A corner belongs to the
+     * impact's contact set iff it is within the contact tolerance or its
+     * extrapolated height z + z' window is: counted here independently,
+     * corner by corner, for windows that take in none, some and all of them. */
+    {
+        pd_quat q = quat_axis_angle(v3_unit(v3(1.0, 0.3, 0.0)), 0.5 * 3.14159265358979323846 / 180.0);
+        int low = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
+        pd_state st = {v3(0, 0, 0), q, v3(0, 0, -1.5), v3(0, 0, 0)};
+        st.x.z = -pd_body_vertex_world(b, &st, low).z + 1e-3;
+        const double windows[] = {0.0, 5e-5, 1e-4, 3e-4};
+        int counts[4];
+        for (int k = 0; k < 4; k++) {
+            CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
+            CHECK_STATUS(pd_flight_impact(b, &f, 1.0, windows[k], contacts, 16, &imp), PD_OK);
+            pd_state at;
+            CHECK_STATUS(pd_flight_eval(&f, imp.t, &at), PD_OK);
+            int want = 0;
+            for (int i = 0; i < b->nverts; i++) {
+                double z = pd_body_vertex_world(b, &at, i).z;
+                want += z <= PD_TOL_CONTACT_REL * L || z + windows[k] * at.v.z <= PD_TOL_CONTACT_REL * L;
+            }
+            CHECK_INT(imp.ncontacts, want);
+            counts[k] = imp.ncontacts;
+        }
+        CHECK(counts[0] == 1 && counts[1] < 4 && counts[1] < counts[3] && counts[3] == 4);
+        printf("flight: contact set of a face landing 0.5 deg off flat, windows 0, 5e-5, 1e-4, 3e-4 s: "
+               "%d, %d, %d, %d corners\n", counts[0], counts[1], counts[2], counts[3]);
+    }
 
     /* Grazing: no gravity, no translation; a corner spinning about a
      * horizontal axis dips 1e-4 L below the floor and comes back. The search
@@ -417,7 +447,7 @@ static void test_impact(void)
         st.q = quat_mul(quat_axis_angle(v3(1, 0, 0), 0.0), st.q);
         CHECK_STATUS(pd_flight_plan(b, &st, 0.0, &f), PD_OK);
         if (scan_height(b, &f, 0.0) > tol) {
-            CHECK_STATUS(pd_flight_impact(b, &f, 0.7, contacts, 16, &imp), PD_OK);
+            CHECK_STATUS(pd_flight_impact(b, &f, 0.7, 0.0, contacts, 16, &imp), PD_OK);
             CHECK_INT(imp.kind, PD_IMPACT_AT);
             double first = 0.7;
             for (double t = 0.0; t < 0.7; t += 1e-6)
