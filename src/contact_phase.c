@@ -72,7 +72,8 @@ static pd_state from_y(const phase *p, const double y[NY])
 }
 
 /* Solves the n x n system A x = b in place by Gaussian elimination with
- * partial pivoting; 0 if a pivot vanishes against the matrix's scale. */
+ * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of the
+ * matrix's largest entry. */
 static int solve_dense(int n, double A[6][6], double b[6])
 {
     double scale = 0.0;
@@ -84,7 +85,7 @@ static int solve_dense(int n, double A[6][6], double b[6])
         for (int i = k + 1; i < n; i++)
             if (fabs(A[i][k]) > fabs(A[piv][k]))
                 piv = i;
-        if (!(fabs(A[piv][k]) > 1e-13 * scale))
+        if (!(fabs(A[piv][k]) > PD_TOL_PHASE_PIVOT_REL * scale))
             return 0;
         for (int j = 0; j < n; j++) {
             double t = A[k][j];

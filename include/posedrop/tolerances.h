@@ -287,6 +287,16 @@
  * same order as the contact tolerance; ~20 halvings from a unit step. */
 #define PD_TOL_PHASE_EVENT_REL 1e-6
 
+/* A phase's contact forces solve a system of at most 6 unknowns (the
+ * contacts' response to unit forces); a pivot below this fraction of its
+ * largest entry is singular and ends the phase (the microcollisions go on).
+ * Why 1e-13: the entries are ~1/m and well scaled (body frame, moments of
+ * the part's own size), so genuine pivots stay far above round-off (~1e-16);
+ * a system that loses rank (as in Painleve's paradox, where friction makes
+ * the normal response vanish) lands near 0.
+ * Larger: healthy phases would be refused; smaller: forces near 1/round-off. */
+#define PD_TOL_PHASE_PIVOT_REL 1e-13
+
 /* Integrator steps one phase may take: bounded work per phase. Why 10000: a
  * sliding phase takes tens of steps; a phase that reaches this ends and the
  * microcollisions go on, so nothing is lost but time. */
