@@ -406,10 +406,10 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             break;
         if (out->collisions == before && phase_ok && m->phases &&
             pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
-            /* Sliding on a vertex or an edge: the exact continuous motion.
-             * It ends at an event the microcollisions must resolve, so the
-             * next rest step is theirs (no phase can start and stop at once
-             * forever). */
+            /* One vertex or one edge in lasting contact, sliding or
+             * sticking: the exact continuous motion. It ends at an event the
+             * microcollisions must resolve, so the next rest step is theirs
+             * (no phase can start and stop at once forever). */
             double dt;
             if (pd_contact_phase(m, w->phase, sc, &s, w->contacts, nc, o->time_limit - t, &dt) != PD_OK)
                 break;
