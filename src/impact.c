@@ -147,6 +147,9 @@ typedef struct {
     int have_ray;     /* sticking is unstable: the diverging ray (rtx, rty) exists */
     double rtx, rty;
     int on_ray;       /* sliding stopped on that ray */
+    int scanned;      /* incoming rays looked for (a stiff approach) */
+    int nin;          /* incoming invariant rays: directions (inx, iny) */
+    double inx[4], iny[4];
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;
@@ -192,6 +195,57 @@ static void coll_compress(collision *c)
     c->W_end = (1.0 - c->e * c->e) * c->W_c;
     if (c->e == 0.0)
         c->done = 1;
+}
+
+/* --- incoming rays ------------------------------------------------------------ *
+ * A ray t is invariant when a - mu B t (the slip's rate in pz) is parallel to
+ * t; with t.(a - mu B t) < 0 the slip runs along it into the origin. Such a
+ * ray attracts nearby directions when sticking is stable, and a trajectory
+ * approaching the origin along it is stiff for an explicit integrator: the
+ * direction relaxes onto the ray far faster than |u_t| shrinks (measured: 1 in
+ * 1e5 random impacts exceeded PD_IMPACT_MAX_STEPS). Along the ray p' is
+ * constant, so once within the event tolerance of it the rest of the way to
+ * the origin is closed form, as on the diverging ray. The invariant rays are
+ * the zeros of n(th).(a - mu B t(th)), a trigonometric polynomial of degree
+ * 2 (at most 4), found by a fine scan and bisection, once, and only when a
+ * collision has already taken RAY_SCAN_STEPS steps. */
+enum { RAY_SCAN_STEPS = 30, RAY_SCAN = 256, RAY_ROOT_BISECT = 60 };
+
+static double ray_turn(const collision *c, double th, double *rate)
+{
+    double tx = cos(th), ty = sin(th);
+    double vx = c->K[0][2] - c->mu * (c->K[0][0] * tx + c->K[0][1] * ty);
+    double vy = c->K[1][2] - c->mu * (c->K[1][0] * tx + c->K[1][1] * ty);
+    *rate = tx * vx + ty * vy;
+    return -ty * vx + tx * vy;
+}
+
+static void find_incoming_rays(collision *c)
+{
+    const double step = 2.0 * M_PI / RAY_SCAN;
+    double rate, g0 = ray_turn(c, 0.0, &rate);
+    c->scanned = 1;
+    c->nin = 0;
+    for (int k = 0; k < RAY_SCAN && c->nin < 4; k++) {
+        double lo = k * step, hi = lo + step, g1 = ray_turn(c, hi, &rate), glo = g0;
+        g0 = g1;
+        if (g1 == 0.0 || (glo > 0.0) == (g1 > 0.0))
+            continue; /* no crossing inside; an exact zero is the next lo */
+        for (int i = 0; i < RAY_ROOT_BISECT && glo != 0.0; i++) {
+            double mid = 0.5 * (lo + hi), gm = ray_turn(c, mid, &rate);
+            if ((gm > 0.0) == (glo > 0.0) && gm != 0.0)
+                lo = mid, glo = gm;
+            else
+                hi = mid;
+        }
+        double th = 0.5 * (lo + hi);
+        (void)ray_turn(c, th, &rate);
+        if (rate < 0.0) {
+            c->inx[c->nin] = cos(th);
+            c->iny[c->nin] = sin(th);
+            c->nin++;
+        }
+    }
 }
 
 /* Advances by h along a constant impulse direction d = p'. */
@@ -295,6 +349,33 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
             fabs(c->rtx * u.y - c->rty * u.x) <= tols) {
             c->on_ray = 1;
             return PD_OK;
+        }
+        if (*nsteps >= RAY_SCAN_STEPS && !c->scanned)
+            find_incoming_rays(c);
+        int in = -1;
+        for (int k = 0; k < c->nin && in < 0; k++)
+            if (u.x * c->inx[k] + u.y * c->iny[k] > 0.0 && fabs(c->inx[k] * u.y - c->iny[k] * u.x) <= tols)
+                in = k;
+        if (in >= 0) {
+            /* On an incoming ray: p' = (-mu t, 1) until the slip reaches the
+             * origin (at pz + s / |rate|) or the next normal event, whichever
+             * comes first; the loop's tests then take over. */
+            pd_vec3 d = v3(-c->mu * c->inx[in], -c->mu * c->iny[in], 1.0);
+            double q = m3_vec(CONST_M3(c->K), d).z, rate;
+            (void)ray_turn(c, atan2(c->iny[in], c->inx[in]), &rate);
+            double hs = s / -rate, he = INFINITY;
+            if (!c->compressed && q > 0.0)
+                he = -u.z / q;
+            else if (c->compressed && c->law == PD_IMPACT_POISSON)
+                he = c->pz_end - c->y[PZ];
+            else if (c->compressed && q > 0.0) {
+                double dw = c->W_end - c->y[PW];
+                he = dw > 0.0 ? 2.0 * dw / (u.z + sqrt(u.z * u.z + 2.0 * q * dw)) : 0.0;
+            }
+            linear_advance(c, d, q, u.z, fmin(hs, fmax(he, 0.0)));
+            pd_ode_reset(ode);
+            ++*nsteps;
+            continue;
         }
         if (*nsteps >= PD_IMPACT_MAX_STEPS)
             return PD_ERR_NO_CONVERGENCE;

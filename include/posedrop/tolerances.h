@@ -337,11 +337,12 @@
 
 /* Largest number of integrator steps (accepted or refused for an event) one
  * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: measured on
- * 2e5 random impacts, the mean is ~20 steps and the worst 388; one impact in
- * 1e5 (a stable stick approached along a slowly closing invariant ray, which
- * is stiff for an explicit integrator) exceeds 1000. 1000 bounds the cost of
- * such a collision to ~1 ms; larger buys that rare case at a high price.
- * Snapping onto incoming rays as onto the diverging one would remove it. */
+ * 2e5 random impacts, the mean is ~20 steps and the worst 53, since a stable
+ * stick approached along a slowly closing invariant ray (stiff for an
+ * explicit integrator; it took up to 388 steps and 1 impact in 1e5, or 1 in
+ * 1e4 microcollisions of the paper's cap, exceeded 1000) is snapped onto
+ * that ray (impact.c). 1000 bounds the cost of a collision to ~1 ms and still
+ * stops a runaway; the drop then resolves it by a counted fallback. */
 #define PD_IMPACT_MAX_STEPS 1000
 
 /* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
