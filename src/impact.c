@@ -148,8 +148,8 @@ typedef struct {
     double rtx, rty;
     int on_ray;       /* sliding stopped on that ray */
     int scanned;      /* incoming rays looked for (a stiff approach) */
-    int nin;          /* incoming invariant rays: directions (inx, iny) */
-    double inx[4], iny[4];
+    int nin;          /* incoming invariant rays: directions (inx, iny) and */
+    double inx[4], iny[4], inrate[4]; /* rates d|u_t|/dpz (< 0) */
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;
@@ -243,6 +243,7 @@ static void find_incoming_rays(collision *c)
         if (rate < 0.0) {
             c->inx[c->nin] = cos(th);
             c->iny[c->nin] = sin(th);
+            c->inrate[c->nin] = rate;
             c->nin++;
         }
     }
@@ -358,12 +359,11 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
                 in = k;
         if (in >= 0) {
             /* On an incoming ray: p' = (-mu t, 1) until the slip reaches the
-             * origin (at pz + s / |rate|) or the next normal event, whichever
-             * comes first; the loop's tests then take over. */
+             * origin (at pz + s / |rate|), where it sticks, or the next normal
+             * event, after which the loop's tests take over. */
             pd_vec3 d = v3(-c->mu * c->inx[in], -c->mu * c->iny[in], 1.0);
-            double q = m3_vec(CONST_M3(c->K), d).z, rate;
-            (void)ray_turn(c, atan2(c->iny[in], c->inx[in]), &rate);
-            double hs = s / -rate, he = INFINITY;
+            double q = m3_vec(CONST_M3(c->K), d).z;
+            double hs = s / -c->inrate[in], he = INFINITY;
             if (!c->compressed && q > 0.0)
                 he = -u.z / q;
             else if (c->compressed && c->law == PD_IMPACT_POISSON)
@@ -372,9 +372,12 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
                 double dw = c->W_end - c->y[PW];
                 he = dw > 0.0 ? 2.0 * dw / (u.z + sqrt(u.z * u.z + 2.0 * q * dw)) : 0.0;
             }
-            linear_advance(c, d, q, u.z, fmin(hs, fmax(he, 0.0)));
-            pd_ode_reset(ode);
+            he = fmax(he, 0.0);
+            linear_advance(c, d, q, u.z, fmin(hs, he));
             ++*nsteps;
+            if (hs <= he)
+                return PD_OK; /* stuck: what is left of the slip is the ray's offset, <= tols */
+            pd_ode_reset(ode);
             continue;
         }
         if (*nsteps >= PD_IMPACT_MAX_STEPS)
