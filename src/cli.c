@@ -87,6 +87,9 @@ static void usage(FILE *out)
         "                     restitution_law, vibration, initial, gravity,\n"
         "                     impact_time; options given after it override it\n"
         "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
+        "                     (pose 0: unsettled); with --group, pose is the class\n"
+        "                     number of the output and a last column member the pose\n"
+        "                     within it, numbered as without --group\n"
         "  --transitions FILE with --initial stationary, the estimated chain as CSV:\n"
         "                     from_pose,to_pose,count,p, one row per pair of poses\n"
         "                     (numbered as in the output, classes with --group);\n"
@@ -275,16 +278,24 @@ static int close_output(FILE *f, const char *path)
     return ok;
 }
 
-static int write_trials(const char *path, const pd_sim_result *sim)
+/* One row per drop. With --group (class_of not NULL) the pose column holds
+ * the class number, as in the main output, so the two files join on it; the
+ * pose within the class follows in a last column, member. An unsettled drop
+ * has pose (and member) 0. */
+static int write_trials(const char *path, const pd_sim_result *sim, const int *class_of)
 {
     FILE *f = open_output(path);
     if (!f)
         return 0;
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end\n");
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
-        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s\n", i + 1, t->q0[0], t->q0[1],
-                t->q0[2], t->q0[3], t->pose + 1, t->collisions, t->time, end_name(t->end));
+        int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
+        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", i + 1, t->q0[0], t->q0[1],
+                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
+        if (class_of)
+            fprintf(f, ",%d", t->pose + 1);
+        fputc('\n', f);
     }
     return close_output(f, path);
 }
@@ -692,7 +703,7 @@ int main(int argc, char **argv)
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
     if (code)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
-    if (sim && a.trials && !write_trials(a.trials, sim))
+    if (sim && a.trials && !write_trials(a.trials, sim, class_of))
         code = EXIT_INTERNAL;
     if (sim && a.transitions && !write_transitions(a.transitions, gsim ? gsim : sim))
         code = EXIT_INTERNAL;

@@ -17,6 +17,7 @@
 #include "posedrop/sim.h"
 #include "qhull_ref.h"
 #include "shapes.h"
+#include "symmetry_search.h"
 #include "vec3.h"
 
 static double now(void)
@@ -191,6 +192,64 @@ static void bench_static(void)
         pd_part_free(part);
         pd_mesh_free(m);
         free(p);
+    }
+}
+
+/* Best of several calls of pd_symmetry_find_by on part, in seconds; the
+ * rotations found go to *nrot. */
+static double time_symmetry(const pd_part *part, pd_symmetry_method method, int best_of, int *nrot)
+{
+    double best = 1e300;
+    for (int r = 0; r < best_of; r++) {
+        pd_symmetry *s = NULL;
+        double t0 = now();
+        if (pd_symmetry_find_by(part, method, &s, NULL) != PD_OK) {
+            fprintf(stderr, "bench: symmetry search failed\n");
+            exit(1);
+        }
+        double t = now() - t0;
+        best = t < best ? t : best;
+        *nrot = s->nrotations;
+        pd_symmetry_free(s);
+    }
+    return best;
+}
+
+/* The symmetry search (--group) on bodies of revolution, against the
+ * exhaustive search it replaced (kept in the library for the tests), which
+ * checks every rotation vertex by vertex: O(n^2) in the vertices. */
+static void bench_symmetry(void)
+{
+    printf("\nsymmetry search (pd_symmetry_find) on n-gon prisms and pyramids\n");
+    printf("reference: the exhaustive search on the same part, same process\n");
+    printf("%-24s %8s %10s %12s %14s %10s %12s\n", "part", "vertices", "rotations",
+           "search ms", "exhaustive ms", "exh/search", "build ms");
+    const struct {
+        const char *name;
+        ring_spec r;
+    } parts[] = {
+        {"500-gon prism", {500, 0, 0.0, 0.0, 0.0, 0, 0}},
+        {"1000-gon prism", {1000, 0, 0.0, 0.0, 0.0, 0, 0}},
+        {"2000-gon prism", {2000, 0, 0.0, 0.0, 0.0, 0, 0}},
+        {"2000-gon prism, float32", {2000, 0, 0.0, 0.0, 0.0, 0, 1}},
+        {"2000-gon pyramid", {2000, 1, 0.0, 0.0, 0.0, 0, 0}},
+    };
+    for (size_t i = 0; i < sizeof parts / sizeof parts[0]; i++) {
+        double t0 = now();
+        pd_part *part = ring_part(&parts[i].r, NULL, 1.0, v3(0, 0, 0));
+        double t_build = now() - t0;
+        if (!part) {
+            fprintf(stderr, "bench: part failed\n");
+            exit(1);
+        }
+        int nrot = 0, nrot_exh = 0;
+        double t_gen = time_symmetry(part, PD_SYMMETRY_GENERATED, BEST_OF, &nrot);
+        /* The reference takes seconds at 4000 vertices: best of 2. */
+        double t_exh = time_symmetry(part, PD_SYMMETRY_EXHAUSTIVE, 2, &nrot_exh);
+        printf("%-24s %8d %10d %12.2f %14.2f %9.1fx %12.2f%s\n", parts[i].name,
+               part->hull->nverts, nrot, 1e3 * t_gen, 1e3 * t_exh, t_exh / t_gen, 1e3 * t_build,
+               nrot == nrot_exh ? "" : "  (rotation counts differ!)");
+        pd_part_free(part);
     }
 }
 
@@ -580,8 +639,10 @@ static int wanted(int argc, char **argv, const char *name)
 int main(int argc, char **argv)
 {
     printf("posedrop %s benchmark (best of %d runs each)\n", PD_VERSION_STRING, BEST_OF);
-    if (wanted(argc, argv, "static"))
+    if (wanted(argc, argv, "static")) {
         bench_static();
+        bench_symmetry();
+    }
     if (wanted(argc, argv, "hull"))
         bench_hull();
     if (wanted(argc, argv, "dynamic"))

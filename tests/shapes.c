@@ -7,6 +7,7 @@
 #include "posedrop/hull.h"
 #include "posedrop/part.h"
 #include "posedrop/sim.h"
+#include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "vec3.h"
 
@@ -314,4 +315,67 @@ pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
     if (st != PD_OK)
         printf("     part_of: %s (%s)\n", pd_status_str(st), diag ? diag->message : "");
     return st == PD_OK ? part : NULL;
+}
+
+/* x rounded to float. Through a volatile: GCC 12.2 at -O2 compiles
+ * v3((float)x, (float)y, (float)z) into one conversion, of z, and leaves x
+ * and y unrounded (its SLP vectorizer; -fno-tree-slp-vectorize or -O1 do
+ * not). */
+static double to_float32(double x)
+{
+    volatile float f = (float)x;
+    return f;
+}
+
+/* Rings: see shapes.h. */
+pd_vec3 *ring_points(const ring_spec *r, test_rng *rng, int *n)
+{
+    int per = r->pair > 0.0 ? 2 : 1, rings = r->pyramid ? 1 : 2;
+    pd_vec3 *p = malloc(sizeof *p * (size_t)(per * rings * r->nsides + 1));
+    int m = 0;
+    for (int i = 0; i < r->nsides; i++)
+        for (int k = 0; k < per; k++) {
+            double t = 2.0 * M_PI * i / r->nsides + k * r->pair;
+            p[m++] = v3(cos(t), sin(t), -0.5);
+            if (!r->pyramid)
+                p[m++] = v3(cos(t + r->twist), sin(t + r->twist), 0.5);
+        }
+    if (r->pyramid)
+        p[m++] = v3(0.0, 0.0, 1.0);
+    double size = sqrt(r->pyramid ? 8.0 + 2.25 : 9.0); /* bounding-box diagonal */
+    for (int i = 0; i < m; i++) {
+        double s = r->noise * PD_TOL_SYMMETRY_REL * size * rng_uniform(rng);
+        p[i] = v3_add(p[i], v3_scale(rng_unit_vector(rng), s));
+        /* A part of 12 mm placed at (37, -21, 5) mm, in mm. */
+        pd_vec3 q = v3_add(v3_scale(p[i], 6.15), v3(37.0, -21.0, 5.0));
+        if (r->float32)
+            q = v3(to_float32(q.x), to_float32(q.y), to_float32(q.z));
+        if (r->digits) {
+            char buf[64];
+            snprintf(buf, sizeof buf, "%.*g %.*g %.*g", r->digits, q.x, r->digits, q.y,
+                     r->digits, q.z);
+            if (sscanf(buf, "%lf %lf %lf", &q.x, &q.y, &q.z) != 3)
+                q = v3(NAN, NAN, NAN);
+        }
+        if (r->float32 || r->digits)
+            p[i] = q;
+    }
+    *n = m;
+    return p;
+}
+
+pd_part *ring_part(const ring_spec *r, const double R[3][3], double scale, pd_vec3 t)
+{
+    test_rng rng = {99};
+    int n;
+    pd_vec3 *pts = ring_points(r, &rng, &n);
+    if (R)
+        points_transform(pts, n, R, scale, t);
+    pd_hull *h = NULL;
+    pd_part *part = NULL;
+    if (pd_hull_build(pts, n, &h, NULL) == PD_OK)
+        part = part_of(mesh_of_hull(h), NULL, NULL);
+    pd_hull_free(h);
+    free(pts);
+    return part;
 }

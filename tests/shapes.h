@@ -58,6 +58,29 @@ struct pd_part;
 struct pd_diag;
 struct pd_part *part_of(pd_mesh *m, const pd_vec3 *com, struct pd_diag *diag);
 
+/* Points of a regular n-gon prism (radius 1, height 1) or pyramid (apex at
+ * z = 1 over the base ring at z = -0.5), for n beyond the fixtures' 32, and
+ * their distortions. */
+typedef struct {
+    int nsides;
+    int pyramid;
+    double twist;   /* top ring turned by this (rad) */
+    double pair;    /* each corner doubled this far round its ring (rad), or 0 */
+    double noise;   /* each point moved at random by up to this x PD_TOL_SYMMETRY_REL x size */
+    int digits;     /* coordinates printed to this many significant digits, as
+                       an exporter would, in millimetres of a 12 mm part placed
+                       off the origin; 0: not */
+    int float32;    /* coordinates rounded to float, as binary STL, in that frame */
+} ring_spec;
+
+/* The points of r (malloc'd, *n of them); noise drawn from rng. */
+pd_vec3 *ring_points(const ring_spec *r, test_rng *rng, int *n);
+
+/* A part of r's points through the library's hull (convex_mesh takes at
+ * most ~200 points), moved by x -> scale R x + t first if R is not NULL;
+ * noise from a fixed seed. NULL on failure. */
+struct pd_part *ring_part(const ring_spec *r, const double R[3][3], double scale, pd_vec3 t);
+
 /* Chi-square test that a Monte Carlo result is uniform over its poses:
  * P(X > statistic) with nposes - 1 degrees of freedom. */
 struct pd_sim_result;

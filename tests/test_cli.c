@@ -494,6 +494,133 @@ static void test_group(void)
     expect_failure("--group --facets parts/cap.off", 2, "--group");
 }
 
+/* The position (from 0) of the column named name in the header line that
+ * starts csv, or -1. */
+static int column_index(const char *csv, const char *name)
+{
+    size_t len = strlen(name);
+    int k = 0;
+    for (const char *p = csv; p && *p && *p != '\n'; k++) {
+        if (strncmp(p, name, len) == 0 && (p[len] == ',' || p[len] == '\n'))
+            return k;
+        p = strpbrk(p, ",\n");
+        p = p && *p == ',' ? p + 1 : NULL;
+    }
+    return -1;
+}
+
+/* Tallies column `name` of every data row of a CSV text into tally[0..max]
+ * (values outside go to bad). Returns the number of data rows, -1 if there
+ * is no such column. */
+static int tally_column(const char *csv, const char *name, long *tally, int max, int *bad)
+{
+    int k = csv ? column_index(csv, name) : -1, rows = 0;
+    if (k < 0)
+        return -1;
+    memset(tally, 0, sizeof *tally * (size_t)(max + 1));
+    *bad = 0;
+    for (const char *p = strchr(csv, '\n'); p && p[1]; p = strchr(p + 1, '\n'), rows++) {
+        double v = column(p + 1, k);
+        if (v >= 0 && v <= max && v == (int)v)
+            tally[(int)v]++;
+        else
+            ++*bad;
+    }
+    return rows;
+}
+
+/* --trials with and without --group, from the same seed (so the same drops):
+ * the trials' pose column joins the main output's rows, class numbers with
+ * --group and pose numbers without. Per-pose tallies of the trials equal the
+ * output's count column exactly (integers), the unsettled drops are pose 0,
+ * and each drop's member is its ungrouped pose and one of its class's
+ * members. */
+static void test_group_trials(void)
+{
+    char *out, *err, *gout, *gerr, args[512], tpath[160], gpath[160];
+    enum { N = 60, MAXP = 64 };
+    snprintf(tpath, sizeof tpath, "%s/trials_plain.csv", tmpdir);
+    snprintf(gpath, sizeof gpath, "%s/trials_group.csv", tmpdir);
+    snprintf(args, sizeof args, "-n %d --trials %s parts/cap.off", N, tpath);
+    CHECK_INT(run(args, &out, &err), 0);
+    snprintf(args, sizeof args, "-n %d --group --trials %s parts/cap.off", N, gpath);
+    CHECK_INT(run(args, &gout, &gerr), 0);
+    char *t = slurp(tpath), *g = slurp(gpath);
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end\n", 42) == 0);
+    const char *ghead = "drop,qw,qx,qy,qz,pose,collisions,time,end,member\n";
+    CHECK(g && strncmp(g, ghead, strlen(ghead)) == 0);
+
+    /* Each file against its own main output: row r of the output is pose
+     * (class) r, its count column the drops that settled there. */
+    const char *csv[2] = {out, gout}, *trials[2] = {t, g};
+    int nrows_out[2] = {0, 0};
+    for (int grouped = 0; grouped < 2; grouped++) {
+        long tally[MAXP + 1];
+        int bad, rows = tally_column(trials[grouped], "pose", tally, MAXP, &bad);
+        CHECK_INT(rows, N);
+        CHECK_INT(bad, 0);
+        int kc = column_index(csv[grouped], "count"), ku = column_index(csv[grouped], "unsettled");
+        CHECK(kc >= 0 && ku >= 0);
+        int r = 0, counts_ok = 1;
+        for (const char *p = strchr(csv[grouped], '\n'); p && p[1]; p = strchr(p + 1, '\n')) {
+            r++;
+            counts_ok &= r <= MAXP && (long)column(p + 1, 0) == r &&
+                         (long)column(p + 1, kc) == tally[r];
+            if (r == 1)
+                CHECK_INT(tally[0], (long)column(p + 1, ku));
+        }
+        CHECK(counts_ok);
+        /* No trial names a pose (class) the output does not have. */
+        long beyond = 0;
+        for (int i = r + 1; i <= MAXP; i++)
+            beyond += tally[i];
+        CHECK_INT(beyond, 0);
+        nrows_out[grouped] = r;
+    }
+    CHECK_INT(nrows_out[0], 34); /* the cap: 34 poses in 3 classes */
+    CHECK_INT(nrows_out[1], 3);
+
+    /* Drop by drop: member = the ungrouped pose, and a member of its class. */
+    int kp = column_index(g, "pose"), km = column_index(g, "member"), kt = column_index(t, "pose");
+    int kmem = column_index(gout, "members");
+    CHECK(kp >= 0 && km >= 0 && kt >= 0 && kmem >= 0);
+    int same = 1, listed = 1, drops = 0;
+    const char *pt = strchr(t, '\n'), *pg = strchr(g, '\n');
+    for (; pt && pt[1] && pg && pg[1]; pt = strchr(pt + 1, '\n'), pg = strchr(pg + 1, '\n')) {
+        drops++;
+        int cls = (int)column(pg + 1, kp), member = (int)column(pg + 1, km);
+        same &= member == (int)column(pt + 1, kt);
+        if (cls == 0) {
+            listed &= member == 0;
+            continue;
+        }
+        /* The members column of row cls: space-separated pose numbers. */
+        const char *row = gout;
+        for (int i = 0; i < cls && row; i++)
+            row = strchr(row + 1, '\n');
+        const char *m = row ? row + 1 : NULL;
+        for (int i = 0; i < kmem && m; i++)
+            m = strchr(m, ',') ? strchr(m, ',') + 1 : NULL;
+        int found = 0;
+        for (char *e; m && *m && *m != '\n'; m = e) {
+            long v = strtol(m, &e, 10);
+            if (e == m)
+                break;
+            found |= v == member;
+        }
+        listed &= found;
+    }
+    CHECK_INT(drops, N);
+    CHECK(same);
+    CHECK(listed);
+    free(t);
+    free(g);
+    free(out);
+    free(err);
+    free(gout);
+    free(gerr);
+}
+
 /* Sums column k (0-based) of every data row of a CSV text. */
 static double column_sum(const char *csv, int k, int *rows)
 {
@@ -590,6 +717,7 @@ void suite_cli(void)
     test_eq16();
     test_scripts();
     test_group();
+    test_group_trials();
     test_stationary();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

@@ -1,7 +1,9 @@
 /* test_symmetry.c: rotation groups of hulls about their centre of mass and
  * the pose classes they induce, against the known groups of the standard
  * solids; mirror images kept apart; a moved centre of mass breaking the
- * symmetry; invariance under rigid motions and scale. */
+ * symmetry; invariance under rigid motions and scale; the generated search
+ * against the exhaustive one, rotation for rotation, on exact, noisy and
+ * rounded hulls; bodies of revolution of thousands of vertices. */
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -9,6 +11,7 @@
 #include "shapes.h"
 #include "stats.h"
 #include "suites.h"
+#include "symmetry_search.h"
 #include "vec3.h"
 
 /* Every rotation found is orthonormal with determinant +1 (round-off of a
@@ -321,6 +324,18 @@ static int signature(const grouping *g, class_sig *sig, int max)
     return n;
 }
 
+/* The classes of a moved part (g1) against the reference's signature. */
+static void check_same_classes(const grouping *g1, const class_sig *s0, int n0)
+{
+    class_sig s1[64];
+    int n1 = signature(g1, s1, 64);
+    CHECK_INT(n1, n0);
+    int same = n1 == n0;
+    for (int c = 0; c < n0 && same; c++)
+        same = s0[c].size == s1[c].size && fabs(s0[c].p - s1[c].p) <= 1e-9;
+    CHECK(same);
+}
+
 static void test_invariance(void)
 {
     test_rng rng = {12345};
@@ -339,7 +354,7 @@ static void test_invariance(void)
         pd_part *ref = part_of(convex_mesh(p, n), NULL, NULL);
         int order = group_order(ref);
         grouping g0;
-        class_sig s0[64], s1[64];
+        class_sig s0[64];
         int n0 = group(ref, &g0) ? signature(&g0, s0, 64) : 0;
         const double scales[] = {1e-3, 1.0, 1e3};
         for (int s = 0; s < 3; s++) {
@@ -352,14 +367,8 @@ static void test_invariance(void)
             pd_part *part = part_of(convex_mesh(q, n), NULL, NULL);
             CHECK_INT(group_order(part), order);
             grouping g1;
-            if (group(part, &g1)) {
-                int n1 = signature(&g1, s1, 64);
-                CHECK_INT(n1, n0);
-                int same = n1 == n0;
-                for (int c = 0; c < n0 && same; c++)
-                    same = s0[c].size == s1[c].size && fabs(s0[c].p - s1[c].p) <= 1e-9;
-                CHECK(same);
-            }
+            if (group(part, &g1))
+                check_same_classes(&g1, s0, n0);
             grouping_free(&g1);
             pd_part_free(part);
         }
@@ -368,29 +377,16 @@ static void test_invariance(void)
     }
 }
 
-/* A mesh of a regular n-gon prism for n beyond the fixtures' 32, through the
- * library's hull. */
-static pd_part *big_prism(int n, pd_diag *diag)
+static pd_part *big_prism(int n)
 {
-    pd_vec3 *pts = malloc(sizeof *pts * 2 * (size_t)n);
-    for (int i = 0; i < n; i++) {
-        double t = 2.0 * M_PI * i / n;
-        pts[i] = v3(cos(t), sin(t), -0.5);
-        pts[n + i] = v3(cos(t), sin(t), 0.5);
-    }
-    pd_hull *h = NULL;
-    pd_part *part = NULL;
-    if (pd_hull_build(pts, 2 * n, &h, NULL) == PD_OK)
-        part = part_of(mesh_of_hull(h), NULL, diag);
-    pd_hull_free(h);
-    free(pts);
-    return part;
+    ring_spec r = {n, 0, 0.0, 0.0, 0.0, 0, 0};
+    return ring_part(&r, NULL, 1.0, v3(0, 0, 0));
 }
 
 static void test_large(void)
 {
     /* A 400-gon: 800 rotations, found among 800 x 800 candidate pairs. */
-    pd_part *part = big_prism(400, NULL);
+    pd_part *part = big_prism(400);
     pd_symmetry *s = NULL;
     CHECK(part != NULL);
     if (part && pd_symmetry_find(part, &s, NULL) == PD_OK) {
@@ -409,7 +405,7 @@ static void test_large(void)
      * class. */
     pd_diag diag;
     pd_diag_init(&diag);
-    part = big_prism(5000, NULL);
+    part = big_prism(5000);
     s = NULL;
     CHECK(part != NULL);
     if (part && pd_symmetry_find(part, &s, &diag) == PD_OK) {
@@ -419,6 +415,175 @@ static void test_large(void)
     }
     pd_symmetry_free(s);
     pd_part_free(part);
+}
+
+/* The generated search against the exhaustive one (the search before it,
+ * kept for this): the same rotations, bit for bit and in the same order,
+ * and the same classes. Returns 1 if they agree. */
+static int methods_agree(const pd_part *part, const char *name)
+{
+    pd_symmetry *gen = NULL, *exh = NULL;
+    pd_static_result *res = NULL;
+    int ok = part && pd_symmetry_find_by(part, PD_SYMMETRY_GENERATED, &gen, NULL) == PD_OK &&
+             pd_symmetry_find_by(part, PD_SYMMETRY_EXHAUSTIVE, &exh, NULL) == PD_OK &&
+             pd_static_estimate(part, NULL, &res, NULL) == PD_OK;
+    ok = ok && gen->nrotations == exh->nrotations && gen->capped == exh->capped &&
+         memcmp(gen->rotation, exh->rotation, sizeof *gen->rotation * (size_t)gen->nrotations) == 0;
+    if (ok) {
+        int *c1 = malloc(sizeof *c1 * (size_t)(res->nposes + 1));
+        int *c2 = malloc(sizeof *c2 * (size_t)(res->nposes + 1));
+        int n1 = -1, n2 = -2;
+        ok = pd_pose_classes_by(part, res, PD_SYMMETRY_GENERATED, c1, &n1, NULL) == PD_OK &&
+             pd_pose_classes_by(part, res, PD_SYMMETRY_EXHAUSTIVE, c2, &n2, NULL) == PD_OK &&
+             n1 == n2 && memcmp(c1, c2, sizeof *c1 * (size_t)res->nposes) == 0;
+        free(c1);
+        free(c2);
+    }
+    if (!ok)
+        printf("     methods disagree (or failed) on %s: %d / %d rotations, static %s\n", name,
+               gen ? gen->nrotations : -1, exh ? exh->nrotations : -1, res ? "ok" : "failed");
+    pd_symmetry_free(gen);
+    pd_symmetry_free(exh);
+    pd_static_result_free(res);
+    return ok;
+}
+
+static void test_methods_agree(void)
+{
+
+    pd_vec3 p[64];
+    const struct {
+        const char *name;
+        int (*pts)(pd_vec3 *);
+    } solids[] = {{"cube", pts_cube}, {"tetrahedron", pts_tetrahedron},
+                  {"octahedron", pts_octahedron}, {"icosahedron", pts_icosahedron},
+                  {"dodecahedron", pts_dodecahedron}};
+    for (size_t i = 0; i < sizeof solids / sizeof solids[0]; i++) {
+        pd_part *part = part_of(convex_mesh(p, solids[i].pts(p)), NULL, NULL);
+        CHECK(methods_agree(part, solids[i].name));
+        pd_part_free(part);
+    }
+    const pd_vec3 coms[] = {{0, 0, 0}, {0.1, 0, 0}, {0.1, 0.2, 0}};
+    for (int i = 0; i < 3; i++) {
+        pd_part *part = part_of(mesh_box(1, 2, 3), &coms[i], NULL);
+        CHECK(methods_agree(part, "box"));
+        pd_part_free(part);
+    }
+    /* Exact rings; a chiral one; noisy corners doubled 1.2-1.6 tolerances
+     * apart, so that the nearest vertex is the only test of some pairs (the
+     * lookup check in the generated search); noise from a tenth of the tolerance,
+     * where the products' error bound no longer decides and each vertex's
+     * distance is measured, to a tolerance, where the rotations found stop
+     * being a group; coordinates as binary STL and as 6- and 7-digit text
+     * give. Sizes up to 400 sides keep the exhaustive search quick. */
+    const double tol_angle = PD_TOL_SYMMETRY_REL * 3.0; /* tol / radius, rad */
+    const ring_spec rings[] = {
+        {5, 0, 0.0, 0.0, 0.0, 0, 0},      {32, 0, 0.0, 0.0, 0.0, 0, 0},
+        {400, 0, 0.0, 0.0, 0.0, 0, 0},    {7, 1, 0.0, 0.0, 0.0, 0, 0},
+        {300, 1, 0.0, 0.0, 0.0, 0, 0},    {12, 0, 0.3, 0.0, 0.0, 0, 0},
+        {6, 0, 0.0, 1.2 * tol_angle, 0.3, 0, 0},  {7, 0, 0.0, 1.6 * tol_angle, 0.6, 0, 0},
+        {7, 0, 0.3, 1.2 * tol_angle, 0.3, 0, 0},
+        {32, 0, 0.0, 0.0, 0.1, 0, 0},     {200, 0, 0.0, 0.0, 0.3, 0, 0},
+        {200, 0, 0.0, 0.0, 0.6, 0, 0},    {200, 1, 0.0, 0.0, 0.6, 0, 0},
+        {32, 0, 0.0, 0.0, 1.0, 0, 0},     {400, 0, 0.0, 0.0, 0.0, 0, 1},
+        {300, 1, 0.0, 0.0, 0.0, 0, 1},    {300, 0, 0.0, 0.0, 0.0, 6, 0},
+        {300, 0, 0.0, 0.0, 0.0, 7, 0},
+    };
+    for (size_t i = 0; i < sizeof rings / sizeof rings[0]; i++) {
+        char name[96];
+        snprintf(name, sizeof name, "%d-gon %s, pair %g, noise %g, digits %d, float %d",
+                 rings[i].nsides, rings[i].pyramid ? "pyramid" : "prism", rings[i].pair,
+                 rings[i].noise, rings[i].digits, rings[i].float32);
+        pd_part *part = ring_part(&rings[i], NULL, 1.0, v3(0, 0, 0));
+        CHECK(methods_agree(part, name));
+        pd_part_free(part);
+    }
+}
+
+/* Bodies of revolution of thousands of vertices, which the exhaustive search
+ * took seconds over: a 4000-gon prism (8000 vertices) has the dihedral group
+ * D_4000 of 8000 rotations, its 4000 sides one class and its two caps
+ * another; a 2000-gon pyramid the cyclic group C_2000, its sides one class,
+ * its base alone. The same prism with float coordinates (binary STL) too:
+ * its sides differ by the rounding, 1e-7 of its size, far inside the
+ * tolerance, but their areas by ~1e-3 relative, so their probabilities are
+ * not compared here as in group(). */
+static void test_revolution(void)
+{
+    const ring_spec shapes[] = {{4000, 0, 0.0, 0.0, 0.0, 0, 0}, {2000, 1, 0.0, 0.0, 0.0, 0, 0},
+                                {4000, 0, 0.0, 0.0, 0.0, 0, 1}};
+    for (int k = 0; k < 3; k++) {
+        const ring_spec *r = &shapes[k];
+        pd_part *part = ring_part(r, NULL, 1.0, v3(0, 0, 0));
+        pd_symmetry *s = NULL;
+        pd_static_result *res = NULL;
+        CHECK(part != NULL);
+        if (part && pd_symmetry_find(part, &s, NULL) == PD_OK) {
+            CHECK_INT(s->nrotations, r->pyramid ? r->nsides : 2 * r->nsides);
+            CHECK_INT(s->capped, 0);
+        }
+        pd_symmetry_free(s);
+        if (part && pd_static_estimate(part, NULL, &res, NULL) == PD_OK) {
+            int *class_of = malloc(sizeof *class_of * (size_t)res->nposes);
+            int nclasses = 0, size[2] = {0, 0}, ends_ok = 1;
+            CHECK_STATUS(pd_pose_classes(part, res, class_of, &nclasses, NULL), PD_OK);
+            CHECK_INT(res->nposes, r->nsides + (r->pyramid ? 1 : 2));
+            CHECK_INT(nclasses, 2);
+            for (int i = 0; i < res->nposes && nclasses == 2; i++)
+                size[class_of[i]]++;
+            int sides = size[0] == r->nsides ? 0 : 1;
+            CHECK_INT(size[sides], r->nsides);
+            CHECK_INT(size[1 - sides], r->pyramid ? 1 : 2);
+            for (int i = 0; i < res->nposes && nclasses == 2; i++)
+                ends_ok &= (class_of[i] != sides) == (fabs(res->poses[i].normal.z) > 0.999);
+            CHECK(ends_ok);
+            free(class_of);
+        } else {
+            CHECK(!"static estimate failed");
+        }
+        pd_static_result_free(res);
+        pd_part_free(part);
+    }
+}
+
+/* Moving, turning and scaling a 500-gon prism and a 300-gon pyramid changes
+ * neither their groups nor their classes (sizes and probabilities, which
+ * are invariant to 1e-9 as in test_invariance). */
+static void test_invariance_large(void)
+{
+    test_rng rng = {2024};
+    const ring_spec shapes[] = {{500, 0, 0.0, 0.0, 0.0, 0, 0}, {300, 1, 0.0, 0.0, 0.0, 0, 0}};
+    for (int k = 0; k < 2; k++) {
+        pd_part *ref = ring_part(&shapes[k], NULL, 1.0, v3(0, 0, 0));
+        pd_symmetry *s0 = NULL;
+        grouping g0;
+        class_sig s0sig[64];
+        int n0 = 0;
+        CHECK(ref && pd_symmetry_find(ref, &s0, NULL) == PD_OK);
+        if (ref && group(ref, &g0))
+            n0 = signature(&g0, s0sig, 64);
+        const double scales[] = {1e-3, 1.0, 1e3};
+        for (int i = 0; i < 3; i++) {
+            double R[3][3];
+            rng_rotation(&rng, R);
+            pd_vec3 t = v3_scale(rng_unit_vector(&rng), 10.0 * scales[i]);
+            pd_part *part = ring_part(&shapes[k], CR(R), scales[i], t);
+            pd_symmetry *s1 = NULL;
+            CHECK(part && pd_symmetry_find(part, &s1, NULL) == PD_OK);
+            if (s0 && s1)
+                CHECK_INT(s1->nrotations, s0->nrotations);
+            grouping g1;
+            if (part && group(part, &g1))
+                check_same_classes(&g1, s0sig, n0);
+            grouping_free(&g1);
+            pd_symmetry_free(s1);
+            pd_part_free(part);
+        }
+        if (ref)
+            grouping_free(&g0);
+        pd_symmetry_free(s0);
+        pd_part_free(ref);
+    }
 }
 
 static void test_grouped_counts(void)
@@ -468,5 +633,8 @@ void suite_symmetry(void)
     test_offset_com();
     test_invariance();
     test_large();
+    test_methods_agree();
+    test_revolution();
+    test_invariance_large();
     test_grouped_counts();
 }
