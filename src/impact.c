@@ -7,7 +7,8 @@
  *    and the velocity is always recomputed as u0 + K p, so u1 = u0 + K p holds
  *    exactly and the energy bookkeeping p.(u0 + u1)/2 matches the work;
  *  - every phase in which p' is constant (no friction, stable sticking,
- *    sliding along the diverging ray) is solved in closed form;
+ *    sliding along the diverging ray or into the origin along an incoming
+ *    one) is solved in closed form;
  *  - events are located by limiting each integrator step to the crossing
  *    predicted by a Newton step, and by secant retries when a step overshoots,
  *    so the integrator never steps over the singularity of eq. 14. */
