@@ -401,6 +401,8 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
     const pd_body *b = m->body;
     phase p = phase_of(m, sc, s, contacts, nc);
     double slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
+    /* First trial step a hundredth of the part's time unit: contact motion
+     * changes on that unit; the controller grows it (at most 10x a step). */
     double tau = 0.0, tau_max = t_max / p.T, h = 0.01, cap = INFINITY;
     double y[NY], y0[NY];
     int hint = 0, pose;
@@ -431,9 +433,11 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
             return st;
         /* An event inside the step: back to its start and retry up to the
          * secant estimate of the first crossing among the margins that
-         * crossed (regula falsi from the step's start, which the margins
-         * being smooth makes converge in a few retries); a failed step or a
-         * model failure halves it. When the crossing is within the event
+         * crossed, aimed 1% short so the retry lands before the event
+         * (regula falsi from the step's start, which the margins being
+         * smooth makes converge in a few retries), and a hundredth of the
+         * step at least, so a margin that is not smooth still shrinks it
+         * geometrically; a failed step or a model failure halves it. When the crossing is within the event
          * tolerance, hand over. */
         tau = tau0;
         memcpy(y, y0, sizeof y);

@@ -107,7 +107,6 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
          * twice that leaves room for what the part's rotation adds. */
         m->rest_fall = PD_TOL_REST_FALL_REL * m->body->size;
         m->v_rest = 2.0 * sqrt(2.0 * scene->gravity * m->rest_fall);
-        m->phases = 1;
     }
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
@@ -404,7 +403,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
             PD_OK)
             break;
-        if (out->collisions == before && phase_ok && m->phases &&
+        if (out->collisions == before && phase_ok &&
             pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the

@@ -30,7 +30,6 @@ struct pd_sim_model {
     double v_eps;               /* approach speeds below this are contact, not impact */
     double rest_fall;           /* m: how far resting contact falls between microcollisions */
     double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
-    int phases;                 /* 1: sliding contact as continuous phases (contact_phase.c) */
 };
 
 struct pd_drop_work {

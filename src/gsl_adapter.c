@@ -84,44 +84,42 @@ pd_status pd_elljac(double u, double m, double *sn, double *cn, double *dn)
     return gsl_sf_elljac_e(u, m, sn, cn, dn) == GSL_SUCCESS ? PD_OK : PD_ERR_NONFINITE;
 }
 
+/* A special function's GSL status and result as a pd_status and a value.
+ * Callers switch the error handler off before the call. */
+static pd_status sf_value(int rc, const gsl_sf_result *r, double *result)
+{
+    if (rc != GSL_SUCCESS)
+        return PD_ERR_NONFINITE;
+    *result = r->val;
+    return PD_OK;
+}
+
 pd_status pd_ellint_F(double phi, double k, double *result)
 {
     gsl_set_error_handler_off();
     gsl_sf_result r;
-    if (gsl_sf_ellint_F_e(phi, k, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
-        return PD_ERR_NONFINITE;
-    *result = r.val;
-    return PD_OK;
+    return sf_value(gsl_sf_ellint_F_e(phi, k, GSL_PREC_DOUBLE, &r), &r, result);
 }
 
 pd_status pd_ellint_P(double phi, double k, double n, double *result)
 {
     gsl_set_error_handler_off();
     gsl_sf_result r;
-    if (gsl_sf_ellint_P_e(phi, k, n, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
-        return PD_ERR_NONFINITE;
-    *result = r.val;
-    return PD_OK;
+    return sf_value(gsl_sf_ellint_P_e(phi, k, n, GSL_PREC_DOUBLE, &r), &r, result);
 }
 
 pd_status pd_ellint_Kcomp(double k, double *result)
 {
     gsl_set_error_handler_off();
     gsl_sf_result r;
-    if (gsl_sf_ellint_Kcomp_e(k, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
-        return PD_ERR_NONFINITE;
-    *result = r.val;
-    return PD_OK;
+    return sf_value(gsl_sf_ellint_Kcomp_e(k, GSL_PREC_DOUBLE, &r), &r, result);
 }
 
 pd_status pd_ellint_Pcomp(double k, double n, double *result)
 {
     gsl_set_error_handler_off();
     gsl_sf_result r;
-    if (gsl_sf_ellint_Pcomp_e(k, n, GSL_PREC_DOUBLE, &r) != GSL_SUCCESS)
-        return PD_ERR_NONFINITE;
-    *result = r.val;
-    return PD_OK;
+    return sf_value(gsl_sf_ellint_Pcomp_e(k, n, GSL_PREC_DOUBLE, &r), &r, result);
 }
 /* ==== end of elliptic functions ============================================= */
 /* --- ODE integration (see gsl_adapter.h) ------------------------------------ */

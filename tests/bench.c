@@ -482,13 +482,18 @@ static void bench_threads(const dyn_part *d)
     pd_sim_result_free(r[1]);
 }
 
+/* The issue's three parts: a 1 cm cube, a 1 x 2 x 3 cm box, a thick coin. */
+static void issue_parts(dyn_part parts[3])
+{
+    parts[0] = dyn_part_make("cube 1 cm", mesh_box(0.01, 0.01, 0.01));
+    parts[1] = dyn_part_make("box 1 x 2 x 3 cm", mesh_box(0.01, 0.02, 0.03));
+    parts[2] = dyn_part_make("coin 32-gon", mesh_prism(32, 0.01, 0.01));
+}
+
 static void bench_dynamic(void)
 {
-    dyn_part parts[3] = {
-        dyn_part_make("cube 1 cm", mesh_box(0.01, 0.01, 0.01)),
-        dyn_part_make("box 1 x 2 x 3 cm", mesh_box(0.01, 0.02, 0.03)),
-        dyn_part_make("coin 32-gon", mesh_prism(32, 0.01, 0.01)),
-    };
+    dyn_part parts[3];
+    issue_parts(parts);
     double t0 = now();
     bench_drop_cost(parts, 3);
     bench_effects(&parts[1]);
@@ -612,11 +617,8 @@ static void bench_engine_dt(const dyn_part *d)
 
 static void bench_engines(void)
 {
-    dyn_part parts[3] = {
-        dyn_part_make("cube 1 cm", mesh_box(0.01, 0.01, 0.01)),
-        dyn_part_make("box 1 x 2 x 3 cm", mesh_box(0.01, 0.02, 0.03)),
-        dyn_part_make("coin 32-gon", mesh_prism(32, 0.01, 0.01)),
-    };
+    dyn_part parts[3];
+    issue_parts(parts);
     double t0 = now();
     bench_engine_cost(parts, 3);
     bench_engine_dt(&parts[1]);
