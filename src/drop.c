@@ -36,6 +36,7 @@
 #include "contact_phase.h"
 #include "diag.h"
 #include "drop_internal.h"
+#include "flat_rest.h"
 #include "flight.h"
 #include "impact.h"
 #include "posedrop/tolerances.h"
@@ -51,6 +52,7 @@ void pd_sim_model_free(pd_sim_model *m)
     pd_body_free(m->body);
     pd_static_result_free(m->descent);
     free(m->barrier);
+    free(m->flat);
     pd_star_free(&m->star);
     free(m->pose_of);
     free(m);
@@ -90,11 +92,13 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
     if (st == PD_OK) {
         m->barrier = malloc(sizeof *m->barrier * (size_t)nf);
         m->pose_of = malloc(sizeof *m->pose_of * (size_t)nf);
-        if (!m->barrier || !m->pose_of)
+        m->flat = malloc(sizeof *m->flat * (size_t)nf);
+        if (!m->barrier || !m->pose_of || !m->flat)
             st = PD_ERR_NOMEM;
     }
     if (st == PD_OK) {
         pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
+        pd_flat_build(m->body, part->hull, m->descent, m->flat);
         for (int f = 0; f < nf; f++)
             m->pose_of[f] = -1;
         for (int k = 0; k < poses->nposes; k++)
@@ -334,18 +338,27 @@ static pd_vec3 gravity_in_part(const pd_sim_model *m, const pd_state *s)
     return quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
 }
 
-int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
+/* pd_drop_decided, also giving the facet the part would land on. */
+static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose,
+                      int *facet)
 {
     pd_vec3 down = gravity_in_part(m, s);
     int f;
     if (pd_descend(m->hull, &m->star, m->com, down, &f, hint) != PD_OK)
         return -1;
+    *facet = f;
     /* A resting vertex may be up to rest_fall below the floor, so the part's
      * potential energy may read that much low: count it. */
     if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier[f]))
         return 0;
     *pose = m->pose_of[m->descent->facets[f].rest];
     return *pose >= 0 ? 1 : -1;
+}
+
+int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
+{
+    int f;
+    return decided_at(m, s, g, hint, pose, &f);
 }
 
 double pd_drop_tilt(const pd_sim_model *m, const pd_state *s, int pose)
@@ -370,7 +383,12 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     double dt_rest = sqrt(2.0 * m->rest_fall / g);
     int hint = 0, phase_ok = 1;
     for (;;) {
-        int pose, d = pd_drop_decided(m, &s, g, &hint, &pose);
+        int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
+        if (d == 0 && m->pose_of[facet] >= 0 &&
+            pd_flat_settled(m->flat, m->body, &s, facet, g, sc->mu, m->rest_fall)) {
+            d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
+            pose = m->pose_of[facet];
+        }
         if (d < 0)
             break;
         if (d > 0) {

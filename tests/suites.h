@@ -16,6 +16,7 @@
     PD_SUITE(flight) \
     PD_SUITE(impact) \
     PD_SUITE(drop)   \
+    PD_SUITE(flat_rest) \
     PD_SUITE(contact_phase) \
     PD_SUITE(sim)    \
     PD_SUITE(markov) \
