@@ -515,10 +515,10 @@ static int column_index(const char *csv, const char *name)
 static int tally_column(const char *csv, const char *name, long *tally, int max, int *bad)
 {
     int k = csv ? column_index(csv, name) : -1, rows = 0;
+    *bad = 0;
     if (k < 0)
         return -1;
     memset(tally, 0, sizeof *tally * (size_t)(max + 1));
-    *bad = 0;
     for (const char *p = strchr(csv, '\n'); p && p[1]; p = strchr(p + 1, '\n'), rows++) {
         double v = column(p + 1, k);
         if (v >= 0 && v <= max && v == (int)v)
