@@ -11,6 +11,7 @@
 #include "shapes.h"
 #include "stats.h"
 #include "suites.h"
+#include "symmetry_orbit.h"
 #include "symmetry_search.h"
 #include "vec3.h"
 
@@ -624,8 +625,49 @@ static void test_grouped_counts(void)
     CHECK(g == NULL);
 }
 
+/* The orbit of the reference pair under the generated permutations: a
+ * 40-cycle gives the cyclic group, 40 elements, each reached by a product
+ * that maps (a, b) where it says; adding a transposition generates all
+ * permutations, whose orbit on pairs (40 x 39) outgrows any rotation group
+ * of 40 vertices (at most 2 x 40 or 60 elements): PD_ORBIT_TOO_LARGE, the
+ * signal on which the search falls back to the exhaustive loop. */
+static void test_orbit_limit(void)
+{
+    enum { NV = 40 };
+    int cyc[NV], swap[NV];
+    for (int i = 0; i < NV; i++) {
+        cyc[i] = (i + 1) % NV;
+        swap[i] = i;
+    }
+    swap[0] = 1;
+    swap[1] = 0;
+    pd_orbit g;
+    CHECK_INT(pd_orbit_init(&g, NV, 0, 1), 1);
+    CHECK_INT(pd_orbit_add_generator(&g, cyc, 0.0), 1);
+    CHECK_INT(g.n, NV);
+    int wrong = 0;
+    for (int k = 0; k < NV; k++) {
+        int e = pd_orbit_find(&g, k, (k + 1) % NV);
+        if (e < 0) {
+            wrong++;
+            continue;
+        }
+        /* Replay the tree of products from the identity. */
+        int x = 0, y = 1, path[NV + 1], len = 0;
+        for (int i = e; g.e[i].parent >= 0; i = g.e[i].parent)
+            path[len++] = g.e[i].gen;
+        while (len-- > 0)
+            x = g.perm[path[len]][x], y = g.perm[path[len]][y];
+        wrong += x != k || y != (k + 1) % NV;
+    }
+    CHECK_INT(wrong, 0);
+    CHECK_INT(pd_orbit_add_generator(&g, swap, 0.0), PD_ORBIT_TOO_LARGE);
+    pd_orbit_free(&g);
+}
+
 void suite_symmetry(void)
 {
+    test_orbit_limit();
     test_platonic();
     test_box();
     test_prisms();
