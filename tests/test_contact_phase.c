@@ -5,6 +5,7 @@
 #include "check.h"
 #include "contact_phase.h"
 #include "drop_fixture.h"
+#include "phase_forces.h"
 #include "quat.h"
 #include "shapes.h"
 #include "suites.h"
@@ -168,8 +169,73 @@ static void test_random_phases(void)
     drop_teardown(&fx);
 }
 
+/* The specialised force solves (one sliding contact's 1 x 1 system, the
+ * constant maps of sticking contacts, the body-axis rows of the rest)
+ * against the general dense solve on the contacts' own tangent axes, on
+ * random states of the box, every layout: equal to round-off. The least-norm
+ * solve of two sticking contacts goes through the normal equations, which
+ * square K's condition number (~1e3 for the box), so round-off ~1e-16 * 1e6:
+ * 1e-9 of each quantity's scale. */
+static void test_specialised_forces(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.5);
+    if (!b)
+        return;
+    test_rng rng = {7};
+    int layouts[2][3] = {{0}}, differ = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 3000; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 0.5)),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 30.0))};
+        int contacts[2] = {(int)(rng_uniform(&rng) * b->nverts), 0}, nc = 1 + (k % 2);
+        int v = contacts[0], deg = b->adj_start[v + 1] - b->adj_start[v];
+        contacts[1] = b->adj[b->adj_start[v] + (int)(rng_uniform(&rng) * deg)];
+        /* Slip threshold: all slide, all stick, or between two slips. */
+        double slip_start = (k / 2) % 3 == 0 ? 0.0 : (k / 2) % 3 == 1 ? HUGE_VAL : -1.0;
+        if (slip_start < 0.0) {
+            pd_phase p;
+            pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, HUGE_VAL);
+            pd_phase_forces F;
+            pd_phase_forces_general(&p, &s, &F);
+            slip_start = nc == 2 ? 0.5 * (F.slip[0] + F.slip[1]) : F.slip[0] * rng_range(&rng, 0.5, 1.5);
+        }
+        pd_phase p;
+        pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+        pd_phase_forces A, B;
+        int fa = pd_phase_forces_of(&p, &s, &A), fb = pd_phase_forces_general(&p, &s, &B);
+        if (fa || fb) {
+            differ += fa != fb;
+            continue;
+        }
+        layouts[nc - 1][p.mode[0] + (nc == 2 ? p.mode[1] : 0)]++;
+        double acc = G + v3_dot(s.w, s.w) * b->size, force = b->mass * acc;
+        double d = fmax(v3_dist(A.acc, B.acc) / acc, v3_dist(A.wdot, B.wdot) * b->size / acc);
+        for (int i = 0; i < nc; i++) {
+            d = fmax(d, fabs(A.fn[i] - B.fn[i]) / force);
+            d = fmax(d, fabs(A.slip[i] - B.slip[i]) / sqrt(acc * b->size));
+            if (isfinite(B.cone[i]))
+                d = fmax(d, fabs(A.cone[i] - B.cone[i]) / force);
+            else
+                differ += isfinite(A.cone[i]);
+        }
+        worst = fmax(worst, d);
+    }
+    CHECK_INT(differ, 0);
+    CHECK_NEAR(worst, 0.0, 1e-9, "round-off through the normal equations (see above)");
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2 + i; j++)
+            CHECK(layouts[i][j] >= 100);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
+    test_specialised_forces();
     test_edge_slide();
     test_edge_topple();
     test_random_phases();

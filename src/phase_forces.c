@@ -1,0 +1,308 @@
+/* phase_forces.c: a contact phase's forces (see phase_forces.h; the model
+ * is described in contact_phase.c).
+ *
+ * The right-hand side of the phase's ODE solves the force system a dozen
+ * times per step, so the common layouts skip the general assembly: one
+ * sliding contact is a 1 x 1 system, and contacts that all stick (a pivot, a
+ * rotation about an edge) have a constant system in the body frame, so
+ * their solution is a constant map computed once per phase. Two contacts
+ * that both slide, or one of each, assemble their 2 x 2 or 4 x 4 system from
+ * the constant response matrices. */
+#include <math.h>
+#include <string.h>
+#include "mat3.h"
+#include "phase_forces.h"
+#include "posedrop/tolerances.h"
+#include "quat.h"
+#include "vec3.h"
+
+enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
+
+static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 t)
+{
+    return v3(b->inv_moment[0] * t.x, b->inv_moment[1] * t.y, b->inv_moment[2] * t.z);
+}
+
+/* Solves the n x n system A x = b in place by Gaussian elimination with
+ * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of the
+ * matrix's largest entry. */
+static int solve_dense(int n, double A[6][6], double b[6])
+{
+    double scale = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            scale = fmax(scale, fabs(A[i][j]));
+    for (int k = 0; k < n; k++) {
+        int piv = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(A[i][k]) > fabs(A[piv][k]))
+                piv = i;
+        if (!(fabs(A[piv][k]) > PD_TOL_PHASE_PIVOT_REL * scale))
+            return 0;
+        for (int j = 0; j < n; j++) {
+            double t = A[k][j];
+            A[k][j] = A[piv][j];
+            A[piv][j] = t;
+        }
+        double t = b[k];
+        b[k] = b[piv];
+        b[piv] = t;
+        for (int i = k + 1; i < n; i++) {
+            double f = A[i][k] / A[k][k];
+            for (int j = k; j < n; j++)
+                A[i][j] -= f * A[k][j];
+            b[i] -= f * b[k];
+        }
+    }
+    for (int i = n - 1; i >= 0; i--) {
+        for (int j = i + 1; j < n; j++)
+            b[i] -= A[i][j] * b[j];
+        b[i] /= A[i][i];
+    }
+    return 1;
+}
+
+/* The constrained directions of the contacts, body frame: a sliding contact
+ * constrains its normal n (one row); a sticking one its whole acceleration,
+ * along axes[0..3) (three rows). The unknowns follow the same layout, a
+ * sliding contact's along its force direction dir[i] (n - mu s for forces,
+ * n for the impulses of the velocity projection). */
+typedef struct {
+    int n;
+    int c[6];       /* contact of each row / unknown */
+    pd_vec3 row[6]; /* constrained direction */
+    pd_vec3 col[6]; /* direction of the unknown force */
+} layout;
+
+static void make_layout(const pd_phase *p, pd_vec3 up, const pd_vec3 dir[2], const pd_vec3 axes[3],
+                        layout *L)
+{
+    L->n = 0;
+    for (int i = 0; i < p->nc; i++) {
+        if (p->mode[i] == SLIDE) {
+            L->c[L->n] = i, L->row[L->n] = up, L->col[L->n] = dir[i], L->n++;
+        } else {
+            for (int k = 0; k < 3; k++)
+                L->c[L->n] = i, L->row[L->n] = axes[k], L->col[L->n] = axes[k], L->n++;
+        }
+    }
+}
+
+static const pd_vec3 body_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+/* The unknowns x of layout L such that each constrained component of the
+ * contacts' acceleration (or velocity) change K x equals rhs. For two
+ * sticking contacts K is singular (the squeeze along the edge moves
+ * nothing): the least-norm solution is taken, from the normal equations with
+ * the squeeze set to zero by one more row. 0 if singular. */
+static int solve_layout(const pd_phase *p, const layout *L, const double rhs[6], double x[6])
+{
+    double K[7][6], r[7];
+    for (int i = 0; i < L->n; i++) {
+        for (int j = 0; j < L->n; j++)
+            K[i][j] = v3_dot(L->row[i], m3_vec(CONST_M3(p->M[L->c[i]][L->c[j]]), L->col[j]));
+        r[i] = rhs[i];
+    }
+    double A[6][6];
+    if (!(p->nc == 2 && p->mode[0] == STICK && p->mode[1] == STICK)) {
+        for (int i = 0; i < L->n; i++) {
+            for (int j = 0; j < L->n; j++)
+                A[i][j] = K[i][j];
+            x[i] = r[i];
+        }
+        return solve_dense(L->n, A, x);
+    }
+    /* Squeeze row: (f0 - f1) . e = 0, e the edge, scaled like K's rows. */
+    pd_vec3 e = v3_unit(v3_sub(p->r[1], p->r[0]));
+    for (int j = 0; j < 6; j++)
+        K[6][j] = (j < 3 ? 1.0 : -1.0) * v3_dot(L->col[j], e) / p->b->mass;
+    r[6] = 0.0;
+    for (int i = 0; i < 6; i++) {
+        x[i] = 0.0;
+        for (int k = 0; k < 7; k++)
+            x[i] += K[k][i] * r[k];
+        for (int j = 0; j < 6; j++) {
+            A[i][j] = 0.0;
+            for (int k = 0; k < 7; k++)
+                A[i][j] += K[k][i] * K[k][j];
+        }
+    }
+    return solve_dense(6, A, x);
+}
+
+static int all_stick(const pd_phase *p)
+{
+    return p->mode[0] == STICK && (p->nc == 1 || p->mode[1] == STICK);
+}
+
+/* The velocity of contact j of state s (world), R the body-to-world matrix;
+ * *wr = w x r, body frame. */
+static pd_vec3 contact_velocity(const pd_phase *p, const double R[3][3], const pd_state *s, int j,
+                                pd_vec3 *wr)
+{
+    *wr = v3_cross(s->w, p->r[j]);
+    return v3_add(s->v, m3_vec(R, *wr));
+}
+
+void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                   const int *contacts, int nc, double slip_start)
+{
+    memset(p, 0, sizeof *p);
+    p->b = b, p->nc = nc, p->mu = mu, p->g = g, p->L = b->size, p->T = sqrt(b->size / g);
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    for (int i = 0; i < nc; i++) {
+        p->v[i] = contacts[i];
+        p->r[i] = b->verts[contacts[i]];
+        pd_vec3 wr, vel = contact_velocity(p, CONST_M3(R), s, i, &wr);
+        p->mode[i] = sqrt(vel.x * vel.x + vel.y * vel.y) > slip_start ? SLIDE : STICK;
+    }
+    if (nc == 1)
+        p->v[1] = -1;
+    /* Column k of M[i][j]: contact i's acceleration by a unit force along
+     * body axis k at contact j, f / m + (I^-1 (r_j x f)) x r_i. */
+    for (int i = 0; i < nc; i++)
+        for (int j = 0; j < nc; j++)
+            for (int k = 0; k < 3; k++) {
+                pd_vec3 f = body_axes[k];
+                pd_vec3 a = v3_add(v3_scale(f, 1.0 / b->mass),
+                                   v3_cross(inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
+                p->M[i][j][0][k] = a.x, p->M[i][j][1][k] = a.y, p->M[i][j][2][k] = a.z;
+            }
+    if (!all_stick(p))
+        return;
+    /* Every contact sticks: the rows and unknowns are the body axes, K is
+     * constant, and the solution is linear in the right-hand side: column k
+     * of P is the solution for the k-th unit right-hand side. */
+    layout L;
+    const pd_vec3 unused[2] = {v3(0, 0, 1), v3(0, 0, 1)};
+    make_layout(p, v3(0, 0, 1), unused, body_axes, &L);
+    for (int k = 0; k < L.n; k++) {
+        double e[6] = {0}, x[6];
+        e[k] = 1.0;
+        if (!solve_layout(p, &L, e, x)) {
+            p->singular = 1;
+            return;
+        }
+        for (int i = 0; i < L.n; i++)
+            p->P[i][k] = x[i];
+    }
+}
+
+static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_forces *out)
+{
+    const pd_body *b = p->b;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
+    pd_vec3 w = s->w;
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(inv_inertia(b, v3_cross(w, Iw)));
+    /* Per contact: its slip, its sliding force direction n - mu s (body
+     * frame), and its free acceleration (body frame): gravity, the
+     * gyroscopic angular acceleration and the centripetal term. */
+    pd_vec3 dir[2], af[2];
+    for (int j = 0; j < p->nc; j++) {
+        pd_vec3 wr, vel = contact_velocity(p, CONST_M3(R), s, j, &wr);
+        double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
+        out->slip[j] = sl;
+        af[j] = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[j]), v3_cross(w, wr)));
+        dir[j] = up;
+        if (p->mode[j] == SLIDE) {
+            if (!(sl > 0.0))
+                return 1;
+            /* R^T (-mu s_x, -mu s_y, 1): rows 0 and 1 of R are the world's
+             * x and y axes in the body frame. */
+            double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+            dir[j] = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
+                        up.z - cx * R[0][2] - cy * R[1][2]);
+        }
+    }
+    pd_vec3 f[2] = {v3(0, 0, 0), v3(0, 0, 0)};
+    if (!general && all_stick(p)) {
+        if (p->singular)
+            return 1;
+        double rhs[6] = {0}, x[6];
+        int n = 3 * p->nc;
+        for (int j = 0; j < p->nc; j++)
+            rhs[3 * j] = -af[j].x, rhs[3 * j + 1] = -af[j].y, rhs[3 * j + 2] = -af[j].z;
+        for (int i = 0; i < n; i++) {
+            x[i] = 0.0;
+            for (int k = 0; k < n; k++)
+                x[i] += p->P[i][k] * rhs[k];
+        }
+        for (int j = 0; j < p->nc; j++)
+            f[j] = v3(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
+    } else if (!general && p->nc == 1) {
+        /* One sliding contact: K is 1 x 1, singular only at 0 (the general
+         * solve's pivot test relative to its own size). */
+        double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), dir[0]));
+        if (!(fabs(k) > 0.0))
+            return 1;
+        f[0] = v3_scale(dir[0], -v3_dot(up, af[0]) / k);
+    } else {
+        pd_vec3 axes[3] = {body_axes[0], body_axes[1], body_axes[2]};
+        if (general) {
+            /* The contact's own tangent axes, as a check that the
+             * body axes of the specialised solves lose nothing. */
+            axes[0] = up;
+            axes[1] = v3_unit(v3_cross(up, fabs(up.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+            axes[2] = v3_cross(up, axes[1]);
+        }
+        layout L;
+        make_layout(p, up, dir, axes, &L);
+        double rhs[6] = {0}, x[6];
+        for (int i = 0; i < L.n; i++)
+            rhs[i] = -v3_dot(L.row[i], af[L.c[i]]);
+        if (!solve_layout(p, &L, rhs, x))
+            return 1;
+        for (int k = 0; k < L.n; k++)
+            f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k]));
+    }
+    pd_vec3 F = v3(0.0, 0.0, 0.0);
+    out->wdot = a0;
+    for (int j = 0; j < p->nc; j++) {
+        out->wdot = v3_add(out->wdot, inv_inertia(b, v3_cross(p->r[j], f[j])));
+        F = v3_add(F, f[j]);
+        double fn = v3_dot(f[j], up);
+        out->fn[j] = fn;
+        out->cone[j] = p->mode[j] == STICK ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+                                            : HUGE_VAL;
+    }
+    out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));
+    return 0;
+}
+
+int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out)
+{
+    return forces(p, s, 0, out);
+}
+
+int pd_phase_forces_general(const pd_phase *p, const pd_state *s, pd_phase_forces *out)
+{
+    return forces(p, s, 1, out);
+}
+
+/* The impulses along the constrained components that change the kinetic
+ * energy least: an orthogonal projection in the mass metric, so the energy
+ * cannot rise whatever the impulses' signs. */
+int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
+{
+    const pd_body *b = p->b;
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    const pd_vec3 dir[2] = {up, up};
+    layout L;
+    make_layout(p, up, dir, body_axes, &L);
+    double rhs[6] = {0}, x[6];
+    pd_vec3 vb = quat_rotate_inv(s->q, s->v);
+    for (int i = 0; i < L.n; i++)
+        rhs[i] = -v3_dot(L.row[i], v3_add(vb, v3_cross(s->w, p->r[L.c[i]])));
+    if (!solve_layout(p, &L, rhs, x))
+        return 0;
+    for (int k = 0; k < L.n; k++) {
+        pd_vec3 P = v3_scale(L.col[k], x[k]);
+        s->v = v3_add(s->v, quat_rotate(s->q, v3_scale(P, 1.0 / b->mass)));
+        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[L.c[k]], P)));
+    }
+    return 1;
+}
