@@ -5,9 +5,10 @@
  * times per step, so the common layouts skip the general assembly: one
  * sliding contact is a 1 x 1 system, and contacts that all stick (a pivot, a
  * rotation about an edge) have a constant system in the body frame, so
- * their solution is a constant map computed once per phase. Two contacts
- * that both slide, or one of each, assemble their 2 x 2 or 4 x 4 system from
- * the constant response matrices. */
+ * their solution is a constant map computed once per phase. Contacts that
+ * all slide have one unknown each (1 x 1 or 2 x 2); one of each (rare)
+ * takes the general layout. Every system is assembled from the contacts'
+ * constant response matrices. */
 #include <math.h>
 #include <string.h>
 #include "mat3.h"
@@ -23,42 +24,43 @@ static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 t)
     return v3(b->inv_moment[0] * t.x, b->inv_moment[1] * t.y, b->inv_moment[2] * t.z);
 }
 
-/* Solves the n x n system A x = b in place by Gaussian elimination with
- * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of the
- * matrix's largest entry. */
-static int solve_dense(int n, double A[6][6], double b[6])
+/* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
+ * n + m columns) and B's columns become X's, by Gaussian elimination with
+ * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of A's
+ * largest entry. */
+enum { AUG = 12 };
+
+static int solve_dense(int n, int m, double Ab[6][AUG])
 {
     double scale = 0.0;
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
-            scale = fmax(scale, fabs(A[i][j]));
+            if (fabs(Ab[i][j]) > scale) /* as fmax, NaN aside, without its call */
+                scale = fabs(Ab[i][j]);
     for (int k = 0; k < n; k++) {
         int piv = k;
         for (int i = k + 1; i < n; i++)
-            if (fabs(A[i][k]) > fabs(A[piv][k]))
+            if (fabs(Ab[i][k]) > fabs(Ab[piv][k]))
                 piv = i;
-        if (!(fabs(A[piv][k]) > PD_TOL_PHASE_PIVOT_REL * scale))
+        if (!(fabs(Ab[piv][k]) > PD_TOL_PHASE_PIVOT_REL * scale))
             return 0;
-        for (int j = 0; j < n; j++) {
-            double t = A[k][j];
-            A[k][j] = A[piv][j];
-            A[piv][j] = t;
+        for (int j = 0; j < n + m; j++) {
+            double t = Ab[k][j];
+            Ab[k][j] = Ab[piv][j];
+            Ab[piv][j] = t;
         }
-        double t = b[k];
-        b[k] = b[piv];
-        b[piv] = t;
         for (int i = k + 1; i < n; i++) {
-            double f = A[i][k] / A[k][k];
-            for (int j = k; j < n; j++)
-                A[i][j] -= f * A[k][j];
-            b[i] -= f * b[k];
+            double f = Ab[i][k] / Ab[k][k];
+            for (int j = k; j < n + m; j++)
+                Ab[i][j] -= f * Ab[k][j];
         }
     }
-    for (int i = n - 1; i >= 0; i--) {
-        for (int j = i + 1; j < n; j++)
-            b[i] -= A[i][j] * b[j];
-        b[i] /= A[i][i];
-    }
+    for (int c = n; c < n + m; c++)
+        for (int i = n - 1; i >= 0; i--) {
+            for (int j = i + 1; j < n; j++)
+                Ab[i][c] -= Ab[i][j] * Ab[j][c];
+            Ab[i][c] /= Ab[i][i];
+        }
     return 1;
 }
 
@@ -90,44 +92,51 @@ static void make_layout(const pd_phase *p, pd_vec3 up, const pd_vec3 dir[2], con
 
 static const pd_vec3 body_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
 
-/* The unknowns x of layout L such that each constrained component of the
- * contacts' acceleration (or velocity) change K x equals rhs. For two
- * sticking contacts K is singular (the squeeze along the edge moves
- * nothing): the least-norm solution is taken, from the normal equations with
- * the squeeze set to zero by one more row. 0 if singular. */
-static int solve_layout(const pd_phase *p, const layout *L, const double rhs[6], double x[6])
+/* The unknowns X of layout L such that each constrained component of the
+ * contacts' acceleration (or velocity) change K X equals B, for m
+ * right-hand sides (columns of B; X's replace them). For two sticking
+ * contacts K is singular (the squeeze along the edge moves nothing): the
+ * least-norm solution is taken, from the normal equations with the squeeze
+ * set to zero by one more row. 0 if singular. */
+static int solve_layout(const pd_phase *p, const layout *L, int m, double B[6][6])
 {
-    double K[7][6], r[7];
-    for (int i = 0; i < L->n; i++) {
-        for (int j = 0; j < L->n; j++)
+    int n = L->n;
+    double K[7][6], Ab[6][AUG];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
             K[i][j] = v3_dot(L->row[i], m3_vec(CONST_M3(p->M[L->c[i]][L->c[j]]), L->col[j]));
-        r[i] = rhs[i];
-    }
-    double A[6][6];
     if (!(p->nc == 2 && p->mode[0] == STICK && p->mode[1] == STICK)) {
-        for (int i = 0; i < L->n; i++) {
-            for (int j = 0; j < L->n; j++)
-                A[i][j] = K[i][j];
-            x[i] = r[i];
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++)
+                Ab[i][j] = K[i][j];
+            for (int c = 0; c < m; c++)
+                Ab[i][n + c] = B[i][c];
         }
-        return solve_dense(L->n, A, x);
-    }
-    /* Squeeze row: (f0 - f1) . e = 0, e the edge, scaled like K's rows. */
-    pd_vec3 e = v3_unit(v3_sub(p->r[1], p->r[0]));
-    for (int j = 0; j < 6; j++)
-        K[6][j] = (j < 3 ? 1.0 : -1.0) * v3_dot(L->col[j], e) / p->b->mass;
-    r[6] = 0.0;
-    for (int i = 0; i < 6; i++) {
-        x[i] = 0.0;
-        for (int k = 0; k < 7; k++)
-            x[i] += K[k][i] * r[k];
-        for (int j = 0; j < 6; j++) {
-            A[i][j] = 0.0;
-            for (int k = 0; k < 7; k++)
-                A[i][j] += K[k][i] * K[k][j];
+    } else {
+        /* Squeeze row: (f0 - f1) . e = 0, e the edge, scaled like K's rows;
+         * its right-hand side is 0. */
+        pd_vec3 e = v3_unit(v3_sub(p->r[1], p->r[0]));
+        for (int j = 0; j < 6; j++)
+            K[6][j] = (j < 3 ? 1.0 : -1.0) * v3_dot(L->col[j], e) / p->b->mass;
+        for (int i = 0; i < 6; i++) {
+            for (int j = 0; j < 6; j++) {
+                Ab[i][j] = 0.0;
+                for (int k = 0; k < 7; k++)
+                    Ab[i][j] += K[k][i] * K[k][j];
+            }
+            for (int c = 0; c < m; c++) {
+                Ab[i][6 + c] = 0.0;
+                for (int k = 0; k < 6; k++)
+                    Ab[i][6 + c] += K[k][i] * B[k][c];
+            }
         }
     }
-    return solve_dense(6, A, x);
+    if (!solve_dense(n, m, Ab))
+        return 0;
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < m; c++)
+            B[i][c] = Ab[i][n + c];
+    return 1;
 }
 
 static int all_stick(const pd_phase *p)
@@ -177,16 +186,10 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     layout L;
     const pd_vec3 unused[2] = {v3(0, 0, 1), v3(0, 0, 1)};
     make_layout(p, v3(0, 0, 1), unused, body_axes, &L);
-    for (int k = 0; k < L.n; k++) {
-        double e[6] = {0}, x[6];
-        e[k] = 1.0;
-        if (!solve_layout(p, &L, e, x)) {
-            p->singular = 1;
-            return;
-        }
-        for (int i = 0; i < L.n; i++)
-            p->P[i][k] = x[i];
-    }
+    for (int i = 0; i < L.n; i++)
+        for (int k = 0; k < L.n; k++)
+            p->P[i][k] = i == k;
+    p->singular = !solve_layout(p, &L, L.n, p->P);
 }
 
 static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_forces *out)
@@ -233,13 +236,20 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         }
         for (int j = 0; j < p->nc; j++)
             f[j] = v3(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
-    } else if (!general && p->nc == 1) {
-        /* One sliding contact: K is 1 x 1, singular only at 0 (the general
-         * solve's pivot test relative to its own size). */
-        double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), dir[0]));
-        if (!(fabs(k) > 0.0))
+    } else if (!general && p->mode[0] == SLIDE && (p->nc == 1 || p->mode[1] == SLIDE)) {
+        /* Every contact slides: one unknown per contact, along its force
+         * direction, and one row, its normal. */
+        int n = p->nc;
+        double A[6][AUG];
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++)
+                A[i][j] = v3_dot(up, m3_vec(CONST_M3(p->M[i][j]), dir[j]));
+            A[i][n] = -v3_dot(up, af[i]);
+        }
+        if (!solve_dense(n, 1, A))
             return 1;
-        f[0] = v3_scale(dir[0], -v3_dot(up, af[0]) / k);
+        for (int j = 0; j < n; j++)
+            f[j] = v3_scale(dir[j], A[j][n]);
     } else {
         pd_vec3 axes[3] = {body_axes[0], body_axes[1], body_axes[2]};
         if (general) {
@@ -251,13 +261,13 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         }
         layout L;
         make_layout(p, up, dir, axes, &L);
-        double rhs[6] = {0}, x[6];
+        double x[6][6];
         for (int i = 0; i < L.n; i++)
-            rhs[i] = -v3_dot(L.row[i], af[L.c[i]]);
-        if (!solve_layout(p, &L, rhs, x))
+            x[i][0] = -v3_dot(L.row[i], af[L.c[i]]);
+        if (!solve_layout(p, &L, 1, x))
             return 1;
         for (int k = 0; k < L.n; k++)
-            f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k]));
+            f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
     }
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
@@ -293,14 +303,14 @@ int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
     const pd_vec3 dir[2] = {up, up};
     layout L;
     make_layout(p, up, dir, body_axes, &L);
-    double rhs[6] = {0}, x[6];
+    double x[6][6];
     pd_vec3 vb = quat_rotate_inv(s->q, s->v);
     for (int i = 0; i < L.n; i++)
-        rhs[i] = -v3_dot(L.row[i], v3_add(vb, v3_cross(s->w, p->r[L.c[i]])));
-    if (!solve_layout(p, &L, rhs, x))
+        x[i][0] = -v3_dot(L.row[i], v3_add(vb, v3_cross(s->w, p->r[L.c[i]])));
+    if (!solve_layout(p, &L, 1, x))
         return 0;
     for (int k = 0; k < L.n; k++) {
-        pd_vec3 P = v3_scale(L.col[k], x[k]);
+        pd_vec3 P = v3_scale(L.col[k], x[k][0]);
         s->v = v3_add(s->v, quat_rotate(s->q, v3_scale(P, 1.0 / b->mass)));
         s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[L.c[k]], P)));
     }
