@@ -11,9 +11,9 @@
  * a force f of three unknowns holding its whole acceleration at zero. The
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
- * undetermined, and the system takes the solution without it (least norm).
- * Sliding friction does negative work and sticking contacts none, so the
- * energy can only fall. The ODE is integrated by gsl_adapter's rk8pd in units
+ * undetermined, and the system takes the solution without it (least norm;
+ * phase_forces.c solves it). Sliding friction does negative work and
+ * sticking contacts none, so the energy can only fall. The ODE is integrated by gsl_adapter's rk8pd in units
  * of the part (length L, time sqrt(L/g)); the phase ends, handing the state
  * back to the microcollisions, just before any of:
  *  - a normal force reaching zero (a contact lifts off),
@@ -21,9 +21,9 @@
  *  - a sticking contact's force leaving the friction cone (it starts to slip),
  *  - another vertex reaching the floor (an impact),
  *  - the system becoming singular (as in Painleve's paradox),
- * located by the secant method on the margin that crossed, to
- * PD_TOL_PHASE_EVENT_REL sqrt(L/g); and it ends the drop when the energy test
- * decides it. */
+ * located from cubic models of the margin that crossed, to within
+ * PD_TOL_PHASE_EVENT_REL sqrt(L/g) before it; and it ends the drop when the
+ * energy test decides it. */
 #include <math.h>
 #include <string.h>
 #include "contact_phase.h"
@@ -61,47 +61,51 @@ static pd_state from_y(const pd_phase *p, const double y[NY])
     return s;
 }
 
-static int phase_rhs(double tau, const double y[], double dydt[], void *user)
+/* The time derivative of y (part units), with the state and forces it
+ * comes from. 1 where the model fails. */
+static int derivs(const pd_phase *p, const double y[NY], pd_state *s, pd_phase_forces *F,
+                  double dydt[NY])
 {
-    (void)tau;
-    const pd_phase *p = user;
-    pd_state s = from_y(p, y);
-    pd_phase_forces F;
-    if (pd_phase_forces_of(p, &s, &F))
+    *s = from_y(p, y);
+    if (pd_phase_forces_of(p, s, F))
         return 1;
-    pd_vec3 acc = F.acc, wdot = F.wdot;
     double T = p->T, V0 = p->L / T;
     pd_quat q = quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]);
     pd_quat dq = quat_mul(q, quat(0.0, y[W], y[W + 1], y[W + 2]));
-    const double d[NY] = {y[V], y[V + 1], y[V + 2], acc.x * T / V0, acc.y * T / V0,
-                          acc.z * T / V0, 0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z,
-                          wdot.x * T * T, wdot.y * T * T, wdot.z * T * T};
+    const double d[NY] = {y[V], y[V + 1], y[V + 2], F->acc.x * T / V0, F->acc.y * T / V0,
+                          F->acc.z * T / V0, 0.5 * dq.w, 0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z,
+                          F->wdot.x * T * T, F->wdot.y * T * T, F->wdot.z * T * T};
     memcpy(dydt, d, sizeof d);
     return 0;
+}
+
+static int phase_rhs(double tau, const double y[], double dydt[], void *user)
+{
+    (void)tau;
+    pd_state s;
+    pd_phase_forces F;
+    return derivs(user, y, &s, &F, dydt);
 }
 
 /* How far s is from the phase's end, in the part's units: per contact its
  * normal force and, sticking, its force's distance inside the friction cone
  * (per unit weight) or, sliding, its slip above slip_min (per sqrt(g L));
  * and the height of the lowest other vertex above the contacts (per L); into
- * g[NMARGIN]. Each is a smooth function of the state, so an event inside a
- * step is found by the secant method on the one that crossed. Returns the
- * smallest (positive while the phase may go on), or -1 where the model
- * fails. */
+ * g[NMARGIN], from s's forces F. Each is a smooth function of the state, so
+ * an event inside a step is found from a smooth model of the one that
+ * crossed. Returns the smallest (positive while the phase may go on). */
 enum { NMARGIN = 5 };
 
-static double margin(const pd_phase *p, const pd_state *s, double slip_min, double g[NMARGIN])
+static double margins(const pd_phase *p, const pd_state *s, const pd_phase_forces *F,
+                      double slip_min, double g[NMARGIN])
 {
-    pd_phase_forces F;
-    for (int k = 0; k < NMARGIN; k++)
-        g[k] = HUGE_VAL;
-    if (pd_phase_forces_of(p, s, &F))
-        return -1.0;
     const pd_body *b = p->b;
     double V0 = p->L / p->T, mg = b->mass * p->g;
+    for (int k = 0; k < NMARGIN; k++)
+        g[k] = HUGE_VAL;
     for (int i = 0; i < p->nc; i++) {
-        g[i] = F.fn[i] / mg;
-        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F.cone[i] / mg : (F.slip[i] - slip_min) / V0;
+        g[i] = F->fn[i] / mg;
+        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg : (F->slip[i] - slip_min) / V0;
     }
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     double floor_z = HUGE_VAL; /* the contacts' own height: they define the floor */
@@ -122,6 +126,97 @@ static double margin(const pd_phase *p, const pd_state *s, double slip_min, doub
     for (int k = 0; k < NMARGIN; k++)
         least = fmin(least, g[k]);
     return least;
+}
+
+/* A point of the phase: its time and state, the state's derivative, its
+ * margins and smallest margin (-1 where the model fails), and, once asked
+ * for (rated), the margins' rates of change. */
+typedef struct {
+    double tau, y[NY], dydt[NY];
+    double g[NMARGIN], dg[NMARGIN], least;
+    int rated;
+} point;
+
+static void point_at(const pd_phase *p, double slip_min, double tau, const double y[NY], point *a)
+{
+    pd_state s;
+    pd_phase_forces F;
+    a->tau = tau, a->rated = 0;
+    memcpy(a->y, y, sizeof a->y);
+    for (int k = 0; k < NMARGIN; k++)
+        a->g[k] = HUGE_VAL;
+    a->least = derivs(p, y, &s, &F, a->dydt) ? -1.0 : margins(p, &s, &F, slip_min, a->g);
+}
+
+/* The margins' rates of change at a, by a forward difference along the flow
+ * (PD_TOL_PHASE_RATE_STEP); NaN where unknown (the model fails there, or
+ * the margin is infinite). */
+static void rate(const pd_phase *p, double slip_min, point *a)
+{
+    if (a->rated)
+        return;
+    double e = PD_TOL_PHASE_RATE_STEP, y[NY];
+    for (int i = 0; i < NY; i++)
+        y[i] = a->y[i] + e * a->dydt[i];
+    point b;
+    point_at(p, slip_min, a->tau + e, y, &b);
+    for (int k = 0; k < NMARGIN; k++)
+        a->dg[k] = b.least > -1.0 && isfinite(a->g[k]) && isfinite(b.g[k]) ? (b.g[k] - a->g[k]) / e
+                                                                           : (double)NAN;
+    a->rated = 1;
+}
+
+/* The cubic Hermite interpolant on [0, 1] of values g0, g1 and slopes m0,
+ * m1 (per unit of the interval), at s. */
+static double hermite(double g0, double m0, double g1, double m1, double s)
+{
+    double s2 = s * s, s3 = s2 * s;
+    return (2.0 * s3 - 3.0 * s2 + 1.0) * g0 + (s3 - 2.0 * s2 + s) * m0 +
+           (3.0 * s2 - 2.0 * s3) * g1 + (s3 - s2) * m1;
+}
+
+/* Its first zero in (0, 1], given g0 > 0 >= g1: the first of 16 cells where
+ * it reaches zero, then bisection to round-off. */
+static double hermite_zero(double g0, double m0, double g1, double m1)
+{
+    enum { CELLS = 16, HALVINGS = 48 };
+    double lo = 0.0, hi = 1.0;
+    for (int i = 1; i < CELLS; i++) {
+        double s = (double)i / CELLS;
+        if (hermite(g0, m0, g1, m1, s) <= 0.0) {
+            hi = s;
+            break;
+        }
+        lo = s;
+    }
+    for (int i = 0; i < HALVINGS; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (hermite(g0, m0, g1, m1, mid) > 0.0)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* The time from a to the first event before b (where some margin is not
+ * positive), by the margins' cubic Hermite models from their values and
+ * rates at both ends: the margins are smooth, so the model's error falls as
+ * the fourth power of the interval (a secant where a rate is unknown). */
+static double time_to_event(const pd_phase *p, double slip_min, point *a, point *b)
+{
+    double len = b->tau - a->tau, frac = 1.0;
+    rate(p, slip_min, a);
+    rate(p, slip_min, b);
+    for (int k = 0; k < NMARGIN; k++) {
+        if (!(b->g[k] <= 0.0))
+            continue;
+        double m0 = len * a->dg[k], m1 = len * b->dg[k];
+        if (!isfinite(m0) || !isfinite(m1))
+            m0 = m1 = b->g[k] - a->g[k];
+        frac = fmin(frac, hermite_zero(a->g[k], m0, b->g[k], m1));
+    }
+    return len * frac;
 }
 
 static double kinetic(const pd_body *b, const pd_state *s)
@@ -160,8 +255,9 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
             return 0; /* nothing holds a contact without friction */
     pd_state t = *s;
     double g[NMARGIN];
-    if (!pd_phase_project_velocity(&p, &t) ||
-        !(margin(&p, &t, PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size), g) > 0.0))
+    pd_phase_forces F;
+    if (!pd_phase_project_velocity(&p, &t) || pd_phase_forces_of(&p, &t, &F) ||
+        !(margins(&p, &t, &F, PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size), g) > 0.0))
         return 0;
     /* The projection is an inelastic impulse: admitted only when it takes
      * next to nothing, else every entry would damp the part like the
@@ -180,59 +276,66 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
     pd_phase p;
     phase_of(&p, m, sc, s, contacts, nc);
     double slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
+    const double tol = PD_TOL_PHASE_EVENT_REL;
     /* First trial step a hundredth of the part's time unit: contact motion
      * changes on that unit; the controller grows it (at most 10x a step). */
-    double tau = 0.0, tau_max = t_max / p.T, h = 0.01, cap = INFINITY;
-    double y[NY], y0[NY];
-    int hint = 0, pose;
+    double tau_max = t_max / p.T, h = 0.01, target = INFINITY;
+    double y[NY];
+    int hint = 0, pose, bracket = 0;
+    point cur, next, end; /* the phase so far; a step's end; the nearest end past an event */
     to_y(&p, s, y);
-    double g0[NMARGIN], g1[NMARGIN];
-    double least = margin(&p, s, slip_min, g0);
+    point_at(&p, slip_min, 0.0, y, &cur);
     pd_ode_reset(ode);
-    for (int step = 0; step < PD_PHASE_MAX_STEPS && tau < tau_max && least > 0.0; step++) {
-        double tau0 = tau, h_try = h;
-        memcpy(y0, y, sizeof y);
-        double t1 = fmin(tau_max, tau + fmin(cap, 10.0 * h));
+    for (int step = 0; step < PD_PHASE_MAX_STEPS && cur.tau < tau_max && cur.least > 0.0; step++) {
+        double tau = cur.tau, h_try = h;
+        memcpy(y, cur.y, sizeof y);
+        double t1 = fmin(tau_max, fmin(target, tau + 10.0 * h));
         pd_status st = pd_ode_step(ode, phase_rhs, &p, &tau, t1, &h, y);
-        double len = st == PD_OK ? tau - tau0 : fmin(t1 - tau0, h_try);
-        pd_state n = from_y(&p, y);
-        double least1 = st == PD_OK ? margin(&p, &n, slip_min, g1) : -1.0;
-        if (least1 > 0.0) {
+        double len = st == PD_OK ? tau - cur.tau : fmin(t1 - cur.tau, h_try);
+        next.least = -1.0;
+        if (st == PD_OK) {
             /* Keep the quaternion on the unit sphere between steps. */
-            y[Q] = n.q.w, y[Q + 1] = n.q.x, y[Q + 2] = n.q.y, y[Q + 3] = n.q.z;
-            *s = n;
-            memcpy(g0, g1, sizeof g0);
-            least = least1;
-            cap = INFINITY;
+            pd_quat q = quat_normalize(quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]));
+            y[Q] = q.w, y[Q + 1] = q.x, y[Q + 2] = q.y, y[Q + 3] = q.z;
+            point_at(&p, slip_min, tau, y, &next);
+        }
+        if (next.least > 0.0) {
+            cur = next;
+            *s = from_y(&p, cur.y);
+            target = INFINITY;
+            if (bracket) {
+                /* Landed short of a known event: aim again, from here. */
+                double dt = time_to_event(&p, slip_min, &cur, &end);
+                if (dt <= tol)
+                    break;
+                target = cur.tau + dt - 0.5 * tol;
+                h = target - cur.tau;
+            }
             if (pd_drop_decided(m, s, sc->gravity, &hint, &pose) > 0)
                 break;
             continue;
         }
         if (st != PD_OK && st != PD_ERR_INTERNAL && st != PD_ERR_NO_CONVERGENCE)
             return st;
-        /* An event inside the step: back to its start and retry up to the
-         * secant estimate of the first crossing among the margins that
-         * crossed, aimed 1% short so the retry lands before the event
-         * (regula falsi from the step's start, which the margins being
-         * smooth makes converge in a few retries), and a hundredth of the
-         * step at least, so a margin that is not smooth still shrinks it
-         * geometrically; a failed step or a model failure halves it. When the crossing is within the event
+        /* An event inside the step: back to its start, and step again to
+         * half the event tolerance short of the event's estimate, which a
+         * smooth model (time_to_event) makes accurate enough that this
+         * retry mostly lands within the tolerance; landing short, the next
+         * step aims again, landing past, the retry does. A failed step or a
+         * model failure halves the step. When the event is within the
          * tolerance, hand over. */
-        tau = tau0;
-        memcpy(y, y0, sizeof y);
         pd_ode_reset(ode);
-        double frac = 0.5;
-        if (least1 > -1.0) {
-            frac = 1.0;
-            for (int k = 0; k < NMARGIN; k++)
-                if (g1[k] <= 0.0)
-                    frac = fmin(frac, g0[k] / (g0[k] - g1[k]));
+        double dt = 0.5 * len;
+        if (next.least > -1.0) {
+            end = next;
+            bracket = 1;
+            dt = time_to_event(&p, slip_min, &cur, &end);
         }
-        if (len * frac <= PD_TOL_PHASE_EVENT_REL)
+        if (dt <= tol)
             break;
-        cap = len * fmax(0.01, 0.99 * frac);
-        h = cap;
+        target = cur.tau + (next.least > -1.0 ? dt - 0.5 * tol : dt);
+        h = target - cur.tau;
     }
-    *t_used = tau * p.T;
+    *t_used = cur.tau * p.T;
     return PD_OK;
 }
