@@ -64,6 +64,41 @@ static int solve_dense(int n, int m, double Ab[6][AUG])
     return 1;
 }
 
+/* solve_dense for n = 1 or 2 and one right-hand side, written out: the
+ * same pivoting, test and arithmetic without the loops, for the sliding
+ * contacts that solve it at every right-hand side. A 1 x 1 system is
+ * singular only at 0 (the test is relative to the entry itself). */
+static int solve_small(int n, double A[6][AUG])
+{
+    if (n == 1) {
+        if (!(fabs(A[0][0]) > 0.0))
+            return 0;
+        A[0][1] /= A[0][0];
+        return 1;
+    }
+    double scale = 0.0;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            if (fabs(A[i][j]) > scale)
+                scale = fabs(A[i][j]);
+    if (fabs(A[1][0]) > fabs(A[0][0]))
+        for (int j = 0; j < 3; j++) {
+            double t = A[0][j];
+            A[0][j] = A[1][j];
+            A[1][j] = t;
+        }
+    if (!(fabs(A[0][0]) > PD_TOL_PHASE_PIVOT_REL * scale))
+        return 0;
+    double f = A[1][0] / A[0][0];
+    A[1][1] -= f * A[0][1];
+    A[1][2] -= f * A[0][2];
+    if (!(fabs(A[1][1]) > PD_TOL_PHASE_PIVOT_REL * scale))
+        return 0;
+    A[1][2] /= A[1][1];
+    A[0][2] = (A[0][2] - A[0][1] * A[1][2]) / A[0][0];
+    return 1;
+}
+
 /* The constrained directions of the contacts, body frame: a sliding contact
  * constrains its normal n (one row); a sticking one its whole acceleration,
  * along axes[0..3) (three rows). The unknowns follow the same layout, a
@@ -146,7 +181,7 @@ static int all_stick(const pd_phase *p)
 
 /* The velocity of contact j of state s (world), R the body-to-world matrix;
  * *wr = w x r, body frame. */
-static pd_vec3 contact_velocity(const pd_phase *p, const double R[3][3], const pd_state *s, int j,
+static inline pd_vec3 contact_velocity(const pd_phase *p, const double R[3][3], const pd_state *s, int j,
                                 pd_vec3 *wr)
 {
     *wr = v3_cross(s->w, p->r[j]);
@@ -246,7 +281,7 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
                 A[i][j] = v3_dot(up, m3_vec(CONST_M3(p->M[i][j]), dir[j]));
             A[i][n] = -v3_dot(up, af[i]);
         }
-        if (!solve_dense(n, 1, A))
+        if (!solve_small(n, A))
             return 1;
         for (int j = 0; j < n; j++)
             f[j] = v3_scale(dir[j], A[j][n]);
