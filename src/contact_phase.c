@@ -289,12 +289,11 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
     point cur, next, end; /* the phase so far; a step's end; the nearest end past an event */
     to_y(&p, s, y);
     point_at(&p, slip_min, 0.0, y, &cur);
-    pd_ode_reset(ode);
     for (int step = 0; step < PD_PHASE_MAX_STEPS && cur.tau < tau_max && cur.least > 0.0; step++) {
         double tau = cur.tau, h_try = h;
         memcpy(y, cur.y, sizeof y);
         double t1 = fmin(tau_max, fmin(target, tau + 10.0 * h));
-        pd_status st = pd_ode_step(ode, phase_rhs, &p, &tau, t1, &h, y);
+        pd_status st = pd_ode_step_from(ode, phase_rhs, &p, &tau, t1, &h, y, cur.dydt);
         double len = st == PD_OK ? tau - cur.tau : fmin(t1 - cur.tau, h_try);
         next.least = -1.0;
         if (st == PD_OK) {
@@ -328,7 +327,6 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
          * step aims again, landing past, the retry does. A failed step or a
          * model failure halves the step. When the event is within the
          * tolerance, hand over. */
-        pd_ode_reset(ode);
         double dt = 0.5 * len;
         if (next.least > -1.0) {
             end = next;
