@@ -176,10 +176,11 @@ static double hermite(double g0, double m0, double g1, double m1, double s)
 }
 
 /* Its first zero in (0, 1], given g0 > 0 >= g1: the first of 16 cells where
- * it reaches zero, then bisection to round-off. */
+ * it reaches zero, then bisection to 2^-36 of a cell, ~1e-12 of the step:
+ * far below the event tolerance for any step the phase takes. */
 static double hermite_zero(double g0, double m0, double g1, double m1)
 {
-    enum { CELLS = 16, HALVINGS = 48 };
+    enum { CELLS = 16, HALVINGS = 36 };
     double lo = 0.0, hi = 1.0;
     for (int i = 1; i < CELLS; i++) {
         double s = (double)i / CELLS;
