@@ -8,6 +8,7 @@
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_elljac.h>
 #include <stdlib.h>
+#include <string.h>
 #include "gsl_adapter.h"
 
 /* Subintervals QAGS may create. The band integrands are smooth apart from at
@@ -129,6 +130,7 @@ struct pd_ode {
     gsl_odeiv2_step *step;
     gsl_odeiv2_control *control;
     gsl_odeiv2_evolve *evolve;
+    double *y0, *yerr; /* pd_ode_step_from's: the step's start, its error estimate */
 };
 
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel)
@@ -144,7 +146,9 @@ pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel)
     ode->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)dim);
     ode->control = gsl_odeiv2_control_y_new(eps_abs, eps_rel);
     ode->evolve = gsl_odeiv2_evolve_alloc((size_t)dim);
-    if (!ode->step || !ode->control || !ode->evolve) {
+    ode->y0 = malloc((size_t)dim * sizeof *ode->y0);
+    ode->yerr = malloc((size_t)dim * sizeof *ode->yerr);
+    if (!ode->step || !ode->control || !ode->evolve || !ode->y0 || !ode->yerr) {
         pd_ode_free(ode);
         return NULL;
     }
@@ -161,6 +165,8 @@ void pd_ode_free(pd_ode *ode)
         gsl_odeiv2_control_free(ode->control);
     if (ode->step)
         gsl_odeiv2_step_free(ode->step);
+    free(ode->y0);
+    free(ode->yerr);
     free(ode);
 }
 
@@ -181,6 +187,47 @@ pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t
      * meeting the tolerance; anything else came from fn. evolve_apply restores
      * (t, y) to the start of the failed step in both cases. */
     return rc == GSL_FAILURE ? PD_ERR_NO_CONVERGENCE : PD_ERR_INTERNAL;
+}
+
+/* evolve_apply's adaptive step (the same stages, control, and retries of a
+ * step the control rejects), but with the derivative at the start from the
+ * caller. evolve_apply takes it from the previous step's end, for which
+ * rk8pd evaluates fn once more in every attempt (rejected ones included),
+ * or evaluates it itself after a reset; a control on y alone never reads
+ * it. A failure of fn ends the step at once (evolve_apply would halve it
+ * down to round-off): the caller knows better what to do. */
+pd_status pd_ode_step_from(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
+                           double y[], const double dydt_in[])
+{
+    gsl_odeiv2_system sys = {fn, NULL, (size_t)ode->dim, user};
+    size_t bytes = (size_t)ode->dim * sizeof *y;
+    const double t0 = *t;
+    double h0 = *h;
+    memcpy(ode->y0, y, bytes);
+    for (;;) {
+        int final_step = h0 > t1 - t0;
+        if (final_step)
+            h0 = t1 - t0;
+        if (gsl_odeiv2_step_apply(ode->step, t0, h0, y, ode->yerr, dydt_in, NULL, &sys) !=
+            GSL_SUCCESS) {
+            memcpy(y, ode->y0, bytes);
+            return PD_ERR_INTERNAL;
+        }
+        /* The control weighs the derivative by zero (a control on y): the
+         * start's stands in for the end's, which was not computed. */
+        double taken = h0;
+        if (gsl_odeiv2_control_hadjust(ode->control, ode->step, y, ode->yerr, dydt_in, &h0) ==
+            GSL_ODEIV_HADJ_DEC) {
+            memcpy(y, ode->y0, bytes);
+            if (h0 < taken && t0 + h0 != t0)
+                continue;
+            return PD_ERR_NO_CONVERGENCE;
+        }
+        *t = final_step ? t1 : t0 + taken;
+        if (!final_step)
+            *h = h0;
+        return PD_OK;
+    }
 }
 
 /* --- end of ODE integration ---------------------------------------------------- */

@@ -46,7 +46,7 @@ pd_status pd_ellint_P(double phi, double k, double n, double *result);
 pd_status pd_ellint_Kcomp(double k, double *result);
 pd_status pd_ellint_Pcomp(double k, double n, double *result);
 /* ==== end of elliptic functions ============================================= */
-/* --- ODE integration (used by impact.c) -------------------------------------
+/* --- ODE integration (used by impact.c and contact_phase.c) -----------------
  * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand
  * 8(9), with step control on |y|), allocated once and reused: pd_ode_step
  * allocates nothing, so a per-thread workspace can serve every collision. */
@@ -73,5 +73,12 @@ void pd_ode_reset(pd_ode *ode);
  * (*t, y) are those of the start of the step. */
 pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
                       double y[]);
+
+/* pd_ode_step given dydt_in = fn(*t, y), which the caller has anyway: one
+ * evaluation of fn fewer per attempted step (the end's, which pd_ode_step
+ * keeps as the next step's start), none after a reset, and no history, so
+ * it may start from any state. Forward only (t1 > *t). */
+pd_status pd_ode_step_from(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
+                           double y[], const double dydt_in[]);
 
 #endif

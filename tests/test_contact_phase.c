@@ -2,9 +2,13 @@
  * forms for a box sliding along an edge and toppling about one, energy that
  * never rises, and a hand-over that leaves no vertex below the floor. */
 #include <math.h>
+#include <string.h>
 #include "check.h"
 #include "contact_phase.h"
 #include "drop_fixture.h"
+#include "gsl_adapter.h"
+#include "phase_forces.h"
+#include "posedrop/tolerances.h"
 #include "quat.h"
 #include "shapes.h"
 #include "suites.h"
@@ -61,14 +65,34 @@ static void test_edge_slide(void)
     pd_ode *ode = pd_contact_phase_ode_alloc();
     double t = 0.0;
     CHECK_STATUS(pd_contact_phase(fx.model, ode, &sc, &s, contacts, nc, 1.0, &t), PD_OK);
-    double stop = v0 / (sc.mu * G);
-    CHECK(t > 0.99 * stop && t < stop);
+    /* It hands over as the slip falls to the end threshold, at most the
+     * event tolerance early; late only by the ODE error of the slip
+     * (1e-8 v0, above), 1e-8 sqrt(L/g) in time. */
+    double T = sqrt(L / G), slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(G * L);
+    double stop = (v0 - slip_min) / (sc.mu * G);
+    CHECK(t <= stop + 1e-8 * T);
+    CHECK(t >= stop - (PD_TOL_PHASE_EVENT_REL + 1e-8) * T);
     CHECK_NEAR(s.v.x, v0 - sc.mu * G * t, 1e-8 * v0, "closed form; ODE tolerance 1e-10 per step");
     CHECK_NEAR(s.x.x, v0 * t - 0.5 * sc.mu * G * t * t, 1e-9 * L, "closed form; ODE tolerance");
     CHECK_NEAR(s.x.z, z0, 1e-9 * L, "balanced over the edge: the height holds");
     CHECK_NEAR(v3_norm(s.w), 0.0, 1e-6, "no turn: ODE error 1e-10 per step in units of 1/sqrt(L/g) ~ 17 rad/s, grown ~12x by the balance's instability");
     pd_ode_free(ode);
     drop_teardown(&fx);
+}
+
+/* Turning about a fixed edge: the rate at turn a (about body x) from the
+ * energy, w^2 = w0^2 + 2 m g (zc(a0) - zc(a)) / I_e, zc(a) = Y sin a +
+ * Z cos a the centre's height above the edge; 1 / w is the time per
+ * radian. */
+typedef struct {
+    double w0sq, k, Y, Z, a0;
+} topple_rate;
+
+static double topple_dt_da(double a, void *user)
+{
+    const topple_rate *r = user;
+    double zc0 = r->Y * sin(r->a0) + r->Z * cos(r->a0), zc = r->Y * sin(a) + r->Z * cos(a);
+    return 1.0 / sqrt(r->w0sq + r->k * (zc0 - zc));
 }
 
 /* Toppling about the edge: started 0.05 rad short of balance and turning
@@ -110,11 +134,38 @@ static void test_edge_topple(void)
         if (i != contacts[0] && i != contacts[1])
             low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
     CHECK_NEAR(low, 0.0, 1e-5 * L, "event located to 1e-6 sqrt(L/g), arriving at a few sqrt(g L): a few 1e-6 L");
+    /* The next face lands at a = pi/2 (its far edge reaches the floor): the
+     * time to it by quadrature of dt/da. The phase hands over at most the
+     * event tolerance early, late only by the ODE error. */
+    topple_rate rate = {w0 * w0, 2.0 * b->mass * G / Ie, h.y, h.z, atan2(h.y, h.z) - 0.05};
+    double t_land, T = sqrt(L / G);
+    CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, rate.a0, 0.5 * M_PI, 1e-13, &t_land), PD_OK);
+    CHECK(t <= t_land + 1e-8 * T);
+    CHECK(t >= t_land - (PD_TOL_PHASE_EVENT_REL + 1e-8) * T);
     double w = sqrt(w0 * w0 + 2.0 * b->mass * G * (z0 - s.x.z) / Ie);
     CHECK_NEAR(fabs(s.w.x), w, 1e-7 * w, "energy about a fixed axis; ODE tolerance");
     CHECK_NEAR(hypot(s.w.y, s.w.z), 0.0, 1e-7 * w, "the axis is the edge");
     pd_ode_free(ode);
     drop_teardown(&fx);
+}
+
+/* A random state of body b touching the floor at its lowest vertices
+ * contacts (their count returned), sliding at up to 0.5 m/s and spinning
+ * at up to 20 rad/s, the first contact moving along the floor, not into or
+ * out of it; a random friction coefficient in sc. */
+static int random_contact(const pd_body *b, test_rng *rng, pd_scene *sc, pd_state *s,
+                          int *contacts)
+{
+    double r[3][3];
+    rng_rotation(rng, r);
+    sc->mu = rng_range(rng, 0.1, 1.0);
+    *s = (pd_state){v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                    v3(rng_range(rng, -0.5, 0.5), rng_range(rng, -0.5, 0.5), 0.0),
+                    v3_scale(rng_unit_vector(rng), rng_range(rng, 0.0, 20.0))};
+    int nc = lowest_vertices(b, s->q, contacts);
+    s->x.z = -quat_rotate(s->q, b->verts[contacts[0]]).z;
+    s->v.z = -v3_cross(quat_rotate(s->q, s->w), quat_rotate(s->q, b->verts[contacts[0]])).z;
+    return nc;
 }
 
 /* Random phases of a box on a vertex or an edge, sliding and spinning: the
@@ -133,16 +184,8 @@ static void test_random_phases(void)
     test_rng rng = {31};
     int started = 0, rises = 0, below = 0;
     for (int k = 0; k < 300; k++) {
-        double r[3][3];
-        rng_rotation(&rng, r);
-        sc.mu = rng_range(&rng, 0.1, 1.0);
-        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
-                      v3(rng_range(&rng, -0.5, 0.5), rng_range(&rng, -0.5, 0.5), 0.0),
-                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 20.0))};
-        int contacts[8], nc = lowest_vertices(b, s.q, contacts);
-        s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
-        /* Contact moving along the floor, not into or out of it. */
-        s.v.z = -v3_cross(quat_rotate(s.q, s.w), quat_rotate(s.q, b->verts[contacts[0]])).z;
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
         double E0 = energy(b, &s);
         if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc))
             continue;
@@ -168,8 +211,177 @@ static void test_random_phases(void)
     drop_teardown(&fx);
 }
 
+/* The specialised force solves (one sliding contact's 1 x 1 system, the
+ * constant maps of sticking contacts, the body-axis rows of the rest)
+ * against the general dense solve on the contacts' own tangent axes, on
+ * random states of the box, every layout: equal to round-off. The least-norm
+ * solve of two sticking contacts goes through the normal equations, which
+ * square K's condition number (~1e3 for the box), so round-off ~1e-16 * 1e6:
+ * 1e-9 of each quantity's scale. */
+static void test_specialised_forces(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.5);
+    if (!b)
+        return;
+    test_rng rng = {7};
+    int layouts[2][3] = {{0}}, differ = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 3000; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 0.5)),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 30.0))};
+        int contacts[2] = {(int)(rng_uniform(&rng) * b->nverts), 0}, nc = 1 + (k % 2);
+        int v = contacts[0], deg = b->adj_start[v + 1] - b->adj_start[v];
+        contacts[1] = b->adj[b->adj_start[v] + (int)(rng_uniform(&rng) * deg)];
+        /* Slip threshold: all slide, all stick, or between two slips. */
+        double slip_start = (k / 2) % 3 == 0 ? 0.0 : (k / 2) % 3 == 1 ? HUGE_VAL : -1.0;
+        if (slip_start < 0.0) {
+            pd_phase p;
+            pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, HUGE_VAL);
+            pd_phase_forces F;
+            pd_phase_forces_general(&p, &s, &F);
+            slip_start = nc == 2 ? 0.5 * (F.slip[0] + F.slip[1]) : F.slip[0] * rng_range(&rng, 0.5, 1.5);
+        }
+        pd_phase p;
+        pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+        pd_phase_forces A, B;
+        int fa = pd_phase_forces_of(&p, &s, &A), fb = pd_phase_forces_general(&p, &s, &B);
+        if (fa || fb) {
+            differ += fa != fb;
+            continue;
+        }
+        layouts[nc - 1][p.mode[0] + (nc == 2 ? p.mode[1] : 0)]++;
+        double acc = G + v3_dot(s.w, s.w) * b->size, force = b->mass * acc;
+        double d = fmax(v3_dist(A.acc, B.acc) / acc, v3_dist(A.wdot, B.wdot) * b->size / acc);
+        for (int i = 0; i < nc; i++) {
+            d = fmax(d, fabs(A.fn[i] - B.fn[i]) / force);
+            d = fmax(d, fabs(A.slip[i] - B.slip[i]) / sqrt(acc * b->size));
+            if (isfinite(B.cone[i]))
+                d = fmax(d, fabs(A.cone[i] - B.cone[i]) / force);
+            else
+                differ += isfinite(A.cone[i]);
+        }
+        worst = fmax(worst, d);
+    }
+    CHECK_INT(differ, 0);
+    CHECK_NEAR(worst, 0.0, 1e-9, "round-off through the normal equations (see above)");
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2 + i; j++)
+            CHECK(layouts[i][j] >= 100);
+    drop_teardown(&fx);
+}
+
+/* The phase's margins at s as the test reads them (contact_phase.c): normal
+ * forces per weight, sticking cone margins per weight, slips above the end
+ * threshold per sqrt(g L), the lowest other vertex above the contacts per L;
+ * the smallest, or -1 where the model fails. */
+static double least_margin(const pd_phase *p, const pd_state *s)
+{
+    const pd_body *b = p->b;
+    pd_phase_forces F;
+    if (pd_phase_forces_of(p, s, &F))
+        return -1.0;
+    double mg = b->mass * G, V0 = sqrt(G * b->size), least = HUGE_VAL, floor_z = HUGE_VAL;
+    for (int i = 0; i < p->nc; i++) {
+        least = fmin(least, F.fn[i] / mg);
+        least = fmin(least, p->mode[i] == PD_PHASE_STICK
+                                ? F.cone[i] / mg
+                                : (F.slip[i] - PD_TOL_PHASE_SLIP_REL * V0) / V0);
+        floor_z = fmin(floor_z, s->x.z + quat_rotate(s->q, b->verts[p->v[i]]).z);
+    }
+    for (int i = 0; i < b->nverts; i++)
+        if (i != p->v[0] && i != p->v[1])
+            least = fmin(least, (s->x.z + quat_rotate(s->q, b->verts[i]).z - floor_z) / b->size);
+    return least;
+}
+
+/* One classical Runge-Kutta step of the phase's motion (SI). */
+static void rk4_step(const pd_phase *p, pd_state *s, double dt)
+{
+    double y[13], k[4][13];
+    const double c[4] = {0.0, 0.5, 0.5, 1.0}, wgt[4] = {1.0, 2.0, 2.0, 1.0};
+    for (int stage = 0; stage < 4; stage++) {
+        pd_state u = *s;
+        if (stage > 0) {
+            double *d = k[stage - 1], a = c[stage] * dt;
+            u.x = v3_add(s->x, v3_scale(v3(d[0], d[1], d[2]), a));
+            u.v = v3_add(s->v, v3_scale(v3(d[3], d[4], d[5]), a));
+            u.q = quat_normalize(quat(s->q.w + a * d[6], s->q.x + a * d[7], s->q.y + a * d[8],
+                                      s->q.z + a * d[9]));
+            u.w = v3_add(s->w, v3_scale(v3(d[10], d[11], d[12]), a));
+        }
+        pd_phase_forces F;
+        pd_phase_forces_of(p, &u, &F);
+        pd_quat dq = quat_mul(u.q, quat(0.0, u.w.x, u.w.y, u.w.z));
+        const double d[13] = {u.v.x, u.v.y, u.v.z, F.acc.x, F.acc.y, F.acc.z, 0.5 * dq.w,
+                              0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z, F.wdot.x, F.wdot.y, F.wdot.z};
+        memcpy(k[stage], d, sizeof d);
+    }
+    const double y0[13] = {s->x.x, s->x.y, s->x.z, s->v.x, s->v.y, s->v.z, s->q.w,
+                           s->q.x, s->q.y, s->q.z, s->w.x, s->w.y, s->w.z};
+    for (int i = 0; i < 13; i++) {
+        y[i] = y0[i];
+        for (int st = 0; st < 4; st++)
+            y[i] += dt / 6.0 * wgt[st] * k[st][i];
+    }
+    *s = (pd_state){v3(y[0], y[1], y[2]), quat_normalize(quat(y[6], y[7], y[8], y[9])),
+                    v3(y[3], y[4], y[5]), v3(y[10], y[11], y[12])};
+}
+
+/* Where a phase of random contacts of the box ends at an event (not the
+ * energy test, not the time limit), it hands over with every margin still
+ * positive and the event at most PD_TOL_PHASE_EVENT_REL sqrt(L/g) ahead:
+ * continued by RK4 in steps of a fiftieth of that (error ~1e-30 L), some
+ * margin reaches zero within it. */
+static void test_event_location(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    double T = sqrt(b->size / G), tol = PD_TOL_PHASE_EVENT_REL * T;
+    pd_ode *ode = pd_contact_phase_ode_alloc();
+    test_rng rng = {53};
+    int events = 0, early = 0, late = 0, hint = 0, pose;
+    double worst = 0.0;
+    for (int k = 0; k < 300; k++) {
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc))
+            continue;
+        pd_phase p;
+        pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc,
+                      2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * b->size));
+        double t;
+        if (pd_contact_phase(fx.model, ode, &sc, &s, contacts, nc, 0.5, &t) != PD_OK || t >= 0.5 ||
+            pd_drop_decided(fx.model, &s, G, &hint, &pose) > 0)
+            continue;
+        events++;
+        early += !(least_margin(&p, &s) > 0.0);
+        int steps = 0; /* of tol / 50 */
+        while (steps < 100 && least_margin(&p, &s) > 0.0) {
+            rk4_step(&p, &s, tol / 50.0);
+            steps++;
+        }
+        late += steps > 50;
+        worst = fmax(worst, steps / 50.0);
+    }
+    CHECK(events >= 100);
+    CHECK_INT(early, 0);
+    CHECK_INT(late, 0);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
+    test_event_location();
+    test_specialised_forces();
     test_edge_slide();
     test_edge_topple();
     test_random_phases();

@@ -297,11 +297,20 @@
  * starts only at twice this, so it cannot start and end at once. */
 #define PD_TOL_PHASE_SLIP_REL 1e-3
 
-/* An event inside a phase step (lift-off, sticking, a new contact) is
- * approached by halving the step until it is this short, in units of
- * sqrt(L/g). Why 1e-6: the state is then within ~1e-6 L of the event, the
- * same order as the contact tolerance; ~20 halvings from a unit step. */
+/* A phase hands over at most this long before its event (lift-off,
+ * sticking, a new contact), in units of sqrt(L/g). Why 1e-6: the state is
+ * then within ~1e-6 L of the event, the same order as the contact
+ * tolerance. Each retry aims half this short of the event's estimate. */
 #define PD_TOL_PHASE_EVENT_REL 1e-6
+
+/* An event is estimated from the margins' values and rates of change at
+ * both ends of a step; a rate is a forward difference along the motion over
+ * this time, in units of sqrt(L/g). Why 1e-7: the margins and their rates
+ * are O(1) in the part's units, so the difference is off by ~1e-7 of the
+ * margin's second derivative (truncation) plus ~1e-16 / 1e-7 = 1e-9
+ * (round-off); a rate off by d moves the estimate by about d times the
+ * step, far below the event tolerance. */
+#define PD_TOL_PHASE_RATE_STEP 1e-7
 
 /* A phase's contact forces solve a system of at most 6 unknowns (the
  * contacts' response to unit forces); a pivot below this fraction of its
