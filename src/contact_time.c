@@ -115,20 +115,32 @@ static int contact_set(const pd_body *b, const pd_state *s, int lowest, double t
 pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
                            int *contacts, int ncap, pd_impact *out)
 {
-    if (!b || !f || !out || !(t_max >= 0.0) || !(window >= 0.0) || ncap < 0 || (ncap > 0 && !contacts))
+    if (!f)
+        return PD_ERR_USAGE;
+    return pd_flight_impact_from(b, f, 0.0, &f->s0, t_max, window, contacts, ncap, out);
+}
+
+pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
+                                double t_max, double window, int *contacts, int ncap, pd_impact *out)
+{
+    if (!b || !f || !at || !out || !(t0 >= 0.0) || !(t_max >= t0) || !(window >= 0.0) || ncap < 0 ||
+        (ncap > 0 && !contacts))
         return PD_ERR_USAGE;
     double tol = PD_TOL_IMPACT_REL * b->size;
     double W = f->wmax * b->rmax;
     double B = f->g + 2.0 * f->wmax * f->wmax * b->rmax;
     pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
-    pd_state s;
+    pd_state s = *at;
     int hint = 0;
-    double t = 0.0, h;
+    double t = t0, h;
     /* Start from the body's lowest vertex in the initial orientation: the scan
      * is avoided by hill-climbing from vertex 0. */
-    pd_status st = support_at(b, f, 0.0, &s, &hint, &h);
-    if (st != PD_OK)
-        return st;
+    pd_vec3 up = quat_rotate_inv(s.q, v3(0.0, 0.0, 1.0));
+    hint = pd_body_support(b, up, 0);
+    h = s.x.z + v3_dot(up, b->verts[hint]);
+    if (!isfinite(h))
+        return PD_ERR_NONFINITE;
+    pd_status st;
     if (h <= tol) {
         r.kind = PD_IMPACT_NOW;
     } else {

@@ -382,6 +382,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * that fall gives (a microcollision) rather than at speed 0. */
     double dt_rest = sqrt(2.0 * m->rest_fall / g);
     int hint = 0, phase_ok = 1;
+    pd_flight f;
+    double f_at = -1.0; /* time on f at which s lies; < 0: plan from s */
     for (;;) {
         int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
         if (d == 0 && m->pose_of[facet] >= 0 &&
@@ -400,11 +402,16 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             out->end = PD_END_COLLISION_LIMIT;
             break;
         }
-        pd_flight f;
+        /* The flight from s: planned afresh after anything that changed the
+         * motion, else the one s already lies on, at its time f_at. */
         pd_impact imp;
-        if (pd_flight_plan(m->body, &s, g, &f) != PD_OK ||
-            pd_flight_impact(m->body, &f, o->time_limit - t, sc->impact_time, w->contacts,
-                             PD_MAX_CONTACTS, &imp) != PD_OK)
+        if (f_at < 0.0) {
+            if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
+                break;
+            f_at = 0.0;
+        }
+        if (pd_flight_impact_from(m->body, &f, f_at, &s, f_at + (o->time_limit - t),
+                                  sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
             break;
         if (imp.kind == PD_IMPACT_NONE) {
             t = o->time_limit;
@@ -414,20 +421,25 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         if (imp.kind == PD_IMPACT_AT) {
             if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
                 break;
-            t += imp.t;
+            t += imp.t - f_at;
+            f_at = imp.t;
         }
         int nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
         int before = out->collisions;
         if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
             PD_OK)
             break;
-        if (out->collisions == before && phase_ok &&
-            pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
+        if (out->collisions != before) {
+            f_at = -1.0;
+            continue;
+        }
+        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
              * microcollisions must resolve, so the next rest step is theirs
              * (no phase can start and stop at once forever). */
             double dt;
+            f_at = -1.0;
             if (pd_contact_phase(m, w->phase, sc, &s, w->contacts, nc, o->time_limit - t, &dt) != PD_OK)
                 break;
             t += dt;
@@ -438,18 +450,16 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             }
             continue;
         }
-        if (out->collisions == before) {
-            /* Touching but not approaching: separating, or resting. An
-             * impact found at once left s as planned: f still holds. */
-            phase_ok = 1;
-            if ((imp.kind != PD_IMPACT_NOW && pd_flight_plan(m->body, &s, g, &f) != PD_OK) ||
-                pd_flight_eval(&f, dt_rest, &s) != PD_OK)
-                break;
-            t += dt_rest;
-            if (t >= o->time_limit) {
-                out->end = PD_END_TIME_LIMIT;
-                break;
-            }
+        /* Touching but not approaching: separating, or resting. Nothing
+         * changed the motion, so s goes on along f. */
+        phase_ok = 1;
+        f_at += dt_rest;
+        if (pd_flight_eval(&f, f_at, &s) != PD_OK)
+            break;
+        t += dt_rest;
+        if (t >= o->time_limit) {
+            out->end = PD_END_TIME_LIMIT;
+            break;
         }
     }
     out->time = t;

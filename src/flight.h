@@ -83,4 +83,12 @@ typedef struct pd_impact {
 pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
                            int *contacts, int ncap, pd_impact *out);
 
+/* The same from time t0 of the flight on, at its state there (as
+ * pd_flight_eval gives it): the first contact in (t0, t_max], or
+ * PD_IMPACT_NOW if touching at t0; times are the flight's own (from its
+ * plan). A flight stays valid until its next contact, so a caller that has
+ * moved the state along it need not plan it again. */
+pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
+                                double t_max, double window, int *contacts, int ncap, pd_impact *out);
+
 #endif
