@@ -364,6 +364,21 @@ static void test_impact(void)
             }
         CHECK(imp.t <= first);
         CHECK(imp.t > first - 2e-5 * 10); /* and not early: within a few scan steps */
+        /* Searched again from part-way along the same flight, at its state
+         * there: a contact as valid (within tol of the floor, never after
+         * the first crossing), and from the contact itself, touching now. */
+        pd_state mid;
+        pd_impact again;
+        double t0 = 0.5 * imp.t;
+        CHECK_STATUS(pd_flight_eval(&f, t0, &mid), PD_OK);
+        CHECK_STATUS(pd_flight_impact_from(b, &f, t0, &mid, 1.0, 0.0, contacts, 16, &again), PD_OK);
+        CHECK_INT(again.kind, PD_IMPACT_AT);
+        CHECK_NEAR(scan_height(b, &f, again.t), 0.0, tol, "impact tolerance");
+        CHECK(again.t <= first);
+        CHECK_STATUS(pd_flight_eval(&f, imp.t, &mid), PD_OK);
+        CHECK_STATUS(pd_flight_impact_from(b, &f, imp.t, &mid, 1.0, 0.0, contacts, 16, &again), PD_OK);
+        CHECK_INT(again.kind, PD_IMPACT_NOW);
+        CHECK_NEAR(again.t, imp.t, 0.0, "touching at t0: the search stays there");
     }
 
     /* Skimming: a fast-spinning box released with its lowest corner 1e-5 to
