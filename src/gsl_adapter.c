@@ -184,8 +184,8 @@ pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t
     if (rc == GSL_SUCCESS)
         return PD_OK;
     /* GSL_FAILURE: the controller shrank the step to round-off of t without
-     * meeting the tolerance; anything else came from fn. evolve_apply restores
-     * (t, y) to the start of the failed step in both cases. */
+     * meeting the tolerance (evolve_apply then leaves y at the rejected
+     * step's end); anything else came from fn (y restored). */
     return rc == GSL_FAILURE ? PD_ERR_NO_CONVERGENCE : PD_ERR_INTERNAL;
 }
 

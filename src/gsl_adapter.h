@@ -69,8 +69,10 @@ void pd_ode_reset(pd_ode *ode);
 /* One accepted adaptive step from (*t, y) towards t1 > *t, never past t1
  * (landing exactly on t1 when it reaches it). *h is the step to try, updated
  * to the one suggested for the next step. PD_ERR_NO_CONVERGENCE when the step
- * size falls to round-off of t, PD_ERR_INTERNAL when fn fails; on failure
- * (*t, y) are those of the start of the step. */
+ * size falls to round-off of t, PD_ERR_INTERNAL when fn fails. On failure *t
+ * is the start of the step; y is too after PD_ERR_INTERNAL, but after
+ * PD_ERR_NO_CONVERGENCE it holds the rejected step's end (GSL 2.7 leaves it
+ * there), so a caller that goes on restarts from its own copy. */
 pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
                       double y[]);
 
