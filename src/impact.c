@@ -12,11 +12,11 @@
  *  - events are located by limiting each integrator step to the crossing
  *    predicted by a Newton step, and by secant retries when a step overshoots,
  *    so the integrator never steps over the singularity of eq. 14. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include "gsl_adapter.h"
 #include "impact.h"
+#include "impact_rays.h"
 #include "posedrop/tolerances.h"
 #include "mat3.h"
 #include "vec3.h"
@@ -69,73 +69,6 @@ void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3
             K[i][j] = 0.5 * (M[i][j] + M[j][i]);
 }
 
-/* --- the diverging ray ------------------------------------------------------- *
- * Sliding in direction t changes the tangential velocity at the rate
- * v(t) = a - mu B t (a = K_tz, B = K_tt: eq. 14's tangential rows). A ray
- * through the origin is invariant when v = lambda t, and trajectories leave
- * along it when lambda > 0. Then (mu B + lambda I) t = a, so
- * t = (mu B + lambda I)^-1 a with |t| = 1: lambda solves
- * phi(lambda) = |(mu B + lambda I)^-1 a|^2 = 1. For lambda >= 0, phi is
- * strictly decreasing (B is positive definite) from phi(0) = |B^-1 a|^2 / mu^2
- * to 0; so an outward ray exists, and is unique, exactly when
- * |B^-1 a| > mu, which is eq. 15's condition for unstable sticking. This is
- * the statement the paper makes without proof ("this ray always exists and is
- * unique"); Mirtich's thesis, which the paper follows, was corrected on
- * resumed sliding by R. Baber (2011), whose note we could not consult, so the
- * construction here is derived directly from eq. 14 rather than taken from it.
- * Newton's method on psi(lambda) = 1/sqrt(phi) - 1 finds it: 1/|t(lambda)|
- * is concave and increasing in lambda (the secular function of trust-region
- * methods; it is exactly linear when a is an eigenvector of B), so Newton
- * from lambda = 0, where psi < 0, climbs monotonically to the root without
- * overshoot and converges quadratically: 4-6 steps, no bracket to keep, no
- * trigonometry. (Bisection took ~50 steps, 10% of a whole drop.) */
-
-enum { RAY_NEWTON = 100 };
-
-/* t = M^-1 a, M = mu B + lam I, and t' M^-1 t (for the derivative). */
-static double ray_phi(const double K[3][3], double mu, double lam, double *tx, double *ty,
-                      double *tMt)
-{
-    double m00 = mu * K[0][0] + lam, m01 = mu * K[0][1], m11 = mu * K[1][1] + lam;
-    double det = m00 * m11 - m01 * m01;
-    *tx = (m11 * K[0][2] - m01 * K[1][2]) / det;
-    *ty = (m00 * K[1][2] - m01 * K[0][2]) / det;
-    double sx = (m11 * *tx - m01 * *ty) / det, sy = (m00 * *ty - m01 * *tx) / det;
-    *tMt = *tx * sx + *ty * sy;
-    return *tx * *tx + *ty * *ty;
-}
-
-/* The ray's unit direction (tx, ty), or 0 when sticking is stable. */
-static int diverging_ray(const double K[3][3], double mu, double *rx, double *ry)
-{
-    double tx, ty, tMt, lam = 0.0;
-    double phi = mu > 0.0 ? ray_phi(K, mu, 0.0, &tx, &ty, &tMt) : 0.0;
-    if (!(phi > 1.0))
-        return 0;
-    for (int i = 0; i < RAY_NEWTON; i++) {
-        double r = sqrt(phi);
-        /* psi = 1/r - 1, psi' = tMt / r^3. */
-        double step = (r - 1.0) * r * r / tMt;
-        if (!(step > 4.0 * DBL_EPSILON * lam))
-            break; /* at the root to round-off (r <= 1 cannot give step > 0) */
-        lam += step;
-        phi = ray_phi(K, mu, lam, &tx, &ty, &tMt);
-    }
-    double n = sqrt(phi);
-    *rx = tx / n;
-    *ry = ty / n;
-    return 1;
-}
-
-pd_status pd_impact_diverging_ray(const double K[3][3], double mu, double *theta)
-{
-    double rx, ry;
-    if (!diverging_ray(K, mu, &rx, &ry))
-        return PD_ERR_NO_CONVERGENCE;
-    *theta = atan2(ry, rx);
-    return PD_OK;
-}
-
 /* --- the collision ------------------------------------------------------------ */
 
 /* The normalised problem and the running state of one collision. */
@@ -149,8 +82,7 @@ typedef struct {
     double rtx, rty;
     int on_ray;       /* sliding stopped on that ray */
     int scanned;      /* incoming rays looked for (a stiff approach) */
-    int nin;          /* incoming invariant rays: directions (inx, iny) and */
-    double inx[4], iny[4], inrate[4]; /* rates d|u_t|/dpz (< 0) */
+    pd_rays in;       /* ...and found */
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;
@@ -198,57 +130,9 @@ static void coll_compress(collision *c)
         c->done = 1;
 }
 
-/* --- incoming rays ------------------------------------------------------------ *
- * A ray t is invariant when a - mu B t (the slip's rate in pz) is parallel to
- * t; with t.(a - mu B t) < 0 the slip runs along it into the origin. Such a
- * ray attracts nearby directions when sticking is stable, and a trajectory
- * approaching the origin along it is stiff for an explicit integrator: the
- * direction relaxes onto the ray far faster than |u_t| shrinks (measured: 1 in
- * 1e5 random impacts exceeded PD_IMPACT_MAX_STEPS). Along the ray p' is
- * constant, so once within the event tolerance of it the rest of the way to
- * the origin is closed form, as on the diverging ray. The invariant rays are
- * the zeros of n(th).(a - mu B t(th)), a trigonometric polynomial of degree
- * 2 (at most 4), found by a fine scan and bisection, once, and only when a
- * collision has already taken RAY_SCAN_STEPS steps. */
-enum { RAY_SCAN_STEPS = 30, RAY_SCAN = 256, RAY_ROOT_BISECT = 60 };
-
-static double ray_turn(const collision *c, double th, double *rate)
-{
-    double tx = cos(th), ty = sin(th);
-    double vx = c->K[0][2] - c->mu * (c->K[0][0] * tx + c->K[0][1] * ty);
-    double vy = c->K[1][2] - c->mu * (c->K[1][0] * tx + c->K[1][1] * ty);
-    *rate = tx * vx + ty * vy;
-    return -ty * vx + tx * vy;
-}
-
-static void find_incoming_rays(collision *c)
-{
-    const double step = 2.0 * M_PI / RAY_SCAN;
-    double rate, g0 = ray_turn(c, 0.0, &rate);
-    c->scanned = 1;
-    c->nin = 0;
-    for (int k = 0; k < RAY_SCAN && c->nin < 4; k++) {
-        double lo = k * step, hi = lo + step, g1 = ray_turn(c, hi, &rate), glo = g0;
-        g0 = g1;
-        if (g1 == 0.0 || (glo > 0.0) == (g1 > 0.0))
-            continue; /* no crossing inside; an exact zero is the next lo */
-        for (int i = 0; i < RAY_ROOT_BISECT && glo != 0.0; i++) {
-            double mid = 0.5 * (lo + hi), gm = ray_turn(c, mid, &rate);
-            if ((gm > 0.0) == (glo > 0.0) && gm != 0.0)
-                lo = mid, glo = gm;
-            else
-                hi = mid;
-        }
-        double th = 0.5 * (lo + hi);
-        (void)ray_turn(c, th, &rate);
-        if (rate < 0.0) {
-            c->inx[c->nin] = cos(th);
-            c->iny[c->nin] = sin(th);
-            c->inrate[c->nin] = rate;
-            c->nin++;
-        }
-    }
-}
+/* Incoming rays are looked for only once a collision has taken this many
+ * steps: a slip that is snapped onto one has approached it for that long. */
+enum { RAY_SCAN_STEPS = 30 };
 
 /* Advances by h along a constant impulse direction d = p'. */
 static void linear_advance(collision *c, pd_vec3 d, double q, double uz, double h)
@@ -352,19 +236,22 @@ static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
             c->on_ray = 1;
             return PD_OK;
         }
-        if (*nsteps >= RAY_SCAN_STEPS && !c->scanned)
-            find_incoming_rays(c);
+        if (*nsteps >= RAY_SCAN_STEPS && !c->scanned) {
+            pd_rays_incoming(CONST_M3(c->K), c->mu, &c->in);
+            c->scanned = 1;
+        }
         int in = -1;
-        for (int k = 0; k < c->nin && in < 0; k++)
-            if (u.x * c->inx[k] + u.y * c->iny[k] > 0.0 && fabs(c->inx[k] * u.y - c->iny[k] * u.x) <= tols)
+        for (int k = 0; k < c->in.n && in < 0; k++)
+            if (u.x * c->in.tx[k] + u.y * c->in.ty[k] > 0.0 &&
+                fabs(c->in.tx[k] * u.y - c->in.ty[k] * u.x) <= tols)
                 in = k;
         if (in >= 0) {
             /* On an incoming ray: p' = (-mu t, 1) until the slip reaches the
              * origin (at pz + s / |rate|), where it sticks, or the next normal
              * event, after which the loop's tests take over. */
-            pd_vec3 d = v3(-c->mu * c->inx[in], -c->mu * c->iny[in], 1.0);
+            pd_vec3 d = v3(-c->mu * c->in.tx[in], -c->mu * c->in.ty[in], 1.0);
             double q = m3_vec(CONST_M3(c->K), d).z;
-            double hs = s / -c->inrate[in], he = INFINITY;
+            double hs = s / -c->in.rate[in], he = INFINITY;
             if (!c->compressed && q > 0.0)
                 he = -u.z / q;
             else if (c->compressed && c->law == PD_IMPACT_POISSON)
@@ -539,7 +426,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         linear_phase(&c, v3(0.0, 0.0, 1.0));
     } else {
         pd_status st = PD_OK;
-        c.have_ray = diverging_ray(CONST_M3(c.K), mu, &c.rtx, &c.rty);
+        c.have_ray = pd_ray_diverging(CONST_M3(c.K), mu, &c.rtx, &c.rty);
         if (hypot(c.u0.x, c.u0.y) > PD_TOL_IMPACT_EVENT_REL)
             st = slide(&c, w->ode, &r.nsteps);
         if (st != PD_OK)
