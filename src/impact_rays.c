@@ -93,12 +93,15 @@ static double quartic(const double p[5], double t, double *dp)
     return (((p[4] * t + p[3]) * t + p[2]) * t + p[1]) * t + p[0];
 }
 
-/* The root of P in (lo, hi), where P is monotone and P(lo) has the sign of
- * flo and P(hi) the other: Newton, bisecting whenever a step would leave the
- * bracket or fails to halve it. */
-static double bracketed_root(const double p[5], double lo, double hi, double flo)
+/* The root of P in (lo, hi), where P is monotone, P(lo) = flo and P(hi) = fhi
+ * of the other sign: Newton from the secant's root, bisecting whenever a step
+ * would leave the bracket or fails to halve the one before, until its
+ * correction falls below round-off. */
+static double bracketed_root(const double p[5], double lo, double hi, double flo, double fhi)
 {
-    double x = 0.5 * (lo + hi), dx_old = hi - lo;
+    double x = lo + (hi - lo) * (flo / (flo - fhi)), dx_old = hi - lo;
+    if (!(x > lo && x < hi))
+        x = 0.5 * (lo + hi);
     for (int i = 0; i < ROOT_ITER; i++) {
         double d, f = quartic(p, x, &d);
         if (f == 0.0)
@@ -107,11 +110,14 @@ static double bracketed_root(const double p[5], double lo, double hi, double flo
             lo = x;
         else
             hi = x;
-        double nx = x - f / d;
-        if (!(nx > lo && nx < hi) || fabs(nx - x) > 0.5 * dx_old)
+        double step = f / d;
+        if (fabs(step) <= 2.0 * DBL_EPSILON * fabs(x))
+            return x; /* converged to round-off */
+        double nx = x - step;
+        if (!(nx > lo && nx < hi) || fabs(step) > 0.5 * dx_old)
             nx = 0.5 * (lo + hi);
         dx_old = fabs(nx - x);
-        if (nx == x || !(hi - lo > 2.0 * DBL_EPSILON * fabs(nx)))
+        if (!(hi - lo > 2.0 * DBL_EPSILON * fabs(nx)))
             return nx;
         x = nx;
     }
@@ -157,7 +163,7 @@ void pd_rays_incoming(const double K[3][3], double mu, pd_rays *in)
     for (int i = 0; i + 1 < nends; i++) {
         double fhi = quartic(p, ends[i + 1], &d);
         if (flo != 0.0 && fhi != 0.0 && (flo > 0.0) != (fhi > 0.0)) {
-            double t = bracketed_root(p, ends[i], ends[i + 1], flo);
+            double t = bracketed_root(p, ends[i], ends[i + 1], flo, fhi);
             double cp = (1.0 - t * t) / (1.0 + t * t), sp = 2.0 * t / (1.0 + t * t);
             double tx = c1[k0] * cp - s1[k0] * sp, ty = s1[k0] * cp + c1[k0] * sp;
             double vx = K[0][2] - mu * (K[0][0] * tx + K[0][1] * ty);
