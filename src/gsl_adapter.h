@@ -67,7 +67,10 @@ typedef int (*pd_ode_fn)(double t, const double y[], double dydt[], void *user);
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel);
 void pd_ode_free(pd_ode *ode);
 
-/* Forgets the history of the previous integration (call before a new one). */
+/* Forgets the history of the previous integration: call before a new one,
+ * and whenever y or the right-hand side changed since the last step, which
+ * the next step would otherwise start from (GSL reuses that step's end
+ * derivative). */
 void pd_ode_reset(pd_ode *ode);
 
 /* One accepted adaptive step from (*t, y) towards t1 > *t, never past t1

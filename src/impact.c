@@ -19,7 +19,8 @@
 #include "posedrop/tolerances.h"
 
 struct pd_impact_work {
-    pd_ode *ode;
+    pd_ode *poisson;   /* dimension NSTATE_P: the impulse */
+    pd_ode *energetic; /* NSTATE: and the normal work */
 };
 
 pd_impact_work *pd_impact_work_alloc(void)
@@ -27,9 +28,10 @@ pd_impact_work *pd_impact_work_alloc(void)
     pd_impact_work *w = calloc(1, sizeof *w);
     if (!w)
         return NULL;
-    w->ode = pd_ode_alloc(NSTATE, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
-    if (!w->ode) {
-        free(w);
+    w->poisson = pd_ode_alloc(NSTATE_P, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
+    w->energetic = pd_ode_alloc(NSTATE, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
+    if (!w->poisson || !w->energetic) {
+        pd_impact_work_free(w);
         return NULL;
     }
     return w;
@@ -39,10 +41,10 @@ void pd_impact_work_free(pd_impact_work *w)
 {
     if (!w)
         return;
-    pd_ode_free(w->ode);
+    pd_ode_free(w->poisson);
+    pd_ode_free(w->energetic);
     free(w);
 }
-
 
 void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3][3])
 {
@@ -168,7 +170,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         pd_status st = PD_OK;
         c.have_ray = pd_ray_diverging(CONST_M3(c.K), mu, &c.rtx, &c.rty);
         if (hypot(c.u0.x, c.u0.y) > PD_TOL_IMPACT_EVENT_REL)
-            st = pd_impact_slide(&c, w->ode, &r.nsteps);
+            st = pd_impact_slide(&c, law == PD_IMPACT_POISSON ? w->poisson : w->energetic, &r.nsteps);
         if (st != PD_OK)
             return st;
         if (!c.done) {

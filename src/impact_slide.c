@@ -34,8 +34,9 @@ static int rhs_tau(double tau, const double y[], double dydt[], void *user)
     double s = sqrt(u.x * u.x + u.y * u.y); /* |u| <~ 1 here: no overflow for hypot to guard */
     dydt[PX] = -c->mu * u.x;
     dydt[PY] = -c->mu * u.y;
-    dydt[PW] = u.z * s;
     dydt[PZ] = s;
+    if (c->law == PD_IMPACT_ENERGETIC)
+        dydt[PW] = u.z * s;
     return 0;
 }
 
@@ -48,8 +49,9 @@ static int rhs_pz(double pz, const double y[], double dydt[], void *user)
     double m = c->mu / sqrt(u.x * u.x + u.y * u.y);
     dydt[PX] = -m * u.x;
     dydt[PY] = -m * u.y;
-    dydt[PW] = u.z;
     dydt[PZ] = 1.0;
+    if (c->law == PD_IMPACT_ENERGETIC)
+        dydt[PW] = u.z;
     return 0;
 }
 
@@ -65,8 +67,9 @@ static int rhs_uz(double uz, const double y[], double dydt[], void *user)
     double m = c->mu / (s * q);
     dydt[PX] = -m * u.x;
     dydt[PY] = -m * u.y;
-    dydt[PW] = u.z / q;
     dydt[PZ] = 1.0 / q;
+    if (c->law == PD_IMPACT_ENERGETIC)
+        dydt[PW] = u.z / q;
     return 0;
 }
 
@@ -79,8 +82,8 @@ static int rhs_w(double w, const double y[], double dydt[], void *user)
     double m = c->mu / (sqrt(u.x * u.x + u.y * u.y) * u.z);
     dydt[PX] = -m * u.x;
     dydt[PY] = -m * u.y;
-    dydt[PW] = 1.0;
     dydt[PZ] = 1.0 / u.z;
+    dydt[PW] = 1.0; /* the energetic law's only */
     return 0;
 }
 
