@@ -12,6 +12,8 @@
 #ifndef PD_IMPACT_RAYS_H
 #define PD_IMPACT_RAYS_H
 
+#include "posedrop/types.h"
+
 /* The incoming rays of one K and mu: at most 4. */
 typedef struct pd_rays {
     int n;
@@ -28,5 +30,15 @@ int pd_ray_diverging(const double K[3][3], double mu, double *tx, double *ty);
  * left out. None when the flow turns nowhere (a = 0 and B isotropic: every
  * ray is invariant and the flow needs no snapping). K is taken as is. */
 void pd_rays_incoming(const double K[3][3], double mu, pd_rays *in);
+
+/* The rest of a slide that ends on incoming ray k of in, from the contact
+ * velocity u, in closed form (the derivation is at the definition): the
+ * impulse *dp it adds (contact frame), after which the slip is 0, and the
+ * normal work *dw. Returns 0 (and sets nothing) unless the ray attracts, the
+ * normal velocity rises along it, and the error of *dp is estimated below
+ * max_err (units of the impulse): third order in the angle eps to the ray,
+ * or, with_work, second order, the order of *dw's. */
+int pd_ray_tail(const double K[3][3], double mu, const pd_rays *in, int k, pd_vec3 u,
+                double max_err, int with_work, pd_vec3 *dp, double *dw);
 
 #endif

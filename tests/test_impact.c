@@ -669,6 +669,79 @@ static void test_laws_oracle(void)
     pd_impact_work_free(w);
 }
 
+/* The tail onto an incoming ray (impact_rays.c) against the slide itself:
+ * eq. 14 in tau integrated by RK4 to the origin (1e-12 of the slip), from
+ * states at an angle eps of 1e-4 to 0.1 from a ray. Where the tail accepts
+ * an error bound (1e-8 or 1e-9), its impulse must meet it; after it the
+ * slip is 0. */
+static void tau_flow(const double K[3][3], double mu, const double y[5], double d[5])
+{
+    /* y = (u_x, u_y, p_x, p_y, p_z) */
+    double s = hypot(y[0], y[1]);
+    d[2] = -mu * y[0];
+    d[3] = -mu * y[1];
+    d[4] = s;
+    d[0] = K[0][0] * d[2] + K[0][1] * d[3] + K[0][2] * d[4];
+    d[1] = K[1][0] * d[2] + K[1][1] * d[3] + K[1][2] * d[4];
+}
+
+static void test_ray_tail(void)
+{
+    test_rng rng = {19};
+    int taken = 0, tried = 0;
+    double worst = 0.0;
+    for (int t = 0; t < 400 && tried < 200; t++) {
+        double K[3][3];
+        random_K(&rng, K);
+        double ks = (K[0][0] + K[1][1] + K[2][2]) / 3.0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                K[i][j] /= ks; /* the library's units, where the bound is stated */
+        double mu = rng_range(&rng, 0.1, 1.5);
+        pd_rays in;
+        pd_rays_incoming(CR(K), mu, &in);
+        for (int k = 0; k < in.n; k++) {
+            double eps = pow(10.0, rng_range(&rng, -4.0, -1.0)) * (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+            double alpha = pow(10.0, rng_range(&rng, -3.0, 0.0));
+            pd_vec3 u = v3(alpha * (in.tx[k] - eps * in.ty[k]), alpha * (in.ty[k] + eps * in.tx[k]), -1.0);
+            const double max_err = tried % 2 ? 1e-8 : 1e-9;
+            pd_vec3 dp;
+            double dw;
+            tried++;
+            if (!pd_ray_tail(CR(K), mu, &in, k, u, max_err, 0, &dp, &dw))
+                continue;
+            taken++;
+            double y[5] = {u.x, u.y, 0.0, 0.0, 0.0};
+            double h = 0.002 / (mu * (K[0][0] + K[1][1] + 2.0 * fabs(K[0][1])) + hypot(K[0][2], K[1][2]));
+            for (long n = 0; n < 100000000 && hypot(y[0], y[1]) > 1e-12 * alpha; n++) {
+                double k1[5], k2[5], k3[5], k4[5], m[5];
+                tau_flow(CR(K), mu, y, k1);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + 0.5 * h * k1[j];
+                tau_flow(CR(K), mu, m, k2);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + 0.5 * h * k2[j];
+                tau_flow(CR(K), mu, m, k3);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + h * k3[j];
+                tau_flow(CR(K), mu, m, k4);
+                for (int j = 0; j < 5; j++)
+                    y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+            }
+            double err = v3_norm(v3_sub(dp, v3(y[2], y[3], y[4])));
+            worst = fmax(worst, err);
+            CHECK_NEAR(err, 0.0, max_err, "the bound the tail accepted; RK4 in steps of 0.002 of the flow's rate adds < 1e-11");
+            /* u_t after it: u_t + B dp_t + a dp_z = 0 to round-off */
+            double rx = u.x + K[0][0] * dp.x + K[0][1] * dp.y + K[0][2] * dp.z;
+            double ry = u.y + K[1][0] * dp.x + K[1][1] * dp.y + K[1][2] * dp.z;
+            CHECK_NEAR(hypot(rx, ry), 0.0, 1e-13 * (alpha + v3_norm(dp)), "round-off: the tail ends at zero slip");
+        }
+    }
+    CHECK(taken >= 40);
+    printf("impact: ray tails: %d of %d offered taken, impulse within %.2g of RK4 to the origin\n",
+           taken, tried, worst);
+}
+
 static void test_incoming_rays(void)
 {
     test_rng rng = {17};
@@ -746,6 +819,7 @@ void suite_impact(void)
     test_figure7();
     test_figure7_portrait();
     test_incoming_rays();
+    test_ray_tail();
     test_marginal_stick();
     test_hard_cases();
     test_homogeneity();
