@@ -40,7 +40,7 @@ static double ray_phi(const double K[3][3], double mu, double lam, double *tx, d
     return *tx * *tx + *ty * *ty;
 }
 
-int pd_ray_diverging(const double K[3][3], double mu, double *rx, double *ry)
+int pd_ray_diverging(const double K[][3], double mu, double *rx, double *ry)
 {
     double tx, ty, tMt, lam = 0.0;
     double phi = mu > 0.0 ? ray_phi(K, mu, 0.0, &tx, &ty, &tMt) : 0.0;
@@ -129,7 +129,7 @@ static double bracketed_root(const double p[5], double lo, double hi, double flo
     return x;
 }
 
-void pd_rays_incoming(const double K[3][3], double mu, pd_rays *in)
+void pd_rays_incoming(const double K[][3], double mu, pd_rays *in)
 {
     in->n = 0;
     const double A = K[1][2], C = -K[0][2], D = -mu * K[0][1], E = 0.5 * mu * (K[0][0] - K[1][1]);
@@ -223,7 +223,7 @@ static double tail_slack(double alpha, double beta, double A, double c, double r
     return 0.5 * beta * beta / (alpha - A) * sum;
 }
 
-int pd_ray_tail(const double K[3][3], double mu, const pd_rays *in, int k, pd_vec3 u,
+int pd_ray_tail(const double K[][3], double mu, const pd_rays *in, int k, pd_vec3 u,
                 double max_err, int with_work, pd_vec3 *dp, double *dw)
 {
     const double tx = in->tx[k], ty = in->ty[k], r = in->rate[k];
