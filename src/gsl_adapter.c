@@ -3,6 +3,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
 #include <gsl/gsl_odeiv2.h>
+#include <gsl/gsl_poly.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 #include <gsl/gsl_sf_ellint.h>
@@ -51,6 +52,11 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
 
 double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }
+
+int pd_gsl_cubic_roots(double a, double b, double c, double x[3])
+{
+    return gsl_poly_solve_cubic(a, b, c, &x[0], &x[1], &x[2]);
+}
 
 /* GSL's samplers draw through a gsl_rng; this type makes one of posedrop's
  * streams that gsl_rng, so no GSL generator (and no GSL seeding convention)
@@ -172,8 +178,10 @@ void pd_ode_free(pd_ode *ode)
 
 void pd_ode_reset(pd_ode *ode)
 {
+    /* The driver keeps the last step's end derivative as the next step's
+     * start; rk8pd itself keeps nothing between steps (its reset only zeroes
+     * scratch, 10% of a step), so the driver's is the history to forget. */
     gsl_odeiv2_evolve_reset(ode->evolve);
-    gsl_odeiv2_step_reset(ode->step);
 }
 
 pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,

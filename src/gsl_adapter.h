@@ -22,6 +22,10 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
 double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
 
+/* The real roots of x^3 + a x^2 + b x + c, ascending, into x[0..n); returns n
+ * (1 or 3; a double root is reported twice). GSL's closed form, no iteration. */
+int pd_gsl_cubic_roots(double a, double b, double c, double x[3]);
+
 /* One multinomial draw: out[0..k) counts of `total` trials over k categories
  * of weights w[0..k) (non-negative, not all zero, normalised by GSL), drawn
  * from rng, one of posedrop's own streams, so the draw is as reproducible as
@@ -63,7 +67,10 @@ typedef int (*pd_ode_fn)(double t, const double y[], double dydt[], void *user);
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel);
 void pd_ode_free(pd_ode *ode);
 
-/* Forgets the history of the previous integration (call before a new one). */
+/* Forgets the history of the previous integration: call before a new one,
+ * and whenever y or the right-hand side changed since the last step, which
+ * the next step would otherwise start from (GSL reuses that step's end
+ * derivative). */
 void pd_ode_reset(pd_ode *ode);
 
 /* One accepted adaptive step from (*t, y) towards t1 > *t, never past t1

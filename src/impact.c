@@ -3,29 +3,24 @@
  * Numerical decisions, each explained where it is made:
  *  - the problem is solved in units where |u0| = 1 and K's mean diagonal is
  *    1, so tolerances are relative and the law is homogeneous to round-off;
- *  - the integrated state is (px, py, W) with pz as the independent variable,
- *    and the velocity is always recomputed as u0 + K p, so u1 = u0 + K p holds
- *    exactly and the energy bookkeeping p.(u0 + u1)/2 matches the work;
+ *  - the integrated state is (px, py, W, pz), the velocity always recomputed
+ *    as u0 + K p (impact_internal.h), and sliding integrated in a rescaled
+ *    parameter in which zero slip is a rest point (impact_slide.c);
  *  - every phase in which p' is constant (no friction, stable sticking,
  *    sliding along the diverging ray or into the origin along an incoming
  *    one) is solved in closed form;
  *  - events are located by limiting each integrator step to the crossing
- *    predicted by a Newton step, and by secant retries when a step overshoots,
+ *    predicted by a Newton step, by secant retries when a step overshoots,
+ *    and by one step in the event's own variable once it is within a step,
  *    so the integrator never steps over the singularity of eq. 14. */
-#include <float.h>
 #include <math.h>
 #include <stdlib.h>
-#include "gsl_adapter.h"
-#include "impact.h"
+#include "impact_internal.h"
 #include "posedrop/tolerances.h"
-#include "mat3.h"
-#include "vec3.h"
-
-/* State of the sliding ODE: the impulse so far, and the normal work W. */
-enum { PX, PY, PW, PZ, NSTATE };
 
 struct pd_impact_work {
-    pd_ode *ode;
+    pd_ode *poisson;   /* dimension NSTATE_P: the impulse */
+    pd_ode *energetic; /* NSTATE: and the normal work */
 };
 
 pd_impact_work *pd_impact_work_alloc(void)
@@ -33,9 +28,10 @@ pd_impact_work *pd_impact_work_alloc(void)
     pd_impact_work *w = calloc(1, sizeof *w);
     if (!w)
         return NULL;
-    w->ode = pd_ode_alloc(NSTATE, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
-    if (!w->ode) {
-        free(w);
+    w->poisson = pd_ode_alloc(NSTATE_P, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
+    w->energetic = pd_ode_alloc(NSTATE, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
+    if (!w->poisson || !w->energetic) {
+        pd_impact_work_free(w);
         return NULL;
     }
     return w;
@@ -45,10 +41,10 @@ void pd_impact_work_free(pd_impact_work *w)
 {
     if (!w)
         return;
-    pd_ode_free(w->ode);
+    pd_ode_free(w->poisson);
+    pd_ode_free(w->energetic);
     free(w);
 }
-
 
 void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3][3])
 {
@@ -69,195 +65,7 @@ void pd_impact_K(double inv_mass, const double Jinv[3][3], pd_vec3 r, double K[3
             K[i][j] = 0.5 * (M[i][j] + M[j][i]);
 }
 
-/* --- the diverging ray ------------------------------------------------------- *
- * Sliding in direction t changes the tangential velocity at the rate
- * v(t) = a - mu B t (a = K_tz, B = K_tt: eq. 14's tangential rows). A ray
- * through the origin is invariant when v = lambda t, and trajectories leave
- * along it when lambda > 0. Then (mu B + lambda I) t = a, so
- * t = (mu B + lambda I)^-1 a with |t| = 1: lambda solves
- * phi(lambda) = |(mu B + lambda I)^-1 a|^2 = 1. For lambda >= 0, phi is
- * strictly decreasing (B is positive definite) from phi(0) = |B^-1 a|^2 / mu^2
- * to 0; so an outward ray exists, and is unique, exactly when
- * |B^-1 a| > mu, which is eq. 15's condition for unstable sticking. This is
- * the statement the paper makes without proof ("this ray always exists and is
- * unique"); Mirtich's thesis, which the paper follows, was corrected on
- * resumed sliding by R. Baber (2011), whose note we could not consult, so the
- * construction here is derived directly from eq. 14 rather than taken from it.
- * Newton's method on psi(lambda) = 1/sqrt(phi) - 1 finds it: 1/|t(lambda)|
- * is concave and increasing in lambda (the secular function of trust-region
- * methods; it is exactly linear when a is an eigenvector of B), so Newton
- * from lambda = 0, where psi < 0, climbs monotonically to the root without
- * overshoot and converges quadratically: 4-6 steps, no bracket to keep, no
- * trigonometry. (Bisection took ~50 steps, 10% of a whole drop.) */
-
-enum { RAY_NEWTON = 100 };
-
-/* t = M^-1 a, M = mu B + lam I, and t' M^-1 t (for the derivative). */
-static double ray_phi(const double K[3][3], double mu, double lam, double *tx, double *ty,
-                      double *tMt)
-{
-    double m00 = mu * K[0][0] + lam, m01 = mu * K[0][1], m11 = mu * K[1][1] + lam;
-    double det = m00 * m11 - m01 * m01;
-    *tx = (m11 * K[0][2] - m01 * K[1][2]) / det;
-    *ty = (m00 * K[1][2] - m01 * K[0][2]) / det;
-    double sx = (m11 * *tx - m01 * *ty) / det, sy = (m00 * *ty - m01 * *tx) / det;
-    *tMt = *tx * sx + *ty * sy;
-    return *tx * *tx + *ty * *ty;
-}
-
-/* The ray's unit direction (tx, ty), or 0 when sticking is stable. */
-static int diverging_ray(const double K[3][3], double mu, double *rx, double *ry)
-{
-    double tx, ty, tMt, lam = 0.0;
-    double phi = mu > 0.0 ? ray_phi(K, mu, 0.0, &tx, &ty, &tMt) : 0.0;
-    if (!(phi > 1.0))
-        return 0;
-    for (int i = 0; i < RAY_NEWTON; i++) {
-        double r = sqrt(phi);
-        /* psi = 1/r - 1, psi' = tMt / r^3. */
-        double step = (r - 1.0) * r * r / tMt;
-        if (!(step > 4.0 * DBL_EPSILON * lam))
-            break; /* at the root to round-off (r <= 1 cannot give step > 0) */
-        lam += step;
-        phi = ray_phi(K, mu, lam, &tx, &ty, &tMt);
-    }
-    double n = sqrt(phi);
-    *rx = tx / n;
-    *ry = ty / n;
-    return 1;
-}
-
-pd_status pd_impact_diverging_ray(const double K[3][3], double mu, double *theta)
-{
-    double rx, ry;
-    if (!diverging_ray(K, mu, &rx, &ry))
-        return PD_ERR_NO_CONVERGENCE;
-    *theta = atan2(ry, rx);
-    return PD_OK;
-}
-
 /* --- the collision ------------------------------------------------------------ */
-
-/* The normalised problem and the running state of one collision. */
-typedef struct {
-    double K[3][3];
-    pd_vec3 u0;
-    double mu, e;
-    pd_impact_law law;
-    double y[NSTATE]; /* p = (px, py, pz) and W so far */
-    int have_ray;     /* sticking is unstable: the diverging ray (rtx, rty) exists */
-    double rtx, rty;
-    int on_ray;       /* sliding stopped on that ray */
-    int scanned;      /* incoming rays looked for (a stiff approach) */
-    int nin;          /* incoming invariant rays: directions (inx, iny) and */
-    double inx[4], iny[4], inrate[4]; /* rates d|u_t|/dpz (< 0) */
-    int compressed;
-    double pz_c, W_c, pz_end, W_end;
-    int done;
-} collision;
-
-static pd_vec3 coll_u(const collision *c, const double y[])
-{
-    return v3_add(c->u0, m3_vec(c->K, v3(y[PX], y[PY], y[PZ])));
-}
-
-/* Eq. 14 in a rescaled parameter tau with dpz/dtau = |u_t|: the state
- * (px, py, W, pz) obeys p' = (-mu u_x, -mu u_y, |u_t|), W' = u_z |u_t|.
- * Along a sliding trajectory this is eq. 14 with the step measure changed, so
- * it has the same solutions, but its right-hand side is Lipschitz: nothing is
- * divided by |u_t|, and the origin of the tangential plane becomes a rest
- * point approached exponentially in tau instead of a singularity reached at a
- * finite pz. In pz the flow near the origin turns the sliding direction at a
- * rate ~1/|u_t| (stiff: an explicit step must shrink with |u_t|, measured ~50
- * steps to come within 1e-9); in tau it turns at a bounded rate, and a
- * trajectory cannot step over the origin. */
-static int slide_rhs(double tau, const double y[], double dydt[], void *user)
-{
-    (void)tau;
-    const collision *c = user;
-    pd_vec3 u = coll_u(c, y);
-    double s = sqrt(u.x * u.x + u.y * u.y); /* |u| <~ 1 here: no overflow for hypot to guard */
-    dydt[PX] = -c->mu * u.x;
-    dydt[PY] = -c->mu * u.y;
-    dydt[PW] = u.z * s;
-    dydt[PZ] = s;
-    return 0;
-}
-
-/* Marks maximum compression at the current state and sets the end target. */
-static void coll_compress(collision *c)
-{
-    c->compressed = 1;
-    c->pz_c = c->y[PZ];
-    c->W_c = c->y[PW];
-    c->pz_end = (1.0 + c->e) * c->pz_c;
-    /* Stronge: restitution work -e^2 W_c, so the total normal work ends at
-     * (1 - e^2) W_c (W_c <= 0). */
-    c->W_end = (1.0 - c->e * c->e) * c->W_c;
-    if (c->e == 0.0)
-        c->done = 1;
-}
-
-/* --- incoming rays ------------------------------------------------------------ *
- * A ray t is invariant when a - mu B t (the slip's rate in pz) is parallel to
- * t; with t.(a - mu B t) < 0 the slip runs along it into the origin. Such a
- * ray attracts nearby directions when sticking is stable, and a trajectory
- * approaching the origin along it is stiff for an explicit integrator: the
- * direction relaxes onto the ray far faster than |u_t| shrinks (measured: 1 in
- * 1e5 random impacts exceeded PD_IMPACT_MAX_STEPS). Along the ray p' is
- * constant, so once within the event tolerance of it the rest of the way to
- * the origin is closed form, as on the diverging ray. The invariant rays are
- * the zeros of n(th).(a - mu B t(th)), a trigonometric polynomial of degree
- * 2 (at most 4), found by a fine scan and bisection, once, and only when a
- * collision has already taken RAY_SCAN_STEPS steps. */
-enum { RAY_SCAN_STEPS = 30, RAY_SCAN = 256, RAY_ROOT_BISECT = 60 };
-
-static double ray_turn(const collision *c, double th, double *rate)
-{
-    double tx = cos(th), ty = sin(th);
-    double vx = c->K[0][2] - c->mu * (c->K[0][0] * tx + c->K[0][1] * ty);
-    double vy = c->K[1][2] - c->mu * (c->K[1][0] * tx + c->K[1][1] * ty);
-    *rate = tx * vx + ty * vy;
-    return -ty * vx + tx * vy;
-}
-
-static void find_incoming_rays(collision *c)
-{
-    const double step = 2.0 * M_PI / RAY_SCAN;
-    double rate, g0 = ray_turn(c, 0.0, &rate);
-    c->scanned = 1;
-    c->nin = 0;
-    for (int k = 0; k < RAY_SCAN && c->nin < 4; k++) {
-        double lo = k * step, hi = lo + step, g1 = ray_turn(c, hi, &rate), glo = g0;
-        g0 = g1;
-        if (g1 == 0.0 || (glo > 0.0) == (g1 > 0.0))
-            continue; /* no crossing inside; an exact zero is the next lo */
-        for (int i = 0; i < RAY_ROOT_BISECT && glo != 0.0; i++) {
-            double mid = 0.5 * (lo + hi), gm = ray_turn(c, mid, &rate);
-            if ((gm > 0.0) == (glo > 0.0) && gm != 0.0)
-                lo = mid, glo = gm;
-            else
-                hi = mid;
-        }
-        double th = 0.5 * (lo + hi);
-        (void)ray_turn(c, th, &rate);
-        if (rate < 0.0) {
-            c->inx[c->nin] = cos(th);
-            c->iny[c->nin] = sin(th);
-            c->inrate[c->nin] = rate;
-            c->nin++;
-        }
-    }
-}
-
-/* Advances by h along a constant impulse direction d = p'. */
-static void linear_advance(collision *c, pd_vec3 d, double q, double uz, double h)
-{
-    c->y[PX] += h * d.x;
-    c->y[PY] += h * d.y;
-    c->y[PW] += h * uz + 0.5 * q * h * h;
-    c->y[PZ] += h;
-}
 
 /* The rest of the collision with p' = d constant (no friction, stable
  * sticking, sliding along the diverging ray): u is linear in pz, W quadratic,
@@ -279,191 +87,12 @@ static void linear_phase(collision *c, pd_vec3 d)
     if (c->done)
         return;
     double uz = coll_u(c, c->y).z, h = 0.0;
-    if (c->law == PD_IMPACT_POISSON) {
+    if (c->law == PD_IMPACT_POISSON)
         h = c->pz_end > c->y[PZ] ? c->pz_end - c->y[PZ] : 0.0;
-    } else {
-        /* W + uz h + q h^2 / 2 = W_end for the root h >= 0, in the form that
-         * does not cancel (uz >= 0 after compression). */
-        double dw = c->W_end - c->y[PW];
-        if (dw > 0.0) {
-            double den = uz + sqrt(uz * uz + 2.0 * q * dw);
-            h = den > 0.0 ? 2.0 * dw / den : 0.0;
-        }
-    }
+    else if (c->W_end > c->y[PW]) /* uz >= 0 after compression */
+        h = fmax(work_step(uz, q, c->W_end - c->y[PW]), 0.0);
     linear_advance(c, d, q, uz, h);
     c->done = 1;
-}
-
-enum { EV_NONE, EV_COMPRESS, EV_END };
-
-/* Sliding (eq. 14) until the collision ends or the tangential velocity
- * vanishes. Returns PD_OK with c->done set, or PD_OK with the state at
- * sticking (c->done clear), or a failure status. Integrates in tau (see
- * slide_rhs); events are functions of the state, located by limiting each
- * step to the Newton estimate of the crossing and by secant retries after an
- * overshoot. Sticking needs no location: the origin is a rest point in tau,
- * so a step may run past the moment |u_t| falls below the tolerance without
- * changing anything but tau. */
-static pd_status slide(collision *c, pd_ode *ode, int *nsteps)
-{
-    const double tols = PD_TOL_IMPACT_EVENT_REL; /* |u0| = 1 */
-    const double tolz = PD_TOL_IMPACT_EVENT_REL * fabs(c->u0.z);
-    /* First trial step: u_t relaxes at rates ~mu K_tt ~ mu in these units,
-     * and the normal velocity changes on a scale ~1; the controller adapts. */
-    double tau = 0.0, h = 0.1 / (1.0 + c->mu);
-    double cap = INFINITY; /* set by an overshoot: the next step ends there */
-    int cap_event = EV_NONE;
-    pd_ode_reset(ode);
-    for (;;) {
-        pd_vec3 u = coll_u(c, c->y);
-        double s = sqrt(u.x * u.x + u.y * u.y);
-        double tolw = PD_TOL_IMPACT_EVENT_REL * fabs(c->W_c);
-        double tolp = PD_TOL_IMPACT_EVENT_REL * c->pz_end;
-        if (!c->compressed && u.z >= -tolz)
-            coll_compress(c);
-        if (c->done)
-            return PD_OK;
-        if (c->compressed && c->law == PD_IMPACT_POISSON && c->y[PZ] >= c->pz_end - tolp) {
-            /* Within the event tolerance of the end: close the gap along the
-             * current impulse direction (error second order in the gap). */
-            double gap = c->pz_end - c->y[PZ];
-            if (s > 0.0) {
-                c->y[PX] -= c->mu * u.x / s * gap;
-                c->y[PY] -= c->mu * u.y / s * gap;
-            }
-            c->y[PW] += u.z * gap;
-            c->y[PZ] = c->pz_end;
-            c->done = 1;
-            return PD_OK;
-        }
-        if (c->compressed && c->law == PD_IMPACT_ENERGETIC && c->y[PW] >= c->W_end - tolw) {
-            c->done = 1;
-            return PD_OK;
-        }
-        if (s <= tols)
-            return PD_OK; /* stuck */
-        /* Within the event tolerance of the diverging ray the trajectory is
-         * on it for good: the ray attracts nearby directions, and along it p'
-         * is constant (closed form). Integrating instead is stiff: when the
-         * ray's outward speed is small the direction relaxes onto the ray
-         * far faster than |u_t| grows (measured: > 1000 steps). */
-        if (c->have_ray && u.x * c->rtx + u.y * c->rty > 0.0 &&
-            fabs(c->rtx * u.y - c->rty * u.x) <= tols) {
-            c->on_ray = 1;
-            return PD_OK;
-        }
-        if (*nsteps >= RAY_SCAN_STEPS && !c->scanned)
-            find_incoming_rays(c);
-        int in = -1;
-        for (int k = 0; k < c->nin && in < 0; k++)
-            if (u.x * c->inx[k] + u.y * c->iny[k] > 0.0 && fabs(c->inx[k] * u.y - c->iny[k] * u.x) <= tols)
-                in = k;
-        if (in >= 0) {
-            /* On an incoming ray: p' = (-mu t, 1) until the slip reaches the
-             * origin (at pz + s / |rate|), where it sticks, or the next normal
-             * event, after which the loop's tests take over. */
-            pd_vec3 d = v3(-c->mu * c->inx[in], -c->mu * c->iny[in], 1.0);
-            double q = m3_vec(CONST_M3(c->K), d).z;
-            double hs = s / -c->inrate[in], he = INFINITY;
-            if (!c->compressed && q > 0.0)
-                he = -u.z / q;
-            else if (c->compressed && c->law == PD_IMPACT_POISSON)
-                he = c->pz_end - c->y[PZ];
-            else if (c->compressed && q > 0.0) {
-                double dw = c->W_end - c->y[PW];
-                he = dw > 0.0 ? 2.0 * dw / (u.z + sqrt(u.z * u.z + 2.0 * q * dw)) : 0.0;
-            }
-            he = fmax(he, 0.0);
-            linear_advance(c, d, q, u.z, fmin(hs, he));
-            ++*nsteps;
-            if (hs <= he)
-                return PD_OK; /* stuck: what is left of the slip is the ray's offset, <= tols */
-            pd_ode_reset(ode);
-            continue;
-        }
-        if (*nsteps >= PD_IMPACT_MAX_STEPS)
-            return PD_ERR_NO_CONVERGENCE;
-
-        /* Newton predictions of the next events, from the slopes in tau:
-         * d/dtau = |u_t| d/dpz, and in pz, u' = K (-mu t, 1). */
-        double tx = u.x / s, ty = u.y / s;
-        pd_vec3 du = m3_vec(CONST_M3(c->K), v3(-c->mu * tx, -c->mu * ty, 1.0));
-        double hlim = INFINITY;
-        int ev = EV_NONE;
-        if (!c->compressed && du.z > 0.0 && -u.z / (s * du.z) < hlim) {
-            hlim = -u.z / (s * du.z);
-            ev = EV_COMPRESS;
-        }
-        if (c->compressed && c->law == PD_IMPACT_POISSON) {
-            hlim = (c->pz_end - c->y[PZ]) / s;
-            ev = EV_END;
-        }
-        if (c->compressed && c->law == PD_IMPACT_ENERGETIC) {
-            /* W(tau) ~ W + A h + B h^2 / 2, A = u_z s,
-             * B = d(u_z s)/dtau = s (s du_z + u_z ds/dpz). */
-            double ds = tx * du.x + ty * du.y;
-            double A = u.z * s, B = s * (s * du.z + u.z * ds);
-            double dw = c->W_end - c->y[PW], disc = A * A + 2.0 * B * dw;
-            double den = disc >= 0.0 ? A + sqrt(disc) : 0.0;
-            if (den > 0.0) {
-                hlim = 2.0 * dw / den;
-                ev = EV_END;
-            }
-        }
-        if (cap < hlim) {
-            hlim = cap;
-            ev = cap_event;
-        }
-        /* No event ahead: let the controller grow the step (it grows by at
-         * most 5x, so 10 h never truncates it). */
-        double t1 = ev == EV_NONE ? tau + 10.0 * h : tau + hlim;
-        /* An event closer than round-off of tau is here: take it rather than
-         * ask the integrator for a step it cannot represent. */
-        if (!(t1 > tau)) {
-            if (ev == EV_COMPRESS) {
-                coll_compress(c);
-                continue;
-            }
-            c->done = 1;
-            return PD_OK;
-        }
-
-        double tau_a = tau, y_a[NSTATE];
-        for (int i = 0; i < NSTATE; i++)
-            y_a[i] = c->y[i];
-        pd_status st = pd_ode_step(ode, slide_rhs, c, &tau, t1, &h, c->y);
-        ++*nsteps;
-        if (st != PD_OK)
-            return st;
-        cap = INFINITY;
-        cap_event = EV_NONE;
-
-        /* Overshoot: an event passed inside the step is bracketed and the
-         * step retried to the secant estimate of its position. */
-        pd_vec3 ub = coll_u(c, c->y);
-        double frac = INFINITY;
-        int fev = EV_NONE;
-        if (!c->compressed && ub.z > tolz) {
-            frac = -u.z / (ub.z - u.z);
-            fev = EV_COMPRESS;
-        }
-        if (c->compressed && c->law == PD_IMPACT_POISSON && c->y[PZ] > c->pz_end + tolp) {
-            frac = (c->pz_end - y_a[PZ]) / (c->y[PZ] - y_a[PZ]);
-            fev = EV_END;
-        }
-        if (c->compressed && c->law == PD_IMPACT_ENERGETIC && c->y[PW] > c->W_end + tolw) {
-            frac = (c->W_end - y_a[PW]) / (c->y[PW] - y_a[PW]);
-            fev = EV_END;
-        }
-        if (fev != EV_NONE) {
-            cap = frac * (tau - tau_a);
-            cap_event = fev;
-            tau = tau_a;
-            for (int i = 0; i < NSTATE; i++)
-                c->y[i] = y_a[i];
-            pd_ode_reset(ode);
-        }
-    }
 }
 
 /* Eq. 15: with u_t = 0, p' = (alpha, beta, 1) keeps u_t' = 0 when
@@ -539,9 +168,9 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         linear_phase(&c, v3(0.0, 0.0, 1.0));
     } else {
         pd_status st = PD_OK;
-        c.have_ray = diverging_ray(CONST_M3(c.K), mu, &c.rtx, &c.rty);
+        c.have_ray = pd_ray_diverging(CONST_M3(c.K), mu, &c.rtx, &c.rty);
         if (hypot(c.u0.x, c.u0.y) > PD_TOL_IMPACT_EVENT_REL)
-            st = slide(&c, w->ode, &r.nsteps);
+            st = pd_impact_slide(&c, law == PD_IMPACT_POISSON ? w->poisson : w->energetic, &r.nsteps);
         if (st != PD_OK)
             return st;
         if (!c.done) {

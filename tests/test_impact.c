@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include "check.h"
 #include "impact.h"
+#include "impact_rays.h"
 #include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "suites.h"
@@ -528,6 +529,285 @@ static void test_status(void)
     CHECK_NEAR(v3_norm(r.p), 0.0, 0.0, "exact: a separating contact needs no impulse");
 }
 
+/* --- incoming rays --------------------------------------------------------- *
+ * The closed form (the quartic's roots, src/impact_rays.c) against a scan of
+ * the turning rate n.v(th) on 4096 directions with bisection, sharing no
+ * code with it: every scanned ray is found, and the closed form may find
+ * more only as pairs closer than the scan's spacing. */
+static double ray_turning(const double K[3][3], double mu, double th, double *rate)
+{
+    double tx = cos(th), ty = sin(th);
+    double vx = K[0][2] - mu * (K[0][0] * tx + K[0][1] * ty);
+    double vy = K[1][2] - mu * (K[1][0] * tx + K[1][1] * ty);
+    *rate = tx * vx + ty * vy;
+    return tx * vy - ty * vx;
+}
+
+enum { SCAN_N = 4096 };
+
+static int scan_incoming(const double K[3][3], double mu, double th_out[8])
+{
+    int n = 0;
+    double rate, g0 = ray_turning(K, mu, 0.0, &rate);
+    for (int k = 0; k < SCAN_N; k++) {
+        double lo = 2.0 * M_PI * k / SCAN_N, hi = 2.0 * M_PI * (k + 1) / SCAN_N;
+        double glo = g0, g1 = ray_turning(K, mu, hi, &rate);
+        g0 = g1;
+        if ((glo > 0.0) == (g1 > 0.0) || glo == 0.0 || g1 == 0.0)
+            continue;
+        for (int i = 0; i < 100; i++) {
+            double mid = 0.5 * (lo + hi), gm = ray_turning(K, mu, mid, &rate);
+            if ((gm > 0.0) == (glo > 0.0))
+                lo = mid;
+            else
+                hi = mid;
+        }
+        (void)ray_turning(K, mu, 0.5 * (lo + hi), &rate);
+        if (rate < 0.0 && n < 8)
+            th_out[n++] = 0.5 * (lo + hi);
+    }
+    return n;
+}
+
+/* Both laws against RK4 in pz (rk4_rhs), events found by bisecting the
+ * length of a last partial RK4 step: for slip that never stops, the impulse
+ * must agree to the event tolerance, also under the energetic law with a
+ * small e, where restitution is short and an error in W is an error of
+ * W / u_z in pz. */
+typedef struct {
+    pd_vec3 p;
+    double W;
+} rk4_state;
+
+static rk4_state rk4_step(const double K[3][3], pd_vec3 u0, double mu, rk4_state a, double h)
+{
+    /* W' = u_z = u0.z + (K p)_z */
+    pd_vec3 k[4];
+    double w[4];
+    rk4_state x = a;
+    for (int i = 0; i < 4; i++) {
+        k[i] = rk4_rhs(K, u0, mu, x.p);
+        w[i] = u0.z + K[2][0] * x.p.x + K[2][1] * x.p.y + K[2][2] * x.p.z;
+        double f = i < 2 ? 0.5 * h : h;
+        x.p = v3_add(a.p, v3_scale(k[i], f));
+        x.W = a.W + f * w[i];
+    }
+    rk4_state b;
+    b.p = v3_add(a.p, v3_scale(v3_add(v3_add(k[0], k[3]), v3_scale(v3_add(k[1], k[2]), 2.0)), h / 6.0));
+    b.W = a.W + h / 6.0 * (w[0] + 2.0 * w[1] + 2.0 * w[2] + w[3]);
+    return b;
+}
+
+/* Steps of h until g(state) >= 0 (g: 0 for u_z, 1 for W - target), the last
+ * one shortened by bisection to land on g = 0. */
+static rk4_state rk4_until(const double K[3][3], pd_vec3 u0, double mu, rk4_state a, double h,
+                           int g, double target)
+{
+    for (int n = 0; n < 1000000; n++) {
+        rk4_state b = rk4_step(K, u0, mu, a, h);
+        double gb = g == 0 ? u0.z + K[2][0] * b.p.x + K[2][1] * b.p.y + K[2][2] * b.p.z : b.W - target;
+        if (gb >= 0.0) {
+            double lo = 0.0, hi = h;
+            for (int i = 0; i < 80; i++) {
+                double mid = 0.5 * (lo + hi);
+                rk4_state m = rk4_step(K, u0, mu, a, mid);
+                double gm = g == 0 ? u0.z + K[2][0] * m.p.x + K[2][1] * m.p.y + K[2][2] * m.p.z
+                                   : m.W - target;
+                if (gm >= 0.0)
+                    hi = mid;
+                else
+                    lo = mid;
+            }
+            return rk4_step(K, u0, mu, a, 0.5 * (lo + hi));
+        }
+        a = b;
+    }
+    return a;
+}
+
+static void test_laws_oracle(void)
+{
+    test_rng rng = {18};
+    pd_impact_work *w = pd_impact_work_alloc();
+    double worst = 0.0;
+    int n = 0;
+    for (int t = 0; t < 12; t++) {
+        double K[3][3];
+        random_K(&rng, K);
+        double ks = (K[0][0] + K[1][1] + K[2][2]) / 3.0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                K[i][j] /= ks; /* units of the library: RK4's step is then O(1e-4) of the collision */
+        double ang = rng_range(&rng, 0.0, 2.0 * M_PI);
+        pd_vec3 u0 = v3(3.0 * cos(ang), 3.0 * sin(ang), -1.0);
+        double mu = 0.2, e = t % 2 ? 0.01 : 0.3;
+        pd_impact_law law = t % 4 < 2 ? PD_IMPACT_ENERGETIC : PD_IMPACT_POISSON;
+        pd_impact_result r;
+        CHECK_STATUS(pd_impact_solve(w, CR(K), u0, mu, e, law, &r), PD_OK);
+        if (r.stuck)
+            continue; /* the oracle is for slip that never stops */
+        const double h = 1e-4;
+        rk4_state c = rk4_until(CR(K), u0, mu, (rk4_state){v3(0, 0, 0), 0.0}, h, 0, 0.0);
+        rk4_state end;
+        if (law == PD_IMPACT_ENERGETIC) {
+            end = rk4_until(CR(K), u0, mu, c, h, 1, (1.0 - e * e) * c.W);
+        } else {
+            double dpz = e * c.p.z;
+            int m = (int)ceil(dpz / h);
+            end = c;
+            for (int i = 0; i < m; i++)
+                end = rk4_step(CR(K), u0, mu, end, dpz / m);
+        }
+        CHECK_REL(r.pz_c, c.p.z, EV, EV_SRC);
+        double err = v3_norm(v3_sub(r.p, end.p)) / v3_norm(end.p);
+        CHECK_NEAR(err, 0.0, EV, EV_SRC);
+        worst = fmax(worst, err);
+        n++;
+    }
+    CHECK(n >= 8);
+    printf("impact: %d sliding collisions, both laws, e = 0.01 and 0.3: impulse within %.2g of RK4's\n", n, worst);
+    pd_impact_work_free(w);
+}
+
+/* The tail onto an incoming ray (impact_rays.c) against the slide itself:
+ * eq. 14 in tau integrated by RK4 to the origin (1e-12 of the slip), from
+ * states at an angle eps of 1e-4 to 0.1 from a ray. Where the tail accepts
+ * an error bound (1e-8 or 1e-9), its impulse must meet it; after it the
+ * slip is 0. */
+static void tau_flow(const double K[3][3], double mu, const double y[5], double d[5])
+{
+    /* y = (u_x, u_y, p_x, p_y, p_z) */
+    double s = hypot(y[0], y[1]);
+    d[2] = -mu * y[0];
+    d[3] = -mu * y[1];
+    d[4] = s;
+    d[0] = K[0][0] * d[2] + K[0][1] * d[3] + K[0][2] * d[4];
+    d[1] = K[1][0] * d[2] + K[1][1] * d[3] + K[1][2] * d[4];
+}
+
+static void test_ray_tail(void)
+{
+    test_rng rng = {19};
+    int taken = 0, tried = 0;
+    double worst = 0.0;
+    for (int t = 0; t < 400 && tried < 200; t++) {
+        double K[3][3];
+        random_K(&rng, K);
+        double ks = (K[0][0] + K[1][1] + K[2][2]) / 3.0;
+        for (int i = 0; i < 3; i++)
+            for (int j = 0; j < 3; j++)
+                K[i][j] /= ks; /* the library's units, where the bound is stated */
+        double mu = rng_range(&rng, 0.1, 1.5);
+        pd_rays in;
+        pd_rays_incoming(CR(K), mu, &in);
+        for (int k = 0; k < in.n; k++) {
+            double eps = pow(10.0, rng_range(&rng, -4.0, -1.0)) * (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+            double alpha = pow(10.0, rng_range(&rng, -3.0, 0.0));
+            pd_vec3 u = v3(alpha * (in.tx[k] - eps * in.ty[k]), alpha * (in.ty[k] + eps * in.tx[k]), -1.0);
+            const double max_err = tried % 2 ? 1e-8 : 1e-9;
+            pd_vec3 dp;
+            double dw;
+            tried++;
+            if (!pd_ray_tail(CR(K), mu, &in, k, u, max_err, 0, &dp, &dw))
+                continue;
+            taken++;
+            double y[5] = {u.x, u.y, 0.0, 0.0, 0.0};
+            double h = 0.002 / (mu * (K[0][0] + K[1][1] + 2.0 * fabs(K[0][1])) + hypot(K[0][2], K[1][2]));
+            for (long n = 0; n < 100000000 && hypot(y[0], y[1]) > 1e-12 * alpha; n++) {
+                double k1[5], k2[5], k3[5], k4[5], m[5];
+                tau_flow(CR(K), mu, y, k1);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + 0.5 * h * k1[j];
+                tau_flow(CR(K), mu, m, k2);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + 0.5 * h * k2[j];
+                tau_flow(CR(K), mu, m, k3);
+                for (int j = 0; j < 5; j++)
+                    m[j] = y[j] + h * k3[j];
+                tau_flow(CR(K), mu, m, k4);
+                for (int j = 0; j < 5; j++)
+                    y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+            }
+            double err = v3_norm(v3_sub(dp, v3(y[2], y[3], y[4])));
+            worst = fmax(worst, err);
+            CHECK_NEAR(err, 0.0, max_err, "the bound the tail accepted; RK4 in steps of 0.002 of the flow's rate adds < 1e-11");
+            /* u_t after it: u_t + B dp_t + a dp_z = 0 to round-off */
+            double rx = u.x + K[0][0] * dp.x + K[0][1] * dp.y + K[0][2] * dp.z;
+            double ry = u.y + K[1][0] * dp.x + K[1][1] * dp.y + K[1][2] * dp.z;
+            CHECK_NEAR(hypot(rx, ry), 0.0, 1e-13 * (alpha + v3_norm(dp)), "round-off: the tail ends at zero slip");
+        }
+    }
+    CHECK(taken >= 40);
+    printf("impact: ray tails: %d of %d offered taken, impulse within %.2g of RK4 to the origin\n",
+           taken, tried, worst);
+}
+
+static void test_incoming_rays(void)
+{
+    test_rng rng = {17};
+    int extra = 0, total = 0;
+    double worst = 0.0, worst_turn = 0.0;
+    for (int t = 0; t < 2000; t++) {
+        double K[3][3];
+        random_K(&rng, K);
+        double mu = rng_range(&rng, 0.01, 2.0), th[8];
+        pd_rays in;
+        pd_rays_incoming(CR(K), mu, &in);
+        int ns = scan_incoming(CR(K), mu, th);
+        total += in.n;
+        CHECK(in.n >= ns);
+        for (int i = 0; i < ns; i++) {
+            double best = INFINITY;
+            for (int j = 0; j < in.n; j++)
+                if (cos(th[i]) * in.tx[j] + sin(th[i]) * in.ty[j] > 0.0)
+                    best = fmin(best, fabs(cos(th[i]) * in.ty[j] - sin(th[i]) * in.tx[j]));
+            worst = fmax(worst, best);
+        }
+        /* The size of v = a - mu B t, for round-off bounds. */
+        double vscale = 0.0;
+        for (int i = 0; i < 2; i++)
+            vscale = fmax(vscale, fabs(K[i][2]) + mu * (fabs(K[i][0]) + fabs(K[i][1])));
+        for (int j = 0; j < in.n; j++) {
+            /* Each is invariant (the turning rate vanishes to round-off of v)
+             * and incoming, at the reported rate. */
+            double rate, g = ray_turning(CR(K), mu, atan2(in.ty[j], in.tx[j]), &rate);
+            worst_turn = fmax(worst_turn, fabs(g) / vscale);
+            CHECK(in.rate[j] < 0.0);
+            CHECK_NEAR(in.rate[j], rate, 1e-14 * vscale, "round-off of t.v, relative to |v|");
+            CHECK_NEAR(hypot(in.tx[j], in.ty[j]), 1.0, 1e-15, "round-off: a unit vector");
+        }
+        extra += in.n - ns;
+    }
+    CHECK_NEAR(worst, 0.0, 1e-12, "both root-finders stop at round-off of th; 1e4 x for the roots' conditioning");
+    CHECK_NEAR(worst_turn, 0.0, 1e-14, "round-off: the turning rate at the root, relative to |v|");
+    printf("impact: incoming rays of 2000 random K: %d, %d more than a 4096-point scan finds; "
+           "directions agree to %.2g, turning rate at them %.2g of |v|\n", total, extra, worst, worst_turn);
+
+    /* Degenerate flows. a = 0, B anisotropic: the eigenvectors of B, all four
+     * incoming at -mu b. */
+    const double Ka[3][3] = {{2.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    pd_rays in;
+    pd_rays_incoming(Ka, 0.5, &in);
+    CHECK_INT(in.n, 4);
+    for (int j = 0; j < in.n; j++) {
+        CHECK_NEAR(in.tx[j] * in.ty[j], 0.0, 1e-15, "round-off: along an axis");
+        CHECK_NEAR(in.rate[j], fabs(in.tx[j]) > 0.5 ? -1.0 : -0.5, 1e-15, "closed form: -mu b");
+    }
+    /* B isotropic, |a| < mu b: the rays are +-a, both incoming. */
+    const double Kb[3][3] = {{1.0, 0.0, 0.3}, {0.0, 1.0, 0.4}, {0.3, 0.4, 1.0}};
+    pd_rays_incoming(Kb, 0.8, &in);
+    CHECK_INT(in.n, 2);
+    for (int j = 0; j < in.n; j++) {
+        CHECK_NEAR(fabs(0.6 * in.tx[j] + 0.8 * in.ty[j]), 1.0, 1e-15, "round-off: along a");
+        double out = 0.6 * in.tx[j] + 0.8 * in.ty[j] > 0.0;
+        CHECK_NEAR(in.rate[j], out ? 0.5 - 0.8 : -0.5 - 0.8, 1e-15, "closed form: t.a - mu b");
+    }
+    /* a = 0, B isotropic: every ray is invariant; none is reported. */
+    const double Kc[3][3] = {{1.0, 0.0, 0.0}, {0.0, 1.0, 0.0}, {0.0, 0.0, 1.0}};
+    pd_rays_incoming(Kc, 0.8, &in);
+    CHECK_INT(in.n, 0);
+}
+
 void suite_impact(void)
 {
     test_status();
@@ -535,8 +815,11 @@ void suite_impact(void)
     test_box_landing();
     test_planar_stick();
     test_rk4_oracle();
+    test_laws_oracle();
     test_figure7();
     test_figure7_portrait();
+    test_incoming_rays();
+    test_ray_tail();
     test_marginal_stick();
     test_hard_cases();
     test_homogeneity();
