@@ -5,6 +5,7 @@
 #include "gsl_adapter.h"
 #include "impact.h"
 #include "impact_rays.h"
+#include "posedrop/tolerances.h"
 #include "vec3.h"
 
 /* --- the diverging ray ------------------------------------------------------- *
@@ -86,10 +87,6 @@ pd_status pd_impact_diverging_ray(const double K[3][3], double mu, double *theta
  * only to its spacing and missed pairs closer than it. */
 
 enum { ROOT_ITER = 100 };
-
-/* The tail is taken only within this angle (rad) of its ray, where the
- * neglected third-order terms stay a tenth of the second-order ones. */
-#define TAIL_ANGLE 0.1
 
 /* P(t) = p[4] t^4 + ... + p[0] and P'(t). */
 static double quartic(const double p[5], double t, double *dp)
@@ -205,7 +202,7 @@ enum { TAIL_SERIES = 200 };
 
 /* The third-order error estimate below, scaled by this: measured against RK4
  * integrated to the origin (tests/test_impact.c), over random K, rays and
- * angles up to TAIL_ANGLE, the impulse's error was at most 2.4% of it. */
+ * angles up to PD_TOL_IMPACT_TAIL_ANGLE, the impulse's error was at most 2.4% of it. */
 #define TAIL_MEASURED 0.1
 
 /* The integral of beta^2 / (2 alpha) along the first-order flow:
@@ -230,7 +227,7 @@ int pd_ray_tail(const double K[][3], double mu, const pd_rays *in, int k, pd_vec
     double alpha = u.x * tx + u.y * ty, beta = tx * u.y - ty * u.x;
     /* Cheap refusals first: this is asked at every step near the origin. S
      * below is at least eps^2 alpha / (4 (2c + r)) and 2c + r < 2 mu tr B. */
-    if (!(alpha > 0.0) || !(fabs(beta) <= TAIL_ANGLE * alpha))
+    if (!(alpha > 0.0) || !(fabs(beta) <= PD_TOL_IMPACT_TAIL_ANGLE * alpha))
         return 0;
     double e2a = beta * beta / alpha, trb = 2.0 * mu * (K[0][0] + K[1][1]);
     if (!(e2a / (4.0 * trb) * (with_work ? 1.0 : TAIL_MEASURED * fabs(beta) / alpha) <= max_err))

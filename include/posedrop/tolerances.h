@@ -370,6 +370,15 @@
  * stops a runaway; the drop then resolves it by a counted fallback. */
 #define PD_IMPACT_MAX_STEPS 1000
 
+/* A slip closing on an attracting incoming ray is finished in closed form
+ * (impact_rays.c) only within this angle (rad) of the ray. Why 0.1: there the
+ * neglected third-order terms of the expansion stay a tenth of the
+ * second-order ones, and the tail's own error estimate must still come out
+ * below a tenth of PD_TOL_IMPACT_EVENT_REL before it is used. Larger: the
+ * estimate, not the angle, would refuse most tails; smaller: more slides
+ * integrated to the end, no change in results. */
+#define PD_TOL_IMPACT_TAIL_ANGLE 0.1
+
 /* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
  * exceeds this fraction of |p| |u0| (the size of the work terms it is a sum
  * of). Why 1e-8: the energetic law's own bookkeeping error is the ODE error
