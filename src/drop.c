@@ -27,7 +27,10 @@
  * barrier of the basin it is in (basin.c): then no future can leave the
  * basin, so its stable pose is the outcome. That needs collisions that never
  * add energy: a Poisson collision that would (possible with friction in 3-D)
- * is redone by the energetic law, which cannot, and counted. */
+ * is redone by the energetic law, which cannot, and counted. It also ends
+ * when the part lies on a stable facet that sliding and spinning cannot tip
+ * it from (flat_rest.c): then only the rocking energy must be below a
+ * barrier, not the energy of the slide. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
