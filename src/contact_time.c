@@ -1,4 +1,4 @@
-/* impact.c: the time of a flight's next contact with the floor (see flight.h).
+/* contact_time.c: the time of a flight's next contact with the floor (see flight.h).
  *
  * Conservative advancement (Mirtich, "Impulse-based dynamic simulation of
  * rigid body systems", PhD thesis, Berkeley 1996, ch. 2; our formulation).
