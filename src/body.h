@@ -74,6 +74,14 @@ int pd_body_support(const pd_body *b, pd_vec3 dir, int start);
 /* The same by scanning every vertex: the reference for tests and debug checks. */
 int pd_body_support_scan(const pd_body *b, pd_vec3 dir);
 
+/* Kinetic energy of state s, J (at density 1 kg/m^3). */
+static inline double pd_body_kinetic(const pd_body *b, const pd_state *s)
+{
+    return 0.5 * b->mass * v3_dot(s->v, s->v) +
+           0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                  b->moment[2] * s->w.z * s->w.z);
+}
+
 /* World coordinates of body vertex i in state s. */
 static inline pd_vec3 pd_body_vertex_world(const pd_body *b, const pd_state *s, int i)
 {

@@ -220,13 +220,6 @@ static double time_to_event(const pd_phase *p, double slip_min, point *a, point 
     return len * frac;
 }
 
-static double kinetic(const pd_body *b, const pd_state *s)
-{
-    return 0.5 * b->mass * v3_dot(s->v, s->v) +
-           0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
-                  b->moment[2] * s->w.z * s->w.z);
-}
-
 /* The phase for contacts[0..nc) of state s, each contact sliding if its
  * slip is above twice the end threshold, else sticking. */
 static void phase_of(pd_phase *p, const pd_sim_model *m, const pd_scene *sc, const pd_state *s,
@@ -263,7 +256,7 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     /* The projection is an inelastic impulse: admitted only when it takes
      * next to nothing, else every entry would damp the part like the
      * microcollisions the phase replaces (tolerances.h). */
-    double lost = kinetic(b, s) - kinetic(b, &t);
+    double lost = pd_body_kinetic(b, s) - pd_body_kinetic(b, &t);
     if (lost > PD_TOL_PHASE_ENTRY_REL * b->mass * sc->gravity * b->size)
         return 0;
     *s = t;

@@ -27,19 +27,24 @@
 #include "posedrop/tolerances.h"
 #include "vec3.h"
 
-/* Support height at t: the lowest vertex (hill-climbed from *hint) and its z. */
-static pd_status support_at(const pd_body *b, const pd_flight *f, double t, pd_state *s,
-                            int *hint, double *height)
+/* Support height of state s: the lowest vertex (hill-climbed from *hint)
+ * and its z. */
+static pd_status support_of(const pd_body *b, const pd_state *s, int *hint, double *height)
 {
-    pd_status st = pd_flight_eval(f, t, s);
-    if (st != PD_OK)
-        return st;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     *hint = pd_body_support(b, up, *hint);
     *height = s->x.z + v3_dot(up, b->verts[*hint]);
     if (!isfinite(*height))
         return PD_ERR_NONFINITE;
     return PD_OK;
+}
+
+/* The same at time t of the flight, s receiving the state there. */
+static pd_status support_at(const pd_body *b, const pd_flight *f, double t, pd_state *s,
+                            int *hint, double *height)
+{
+    pd_status st = pd_flight_eval(f, t, s);
+    return st != PD_OK ? st : support_of(b, s, hint, height);
 }
 
 /* Per-vertex bound: above this many vertices the scan costs more than the
@@ -135,12 +140,9 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
     double t = t0, h;
     /* Start from the body's lowest vertex in the initial orientation: the scan
      * is avoided by hill-climbing from vertex 0. */
-    pd_vec3 up = quat_rotate_inv(s.q, v3(0.0, 0.0, 1.0));
-    hint = pd_body_support(b, up, 0);
-    h = s.x.z + v3_dot(up, b->verts[hint]);
-    if (!isfinite(h))
-        return PD_ERR_NONFINITE;
-    pd_status st;
+    pd_status st = support_of(b, &s, &hint, &h);
+    if (st != PD_OK)
+        return st;
     if (h <= tol) {
         r.kind = PD_IMPACT_NOW;
     } else {

@@ -81,8 +81,7 @@ int pd_flat_settled(const pd_flat_facet *ff, const pd_body *b, const pd_state *s
     const pd_vec3 w = s->w;
     pd_vec3 In = v3(b->moment[0] * F->n.x, b->moment[1] * F->n.y, b->moment[2] * F->n.z);
     double wn = v3_dot(w, In) / F->inn;
-    double ke = 0.5 * b->mass * v3_dot(s->v, s->v) +
-                0.5 * (b->moment[0] * w.x * w.x + b->moment[1] * w.y * w.y + b->moment[2] * w.z * w.z);
+    double ke = pd_body_kinetic(b, s);
     double ke_flat = 0.5 * b->mass * (s->v.x * s->v.x + s->v.y * s->v.y) + 0.5 * F->inn * wn * wn;
     double mg = b->mass * g;
     /* Rocking energy per unit weight: height above lying flat on the lowest

@@ -197,7 +197,7 @@ static int onto_incoming(collision *c, pd_vec3 u, double s)
     for (int k = 0; k < c->in.n; k++) {
         pd_vec3 dp;
         double dw;
-        if (!pd_ray_tail(CONST_M3(c->K), c->mu, &c->in, k, u, 0.1 * tols,
+        if (!pd_ray_tail(CONST_M3(c->K), c->mu, &c->in, k, u, PD_TOL_IMPACT_TAIL_REL,
                          c->law == PD_IMPACT_ENERGETIC, &dp, &dw))
             continue;
         /* u_z and W rise monotonically along it: an event is at its end. */

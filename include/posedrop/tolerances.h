@@ -374,10 +374,18 @@
  * (impact_rays.c) only within this angle (rad) of the ray. Why 0.1: there the
  * neglected third-order terms of the expansion stay a tenth of the
  * second-order ones, and the tail's own error estimate must still come out
- * below a tenth of PD_TOL_IMPACT_EVENT_REL before it is used. Larger: the
+ * below PD_TOL_IMPACT_TAIL_REL before it is used. Larger: the
  * estimate, not the angle, would refuse most tails; smaller: more slides
  * integrated to the end, no change in results. */
 #define PD_TOL_IMPACT_TAIL_ANGLE 0.1
+
+/* The closed-form ray tail is used only when its error estimate is at most
+ * this, relative to |u0| like the event tolerance. Why a tenth of
+ * PD_TOL_IMPACT_EVENT_REL: sticking is declared at that slip anyway, so the
+ * tail then adds no error the event location does not already allow.
+ * Larger: the tail's error would show beside the events'; smaller: more
+ * slides integrated to the end, no change in results. */
+#define PD_TOL_IMPACT_TAIL_REL (0.1 * PD_TOL_IMPACT_EVENT_REL)
 
 /* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
  * exceeds this fraction of |p| |u0| (the size of the work terms it is a sum
