@@ -384,9 +384,16 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * vertex pressed on the floor by gravity meets it again with the speed
      * that fall gives (a microcollision) rather than at speed 0. */
     double dt_rest = sqrt(2.0 * m->rest_fall / g);
-    int hint = 0, phase_ok = 1;
+    int hint = 0, phase_ok = 1, nc = 0;
     pd_flight f;
     double f_at = -1.0; /* time on f at which s lies; < 0: plan from s */
+    /* 1 right after pd_drop_collide stopped because no contact approached:
+     * s then sits where the last search found it, touching at
+     * w->contacts[0..nc), and a new search and a new pass of the collision
+     * would find the same set (without an impact window it depends on
+     * positions alone, which an impulse leaves as they were) and nothing to
+     * resolve, so both are skipped. */
+    int resolved = 0;
     for (;;) {
         int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
         if (d == 0 && m->pose_of[facet] >= 0 &&
@@ -407,35 +414,41 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         /* The flight from s: planned afresh after anything that changed the
          * motion, else the one s already lies on, at its time f_at. */
-        pd_impact imp;
         if (f_at < 0.0) {
             if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
                 break;
             f_at = 0.0;
         }
-        if (pd_flight_impact_from(m->body, &f, f_at, &s, f_at + (o->time_limit - t),
-                                  sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
-            break;
-        if (imp.kind == PD_IMPACT_NONE) {
-            t = o->time_limit;
-            out->end = PD_END_TIME_LIMIT;
-            break;
-        }
-        if (imp.kind == PD_IMPACT_AT) {
-            if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
+        if (!resolved) {
+            pd_impact imp;
+            if (pd_flight_impact_from(m->body, &f, f_at, &s, f_at + (o->time_limit - t),
+                                      sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
-            t += imp.t - f_at;
-            f_at = imp.t;
+            if (imp.kind == PD_IMPACT_NONE) {
+                t = o->time_limit;
+                out->end = PD_END_TIME_LIMIT;
+                break;
+            }
+            if (imp.kind == PD_IMPACT_AT) {
+                if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
+                    break;
+                t += imp.t - f_at;
+                f_at = imp.t;
+            }
+            nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
+            int before = out->collisions;
+            if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
+                                fallbacks) != PD_OK)
+                break;
+            if (out->collisions != before) {
+                /* Each round applies one impulse, so fewer than
+                 * PD_MAX_ROUNDS means a round found nothing approaching. */
+                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->impact_time == 0.0;
+                f_at = -1.0;
+                continue;
+            }
         }
-        int nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
-        int before = out->collisions;
-        if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain, fallbacks) !=
-            PD_OK)
-            break;
-        if (out->collisions != before) {
-            f_at = -1.0;
-            continue;
-        }
+        resolved = 0;
         if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
