@@ -92,12 +92,9 @@ static const pd_ode_fn form_rhs[] = {rhs_tau, rhs_pz, rhs_uz, rhs_w};
 
 /* First trial step in tau, in units of the flow's rate: u_t' = |u_t| a -
  * mu B u_t changes at most at |a| + mu |B| (Frobenius norm) per unit tau.
- * Measured at PD_TOL_IMPACT_ODE_REL = 1e-9, instructions per collision
- * (recorded cube and coin drops, random impacts) against 0.3: 0.6 took
- * 3-4% fewer; 1.0 and 1.5 fewer accepted steps but more refused ones,
- * 3-5% more than 0.6 on the cube and the random impacts (2% less on the
- * coin). */
-#define TAU_FIRST_STEP 0.6
+ * Measured, rk8pd's first accepted steps at 1e-11 are about this long: 0.1
+ * spent a step or two growing to it, 0.6 had more refused. */
+#define TAU_FIRST_STEP 0.3
 
 /* Incoming rays are looked for once the slip falls below this (units of
  * |u0|): a trajectory comes within reach of one (the snap or the tail)
