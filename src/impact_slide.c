@@ -335,10 +335,11 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
         double tau_a = tau, y_a[NSTATE];
         for (int i = 0; i < NSTATE; i++)
             y_a[i] = c->y[i];
-        /* The derivative here from u and s, which are at hand: the step
-         * evaluates no end derivative and keeps no history, so the jumps of
-         * the state between steps (closed forms, retries) need no restart. */
-        double dy[NSTATE] = {-c->mu * u.x, -c->mu * u.y, s, u.z * s};
+        /* The step is given the derivative at its start, evaluates none at
+         * its end and keeps no history, so the jumps of the state between
+         * steps (closed forms, retries) need no restart. */
+        double dy[NSTATE];
+        rhs_tau(tau, c->y, dy, c);
         pd_status st = pd_ode_step_from(ode, rhs_tau, c, &tau, t1, &h, c->y, dy);
         ++*nsteps;
         if (st != PD_OK)

@@ -368,13 +368,15 @@
 #define PD_TOL_IMPACT_EVENT_REL 1e-9
 
 /* Largest number of integrator steps (accepted or refused for an event) one
- * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: measured on
- * 2e5 random impacts, the mean is ~14 steps and the worst 43, since a stable
- * stick approached along a slowly closing invariant ray (stiff for an
- * explicit integrator; it took up to 388 steps and 1 impact in 1e5, or 1 in
- * 1e4 microcollisions of the paper's cap, exceeded 1000) is snapped onto
- * that ray or finished along it in closed form (impact_slide.c). 1000 bounds the cost of a collision to ~1 ms and still
- * stops a runaway; the drop then resolves it by a counted fallback. */
+ * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: at the ODE
+ * tolerance above, collisions recorded from drops take 5-12 steps on average
+ * and random impacts at most ~30 (test_impact.c), since a stable stick
+ * approached along a slowly closing invariant ray (stiff for an explicit
+ * integrator; it once took up to 388 steps and 1 impact in 1e5, or 1 in 1e4
+ * microcollisions of the paper's cap, exceeded 1000) is snapped onto that
+ * ray or finished along it in closed form (impact_slide.c). 1000 bounds the
+ * cost of a collision to ~1 ms and still stops a runaway; the drop then
+ * resolves it by a counted fallback. */
 #define PD_IMPACT_MAX_STEPS 1000
 
 /* A slip closing on an attracting incoming ray is finished in closed form
