@@ -237,7 +237,7 @@ static void phase_of(pd_phase *p, const pd_sim_model *m, const pd_scene *sc, con
 }
 
 int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *s,
-                           const int *contacts, int nc)
+                           const int *contacts, int nc, pd_phase *phase)
 {
     if (nc < 1 || nc > 2)
         return 0;
@@ -265,16 +265,20 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     double lost = pd_body_kinetic(b, s) - pd_body_kinetic(b, &t);
     if (lost > PD_TOL_PHASE_ENTRY_REL * b->mass * sc->gravity * b->size)
         return 0;
+    /* The phase goes on with the modes the projection was for: taken
+     * afresh from t, a contact that slid above the start threshold and
+     * slips less after the projection would count as sticking, and its
+     * force would push it along at that slip, doing work. */
     *s = t;
+    *phase = p;
     return 1;
 }
 
-pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *sc, pd_state *s,
-                           const int *contacts, int nc, double t_max, double *t_used)
+pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *sc,
+                           const pd_phase *phase, pd_state *s, double t_max, double *t_used)
 {
     const pd_body *b = m->body;
-    pd_phase p;
-    phase_of(&p, m, sc, s, contacts, nc);
+    pd_phase p = *phase; /* the right-hand side takes it as void * */
     double slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     const double tol = PD_TOL_PHASE_EVENT_REL;
     /* First trial step a twentieth of the part's time unit: contact motion

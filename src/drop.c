@@ -436,14 +436,15 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             f_at = -1.0;
             continue;
         }
-        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
+        pd_phase phase;
+        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc, &phase)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
              * microcollisions must resolve, so the next rest step is theirs
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if (pd_contact_phase(m, w->phase, sc, &s, w->contacts, nc, o->time_limit - t, &dt) != PD_OK)
+            if (pd_contact_phase(m, w->phase, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
                 break;
             t += dt;
             phase_ok = 0;
