@@ -99,11 +99,15 @@ static int phase_rhs(double tau, const double y[], double dydt[], void *user)
  * and the height of the lowest other vertex above the contacts (per L); into
  * g[NMARGIN], from s's forces F. Each is a smooth function of the state, so
  * an event inside a step is found from a smooth model of the one that
- * crossed. Returns the smallest (positive while the phase may go on). */
-enum { NMARGIN = 5 };
+ * crossed. The height's rate of change comes with it, into *height_rate
+ * (per sqrt(g L)): it is that vertex's normal speed less the contact's, a
+ * function of the state alone, where the forces' rates take a difference of
+ * two right-hand sides (rate). Returns the smallest (positive while the
+ * phase may go on). */
+enum { HEIGHT = 4, NMARGIN = 5 };
 
 static double margins(const pd_phase *p, const pd_state *s, const pd_phase_forces *F,
-                      double slip_min, double g[NMARGIN])
+                      double slip_min, double g[NMARGIN], double *height_rate)
 {
     const pd_body *b = p->b;
     double V0 = p->L / p->T, mg = b->mass * p->g;
@@ -115,8 +119,12 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
     }
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     double floor_z = HUGE_VAL; /* the contacts' own height: they define the floor */
-    for (int i = 0; i < p->nc; i++)
-        floor_z = fmin(floor_z, s->x.z + v3_dot(up, b->verts[p->v[i]]));
+    int low_c = p->v[0], low_w = -1;
+    for (int i = 0; i < p->nc; i++) {
+        double z = s->x.z + v3_dot(up, b->verts[p->v[i]]);
+        if (z < floor_z)
+            floor_z = z, low_c = p->v[i];
+    }
     /* The next vertex to touch: while the contacts are the lowest, the
      * lowest other vertex is an edge neighbour of one of them (on a convex
      * polytope the vertices below any height are connected), and the margin
@@ -126,8 +134,13 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
             int w = b->adj[k];
             if (w == p->v[0] || (p->nc == 2 && w == p->v[1]))
                 continue;
-            g[4] = fmin(g[4], (s->x.z + v3_dot(up, b->verts[w]) - floor_z) / p->L);
+            double h = (s->x.z + v3_dot(up, b->verts[w]) - floor_z) / p->L;
+            if (h < g[HEIGHT])
+                g[HEIGHT] = h, low_w = w;
         }
+    /* d/dt of up . r is up . (w x r) in the body frame (up turns by -w x up). */
+    *height_rate = low_w < 0 ? (double)NAN
+                             : v3_dot(up, v3_cross(s->w, v3_sub(b->verts[low_w], b->verts[low_c]))) / V0;
     double least = HUGE_VAL;
     for (int k = 0; k < NMARGIN; k++)
         least = fmin(least, g[k]);
@@ -135,8 +148,8 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
 }
 
 /* A point of the phase: its time and state, the state's derivative, its
- * margins and smallest margin (-1 where the model fails), and, once asked
- * for (rated), the margins' rates of change. */
+ * margins and smallest margin (-1 where the model fails), the height's rate
+ * of change and, once asked for (rated), the other margins'. */
 typedef struct {
     double tau, y[NY], dydt[NY];
     double g[NMARGIN], dg[NMARGIN], least;
@@ -150,13 +163,14 @@ static void point_at(const pd_phase *p, double slip_min, double tau, const doubl
     a->tau = tau, a->rated = 0;
     memcpy(a->y, y, sizeof a->y);
     for (int k = 0; k < NMARGIN; k++)
-        a->g[k] = HUGE_VAL;
-    a->least = derivs(p, y, &s, &F, a->dydt) ? -1.0 : margins(p, &s, &F, slip_min, a->g);
+        a->g[k] = HUGE_VAL, a->dg[k] = (double)NAN;
+    a->least = derivs(p, y, &s, &F, a->dydt) ? -1.0
+                                             : margins(p, &s, &F, slip_min, a->g, &a->dg[HEIGHT]);
 }
 
-/* The margins' rates of change at a, by a forward difference along the flow
- * (PD_TOL_PHASE_RATE_STEP); NaN where unknown (the model fails there, or
- * the margin is infinite). */
+/* The force margins' rates of change at a, by a forward difference along
+ * the flow (PD_TOL_PHASE_RATE_STEP); NaN where unknown (the model fails
+ * there, or the margin is infinite). */
 static void rate(const pd_phase *p, double slip_min, point *a)
 {
     if (a->rated)
@@ -166,7 +180,7 @@ static void rate(const pd_phase *p, double slip_min, point *a)
         y[i] = a->y[i] + e * a->dydt[i];
     point b;
     point_at(p, slip_min, a->tau + e, y, &b);
-    for (int k = 0; k < NMARGIN; k++)
+    for (int k = 0; k < HEIGHT; k++)
         a->dg[k] = b.least > -1.0 && isfinite(a->g[k]) && isfinite(b.g[k]) ? (b.g[k] - a->g[k]) / e
                                                                            : (double)NAN;
     a->rated = 1;
@@ -213,11 +227,13 @@ static double hermite_zero(double g0, double m0, double g1, double m1)
 static double time_to_event(const pd_phase *p, double slip_min, point *a, point *b)
 {
     double len = b->tau - a->tau, frac = 1.0;
-    rate(p, slip_min, a);
-    rate(p, slip_min, b);
     for (int k = 0; k < NMARGIN; k++) {
         if (!(b->g[k] <= 0.0))
             continue;
+        if (k != HEIGHT) {
+            rate(p, slip_min, a);
+            rate(p, slip_min, b);
+        }
         double m0 = len * a->dg[k], m1 = len * b->dg[k];
         if (!isfinite(m0) || !isfinite(m1))
             m0 = m1 = b->g[k] - a->g[k];
@@ -254,10 +270,11 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
         if (p.mode[i] == PD_PHASE_STICK && sc->mu == 0.0)
             return 0; /* nothing holds a contact without friction */
     pd_state t = *s;
-    double g[NMARGIN];
+    double g[NMARGIN], rate_unused;
     pd_phase_forces F;
     if (!pd_phase_project_velocity(&p, &t) || pd_phase_forces_of(&p, &t, &F) ||
-        !(margins(&p, &t, &F, PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size), g) > 0.0))
+        !(margins(&p, &t, &F, PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size), g,
+                  &rate_unused) > 0.0))
         return 0;
     /* The projection is an inelastic impulse: admitted only when it takes
      * next to nothing, else every entry would damp the part like the
