@@ -6,23 +6,25 @@
 
 #include "drop.h"
 #include "gsl_adapter.h"
+#include "phase_forces.h"
 
 /* The phase's integrator (13 unknowns), one per thread. NULL if out of memory. */
 pd_ode *pd_contact_phase_ode_alloc(void);
 
 /* 1 if state s, touching the floor at body vertices contacts[0..nc), is a
- * sliding contact the phase can take: one or two contacts moving normally
- * no faster than the microcollisions' rest speed, all sliding, pressed by
- * positive forces, no other vertex down. Then s's normal contact speeds are
- * zeroed, without adding energy, for the phase to start from; otherwise s is
- * left alone. */
+ * contact the phase can take: one or two contacts moving normally no faster
+ * than the microcollisions' rest speed, each sliding or sticking, pressed by
+ * positive forces, no other vertex down. Then s's constrained velocities are
+ * zeroed (a sliding contact's normal one, a sticking contact's whole one),
+ * without adding energy, for the phase to start from, and *phase is the
+ * phase; otherwise s is left alone. */
 int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_state *s,
-                           const int *contacts, int nc);
+                           const int *contacts, int nc, pd_phase *phase);
 
-/* Runs the phase from s for at most t_max seconds, or until the energy test
- * decides the drop; s becomes the state where it ended and *t_used the time
- * it took. */
+/* Runs phase (from pd_contact_phase_start) from s for at most t_max
+ * seconds, or until the energy test decides the drop; s becomes the state
+ * where it ended and *t_used the time it took. */
 pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, const pd_scene *scene,
-                           pd_state *s, const int *contacts, int nc, double t_max, double *t_used);
+                           const pd_phase *phase, pd_state *s, double t_max, double *t_used);
 
 #endif

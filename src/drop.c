@@ -102,8 +102,11 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
     if (st == PD_OK) {
         pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
         pd_flat_build(m->body, part->hull, m->descent, m->flat);
-        for (int f = 0; f < nf; f++)
+        m->barrier_max = -INFINITY;
+        for (int f = 0; f < nf; f++) {
             m->pose_of[f] = -1;
+            m->barrier_max = fmax(m->barrier_max, m->barrier[f]);
+        }
         for (int k = 0; k < poses->nposes; k++)
             m->pose_of[poses->poses[k].facet] = k;
         /* A speed scale of the part: sqrt(g L), the speed of falling its own
@@ -360,6 +363,11 @@ static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *h
 
 int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
 {
+    /* Above every barrier nothing is decided, whichever basin s is in: the
+     * descent, most of the test's cost, is left out (most of a contact
+     * phase's tests, which come after every step, are up there). */
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max))
+        return 0;
     int f;
     return decided_at(m, s, g, hint, pose, &f);
 }
@@ -449,14 +457,15 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             }
         }
         resolved = 0;
-        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc)) {
+        pd_phase phase;
+        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc, &phase)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
              * microcollisions must resolve, so the next rest step is theirs
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if (pd_contact_phase(m, w->phase, sc, &s, w->contacts, nc, o->time_limit - t, &dt) != PD_OK)
+            if (pd_contact_phase(m, w->phase, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
                 break;
             t += dt;
             phase_ok = 0;

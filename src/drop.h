@@ -53,7 +53,8 @@ void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
                      pd_state *s, pd_trial *out);
 
 /* 1 and the pose index if the outcome of state s is decided (energy below its
- * basin's barrier, see drop.c), 0 if not yet, -1 on failure. hint speeds up
+ * basin's barrier, see drop.c), 0 if not yet, -1 on failure (of the descent,
+ * which is not taken when the energy is above every barrier). hint speeds up
  * successive calls. */
 int pd_drop_decided(const pd_sim_model *model, const pd_state *s, double gravity, int *hint,
                     int *pose);

@@ -22,6 +22,7 @@ struct pd_sim_model {
     pd_vec3 com;                /* part frame */
     pd_static_result *descent;  /* the exact quasi-static rest[] of every facet */
     double *barrier;            /* per facet: its basin's barrier height, m */
+    double barrier_max;         /* the largest of them */
     struct pd_flat_facet *flat; /* per facet: what lying flat on it takes (flat_rest.h) */
     pd_star star;
     int *pose_of;               /* facet -> pose index in the caller's table, or -1 */

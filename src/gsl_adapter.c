@@ -141,15 +141,22 @@ struct pd_ode {
 
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel)
 {
+    /* rk8pd: the collision ODE is smooth between events and asked for ~1e-10,
+     * where an 8th-order pair takes far fewer right-hand-side evaluations
+     * than a 4th/5th-order pair (cost ~ tol^(-1/8) vs tol^(-1/5)). */
+    return pd_ode_alloc_method(PD_ODE_RK8PD, dim, eps_abs, eps_rel);
+}
+
+pd_ode *pd_ode_alloc_method(pd_ode_method method, int dim, double eps_abs, double eps_rel)
+{
     gsl_set_error_handler_off();
     pd_ode *ode = calloc(1, sizeof *ode);
     if (!ode)
         return NULL;
     ode->dim = dim;
-    /* rk8pd: the collision ODE is smooth between events and asked for ~1e-10,
-     * where an 8th-order pair takes far fewer right-hand-side evaluations
-     * than a 4th/5th-order pair (cost ~ tol^(-1/8) vs tol^(-1/5)). */
-    ode->step = gsl_odeiv2_step_alloc(gsl_odeiv2_step_rk8pd, (size_t)dim);
+    const gsl_odeiv2_step_type *type =
+        method == PD_ODE_RKCK ? gsl_odeiv2_step_rkck : gsl_odeiv2_step_rk8pd;
+    ode->step = gsl_odeiv2_step_alloc(type, (size_t)dim);
     ode->control = gsl_odeiv2_control_y_new(eps_abs, eps_rel);
     ode->evolve = gsl_odeiv2_evolve_alloc((size_t)dim);
     ode->y0 = malloc((size_t)dim * sizeof *ode->y0);
@@ -179,8 +186,9 @@ void pd_ode_free(pd_ode *ode)
 void pd_ode_reset(pd_ode *ode)
 {
     /* The driver keeps the last step's end derivative as the next step's
-     * start; rk8pd itself keeps nothing between steps (its reset only zeroes
-     * scratch, 10% of a step), so the driver's is the history to forget. */
+     * start; rk8pd and rkck themselves keep nothing between steps (their
+     * reset only zeroes scratch, 10% of a step), so the driver's is the
+     * history to forget. */
     gsl_odeiv2_evolve_reset(ode->evolve);
 }
 
@@ -200,7 +208,7 @@ pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t
 /* evolve_apply's adaptive step (the same stages, control, and retries of a
  * step the control rejects), but with the derivative at the start from the
  * caller. evolve_apply takes it from the previous step's end, for which
- * rk8pd evaluates fn once more in every attempt (rejected ones included),
+ * the stepper evaluates fn once more in every attempt (rejected ones included),
  * or evaluates it itself after a reset; a control on y alone never reads
  * it. A failure of fn ends the step at once (evolve_apply would halve it
  * down to round-off): the caller knows better what to do. */

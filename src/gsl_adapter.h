@@ -52,10 +52,16 @@ pd_status pd_ellint_Pcomp(double k, double n, double *result);
 /* ==== end of elliptic functions ============================================= */
 /* --- ODE integration (used by impact.c and contact_phase.c) -----------------
  * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand
- * 8(9), with step control on |y|), allocated once and reused: pd_ode_step
- * allocates nothing, so a per-thread workspace can serve every collision. */
+ * 8(9), or rkck, Cash-Karp 4(5), with step control on |y|), allocated once
+ * and reused: pd_ode_step allocates nothing, so a per-thread workspace can
+ * serve every collision. */
 
 typedef struct pd_ode pd_ode;
+
+/* The embedded pair: rk8pd, 12 new right-hand sides a step given the
+ * start's derivative, pays off at tight tolerances over long stretches;
+ * rkck, 5 a step, at looser ones or where events cut the steps short. */
+typedef enum { PD_ODE_RK8PD, PD_ODE_RKCK } pd_ode_method;
 
 /* Right-hand side dy/dt = f(t, y); returns 0 (any other value aborts the
  * step and pd_ode_step reports PD_ERR_INTERNAL). Same shape as GSL's, so it
@@ -65,6 +71,8 @@ typedef int (*pd_ode_fn)(double t, const double y[], double dydt[], void *user);
 /* An integrator for systems of dim unknowns, each step held to
  * eps_abs + eps_rel * |y_i| local error. NULL if allocation fails. */
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel);
+/* The same with the pair of the caller's choice (pd_ode_alloc: rk8pd). */
+pd_ode *pd_ode_alloc_method(pd_ode_method method, int dim, double eps_abs, double eps_rel);
 void pd_ode_free(pd_ode *ode);
 
 /* Forgets the history of the previous integration: call before a new one,
