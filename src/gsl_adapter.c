@@ -135,13 +135,12 @@ struct pd_ode {
     int dim;
     gsl_odeiv2_step *step;
     gsl_odeiv2_control *control;
-    gsl_odeiv2_evolve *evolve;
     double *y0, *yerr; /* pd_ode_step_from's: the step's start, its error estimate */
 };
 
 pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel)
 {
-    /* rk8pd: the collision ODE is smooth between events and asked for ~1e-10,
+    /* rk8pd: the collision ODE is smooth between events and asked for ~1e-9,
      * where an 8th-order pair takes far fewer right-hand-side evaluations
      * than a 4th/5th-order pair (cost ~ tol^(-1/8) vs tol^(-1/5)). */
     return pd_ode_alloc_method(PD_ODE_RK8PD, dim, eps_abs, eps_rel);
@@ -158,10 +157,9 @@ pd_ode *pd_ode_alloc_method(pd_ode_method method, int dim, double eps_abs, doubl
         method == PD_ODE_RKCK ? gsl_odeiv2_step_rkck : gsl_odeiv2_step_rk8pd;
     ode->step = gsl_odeiv2_step_alloc(type, (size_t)dim);
     ode->control = gsl_odeiv2_control_y_new(eps_abs, eps_rel);
-    ode->evolve = gsl_odeiv2_evolve_alloc((size_t)dim);
     ode->y0 = malloc((size_t)dim * sizeof *ode->y0);
     ode->yerr = malloc((size_t)dim * sizeof *ode->yerr);
-    if (!ode->step || !ode->control || !ode->evolve || !ode->y0 || !ode->yerr) {
+    if (!ode->step || !ode->control || !ode->y0 || !ode->yerr) {
         pd_ode_free(ode);
         return NULL;
     }
@@ -172,8 +170,6 @@ void pd_ode_free(pd_ode *ode)
 {
     if (!ode)
         return;
-    if (ode->evolve)
-        gsl_odeiv2_evolve_free(ode->evolve);
     if (ode->control)
         gsl_odeiv2_control_free(ode->control);
     if (ode->step)
@@ -183,35 +179,13 @@ void pd_ode_free(pd_ode *ode)
     free(ode);
 }
 
-void pd_ode_reset(pd_ode *ode)
-{
-    /* The driver keeps the last step's end derivative as the next step's
-     * start; rk8pd and rkck themselves keep nothing between steps (their
-     * reset only zeroes scratch, 10% of a step), so the driver's is the
-     * history to forget. */
-    gsl_odeiv2_evolve_reset(ode->evolve);
-}
-
-pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
-                      double y[])
-{
-    gsl_odeiv2_system sys = {fn, NULL, (size_t)ode->dim, user};
-    int rc = gsl_odeiv2_evolve_apply(ode->evolve, ode->control, ode->step, &sys, t, t1, h, y);
-    if (rc == GSL_SUCCESS)
-        return PD_OK;
-    /* GSL_FAILURE: the controller shrank the step to round-off of t without
-     * meeting the tolerance (evolve_apply then leaves y at the rejected
-     * step's end); anything else came from fn (y restored). */
-    return rc == GSL_FAILURE ? PD_ERR_NO_CONVERGENCE : PD_ERR_INTERNAL;
-}
-
-/* evolve_apply's adaptive step (the same stages, control, and retries of a
- * step the control rejects), but with the derivative at the start from the
- * caller. evolve_apply takes it from the previous step's end, for which
- * the stepper evaluates fn once more in every attempt (rejected ones included),
- * or evaluates it itself after a reset; a control on y alone never reads
- * it. A failure of fn ends the step at once (evolve_apply would halve it
- * down to round-off): the caller knows better what to do. */
+/* GSL's evolve_apply's adaptive step (the same stages, control, and retries
+ * of a step the control rejects), but with the derivative at the start from
+ * the caller. evolve_apply takes it from the previous step's end, for which
+ * the stepper evaluates fn once more in every attempt (rejected ones
+ * included), or evaluates it itself after a reset; a control on y alone
+ * never reads it. A failure of fn ends the step at once (evolve_apply would
+ * halve it down to round-off): the caller knows better what to do. */
 pd_status pd_ode_step_from(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
                            double y[], const double dydt_in[])
 {

@@ -53,7 +53,7 @@ pd_status pd_ellint_Pcomp(double k, double n, double *result);
 /* --- ODE integration (used by impact.c and contact_phase.c) -----------------
  * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand
  * 8(9), or rkck, Cash-Karp 4(5), with step control on |y|), allocated once
- * and reused: pd_ode_step allocates nothing, so a per-thread workspace can
+ * and reused: pd_ode_step_from allocates nothing, so a per-thread workspace can
  * serve every collision. */
 
 typedef struct pd_ode pd_ode;
@@ -64,7 +64,7 @@ typedef struct pd_ode pd_ode;
 typedef enum { PD_ODE_RK8PD, PD_ODE_RKCK } pd_ode_method;
 
 /* Right-hand side dy/dt = f(t, y); returns 0 (any other value aborts the
- * step and pd_ode_step reports PD_ERR_INTERNAL). Same shape as GSL's, so it
+ * step and pd_ode_step_from reports PD_ERR_INTERNAL). Same shape as GSL's, so it
  * is handed to GSL without a trampoline. */
 typedef int (*pd_ode_fn)(double t, const double y[], double dydt[], void *user);
 
@@ -75,26 +75,13 @@ pd_ode *pd_ode_alloc(int dim, double eps_abs, double eps_rel);
 pd_ode *pd_ode_alloc_method(pd_ode_method method, int dim, double eps_abs, double eps_rel);
 void pd_ode_free(pd_ode *ode);
 
-/* Forgets the history of the previous integration: call before a new one,
- * and whenever y or the right-hand side changed since the last step, which
- * the next step would otherwise start from (GSL reuses that step's end
- * derivative). */
-void pd_ode_reset(pd_ode *ode);
-
 /* One accepted adaptive step from (*t, y) towards t1 > *t, never past t1
- * (landing exactly on t1 when it reaches it). *h is the step to try, updated
- * to the one suggested for the next step. PD_ERR_NO_CONVERGENCE when the step
- * size falls to round-off of t, PD_ERR_INTERNAL when fn fails. On failure *t
- * is the start of the step; y is too after PD_ERR_INTERNAL, but after
- * PD_ERR_NO_CONVERGENCE it holds the rejected step's end (GSL 2.7 leaves it
- * there), so a caller that goes on restarts from its own copy. */
-pd_status pd_ode_step(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
-                      double y[]);
-
-/* pd_ode_step given dydt_in = fn(*t, y), which the caller has anyway: one
- * evaluation of fn fewer per attempted step (the end's, which pd_ode_step
- * keeps as the next step's start), none after a reset, and no history, so
- * it may start from any state. Forward only (t1 > *t). */
+ * (landing exactly on t1 when it reaches it), given dydt_in = fn(*t, y),
+ * which the callers have anyway: no end derivative is evaluated and no
+ * history kept, so a step may start from any state. *h is the step to try,
+ * updated to the one suggested for the next step. PD_ERR_NO_CONVERGENCE
+ * when the step size falls to round-off of t, PD_ERR_INTERNAL when fn
+ * fails; on either, *t and y are the step's start. */
 pd_status pd_ode_step_from(pd_ode *ode, pd_ode_fn fn, void *user, double *t, double t1, double *h,
                            double y[], const double dydt_in[]);
 
