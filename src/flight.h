@@ -9,6 +9,7 @@
 #define PD_FLIGHT_H
 
 #include "body.h"
+#include "flight_theta.h"
 #include "posedrop/status.h"
 
 typedef enum pd_flight_kind {
@@ -41,6 +42,9 @@ typedef struct pd_flight {
     double K2;           /* the period 2K of dn (0 on the separatrix: no period) */
     double Pc;           /* complete integral of the third kind */
     double P0;           /* P(am tau0) with periods unrolled */
+    int theta;           /* 1: by theta series (th), else by Legendre's integrals */
+    pd_theta th;
+    double rate;         /* theta form: phi(t) = rate t + arg X(v) - arg X(v0) */
 } pd_flight;
 
 /* Plans the flight of body b from state s0 under gravity g (m/s^2, >= 0).

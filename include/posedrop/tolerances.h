@@ -200,6 +200,28 @@
  * exact form has failed; larger would hide genuine tumbling. */
 #define PD_TOL_FLIGHT_NEAR_AXIS_REL 1e-6
 
+/* The asymmetric top's flight evaluates its elliptic functions and its
+ * precession by Jacobi's theta series in the nome q (flight_theta.c) while q
+ * is at most this; closer to the separatrix (q -> 1 as the polhode nears the
+ * middle axis) it falls back to GSL's Legendre integrals. Dimensionless: q
+ * depends on the inertia ratios and the energy only, not on the part's size.
+ * Why 0.5: theta4(v) near v = 0 shrinks to sqrt(2 k' K / pi), 0.12 at q = 0.5,
+ * out of terms of order 1, so sn, cn, dn lose at most 3 bits there, and 8
+ * terms reach PD_TOL_FLIGHT_SERIES. Larger: both grow without bound (at
+ * q = 0.9, 4 digits and 20 terms). Smaller: more flights pay for the
+ * Legendre form (about 2% of a 1:2:3 box's flights lie above 0.5, 7% above
+ * 0.2). */
+#define PD_FLIGHT_NOME_MAX 0.5
+
+/* A theta series stops at the first term k with q^(k^2) below this, which
+ * bounds that term (and so, geometrically, the rest) relative to the
+ * series' leading one. Dimensionless: the series give unit vectors and
+ * angles. Why 1e-17: below the double-precision round-off (1.1e-16) of the
+ * sums themselves, so truncation adds nothing to it. Larger: the flight's
+ * orientation would err by the truncation (1e-12 at 1e-12); smaller costs
+ * terms that round-off swallows. */
+#define PD_TOL_FLIGHT_SERIES 1e-17
+
 /* The time of impact is found when the lowest hull vertex is within this height
  * of the floor, approached from above (never below it by more). Why 1e-9: the
  * flight's positions carry round-off of ~1e-15 L at drop heights of a few L and
