@@ -22,12 +22,12 @@
  * is |L|^2 u.J u / 2 = |L|^2 D / 2 since the elliptic functions satisfy
  * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off.
  *
- * Evaluation. Away from the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by
+ * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by
  * Jacobi's theta series, planned once per flight (flight_theta.c): there
  * phi = rate t + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so
- * an evaluation takes two sincos and a few series terms. Nearer the
- * separatrix, where the series converge slowly and cancel, by GSL's sn, cn,
- * dn and Legendre's integrals. Either way the quaternion is built from u and
+ * an evaluation takes two sincos and a few series terms. On the separatrix
+ * itself (m = 1 to double precision), where the series would converge
+ * slowly and cancel, by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is built from u and
  * e^(i phi/2) by half-angle formulas (chart_rotation), with no arc tangent. */
 #include <math.h>
 #include <stddef.h>
@@ -198,8 +198,8 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
      * sigma arg X, and lambda (J1 - J3) sigma / Omega = 1 exactly (sigma^2 =
      * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios). */
     double mc = (J1 - J3) * -DmJ2 / ((J2 - J3) * J1mD);
-    if (F->m < 1.0 && pd_theta_plan(&F->th, F->m, mc, F->n, uch[1] / F->alpha[1],
-                                    uch[0] / F->alpha[0], F->Omega) == PD_OK) {
+    if (pd_theta_plan(&F->th, F->m, mc, F->n, uch[1] / F->alpha[1], uch[0] / F->alpha[0],
+                      F->Omega) == PD_OK) {
         F->theta = 1;
         F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu);
         return PD_OK;

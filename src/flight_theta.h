@@ -13,7 +13,7 @@
 
 /* Series terms kept at most: enough for nomes up to PD_FLIGHT_NOME_MAX at the
  * truncation PD_TOL_FLIGHT_SERIES (flight_theta.c). */
-enum { PD_THETA_TERMS = 10 };
+enum { PD_THETA_TERMS = 14 };
 
 typedef struct pd_theta {
     int nterms;

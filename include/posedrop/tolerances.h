@@ -202,16 +202,19 @@
 
 /* The asymmetric top's flight evaluates its elliptic functions and its
  * precession by Jacobi's theta series in the nome q (flight_theta.c) while q
- * is at most this; closer to the separatrix (q -> 1 as the polhode nears the
- * middle axis) it falls back to GSL's Legendre integrals. Dimensionless: q
- * depends on the inertia ratios and the energy only, not on the part's size.
- * Why 0.5: theta4(v) near v = 0 shrinks to sqrt(2 k' K / pi), 0.12 at q = 0.5,
- * out of terms of order 1, so sn, cn, dn lose at most 3 bits there, and 8
- * terms reach PD_TOL_FLIGHT_SERIES. Larger: both grow without bound (at
- * q = 0.9, 4 digits and 20 terms). Smaller: more flights pay for the
- * Legendre form (about 2% of a 1:2:3 box's flights lie above 0.5, 7% above
- * 0.2). */
-#define PD_FLIGHT_NOME_MAX 0.5
+ * is at most this; beyond, on the separatrix itself, by GSL's Legendre
+ * integrals. Dimensionless: q depends on the inertia ratios and the energy
+ * only, not on the part's size. Why 0.8: q = 0.8 is 1 - m ~ 1e-18, below
+ * the resolution of m near 1 in double precision, so every polhode that is
+ * not the separatrix takes the series (whose 1 - m is computed without
+ * cancellation: GSL's forms, handed m alone, erred there by up to 0.1 rad
+ * against an ODE after 100 rad of turning). The cost: theta4(v) near v = 0
+ * shrinks to sqrt(2 k' K / pi), 1.2e-4 at q = 0.8, out of terms of order 1,
+ * so sn, cn, dn lose 4 digits there (energy and momentum then hold to 1e-11,
+ * measured, within their 1e-10), and 14 terms reach PD_TOL_FLIGHT_SERIES.
+ * Larger: both grow without bound (at q = 0.9, 9 digits and 20 terms).
+ * Smaller: the Legendre forms' errors near the separatrix come back. */
+#define PD_FLIGHT_NOME_MAX 0.8
 
 /* A theta series stops at the first term k with q^(k^2) below this, which
  * bounds that term (and so, geometrically, the rest) relative to the
