@@ -20,15 +20,17 @@
  * then positive). Conservation is by construction: the world angular
  * momentum is R(t) |L| u(t) = Q0 Rz(phi) |L| z = L for any phi, and the energy
  * is |L|^2 u.J u / 2 = |L|^2 D / 2 since the elliptic functions satisfy
- * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off.
+ * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off (the theta series: to
+ * 1e-11 closest to the separatrix, see PD_FLIGHT_NOME_MAX).
  *
- * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by
- * Jacobi's theta series, planned once per flight (flight_theta.c): there
- * phi = rate t + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so
- * an evaluation takes two sincos and a few series terms. On the separatrix
- * itself (m = 1 to double precision), where the series would converge
- * slowly and cancel, by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is built from u and
- * e^(i phi/2) by half-angle formulas (chart_rotation), with no arc tangent. */
+ * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by Jacobi's
+ * theta series, planned once per flight (flight_theta.c): there phi = rate t
+ * + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so an evaluation
+ * takes two sincos and a few series terms. On the separatrix itself (m = 1
+ * in double precision), where the series would converge slowly and cancel,
+ * by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is
+ * built from u and e^(i phi/2) by half-angle formulas (chart_rotation), with
+ * no arc tangent. */
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -243,7 +245,6 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
      * those are written when used, and the struct is mostly theirs. */
     pd_flight *F = f;
     memset(F, 0, offsetof(pd_flight, th));
-    F->rate = 0.0;
     F->s0 = *s0;
     F->s0.q = quat_normalize(s0->q);
     F->g = g;
