@@ -295,11 +295,17 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
     s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
     if (f->kind == PD_FLIGHT_AXIAL) {
         /* omega_body(t) = rot(axis, -b t) omega_body(0): for equal moments J
-         * commutes with that rotation (see the derivation in flight.h). */
-        pd_quat back = quat_axis_angle(f->axis, -f->b * t);
-        s.q = quat_mul(quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q),
-                       quat_conj(back));
-        s.w = quat_rotate(back, f->s0.w);
+         * commutes with that rotation (see the derivation in flight.h). A
+         * spherical top or a steady spin (b = 0) turns about L alone: its
+         * body rotation, the identity, is skipped (exactly what it gives). */
+        pd_quat about_L = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
+        if (f->b == 0.0) {
+            s.q = about_L;
+        } else {
+            pd_quat back = quat_axis_angle(f->axis, -f->b * t);
+            s.q = quat_mul(about_L, quat_conj(back));
+            s.w = quat_rotate(back, f->s0.w);
+        }
     } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
         double u[3], phc, phs; /* e^(i phi/2) */
         if (f->theta) {
