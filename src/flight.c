@@ -20,8 +20,20 @@
  * then positive). Conservation is by construction: the world angular
  * momentum is R(t) |L| u(t) = Q0 Rz(phi) |L| z = L for any phi, and the energy
  * is |L|^2 u.J u / 2 = |L|^2 D / 2 since the elliptic functions satisfy
- * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off. */
+ * sn^2 + cn^2 = 1 and dn^2 + m sn^2 = 1 to round-off (the theta series: to
+ * 1e-11 closest to the separatrix, see PD_FLIGHT_NOME_MAX).
+ *
+ * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by Jacobi's
+ * theta series, planned once per flight (flight_theta.c): there phi = rate t
+ * + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so an evaluation
+ * takes two sincos and a few series terms. On the separatrix itself (m = 1
+ * in double precision), where the series would converge slowly and cancel,
+ * by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is
+ * built from u and e^(i phi/2) by half-angle formulas (chart_rotation), with
+ * no arc tangent. */
 #include <math.h>
+#include <stddef.h>
+#include <string.h>
 #include "flight.h"
 #include "gsl_adapter.h"
 #include "posedrop/tolerances.h"
@@ -36,20 +48,45 @@ static pd_vec3 body_L(const pd_body *b, pd_vec3 w)
 
 static double comp(pd_vec3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
-/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, in the
- * product form of the three half-angle rotations. */
-static pd_quat euler_zxz(double phi, double theta, double psi)
+/* e^(i a/2) for a in (-pi, pi] from the unit e^(i a) = c + i s, without
+ * trigonometry: the half-angle formulas, each on the side where it has no
+ * cancellation. */
+static void half_angle(double c, double s, double *hc, double *hs)
 {
-    double ct = cos(0.5 * theta), st = sin(0.5 * theta);
-    double sp = 0.5 * (phi + psi), dp = 0.5 * (phi - psi);
-    return quat(ct * cos(sp), st * cos(dp), st * sin(dp), ct * sin(sp));
+    if (c >= 0.0) {
+        *hc = sqrt(0.5 * (1.0 + c));
+        *hs = s / (2.0 * *hc);
+    } else {
+        *hs = copysign(sqrt(0.5 * (1.0 - c)), s);
+        *hc = s / (2.0 * *hs);
+    }
 }
 
-/* The chart angles of a unit vector u (chart frame): u = Rz(psi)^T Rx(theta)^T z. */
-static void chart_angles(double u1, double u2, double u3, double *theta, double *psi)
+/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, in the
+ * product form of the three half-angle rotations, with theta and psi the
+ * chart angles of u (u = Rz(psi)^T Rx(theta)^T z / |u|: theta =
+ * atan2(|u1, u2|, u3), psi = atan2(u1, u2)) and phi given as e^(i phi/2) =
+ * phc + i phs. The half angles come from u algebraically (half_angle):
+ * nothing here is an arc tangent or a sine. */
+static pd_quat chart_rotation(const double u[3], double phc, double phs)
 {
-    *theta = atan2(sqrt(u1 * u1 + u2 * u2), u3);
-    *psi = atan2(u1, u2);
+    double rho2 = u[0] * u[0] + u[1] * u[1], rho = sqrt(rho2);
+    double r = sqrt(rho2 + u[2] * u[2]);
+    double ct, st; /* cos, sin theta/2 */
+    if (u[2] >= 0.0) {
+        ct = sqrt(0.5 * (1.0 + u[2] / r));
+        st = rho / (2.0 * r * ct);
+    } else {
+        st = sqrt(0.5 * (1.0 - u[2] / r));
+        ct = rho / (2.0 * r * st);
+    }
+    double hc = 1.0, hs = 0.0; /* e^(i psi/2); psi = 0 on the axis itself */
+    if (rho > 0.0)
+        half_angle(u[1] / rho, u[0] / rho, &hc, &hs);
+    /* e^(i (phi + psi)/2) and e^(i (phi - psi)/2) */
+    double spc = phc * hc - phs * hs, sps = phs * hc + phc * hs;
+    double dpc = phc * hc + phs * hs, dps = phs * hc - phc * hs;
+    return quat(ct * spc, st * dpc, st * dps, ct * sps);
 }
 
 /* Elliptic state at argument tau: u in the chart, and the unrolled
@@ -153,6 +190,22 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     F->k = sqrt(F->m);
     F->n = (J1 - J2) / (J2 - J3);
     F->Omega = (J2 > J3 ? 1.0 : -1.0) * F->lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
+    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
+     * to round-off. */
+    F->Q0 = quat_mul(quat_mul(F->s0.q, quat_conj(F->e)), quat_conj(chart_rotation(uch, 1.0, 0.0)));
+    F->kind = PD_FLIGHT_ELLIPTIC;
+    /* The theta series where they converge fast (flight_theta.h), with
+     * 1 - m = (J1 - J3)(J2 - D) / ((J2 - J3)(J1 - D)) free of cancellation.
+     * phi = lambda (J3 t + (J1 - J3)(P(tau) - P(tau0)) / Omega), P = mu tau +
+     * sigma arg X, and lambda (J1 - J3) sigma / Omega = 1 exactly (sigma^2 =
+     * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios). */
+    double mc = (J1 - J3) * -DmJ2 / ((J2 - J3) * J1mD);
+    if (pd_theta_plan(&F->th, F->m, mc, F->n, uch[1] / F->alpha[1], uch[0] / F->alpha[0],
+                      F->Omega) == PD_OK) {
+        F->theta = 1;
+        F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu);
+        return PD_OK;
+    }
     pd_status st;
     double K = 0.0;
     if (F->m < 1.0) {
@@ -178,15 +231,7 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     }
     F->tau0 = Fr + j0 * F->K2;
     double u0[3];
-    if ((st = elliptic_at(F, F->tau0, u0, &F->P0)) != PD_OK)
-        return st;
-    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
-     * to round-off. */
-    double th, ps;
-    chart_angles(uch[0], uch[1], uch[2], &th, &ps);
-    F->Q0 = quat_mul(quat_mul(F->s0.q, quat_conj(F->e)), quat_conj(euler_zxz(0.0, th, ps)));
-    F->kind = PD_FLIGHT_ELLIPTIC;
-    return PD_OK;
+    return elliptic_at(F, F->tau0, u0, &F->P0);
 }
 
 pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
@@ -196,22 +241,24 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
     if (!v3_isfinite(s0->x) || !v3_isfinite(s0->v) || !v3_isfinite(s0->w) ||
         !isfinite(s0->q.w + s0->q.x + s0->q.y + s0->q.z))
         return PD_ERR_NONFINITE;
-    pd_flight F = {0};
-    F.s0 = *s0;
-    F.s0.q = quat_normalize(s0->q);
-    F.g = g;
+    /* Planned in place, and only the fields before the theta series zeroed:
+     * those are written when used, and the struct is mostly theirs. */
+    pd_flight *F = f;
+    memset(F, 0, offsetof(pd_flight, th));
+    F->s0 = *s0;
+    F->s0.q = quat_normalize(s0->q);
+    F->g = g;
     for (int i = 0; i < 3; i++)
-        F.J0[i] = b->inv_moment[i];
+        F->J0[i] = b->inv_moment[i];
     pd_vec3 Lb = body_L(b, s0->w);
-    F.lambda = v3_norm(Lb);
-    F.wmax = F.lambda * b->inv_moment[0]; /* |J L| <= max(J) |L| */
-    if (F.lambda == 0.0) {
-        F.kind = PD_FLIGHT_STILL;
-        *f = F;
+    F->lambda = v3_norm(Lb);
+    F->wmax = F->lambda * b->inv_moment[0]; /* |J L| <= max(J) |L| */
+    if (F->lambda == 0.0) {
+        F->kind = PD_FLIGHT_STILL;
         return PD_OK;
     }
-    pd_vec3 u = v3_scale(Lb, 1.0 / F.lambda);
-    F.lhat = quat_rotate(F.s0.q, u);
+    pd_vec3 u = v3_scale(Lb, 1.0 / F->lambda);
+    F->lhat = quat_rotate(F->s0.q, u);
     const double *I = b->moment, *J = b->inv_moment;
 
     /* Axial cases: equal moments (exact after the body's snapping), or u on a
@@ -219,20 +266,18 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
      * which an exact solution keeps). */
     int on_axis = principal_axis(u, PD_TOL_FLIGHT_AXIS_REL);
     if (I[0] == I[2] || on_axis >= 0 || I[0] == I[1] || I[1] == I[2]) {
-        set_axial(&F, I, J, u, on_axis);
-        *f = F;
+        set_axial(F, I, J, u, on_axis);
         return PD_OK;
     }
-    pd_status st = plan_elliptic(&F, u, J);
+    pd_status st = plan_elliptic(F, u, J);
     if (st != PD_OK) {
         /* Within PD_TOL_FLIGHT_NEAR_AXIS_REL of the separatrix's end, the
          * middle axis, the elliptic phase can overflow: a steady spin. */
         int near = principal_axis(u, PD_TOL_FLIGHT_NEAR_AXIS_REL);
         if (near < 0)
             return st;
-        set_axial(&F, I, J, u, near);
+        set_axial(F, I, J, u, near);
     }
-    *f = F;
     return PD_OK;
 }
 
@@ -250,20 +295,41 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
     s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
     if (f->kind == PD_FLIGHT_AXIAL) {
         /* omega_body(t) = rot(axis, -b t) omega_body(0): for equal moments J
-         * commutes with that rotation (see the derivation in flight.h). */
-        pd_quat back = quat_axis_angle(f->axis, -f->b * t);
-        s.q = quat_mul(quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q),
-                       quat_conj(back));
-        s.w = quat_rotate(back, f->s0.w);
+         * commutes with that rotation (see the derivation in flight.h). A
+         * spherical top or a steady spin (b = 0) turns about L alone: its
+         * body rotation, the identity, is skipped (exactly what it gives). */
+        pd_quat about_L = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
+        if (f->b == 0.0) {
+            s.q = about_L;
+        } else {
+            pd_quat back = quat_axis_angle(f->axis, -f->b * t);
+            s.q = quat_mul(about_L, quat_conj(back));
+            s.w = quat_rotate(back, f->s0.w);
+        }
     } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
-        double u[3], P;
-        pd_status st = elliptic_at(f, f->tau0 + f->Omega * t, u, &P);
-        if (st != PD_OK)
-            return st;
-        double phi = f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
-        double th, ps;
-        chart_angles(u[0], u[1], u[2], &th, &ps);
-        s.q = quat_mul(quat_mul(f->Q0, euler_zxz(phi, th, ps)), f->e);
+        double u[3], phc, phs; /* e^(i phi/2) */
+        if (f->theta) {
+            double sn, cn, dn, ph[2], hc, hs;
+            pd_theta_eval(&f->th, t, &sn, &cn, &dn, ph);
+            u[0] = f->alpha[0] * cn;
+            u[1] = f->alpha[1] * sn;
+            u[2] = f->alpha[2] * dn;
+            /* e^(i phi/2) = e^(i rate t/2) e^(i (arg X - arg X0)/2); the half
+             * angle's branch only picks the quaternion's sign. */
+            half_angle(ph[0], ph[1], &hc, &hs);
+            double a = 0.5 * f->rate * t, c = cos(a), sa = sin(a);
+            phc = c * hc - sa * hs;
+            phs = sa * hc + c * hs;
+        } else {
+            double P;
+            pd_status st = elliptic_at(f, f->tau0 + f->Omega * t, u, &P);
+            if (st != PD_OK)
+                return st;
+            double phi = f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
+            phc = cos(0.5 * phi);
+            phs = sin(0.5 * phi);
+        }
+        s.q = quat_mul(quat_mul(f->Q0, chart_rotation(u, phc, phs)), f->e);
         double wb[3] = {0};
         for (int i = 0; i < 3; i++)
             wb[f->perm[i]] = f->sgn[i] * f->lambda * f->J[i] * u[i];

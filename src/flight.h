@@ -9,6 +9,7 @@
 #define PD_FLIGHT_H
 
 #include "body.h"
+#include "flight_theta.h"
 #include "posedrop/status.h"
 
 typedef enum pd_flight_kind {
@@ -37,10 +38,15 @@ typedef struct pd_flight {
     double J[3];         /* inverse moments in chart order */
     double alpha[3];     /* amplitudes of u = L/|L| in the chart: cn, sn, dn */
     double m, k, n;      /* parameter, modulus, characteristic */
-    double Omega, tau0;  /* elliptic argument tau(t) = tau0 + Omega t */
+    double Omega;        /* d tau / dt */
+    int theta;           /* 1: by theta series (th, rate), else by Legendre's
+                            integrals (tau0, K2, Pc, P0) */
+    double tau0;         /* elliptic argument tau(t) = tau0 + Omega t */
     double K2;           /* the period 2K of dn (0 on the separatrix: no period) */
     double Pc;           /* complete integral of the third kind */
     double P0;           /* P(am tau0) with periods unrolled */
+    double rate;         /* phi(t) = rate t + arg X(v) - arg X(v0) (flight_theta.h) */
+    pd_theta th;         /* last: pd_flight_plan zeroes only what precedes it */
 } pd_flight;
 
 /* Plans the flight of body b from state s0 under gravity g (m/s^2, >= 0).

@@ -6,6 +6,7 @@
 #include "body.h"
 #include "check.h"
 #include "flight.h"
+#include "gsl_adapter.h"
 #include "posedrop/posedrop.h"
 #include "posedrop/tolerances.h"
 #include "shapes.h"
@@ -293,6 +294,121 @@ static void test_flight(void)
     pd_part_free(p);
 }
 
+/* Reference for the closed form: GSL's Prince-Dormand 8(9) on q' = q (0, w) / 2
+ * and Euler's equations, held to 1e-14 relative per step; shares no formula
+ * with flight.c. y = (q, w), renormalised only when compared. */
+static int euler_rhs(double t, const double y[], double dy[], void *user)
+{
+    (void)t;
+    const double *I = user;
+    double w0 = y[4], w1 = y[5], w2 = y[6];
+    dy[0] = 0.5 * (-y[1] * w0 - y[2] * w1 - y[3] * w2);
+    dy[1] = 0.5 * (y[0] * w0 + y[2] * w2 - y[3] * w1);
+    dy[2] = 0.5 * (y[0] * w1 + y[3] * w0 - y[1] * w2);
+    dy[3] = 0.5 * (y[0] * w2 + y[1] * w1 - y[2] * w0);
+    dy[4] = (I[1] - I[2]) * w1 * w2 / I[0];
+    dy[5] = (I[2] - I[0]) * w2 * w0 / I[1];
+    dy[6] = (I[0] - I[1]) * w0 * w1 / I[2];
+    return 0;
+}
+
+/* The flight of a body of moments I (ascending) from orientation q and body
+ * rate w against the ODE over T, sampled 20 times: the worst rotation angle
+ * (rad) and relative rate error go into worst[0], worst[1], the larger of
+ * them times 1 - m (the separatrix's amplification, see below) into
+ * worst[2]; flags[0] counts polhodes about the largest moment, flags[1]
+ * flights by theta series. Only the moments enter the flight, so a bare body
+ * serves. */
+static void vs_ode(pd_ode *ode, const double I[3], pd_quat q, pd_vec3 w, double T, double worst[3],
+                   int flags[2])
+{
+    pd_body b = {0};
+    for (int i = 0; i < 3; i++) {
+        b.moment[i] = I[i];
+        b.inv_moment[i] = 1.0 / I[i];
+    }
+    pd_state s0 = state_at(v3(0, 0, 1), q, v3(0, 0, 0), w);
+    pd_flight f;
+    CHECK_STATUS(pd_flight_plan(&b, &s0, G, &f), PD_OK);
+    CHECK_INT(f.kind, PD_FLIGHT_ELLIPTIC);
+    flags[0] += f.perm[2] == 2;
+    flags[1] += f.theta;
+    double y[7] = {q.w, q.x, q.y, q.z, w.x, w.y, w.z}, t = 0.0, h = 1e-4;
+    pd_ode_reset(ode);
+    for (int i = 1; i <= 20; i++) {
+        double Ti = T * i / 20;
+        while (t < Ti)
+            if (pd_ode_step(ode, euler_rhs, (void *)I, &t, Ti, &h, y) != PD_OK) {
+                CHECK(0);
+                return;
+            }
+        pd_state s;
+        CHECK_STATUS(pd_flight_eval(&f, Ti, &s), PD_OK);
+        double a = quat_angle(s.q, quat_normalize(quat(y[0], y[1], y[2], y[3])));
+        double e = v3_dist(s.w, v3(y[4], y[5], y[6])) / v3_norm(w);
+        worst[0] = a > worst[0] ? a : worst[0];
+        worst[1] = e > worst[1] ? e : worst[1];
+        double sc = (a > e ? a : e) * (1.0 - f.m);
+        worst[2] = sc > worst[2] ? sc : worst[2];
+    }
+}
+
+/* The asymmetric top against the ODE reference: random bodies with the
+ * polhode about either extreme axis (both orderings of the chart's J), near
+ * the separatrix (1 - m down to ~5e-9, nomes up to ~0.65), and nearly symmetric bodies
+ * (two moments 1e-3 to 1e-9 apart, n up to 1e9, where the third-kind phase
+ * passes close to a zero of theta4). 20 rad/s for 1 s, moments from 1e-8 to
+ * 1e-4 kg m^2. Near the separatrix the motion itself is ill-conditioned: the
+ * period grows as ln(1/(1 - m)), so a relative change d of the state (its
+ * round-off, 1e-16, in either computation) moves the phase after the ~20 rad
+ * turned by ~20 d / (1 - m); there the error is bounded times 1 - m. */
+static void test_flight_reference(void)
+{
+    pd_ode *ode = pd_ode_alloc(7, 0.0, 1e-14);
+    CHECK(ode != NULL);
+    if (!ode)
+        return;
+    test_rng r = {17};
+    double generic[3] = {0}, sep[3] = {0}, sym[3] = {0};
+    int gflags[2] = {0}, sflags[2] = {0}, yflags[2] = {0};
+    enum { N = 24 };
+    for (int i = 0; i < N; i++) {
+        double sc = pow(10.0, rng_range(&r, -8.0, -4.0));
+        double I[3] = {sc, sc * rng_range(&r, 1.2, 3.0), 0.0};
+        I[2] = I[1] * rng_range(&r, 1.2, 3.0);
+        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
+                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        /* Generic: omega mostly along an extreme axis, so that both charts occur. */
+        pd_vec3 d = rng_unit_vector(&r);
+        pd_vec3 w = i % 2 ? v3(d.x, d.y, 2.0 * copysign(1.0, d.z) + d.z)
+                          : v3(2.0 * copysign(1.0, d.x) + d.x, d.y, d.z);
+        vs_ode(ode, I, q, v3_scale(v3_unit(w), 20.0), 1.0, generic, gflags);
+        /* Near the separatrix: omega along the middle axis, off by eps. */
+        double eps = pow(10.0, -1.0 - (i % 4));
+        w = v3(eps * d.x, copysign(1.0, d.y), eps * d.z);
+        vs_ode(ode, I, q, v3_scale(v3_unit(w), 20.0), 1.0, sep, sflags);
+        /* Nearly symmetric: the middle moment 1e-3 .. 1e-9 from one of the others. */
+        double delta = pow(10.0, -3.0 - (i % 7));
+        double J[3] = {I[0], i % 2 ? I[0] * (1.0 + delta) : I[2] * (1.0 - delta), I[2]};
+        vs_ode(ode, J, q, v3_scale(d, 20.0), 1.0, sym, yflags);
+    }
+    pd_ode_free(ode);
+    printf("flight: closed form vs rk8pd at 1e-14, 20 rad/s for 1 s: generic %.1e rad %.1e rel, "
+           "nearly symmetric %.1e rad %.1e rel, near the separatrix %.1e rad %.1e rel "
+           "(%.1e times 1 - m); theta series in %d, %d, %d of %d\n",
+           generic[0], generic[1], sym[0], sym[1], sep[0], sep[1], sep[2], gflags[1], yflags[1],
+           sflags[1], N);
+    CHECK(gflags[0] > 0 && gflags[0] < N);           /* both charts */
+    CHECK(sflags[1] == N); /* off the separatrix itself, always the theta series */
+    CHECK(yflags[0] > 0 && yflags[0] < N && yflags[1] > 0);
+    CHECK_NEAR(generic[0], 0.0, 1e-12, "ODE reference, its global error ~1e-13");
+    CHECK_NEAR(generic[1], 0.0, 1e-12, "ODE reference, its global error ~1e-13");
+    CHECK_NEAR(sym[0], 0.0, 1e-12, "ODE reference, its global error ~1e-13");
+    CHECK_NEAR(sym[1], 0.0, 1e-12, "ODE reference, its global error ~1e-13");
+    CHECK_NEAR(sep[2], 0.0, 1e-14, "ODE reference, 20 rad x round-off 1e-16 / (1 - m) x 5");
+    CHECK_NEAR(sep[0], 0.0, 1e-9, "ODE reference; Legendre's forms erred 4e-8 here");
+}
+
 /* Lowest vertex height by scanning: the oracle for the impact tests. */
 static double scan_height(const pd_body *b, const pd_flight *f, double t)
 {
@@ -517,6 +633,7 @@ void suite_flight(void)
 {
     test_eigen();
     test_flight();
+    test_flight_reference();
     test_impact();
     test_support();
 }

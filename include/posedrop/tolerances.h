@@ -200,6 +200,31 @@
  * exact form has failed; larger would hide genuine tumbling. */
 #define PD_TOL_FLIGHT_NEAR_AXIS_REL 1e-6
 
+/* The asymmetric top's flight evaluates its elliptic functions and its
+ * precession by Jacobi's theta series in the nome q (flight_theta.c) while q
+ * is at most this; beyond, on the separatrix itself, by GSL's Legendre
+ * integrals. Dimensionless: q depends on the inertia ratios and the energy
+ * only, not on the part's size. Why 0.8: q = 0.8 is 1 - m ~ 1e-18, below
+ * the resolution of m near 1 in double precision, so every polhode that is
+ * not the separatrix takes the series (whose 1 - m is computed without
+ * cancellation: GSL's forms, handed m alone, erred there by up to 0.1 rad
+ * against an ODE after 100 rad of turning). The cost: theta4(v) near v = 0
+ * shrinks to sqrt(2 k' K / pi), 1.2e-4 at q = 0.8, out of terms of order 1,
+ * so sn, cn, dn lose 4 digits there (energy and momentum then hold to 1e-11,
+ * measured, within their 1e-10), and 14 terms reach PD_TOL_FLIGHT_SERIES.
+ * Larger: both grow without bound (at q = 0.9, 9 digits and 20 terms).
+ * Smaller: the Legendre forms' errors near the separatrix come back. */
+#define PD_FLIGHT_NOME_MAX 0.8
+
+/* A theta series stops at the first term k with q^(k^2) below this, which
+ * bounds that term (and so, geometrically, the rest) relative to the
+ * series' leading one. Dimensionless: the series give unit vectors and
+ * angles. Why 1e-17: below the double-precision round-off (1.1e-16) of the
+ * sums themselves, so truncation adds nothing to it. Larger: the flight's
+ * orientation would err by the truncation (1e-12 at 1e-12); smaller costs
+ * terms that round-off swallows. */
+#define PD_TOL_FLIGHT_SERIES 1e-17
+
 /* The time of impact is found when the lowest hull vertex is within this height
  * of the floor, approached from above (never below it by more). Why 1e-9: the
  * flight's positions carry round-off of ~1e-15 L at drop heights of a few L and
