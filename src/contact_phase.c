@@ -272,14 +272,15 @@ static double time_to_event(const pd_phase *p, double slip_min, point *a, point 
     return len * frac;
 }
 
-/* The phase for contacts[0..nc) of state s, each contact sliding if its
- * slip is above twice the end threshold, else sticking. */
+/* The contacts and modes of the phase for contacts[0..nc) of state s,
+ * each contact sliding if its slip is above twice the end threshold, else
+ * sticking; no force solve set up yet (pd_phase_map). */
 static void phase_of(pd_phase *p, const pd_sim_model *m, const pd_scene *sc, const pd_state *s,
                      const int *contacts, int nc)
 {
     const pd_body *b = m->body;
     double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
-    pd_phase_init(p, b, sc->gravity, sc->mu, s, contacts, nc, slip_start);
+    pd_phase_modes(p, b, sc->gravity, sc->mu, s, contacts, nc, slip_start);
 }
 
 int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *s,
@@ -299,6 +300,7 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     for (int i = 0; i < nc; i++)
         if (p.mode[i] == PD_PHASE_STICK && sc->mu == 0.0)
             return 0; /* nothing holds a contact without friction */
+    pd_phase_map(&p); /* after the refusals that need no solve */
     pd_state t = *s;
     double g[NMARGIN], rate_unused;
     pd_phase_forces F;

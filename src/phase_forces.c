@@ -188,8 +188,8 @@ static inline pd_vec3 contact_velocity(const pd_phase *p, const double R[3][3], 
     return v3_add(s->v, m3_vec(R, *wr));
 }
 
-void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
-                   const int *contacts, int nc, double slip_start)
+void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                    const int *contacts, int nc, double slip_start)
 {
     memset(p, 0, sizeof *p);
     p->b = b, p->nc = nc, p->mu = mu, p->g = g, p->L = b->size, p->T = sqrt(b->size / g);
@@ -203,6 +203,13 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     }
     if (nc == 1)
         p->v[1] = -1;
+}
+
+void pd_phase_map(pd_phase *p)
+{
+    const pd_body *b = p->b;
+    int nc = p->nc;
+    p->mapped = 1;
     /* Column k of M[i][j]: contact i's acceleration by a unit force along
      * body axis k at contact j, f / m + (I^-1 (r_j x f)) x r_i. */
     for (int i = 0; i < nc; i++)
@@ -227,9 +234,18 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     p->singular = !solve_layout(p, &L, L.n, p->P);
 }
 
+void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                   const int *contacts, int nc, double slip_start)
+{
+    pd_phase_modes(p, b, g, mu, s, contacts, nc, slip_start);
+    pd_phase_map(p);
+}
+
 static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_forces *out)
 {
     const pd_body *b = p->b;
+    if (!p->mapped)
+        return 1;
     double R[3][3];
     quat_to_matrix(s->q, R);
     pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
@@ -334,6 +350,8 @@ int pd_phase_forces_general(const pd_phase *p, const pd_state *s, pd_phase_force
 int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
 {
     const pd_body *b = p->b;
+    if (!p->mapped)
+        return 0;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     const pd_vec3 dir[2] = {up, up};
     layout L;

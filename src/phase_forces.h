@@ -24,6 +24,7 @@ typedef struct {
     double M[2][2][3][3]; /* M[i][j] f: acceleration of contact i by force f at j */
     int singular;      /* every contact sticks and the constant system is singular */
     double P[6][6];    /* every contact sticks: forces = P (minus free accelerations) */
+    int mapped;        /* M, singular and P set (pd_phase_map) */
 } pd_phase;
 
 /* What the forces of a state give: the com's acceleration (world), wdot
@@ -35,7 +36,15 @@ typedef struct {
 } pd_phase_forces;
 
 /* The phase of contacts[0..nc) (1 or 2) of state s: each contact slides if
- * it slips faster than slip_start, else sticks; gravity g, friction mu. */
+ * it slips faster than slip_start, else sticks; gravity g, friction mu.
+ * pd_phase_modes sets the contacts and their modes alone, for a caller that
+ * may refuse the phase on them or needs no force solve (a pivot,
+ * contact_pivot.h); pd_phase_map then sets up the solves, which
+ * pd_phase_forces_of and pd_phase_project_velocity need (they fail
+ * without); pd_phase_init does both. */
+void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                    const int *contacts, int nc, double slip_start);
+void pd_phase_map(pd_phase *p);
 void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
                    const int *contacts, int nc, double slip_start);
 
