@@ -13,10 +13,12 @@
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
  * phase_forces.c solves it). Sliding friction does negative work and
- * sticking contacts none, so the energy can only fall. The ODE is integrated
- * by gsl_adapter's Cash-Karp pair (rkck) in units of the part (length L,
- * time sqrt(L/g)); the phase ends, handing the state
- * back to the microcollisions, just before any of:
+ * sticking contacts none, so the energy can only fall. Two sticking
+ * contacts are a rotation about their edge, integrated as one angle
+ * (contact_pivot.c), the commonest phase of a part rolling on a rim. The
+ * ODE is integrated by gsl_adapter's Cash-Karp pair (rkck) in units of the
+ * part (length L, time sqrt(L/g)); the phase ends, handing the state back
+ * to the microcollisions, just before any of:
  *  - a normal force reaching zero (a contact lifts off),
  *  - a sliding contact's slip falling below PD_TOL_PHASE_SLIP_REL sqrt(g L),
  *  - a sticking contact's force leaving the friction cone (it starts to slip),
@@ -28,6 +30,7 @@
 #include <math.h>
 #include <string.h>
 #include "contact_phase.h"
+#include "contact_pivot.h"
 #include "drop_internal.h"
 #include "gsl_adapter.h"
 #include "phase_forces.h"
@@ -47,8 +50,30 @@ pd_ode *pd_contact_phase_ode_alloc(void)
     return pd_ode_alloc_method(PD_ODE_RKCK, NY, PD_TOL_PHASE_ODE_REL, PD_TOL_PHASE_ODE_REL);
 }
 
-static void to_y(const pd_phase *p, const pd_state *s, double y[NY])
+/* The same pair and tolerance for a pivot's angle (rad) and rate (per
+ * sqrt(L/g)): an error of e in the angle moves the part by e L at most,
+ * as an error of e in the full motion's position (per L) does. */
+pd_ode *pd_contact_pivot_ode_alloc(void)
 {
+    return pd_ode_alloc_method(PD_ODE_RKCK, 2, PD_TOL_PHASE_ODE_REL, PD_TOL_PHASE_ODE_REL);
+}
+
+/* What a phase integrates: the full motion, y = (x, v, q, w) in the part's
+ * units, or a pivot's (contact_pivot.h), y = (angle, rate in the part's
+ * units); n unknowns. */
+typedef struct {
+    const pd_phase *p;
+    const pd_pivot *pv; /* NULL: the full motion */
+    int n;
+} motion;
+
+static void to_y(const motion *mo, const pd_state *s, double y[NY])
+{
+    const pd_phase *p = mo->p;
+    if (mo->pv) {
+        y[0] = 0.0, y[1] = pd_pivot_rate_of(mo->pv, s) * p->T;
+        return;
+    }
     double V0 = p->L / p->T;
     const double c[NY] = {s->x.x / p->L, s->x.y / p->L, s->x.z / p->L, s->v.x / V0, s->v.y / V0,
                           s->v.z / V0, s->q.w, s->q.x, s->q.y, s->q.z, s->w.x * p->T,
@@ -69,13 +94,20 @@ static pd_state from_y(const pd_phase *p, const double y[NY])
 
 /* The time derivative of y (part units), with the state and forces it
  * comes from. 1 where the model fails. */
-static int derivs(const pd_phase *p, const double y[NY], pd_state *s, pd_phase_forces *F,
+static int derivs(const motion *mo, const double y[NY], pd_state *s, pd_phase_forces *F,
                   double dydt[NY])
 {
+    const pd_phase *p = mo->p;
+    double T = p->T;
+    if (mo->pv) {
+        double alpha = pd_pivot_state(mo->pv, y[0], y[1] / T, s, F);
+        dydt[0] = y[1], dydt[1] = alpha * T * T;
+        return 0;
+    }
     *s = from_y(p, y);
     if (pd_phase_forces_of(p, s, F))
         return 1;
-    double T = p->T, V0 = p->L / T;
+    double V0 = p->L / T;
     pd_quat q = quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]);
     pd_quat dq = quat_mul(q, quat(0.0, y[W], y[W + 1], y[W + 2]));
     const double d[NY] = {y[V], y[V + 1], y[V + 2], F->acc.x * T / V0, F->acc.y * T / V0,
@@ -85,12 +117,19 @@ static int derivs(const pd_phase *p, const double y[NY], pd_state *s, pd_phase_f
     return 0;
 }
 
+/* A pivot's right-hand side needs neither the state nor the forces. */
 static int phase_rhs(double tau, const double y[], double dydt[], void *user)
 {
     (void)tau;
+    const motion *mo = user;
+    if (mo->pv) {
+        double T = mo->p->T;
+        dydt[0] = y[1], dydt[1] = pd_pivot_accel(mo->pv, y[0]) * T * T;
+        return 0;
+    }
     pd_state s;
     pd_phase_forces F;
-    return derivs(user, y, &s, &F, dydt);
+    return derivs(mo, y, &s, &F, dydt);
 }
 
 /* How far s is from the phase's end, in the part's units: per contact its
@@ -147,39 +186,40 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
     return least;
 }
 
-/* A point of the phase: its time and state, the state's derivative, its
+/* A point of the phase: its time, y and state, y's derivative, its
  * margins and smallest margin (-1 where the model fails), the height's rate
  * of change and, once asked for (rated), the other margins'. */
 typedef struct {
     double tau, y[NY], dydt[NY];
+    pd_state s;
     double g[NMARGIN], dg[NMARGIN], least;
     int rated;
 } point;
 
-static void point_at(const pd_phase *p, double slip_min, double tau, const double y[NY], point *a)
+static void point_at(const motion *mo, double slip_min, double tau, const double y[NY], point *a)
 {
-    pd_state s;
     pd_phase_forces F;
     a->tau = tau, a->rated = 0;
-    memcpy(a->y, y, sizeof a->y);
+    memcpy(a->y, y, (size_t)mo->n * sizeof *y);
     for (int k = 0; k < NMARGIN; k++)
         a->g[k] = HUGE_VAL, a->dg[k] = (double)NAN;
-    a->least = derivs(p, y, &s, &F, a->dydt) ? -1.0
-                                             : margins(p, &s, &F, slip_min, a->g, &a->dg[HEIGHT]);
+    a->least = derivs(mo, y, &a->s, &F, a->dydt)
+                   ? -1.0
+                   : margins(mo->p, &a->s, &F, slip_min, a->g, &a->dg[HEIGHT]);
 }
 
 /* The force margins' rates of change at a, by a forward difference along
  * the flow (PD_TOL_PHASE_RATE_STEP); NaN where unknown (the model fails
  * there, or the margin is infinite). */
-static void rate(const pd_phase *p, double slip_min, point *a)
+static void rate(const motion *mo, double slip_min, point *a)
 {
     if (a->rated)
         return;
     double e = PD_TOL_PHASE_RATE_STEP, y[NY];
-    for (int i = 0; i < NY; i++)
+    for (int i = 0; i < mo->n; i++)
         y[i] = a->y[i] + e * a->dydt[i];
     point b;
-    point_at(p, slip_min, a->tau + e, y, &b);
+    point_at(mo, slip_min, a->tau + e, y, &b);
     for (int k = 0; k < HEIGHT; k++)
         a->dg[k] = b.least > -1.0 && isfinite(a->g[k]) && isfinite(b.g[k]) ? (b.g[k] - a->g[k]) / e
                                                                            : (double)NAN;
@@ -254,15 +294,15 @@ static double hermite_zero(double g0, double m0, double g1, double m1)
  * positive), by the margins' cubic Hermite models from their values and
  * rates at both ends: the margins are smooth, so the model's error falls as
  * the fourth power of the interval (a secant where a rate is unknown). */
-static double time_to_event(const pd_phase *p, double slip_min, point *a, point *b)
+static double time_to_event(const motion *mo, double slip_min, point *a, point *b)
 {
     double len = b->tau - a->tau, frac = 1.0;
     for (int k = 0; k < NMARGIN; k++) {
         if (!(b->g[k] <= 0.0))
             continue;
         if (k != HEIGHT) {
-            rate(p, slip_min, a);
-            rate(p, slip_min, b);
+            rate(mo, slip_min, a);
+            rate(mo, slip_min, b);
         }
         double m0 = len * a->dg[k], m1 = len * b->dg[k];
         if (!isfinite(m0) || !isfinite(m1))
@@ -300,14 +340,27 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     for (int i = 0; i < nc; i++)
         if (p.mode[i] == PD_PHASE_STICK && sc->mu == 0.0)
             return 0; /* nothing holds a contact without friction */
-    pd_phase_map(&p); /* after the refusals that need no solve */
     pd_state t = *s;
-    double g[NMARGIN], rate_unused;
+    double g[NMARGIN], rate_unused, slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     pd_phase_forces F;
-    if (!pd_phase_project_velocity(&p, &t) || pd_phase_forces_of(&p, &t, &F) ||
-        !(margins(&p, &t, &F, PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size), g,
-                  &rate_unused) > 0.0))
-        return 0;
+    pd_pivot pv;
+    if (pd_pivot_init(&pv, &p, s)) {
+        /* Two sticking contacts: the projection and the forces in closed
+         * form (contact_pivot.h), no solve set up; a full phase sets it up
+         * if it needs it (pd_contact_phase). */
+        double w = pd_pivot_rate_of(&pv, s);
+        t.v = v3_scale(pv.e_u, w);
+        t.w = v3_scale(pv.eb, w);
+        pd_state u;
+        pd_pivot_state(&pv, 0.0, w, &u, &F);
+        if (!(margins(&p, &t, &F, slip_min, g, &rate_unused) > 0.0))
+            return 0;
+    } else {
+        pd_phase_map(&p); /* after the refusals that need no solve */
+        if (!pd_phase_project_velocity(&p, &t) || pd_phase_forces_of(&p, &t, &F) ||
+            !(margins(&p, &t, &F, slip_min, g, &rate_unused) > 0.0))
+            return 0;
+    }
     /* The projection is an inelastic impulse: admitted only when it takes
      * next to nothing, else every entry would damp the part like the
      * microcollisions the phase replaces (tolerances.h). */
@@ -323,11 +376,18 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     return 1;
 }
 
-pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *sc,
-                           const pd_phase *phase, pd_state *s, double t_max, double *t_used)
+pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, pd_ode *pivot_ode,
+                           const pd_scene *sc, const pd_phase *phase, pd_state *s, double t_max,
+                           double *t_used)
 {
     const pd_body *b = m->body;
-    pd_phase p = *phase; /* the right-hand side takes it as void * */
+    pd_phase p = *phase;
+    pd_pivot pv;
+    motion mo = {&p, NULL, NY}; /* the right-hand side takes it as void * */
+    if (pivot_ode && pd_pivot_init(&pv, &p, s))
+        mo.pv = &pv, mo.n = 2, ode = pivot_ode;
+    else if (!p.mapped)
+        pd_phase_map(&p);
     double slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     const double tol = PD_TOL_PHASE_EVENT_REL;
     /* First trial step a twentieth of the part's time unit: contact motion
@@ -339,28 +399,30 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
     double y[NY];
     int hint = 0, pose, bracket = 0;
     point cur, next, end; /* the phase so far; a step's end; the nearest end past an event */
-    to_y(&p, s, y);
-    point_at(&p, slip_min, 0.0, y, &cur);
+    to_y(&mo, s, y);
+    point_at(&mo, slip_min, 0.0, y, &cur);
     for (int step = 0; step < PD_PHASE_MAX_STEPS && cur.tau < tau_max && cur.least > 0.0; step++) {
         double tau = cur.tau, h_try = h;
         memcpy(y, cur.y, sizeof y);
         double t1 = fmin(tau_max, fmin(target, tau + 10.0 * h));
-        pd_status st = pd_ode_step_from(ode, phase_rhs, &p, &tau, t1, &h, y, cur.dydt);
+        pd_status st = pd_ode_step_from(ode, phase_rhs, &mo, &tau, t1, &h, y, cur.dydt);
         double len = st == PD_OK ? tau - cur.tau : fmin(t1 - cur.tau, h_try);
         next.least = -1.0;
         if (st == PD_OK) {
-            /* Keep the quaternion on the unit sphere between steps. */
-            pd_quat q = quat_normalize(quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]));
-            y[Q] = q.w, y[Q + 1] = q.x, y[Q + 2] = q.y, y[Q + 3] = q.z;
-            point_at(&p, slip_min, tau, y, &next);
+            if (!mo.pv) {
+                /* Keep the quaternion on the unit sphere between steps. */
+                pd_quat q = quat_normalize(quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]));
+                y[Q] = q.w, y[Q + 1] = q.x, y[Q + 2] = q.y, y[Q + 3] = q.z;
+            }
+            point_at(&mo, slip_min, tau, y, &next);
         }
         if (next.least > 0.0) {
             cur = next;
-            *s = from_y(&p, cur.y);
+            *s = cur.s;
             target = INFINITY;
             if (bracket) {
                 /* Landed short of a known event: aim again, from here. */
-                double dt = time_to_event(&p, slip_min, &cur, &end);
+                double dt = time_to_event(&mo, slip_min, &cur, &end);
                 if (dt <= tol)
                     break;
                 target = cur.tau + dt - 0.5 * tol;
@@ -383,7 +445,7 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, const pd_scene *s
         if (next.least > -1.0) {
             end = next;
             bracket = 1;
-            dt = time_to_event(&p, slip_min, &cur, &end);
+            dt = time_to_event(&mo, slip_min, &cur, &end);
         }
         if (dt <= tol)
             break;

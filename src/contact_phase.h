@@ -8,8 +8,11 @@
 #include "gsl_adapter.h"
 #include "phase_forces.h"
 
-/* The phase's integrator (13 unknowns), one per thread. NULL if out of memory. */
+/* The phase's integrators, one each per thread: the full motion's (13
+ * unknowns) and a pivot's (2: two sticking contacts turning about their
+ * edge, contact_pivot.h). NULL if out of memory. */
 pd_ode *pd_contact_phase_ode_alloc(void);
+pd_ode *pd_contact_pivot_ode_alloc(void);
 
 /* 1 if state s, touching the floor at body vertices contacts[0..nc), is a
  * contact the phase can take: one or two contacts moving normally no faster
@@ -23,8 +26,11 @@ int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_
 
 /* Runs phase (from pd_contact_phase_start) from s for at most t_max
  * seconds, or until the energy test decides the drop; s becomes the state
- * where it ended and *t_used the time it took. */
-pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, const pd_scene *scene,
-                           const pd_phase *phase, pd_state *s, double t_max, double *t_used);
+ * where it ended and *t_used the time it took. Two sticking contacts turn
+ * about their edge by pivot_ode, or by ode in full where pivot_ode is NULL
+ * (the reference the reduced motion is tested against). */
+pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, pd_ode *pivot_ode,
+                           const pd_scene *scene, const pd_phase *phase, pd_state *s,
+                           double t_max, double *t_used);
 
 #endif

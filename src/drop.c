@@ -140,10 +140,12 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     else {
         w->impact = pd_impact_work_alloc();
         w->phase = pd_contact_phase_ode_alloc();
+        w->pivot = pd_contact_pivot_ode_alloc();
     }
-    if ((!w->impact || !w->phase) && !w->world) {
+    if ((!w->impact || !w->phase || !w->pivot) && !w->world) {
         pd_impact_work_free(w->impact);
         pd_ode_free(w->phase);
+        pd_ode_free(w->pivot);
         free(w);
         return NULL;
     }
@@ -157,6 +159,7 @@ void pd_drop_work_free(pd_drop_work *w)
         return;
     pd_impact_work_free(w->impact);
     pd_ode_free(w->phase);
+    pd_ode_free(w->pivot);
     if (w->world)
         w->engine->world_free(w->world);
     free(w);
@@ -465,7 +468,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if (pd_contact_phase(m, w->phase, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
+            if (pd_contact_phase(m, w->phase, w->pivot, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
                 break;
             t += dt;
             phase_ok = 0;

@@ -37,6 +37,7 @@ struct pd_sim_model {
 struct pd_drop_work {
     pd_impact_work *impact;
     pd_ode *phase;              /* the sliding phases' integrator */
+    pd_ode *pivot;              /* and the pivots' (contact_pivot.h) */
     pd_engine_world *world;     /* the stepping engine's, or NULL */
     const pd_engine *engine;
     int contacts[PD_MAX_CONTACTS];

@@ -56,3 +56,17 @@ double kinetic_energy(const pd_body *b, const pd_state *s)
            0.5 * (b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
                   b->moment[2] * s->w.z * s->w.z);
 }
+
+void state_gap_add(state_gap *gap, const pd_body *b, double g, const pd_state *a,
+                   const pd_state *r)
+{
+    double L = b->size, T = sqrt(L / g), V0 = L / T, mgL = b->mass * g * L;
+    double Ea = kinetic_energy(b, a) + b->mass * g * a->x.z;
+    double Er = kinetic_energy(b, r) + b->mass * g * r->x.z;
+    gap->x = fmax(gap->x, v3_dist(a->x, r->x) / L);
+    gap->v = fmax(gap->v, v3_dist(a->v, r->v) / V0);
+    gap->q = fmax(gap->q, fmax(fmax(fabs(a->q.w - r->q.w), fabs(a->q.x - r->q.x)),
+                               fmax(fabs(a->q.y - r->q.y), fabs(a->q.z - r->q.z))));
+    gap->w = fmax(gap->w, v3_dist(a->w, r->w) * T);
+    gap->E = fmax(gap->E, fabs(Ea - Er) / mgL);
+}

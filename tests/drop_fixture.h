@@ -27,4 +27,14 @@ int lowest_vertices(const pd_body *b, pd_quat q, int *out);
 
 double kinetic_energy(const pd_body *b, const pd_state *s);
 
+/* The largest differences between pairs of states of one body, in its
+ * units: position per L, velocity per sqrt(g L), quaternion components,
+ * rate of turn per 1/sqrt(L/g), energy (gravity g) per m g L. */
+typedef struct {
+    double x, v, q, w, E;
+} state_gap;
+
+void state_gap_add(state_gap *gap, const pd_body *b, double g, const pd_state *a,
+                   const pd_state *r);
+
 #endif
