@@ -344,28 +344,35 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     double g[NMARGIN], rate_unused, slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     pd_phase_forces F;
     pd_pivot pv;
-    if (pd_pivot_init(&pv, &p, s)) {
+    int pivot = pd_pivot_init(&pv, &p, s);
+    double w = 0.0;
+    if (pivot) {
         /* Two sticking contacts: the projection and the forces in closed
          * form (contact_pivot.h), no solve set up; a full phase sets it up
          * if it needs it (pd_contact_phase). */
-        double w = pd_pivot_rate_of(&pv, s);
+        w = pd_pivot_rate_of(&pv, s);
         t.v = v3_scale(pv.e_u, w);
         t.w = v3_scale(pv.eb, w);
-        pd_state u;
-        pd_pivot_state(&pv, 0.0, w, &u, &F);
-        if (!(margins(&p, &t, &F, slip_min, g, &rate_unused) > 0.0))
-            return 0;
     } else {
         pd_phase_map(&p); /* after the refusals that need no solve */
-        if (!pd_phase_project_velocity(&p, &t) || pd_phase_forces_of(&p, &t, &F) ||
-            !(margins(&p, &t, &F, slip_min, g, &rate_unused) > 0.0))
+        if (!pd_phase_project_velocity(&p, &t))
             return 0;
     }
     /* The projection is an inelastic impulse: admitted only when it takes
      * next to nothing, else every entry would damp the part like the
-     * microcollisions the phase replaces (tolerances.h). */
+     * microcollisions the phase replaces (tolerances.h). Tested before
+     * the forces: it refuses more starts than they do (100 drops, seed 3:
+     * 102 of 124 late refusals on the cube, 418 of 761 on the coin). */
     double lost = pd_body_kinetic(b, s) - pd_body_kinetic(b, &t);
     if (lost > PD_TOL_PHASE_ENTRY_REL * b->mass * sc->gravity * b->size)
+        return 0;
+    if (pivot) {
+        pd_state u;
+        pd_pivot_state(&pv, 0.0, w, &u, &F);
+    } else if (pd_phase_forces_of(&p, &t, &F)) {
+        return 0;
+    }
+    if (!(margins(&p, &t, &F, slip_min, g, &rate_unused) > 0.0))
         return 0;
     /* The phase goes on with the modes the projection was for: taken
      * afresh from t, a contact that slid above the start threshold and
