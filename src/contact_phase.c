@@ -200,7 +200,7 @@ static void point_at(const motion *mo, double slip_min, double tau, const double
 {
     pd_phase_forces F;
     a->tau = tau, a->rated = 0;
-    memcpy(a->y, y, (size_t)mo->n * sizeof *y);
+    memcpy(a->y, y, sizeof a->y); /* fixed size, inlined; a pivot's y is a full buffer too */
     for (int k = 0; k < NMARGIN; k++)
         a->g[k] = HUGE_VAL, a->dg[k] = (double)NAN;
     a->least = derivs(mo, y, &a->s, &F, a->dydt)
