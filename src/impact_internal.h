@@ -7,6 +7,7 @@
 #include <math.h>
 #include "gsl_adapter.h"
 #include "impact.h"
+#include "impact_ray_series.h"
 #include "impact_rays.h"
 #include "mat3.h"
 #include "vec3.h"
@@ -28,6 +29,8 @@ typedef struct {
     double rtx, rty;
     int on_ray;       /* sliding stopped on that ray */
     pd_rays in;       /* the incoming rays */
+    unsigned built;   /* bit k: ser[k] is built (once the slip comes near ray k) */
+    pd_ray_series *ser; /* [4], the slide's: left out of the collision's zeroing */
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;

@@ -5,7 +5,6 @@
 #include "gsl_adapter.h"
 #include "impact.h"
 #include "impact_rays.h"
-#include "posedrop/tolerances.h"
 #include "vec3.h"
 
 /* --- the diverging ray ------------------------------------------------------- *
@@ -180,85 +179,4 @@ void pd_rays_incoming(const double K[][3], double mu, pd_rays *in)
         }
         flo = fhi;
     }
-}
-
-/* --- the slide's tail onto an incoming ray -------------------------------------- *
- * Near an incoming ray t (rate r < 0, normal n), write u_t = alpha t + beta n.
- * In tau (dpz/dtau = |u_t| = s), u_t' = s a - mu B u_t; with g = t.a,
- * k = mu t.B n = n.a (the ray is invariant) and c = mu n.B n this is exactly
- *   alpha' = r alpha - k beta + g (s - alpha),  beta' = -c beta + k (s - alpha),
- * where s - alpha = beta^2 / (s + alpha) is second order in eps = beta / alpha.
- * When the ray attracts (c + r > 0, the decay rate of eps) both reach 0 as
- * tau grows, so integrating from here to the origin gives, exactly,
- *   -alpha0 = r I_alpha - k I_beta + g S,  -beta0 = -c I_beta + k S,
- * with I the integrals of alpha, beta and S that of s - alpha: the rest of
- * the slide's impulse (-mu (t I_alpha + n I_beta), I_alpha + S) follows from
- * S alone, and ends with the slip at 0 whatever S is. S is taken from the
- * first-order flow (beta = beta0 e^(-c tau), alpha = (alpha0 - A) e^(r tau)
- * + A e^(-c tau), A = k beta0 / (c + r)), which leaves it wrong by its own
- * size times ~(|k| / (c + r) + eps): third order in eps, where leaving S out
- * would be second. */
-enum { TAIL_SERIES = 200 };
-
-/* The third-order error estimate below, scaled by this: measured against RK4
- * integrated to the origin (tests/test_impact.c), over random K, rays and
- * angles up to PD_TOL_IMPACT_TAIL_ANGLE, the impulse's error was at most 2.4% of it. */
-#define TAIL_MEASURED 0.1
-
-/* The integral of beta^2 / (2 alpha) along the first-order flow:
- * beta0^2 / (2 (alpha0 - A)) sum_j (-x)^j / ((2c + r) + j (c + r)), with
- * x = A / (alpha0 - A), |x| < 1 under the caller's attraction test. */
-static double tail_slack(double alpha, double beta, double A, double c, double r)
-{
-    double x = A / (alpha - A), term = 1.0, sum = 0.0;
-    for (int j = 0; j < TAIL_SERIES; j++, term *= -x) {
-        double add = term / ((2.0 * c + r) + j * (c + r));
-        sum += add;
-        if (!(fabs(add) > DBL_EPSILON * fabs(sum)))
-            break;
-    }
-    return 0.5 * beta * beta / (alpha - A) * sum;
-}
-
-int pd_ray_tail(const double K[][3], double mu, const pd_rays *in, int k, pd_vec3 u,
-                double max_err, int with_work, pd_vec3 *dp, double *dw)
-{
-    const double tx = in->tx[k], ty = in->ty[k], r = in->rate[k];
-    double alpha = u.x * tx + u.y * ty, beta = tx * u.y - ty * u.x;
-    /* Cheap refusals first: this is asked at every step near the origin. S
-     * below is at least eps^2 alpha / (4 (2c + r)) and 2c + r < 2 mu tr B. */
-    if (!(alpha > 0.0) || !(fabs(beta) <= PD_TOL_IMPACT_TAIL_ANGLE * alpha))
-        return 0;
-    double e2a = beta * beta / alpha, trb = 2.0 * mu * (K[0][0] + K[1][1]);
-    if (!(e2a / (4.0 * trb) * (with_work ? 1.0 : TAIL_MEASURED * fabs(beta) / alpha) <= max_err))
-        return 0;
-    double btt = K[0][0] * tx * tx + 2.0 * K[0][1] * tx * ty + K[1][1] * ty * ty;
-    double bnn = K[0][0] * ty * ty - 2.0 * K[0][1] * tx * ty + K[1][1] * tx * tx;
-    double btn = (K[1][1] - K[0][0]) * tx * ty + K[0][1] * (tx * tx - ty * ty);
-    double c = mu * bnn, kq = mu * btn, g = r + mu * btt;
-    /* The quadratic term of eps' = -(c + r) eps + (3/2) k eps^2 + ... must
-     * not rival the decay; and u_z must rise along the ray (q > 0), so that
-     * no normal event can hide inside the tail. */
-    double q = K[2][2] - mu * (K[2][0] * tx + K[2][1] * ty);
-    if (!(c + r > 2.0 * fabs(kq * beta / alpha)) || !(q > 0.0))
-        return 0;
-    double A = kq * beta / (c + r);
-    double S = tail_slack(alpha, beta, A, c, r);
-    /* An error dS in S moves the impulse by dS (1 + (|g| + k^2 / c) / |r|)
-     * through the identities. dS is taken as S times (|k| / (c + r) + |eps|)
-     * times TAIL_MEASURED; with the work, whose closed form is first order,
-     * as S itself. */
-    double carry = S * (1.0 + (fabs(g) + kq * kq / c) / -r);
-    if (!((with_work ? 1.0 : TAIL_MEASURED * (fabs(kq) / (c + r) + fabs(beta) / alpha)) * carry <= max_err))
-        return 0;
-    double Ib = (beta + kq * S) / c;
-    double Ia = (alpha - kq * Ib + g * S) / -r;
-    *dp = v3(-mu * (tx * Ia - ty * Ib), -mu * (ty * Ia + tx * Ib), Ia + S);
-    /* W' = u_z s, u_z = u_z0 + q I_alpha(tau) - mu (K_zt.n) I_beta(tau) + O(S):
-     * to first order the integral of I_alpha alpha is I_alpha^2 / 2, and that
-     * of I_beta alpha follows from the first-order flow. */
-    double kzn = K[2][1] * tx - K[2][0] * ty;
-    double iba = beta / c * (Ia - (alpha - A) / (c - r) - 0.5 * A / c);
-    *dw = u.z * (Ia + S) + 0.5 * q * Ia * Ia - mu * kzn * iba;
-    return 1;
 }

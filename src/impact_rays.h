@@ -8,7 +8,8 @@
  * the rate lambda, out of the origin when lambda > 0 (the diverging ray of
  * unstable sticking), into it when lambda < 0 (an incoming ray). Along an
  * invariant ray the impulse direction (-mu t, 1) is constant, so a collision
- * on one is solved in closed form (src/impact_slide.c). K is 3 x 3, declared
+ * on one is solved in closed form (src/impact_slide.c), and one that ends on
+ * an incoming ray as a power series (src/impact_ray_series.c). K is 3 x 3, declared
  * K[][3]: with the sanitizers, GCC's -Wstringop-overflow takes a struct
  * member passed through CONST_M3 for its first row alone. */
 #ifndef PD_IMPACT_RAYS_H
@@ -32,15 +33,5 @@ int pd_ray_diverging(const double K[][3], double mu, double *tx, double *ty);
  * left out. None when the flow turns nowhere (a = 0 and B isotropic: every
  * ray is invariant and the flow needs no snapping). K is taken as is. */
 void pd_rays_incoming(const double K[][3], double mu, pd_rays *in);
-
-/* The rest of a slide that ends on incoming ray k of in, from the contact
- * velocity u, in closed form (the derivation is at the definition): the
- * impulse *dp it adds (contact frame), after which the slip is 0, and the
- * normal work *dw. Returns 0 (and sets nothing) unless the ray attracts, the
- * normal velocity rises along it, and the error of *dp is estimated below
- * max_err (units of the impulse): third order in the angle eps to the ray,
- * or, with_work, second order, the order of *dw's. */
-int pd_ray_tail(const double K[][3], double mu, const pd_rays *in, int k, pd_vec3 u,
-                double max_err, int with_work, pd_vec3 *dp, double *dw);
 
 #endif

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include "check.h"
 #include "impact.h"
+#include "impact_ray_series.h"
 #include "impact_rays.h"
 #include "posedrop/tolerances.h"
 #include "shapes.h"
@@ -669,27 +670,51 @@ static void test_laws_oracle(void)
     pd_impact_work_free(w);
 }
 
-/* The tail onto an incoming ray (impact_rays.c) against the slide itself:
- * eq. 14 in tau integrated by RK4 to the origin (1e-12 of the slip), from
- * states at an angle eps of 1e-4 to 0.1 from a ray. Where the tail accepts
- * an error bound (1e-8 or 1e-9), its impulse must meet it; after it the
- * slip is 0. */
-static void tau_flow(const double K[3][3], double mu, const double y[5], double d[5])
+/* The tail onto an incoming ray (impact_ray_series.c) against the slide
+ * itself: eq. 14 in tau integrated by RK4 to the origin (1e-12 of the
+ * slip), with the normal work, from states at an angle eps of 1e-4 to
+ * PD_TOL_IMPACT_SERIES_ANGLE from a ray and slips of 1e-3 to 1. Where the tail accepts an error bound
+ * (1e-8 or 1e-9), its impulse and work must meet it; after it the slip is
+ * 0. The closed form that exists, on the ray itself, to round-off. */
+static void tau_flow(const double K[3][3], double mu, double uz0, const double y[6], double d[6])
 {
-    /* y = (u_x, u_y, p_x, p_y, p_z) */
+    /* y = (u_x, u_y, p_x, p_y, p_z, W) */
     double s = hypot(y[0], y[1]);
     d[2] = -mu * y[0];
     d[3] = -mu * y[1];
     d[4] = s;
     d[0] = K[0][0] * d[2] + K[0][1] * d[3] + K[0][2] * d[4];
     d[1] = K[1][0] * d[2] + K[1][1] * d[3] + K[1][2] * d[4];
+    d[5] = (uz0 + K[2][0] * y[2] + K[2][1] * y[3] + K[2][2] * y[4]) * s;
+}
+
+static void rk4_to_origin(const double K[3][3], double mu, pd_vec3 u, double y[6])
+{
+    double h = 0.002 / (mu * (K[0][0] + K[1][1] + 2.0 * fabs(K[0][1])) + hypot(K[0][2], K[1][2]));
+    const double s0 = hypot(u.x, u.y);
+    y[0] = u.x, y[1] = u.y, y[2] = y[3] = y[4] = y[5] = 0.0;
+    for (long n = 0; n < 100000000 && hypot(y[0], y[1]) > 1e-12 * s0; n++) {
+        double k1[6], k2[6], k3[6], k4[6], m[6];
+        tau_flow(K, mu, u.z, y, k1);
+        for (int j = 0; j < 6; j++)
+            m[j] = y[j] + 0.5 * h * k1[j];
+        tau_flow(K, mu, u.z, m, k2);
+        for (int j = 0; j < 6; j++)
+            m[j] = y[j] + 0.5 * h * k2[j];
+        tau_flow(K, mu, u.z, m, k3);
+        for (int j = 0; j < 6; j++)
+            m[j] = y[j] + h * k3[j];
+        tau_flow(K, mu, u.z, m, k4);
+        for (int j = 0; j < 6; j++)
+            y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+    }
 }
 
 static void test_ray_tail(void)
 {
     test_rng rng = {19};
-    int taken = 0, tried = 0;
-    double worst = 0.0;
+    int taken = 0, tried = 0, wide = 0;
+    double worst = 0.0, worst_w = 0.0, worst_on = 0.0;
     for (int t = 0; t < 400 && tried < 200; t++) {
         double K[3][3];
         random_K(&rng, K);
@@ -701,36 +726,40 @@ static void test_ray_tail(void)
         pd_rays in;
         pd_rays_incoming(CR(K), mu, &in);
         for (int k = 0; k < in.n; k++) {
-            double eps = pow(10.0, rng_range(&rng, -4.0, -1.0)) * (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+            const double tx = in.tx[k], ty = in.ty[k], r = in.rate[k];
+            pd_ray_series sr;
+            pd_ray_series_build(CR(K), mu, tx, ty, 1, &sr);
+            if (!sr.ok)
+                continue; /* a ray that repels nearby directions has no tail */
+            /* On the ray: p' = (-mu t, 1) for pz = s / |rate|, u_z linear in pz. */
             double alpha = pow(10.0, rng_range(&rng, -3.0, 0.0));
-            pd_vec3 u = v3(alpha * (in.tx[k] - eps * in.ty[k]), alpha * (in.ty[k] + eps * in.tx[k]), -1.0);
-            const double max_err = tried % 2 ? 1e-8 : 1e-9;
-            pd_vec3 dp;
+            pd_vec3 u = v3(alpha * tx, alpha * ty, -1.0), dp;
             double dw;
+            CHECK(pd_ray_series_tail(CR(K), mu, &sr, u, PD_TOL_IMPACT_SERIES_ANGLE, 1e-9, 1, &dp, &dw));
+            double pz = alpha / -r, q = K[2][2] - mu * (K[2][0] * tx + K[2][1] * ty);
+            double on = v3_norm(v3_sub(dp, v3(-mu * tx * pz, -mu * ty * pz, pz))) / pz;
+            worst_on = fmax(worst_on, on);
+            CHECK_NEAR(on, 0.0, 1e-13, "round-off: on the ray the series is its first term");
+            CHECK_REL(dw, u.z * pz + 0.5 * q * pz * pz, 1e-12, "round-off: the work on the ray");
+
+            double eps = pow(10.0, rng_range(&rng, -4.0, log10(PD_TOL_IMPACT_SERIES_ANGLE))) *
+                         (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+            u = v3(alpha * (tx * cos(eps) - ty * sin(eps)), alpha * (ty * cos(eps) + tx * sin(eps)), -1.0);
+            const double max_err = tried % 2 ? 1e-8 : 1e-9;
             tried++;
-            if (!pd_ray_tail(CR(K), mu, &in, k, u, max_err, 0, &dp, &dw))
+            if (!pd_ray_series_tail(CR(K), mu, &sr, u, PD_TOL_IMPACT_SERIES_ANGLE, max_err, 1, &dp, &dw))
                 continue;
             taken++;
-            double y[5] = {u.x, u.y, 0.0, 0.0, 0.0};
-            double h = 0.002 / (mu * (K[0][0] + K[1][1] + 2.0 * fabs(K[0][1])) + hypot(K[0][2], K[1][2]));
-            for (long n = 0; n < 100000000 && hypot(y[0], y[1]) > 1e-12 * alpha; n++) {
-                double k1[5], k2[5], k3[5], k4[5], m[5];
-                tau_flow(CR(K), mu, y, k1);
-                for (int j = 0; j < 5; j++)
-                    m[j] = y[j] + 0.5 * h * k1[j];
-                tau_flow(CR(K), mu, m, k2);
-                for (int j = 0; j < 5; j++)
-                    m[j] = y[j] + 0.5 * h * k2[j];
-                tau_flow(CR(K), mu, m, k3);
-                for (int j = 0; j < 5; j++)
-                    m[j] = y[j] + h * k3[j];
-                tau_flow(CR(K), mu, m, k4);
-                for (int j = 0; j < 5; j++)
-                    y[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
-            }
+            wide += fabs(eps) > 0.1 && alpha > 0.1; /* beyond the third-order tail's reach */
+            double y[6];
+            rk4_to_origin(CR(K), mu, u, y);
             double err = v3_norm(v3_sub(dp, v3(y[2], y[3], y[4])));
             worst = fmax(worst, err);
+            worst_w = fmax(worst_w, fabs(dw - y[5]) / fmax(1.0, fabs(y[5])));
             CHECK_NEAR(err, 0.0, max_err, "the bound the tail accepted; RK4 in steps of 0.002 of the flow's rate adds < 1e-11");
+            /* relative beyond 1: a slowly closing ray's work reaches 1e3 and
+             * RK4's 1e7 steps sum round-off of 1e-12 of it */
+            CHECK_NEAR(dw, y[5], max_err * fmax(1.0, fabs(y[5])), "the work's bound");
             /* u_t after it: u_t + B dp_t + a dp_z = 0 to round-off */
             double rx = u.x + K[0][0] * dp.x + K[0][1] * dp.y + K[0][2] * dp.z;
             double ry = u.y + K[1][0] * dp.x + K[1][1] * dp.y + K[1][2] * dp.z;
@@ -738,8 +767,11 @@ static void test_ray_tail(void)
         }
     }
     CHECK(taken >= 40);
-    printf("impact: ray tails: %d of %d offered taken, impulse within %.2g of RK4 to the origin\n",
-           taken, tried, worst);
+    CHECK(wide >= 5);
+    printf("impact: ray tails (series): %d of %d offered taken (%d beyond 0.1 rad at slip > 0.1), "
+           "impulse within %.2g and work within %.2g (relative beyond 1) of RK4 to the origin; "
+           "on the ray within %.2g\n",
+           taken, tried, wide, worst, worst_w, worst_on);
 }
 
 static void test_incoming_rays(void)
