@@ -70,3 +70,12 @@ void state_gap_add(state_gap *gap, const pd_body *b, double g, const pd_state *a
     gap->w = fmax(gap->w, v3_dist(a->w, r->w) * T);
     gap->E = fmax(gap->E, fabs(Ea - Er) / mgL);
 }
+
+void state_gap_check(const state_gap *gap, double tol)
+{
+    CHECK_NEAR(gap->x, 0.0, tol, "position per L");
+    CHECK_NEAR(gap->v, 0.0, tol, "velocity per sqrt(g L)");
+    CHECK_NEAR(gap->q, 0.0, tol, "unit quaternion components");
+    CHECK_NEAR(gap->w, 0.0, tol, "rate of turn per 1/sqrt(L/g)");
+    CHECK_NEAR(gap->E, 0.0, tol, "energy per m g L");
+}

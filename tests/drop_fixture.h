@@ -37,4 +37,8 @@ typedef struct {
 void state_gap_add(state_gap *gap, const pd_body *b, double g, const pd_state *a,
                    const pd_state *r);
 
+/* Checks every component of gap against tol (the same tolerance in each
+ * unit: the callers' sources are errors relative to the part's scales). */
+void state_gap_check(const state_gap *gap, double tol);
+
 #endif

@@ -177,11 +177,7 @@ static void check_motion(drop_fixture *fx, pd_scene *sc, test_rng *rng)
     CHECK(compared >= 50);
     CHECK_INT(other_event, 0);
     CHECK_NEAR(dt, 0.0, PD_TOL_PHASE_EVENT_REL + 1e-7, "end times per sqrt(L/g)");
-    CHECK_NEAR(gap.x, 0.0, tol, "position per L");
-    CHECK_NEAR(gap.v, 0.0, tol, "velocity per sqrt(g L)");
-    CHECK_NEAR(gap.q, 0.0, tol, "unit quaternion components");
-    CHECK_NEAR(gap.w, 0.0, tol, "rate of turn per 1/sqrt(L/g)");
-    CHECK_NEAR(gap.E, 0.0, tol, "energy per m g L");
+    state_gap_check(&gap, tol);
     CHECK_NEAR(drift, 0.0, tol, "the pivot's energy over a phase");
     printf("contact_pivot: %d events, %d compared: t %.1e x %.1e v %.1e q %.1e w %.1e E %.1e, "
            "pivot energy drift %.1e m g L\n",
