@@ -17,7 +17,12 @@ LIB_PKGS  := gsl ode ccd bullet
 TEST_PKGS := qhull_r
 
 CONFIG := opt
-CFLAGS_OPT := -O2
+# -O3 changes no result (no reassociation without -ffast-math): measured with
+# callgrind on the median drops of make bench's parts, 4-6% fewer
+# instructions than -O2, the same bytes out. -fno-math-errno lets sqrt compile
+# to its instruction without the errno call path; posedrop reads errno only
+# after strtod/strtol and I/O, which the flag does not touch.
+CFLAGS_OPT := -O3 -fno-math-errno
 ifeq ($(DEBUG),1)
 CONFIG := debug
 CFLAGS_OPT := -O0 -g3 -DPD_DEBUG
