@@ -102,6 +102,7 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
     if (st == PD_OK) {
         pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
         pd_flat_build(m->body, part->hull, m->descent, m->flat);
+        m->flat_height = pd_flat_height_max(m->flat, nf);
         m->barrier_max = -INFINITY;
         for (int f = 0; f < nf; f++) {
             m->pose_of[f] = -1;
@@ -347,10 +348,17 @@ static pd_vec3 gravity_in_part(const pd_sim_model *m, const pd_state *s)
     return quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
 }
 
-/* pd_drop_decided, also giving the facet the part would land on. */
+/* pd_drop_decided, also giving the facet the part would land on, or -1
+ * when neither that test nor pd_flat_settled can pass (the energy above
+ * every barrier, the centre of mass above every flat rest's reach), where
+ * the descent is skipped. */
 static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose,
                       int *facet)
 {
+    *facet = -1;
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max) &&
+        !(s->x.z < m->flat_height))
+        return 0;
     pd_vec3 down = gravity_in_part(m, s);
     int f;
     if (pd_descend(m->hull, &m->star, m->com, down, &f, hint) != PD_OK)
@@ -407,7 +415,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     int resolved = 0;
     for (;;) {
         int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
-        if (d == 0 && m->pose_of[facet] >= 0 &&
+        if (d == 0 && facet >= 0 && m->pose_of[facet] >= 0 &&
             pd_flat_settled(m->flat, m->body, &s, facet, g, sc->mu, m->rest_fall)) {
             d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
             pose = m->pose_of[facet];

@@ -24,6 +24,7 @@ struct pd_sim_model {
     double *barrier;            /* per facet: its basin's barrier height, m */
     double barrier_max;         /* the largest of them */
     struct pd_flat_facet *flat; /* per facet: what lying flat on it takes (flat_rest.h) */
+    double flat_height;         /* m: with the centre of mass this high, flat on none */
     pd_star star;
     int *pose_of;               /* facet -> pose index in the caller's table, or -1 */
     const pd_static_result *poses;

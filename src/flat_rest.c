@@ -63,6 +63,25 @@ void pd_flat_build(const pd_body *b, const pd_hull *hull, const pd_static_result
     }
 }
 
+/* The share of PD_FLAT_SAFETY at which pd_flat_settled refuses before its
+ * pass over the corners (below): shared by pd_flat_height_max. */
+#define EARLY_SAFETY (0.99 * PD_FLAT_SAFETY)
+
+double pd_flat_height_max(const pd_flat_facet *ff, int nfacets)
+{
+    /* pd_flat_settled's early refusal holds once EARLY_SAFETY (z - h) reaches
+     * the largest barrier the facet can give, sqrt(inside^2 + h^2) - h (no
+     * tilting torque), its rocking energy being at least z - h. */
+    double zmax = -INFINITY;
+    for (int f = 0; f < nfacets; f++) {
+        const pd_flat_facet *F = &ff[f];
+        if (F->inside > 0.0)
+            zmax = fmax(zmax, F->h + (sqrt(F->inside * F->inside + F->h * F->h) - F->h) /
+                                         EARLY_SAFETY);
+    }
+    return zmax;
+}
+
 int pd_flat_settled(const pd_flat_facet *ff, const pd_body *b, const pd_state *s, int f, double g,
                     double mu, double rest_fall)
 {
@@ -91,7 +110,7 @@ int pd_flat_settled(const pd_flat_facet *ff, const pd_body *b, const pd_state *s
      * beyond the bound, so that the round-off of the two sums never refuses
      * what the exact test below would take. */
     double rock_least = (s->x.z - F->h) + (ke - ke_flat) / mg;
-    if (!(barrier > 0.99 * PD_FLAT_SAFETY * (fmax(rock_least, 0.0) + rest_fall)))
+    if (!(barrier > EARLY_SAFETY * (fmax(rock_least, 0.0) + rest_fall)))
         return 0;
     int base = b->facet_start[f], k = b->facet_start[f + 1] - base;
     double zmin = INFINITY;

@@ -33,6 +33,12 @@ typedef struct pd_flat_facet {
 void pd_flat_build(const pd_body *b, const pd_hull *hull, const pd_static_result *descent,
                    pd_flat_facet *out);
 
+/* A height of the centre of mass above the floor, m, at and above which
+ * pd_flat_settled refuses whatever the facet and the motion (its test needs
+ * the centre of mass within a facet's barrier of lying flat on it), so a
+ * caller may skip finding the facet. -INFINITY if no facet is stable. */
+double pd_flat_height_max(const pd_flat_facet *ff, int nfacets);
+
 /* 1 if state s lies on stable facet f, flat up to a rocking energy that
  * cannot tip it, and so stays there for good under friction mu and gravity g:
  * its outcome is facet f. rest_fall is the depth a resting contact may have
