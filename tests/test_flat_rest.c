@@ -97,9 +97,9 @@ static void test_placement(void)
     }
 }
 
-/* The cube of side L lying flat on facet f, sliding at v and spinning about
+/* The part lying flat on facet f, sliding at v and spinning about
  * the vertical at spin, plus a rocking rate about a horizontal axis. */
-static pd_state cube_flat(const pd_sim_model *m, int f, pd_vec3 v, double spin, double rock)
+static pd_state lying_flat(const pd_sim_model *m, int f, pd_vec3 v, double spin, double rock)
 {
     const pd_flat_facet *F = &m->flat[f];
     pd_vec3 down = v3(0, 0, -1), axis = v3_cross(F->n, down);
@@ -130,13 +130,13 @@ static void test_rule(void)
     /* Rocking rate whose energy per unit weight is e: I w^2 / 2 = m g e. */
     double I = b->moment[0];
     for (int f = 0; f < 6; f++) {
-        pd_state fast = cube_flat(m, f, v3(2.0, -1.0, 0.0), 300.0, 0.0);
+        pd_state fast = lying_flat(m, f, v3(2.0, -1.0, 0.0), 300.0, 0.0);
         CHECK(pd_flat_settled(m->flat, b, &fast, f, g, 0.3, rf));
         CHECK(!pd_flat_settled(m->flat, b, &fast, f, g, 1.0, rf)); /* mu h = inside */
         double w_in = sqrt(2.0 * b->mass * g * 0.99 * allowed / I);
         double w_out = sqrt(2.0 * b->mass * g * 1.01 * allowed / I);
-        pd_state in = cube_flat(m, f, v3(0.5, 0, 0), 0.0, w_in);
-        pd_state out = cube_flat(m, f, v3(0.5, 0, 0), 0.0, w_out);
+        pd_state in = lying_flat(m, f, v3(0.5, 0, 0), 0.0, w_in);
+        pd_state out = lying_flat(m, f, v3(0.5, 0, 0), 0.0, w_out);
         CHECK(pd_flat_settled(m->flat, b, &in, f, g, 0.3, rf));
         CHECK(!pd_flat_settled(m->flat, b, &out, f, g, 0.3, rf));
         /* Lifted by the same energy: the same verdicts. */
@@ -147,6 +147,57 @@ static void test_rule(void)
         CHECK(!pd_flat_settled(m->flat, b, &out, f, g, 0.3, rf));
     }
     drop_teardown(&fx);
+}
+
+/* pd_flat_height_max: with the centre of mass at or above it no facet
+ * passes, lying level and at rest (the test's most lenient state) or turned
+ * and moving at random, even at mu 0 and no rest fall (its most lenient
+ * settings); and it is tight: lying level and at rest 2% of the way below
+ * it, on the facet that sets it, the part passes. */
+static void height_max_check(pd_mesh *mesh)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    drop_fixture fx;
+    if (!drop_setup(&fx, mesh, &sc))
+        return;
+    const pd_sim_model *m = fx.model;
+    const pd_body *b = m->body;
+    int nf = m->hull->nfacets;
+    double zmax = pd_flat_height_max(m->flat, nf), g = sc.gravity;
+    CHECK(isfinite(zmax) && zmax > 0.0);
+    test_rng rng = {7};
+    int passed = 0;
+    for (int t = 0; t < 200; t++) {
+        pd_vec3 axis = rng_unit_vector(&rng);
+        pd_state s = {v3(0, 0, zmax * (1.0 + rng_range(&rng, 0.0, 0.5) * (t > 0))),
+                      quat_axis_angle(axis, rng_range(&rng, 0.0, M_PI)),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 0.5)),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 50.0))};
+        for (int f = 0; f < nf; f++)
+            passed += pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+    }
+    int tight = 0;
+    for (int f = 0; f < nf; f++) {
+        const pd_flat_facet *F = &m->flat[f];
+        if (!(F->inside > 0.0))
+            continue;
+        pd_state s = lying_flat(m, f, v3(0, 0, 0), 0.0, 0.0);
+        s.x.z = zmax;
+        passed += pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+        s.x.z = F->h + 0.98 * (zmax - F->h);
+        tight |= pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+    }
+    CHECK_INT(passed, 0);
+    CHECK(tight);
+    drop_teardown(&fx);
+}
+
+static void test_height_max(void)
+{
+    height_max_check(mesh_box(0.01, 0.01, 0.01));
+    height_max_check(mesh_box(0.01, 0.02, 0.03));
+    height_max_check(mesh_prism(32, 0.01, 0.01));
 }
 
 /* Runs n drops of mesh in the default scene with the test and again with it
@@ -216,5 +267,6 @@ void suite_flat_rest(void)
     test_box_facets();
     test_placement();
     test_rule();
+    test_height_max();
     test_agreement();
 }
