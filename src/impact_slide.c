@@ -236,12 +236,12 @@ static int onto_incoming(collision *c, pd_vec3 u, double s)
  * slip stays away from zero (by the Newton estimate it cannot fall below
  * half), and the variable's rate away from zero: q = du_z/dpz > 1/4 of its
  * value here for every direction, u_z > 4 times its growth over the step.
+ * qmin is q's least over directions, K_zz - mu |K_zt|.
  * Returns the form to step in and sets its range [*e0, *e1] and *rate =
  * dsigma/dpz here, or -1. */
-static int henon_form(const collision *c, int ev, pd_vec3 u, double s, pd_vec3 du, double hlim,
-                      double *e0, double *e1, double *rate)
+static int henon_form(const collision *c, double qmin, int ev, pd_vec3 u, double s, pd_vec3 du,
+                      double hlim, double *e0, double *e1, double *rate)
 {
-    const double qmin = c->K[2][2] - c->mu * hypot(c->K[2][0], c->K[2][1]); /* q's least */
     if ((u.x * du.x + u.y * du.y) * hlim < -0.5 * s)
         return -1;
     if (ev == EV_COMPRESS && qmin > 0.25 * du.z) {
@@ -266,6 +266,7 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
     double flow = c->mu * sqrt(c->K[0][0] * c->K[0][0] + 2.0 * c->K[0][1] * c->K[0][1] +
                                c->K[1][1] * c->K[1][1]) + hypot(c->K[0][2], c->K[1][2]);
     double tau = 0.0, h = TAU_FIRST_STEP / flow;
+    const double qmin = c->K[2][2] - c->mu * hypot(c->K[2][0], c->K[2][1]); /* q's least */
     double cap = INFINITY; /* set by an overshoot: the next step ends there */
     int cap_event = EV_NONE;
     int henon = 1; /* cleared if a step onto an event ever fails */
@@ -311,7 +312,7 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
         double hlim, e0, e1, rate;
         int ev = next_event(c, u, s, du, &hlim);
         int f = henon && ev != EV_NONE && isinf(cap) && hlim <= h
-                    ? henon_form(c, ev, u, s, du, hlim, &e0, &e1, &rate) : -1;
+                    ? henon_form(c, qmin, ev, u, s, du, hlim, &e0, &e1, &rate) : -1;
         if (f >= 0 && e1 > e0) {
             double he = h * s * rate, dy[NSTATE];
             form_rhs[f](e0, c->y, dy, c);
