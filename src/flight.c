@@ -122,13 +122,30 @@ static void set_chart(pd_flight *f, int c, double s)
     if (c == 2) {
         f->perm[0] = 0, f->perm[1] = 1, f->perm[2] = 2;
         f->sgn[0] = 1.0, f->sgn[1] = s, f->sgn[2] = s;
+        f->e_kind = s > 0.0 ? 0 : 1;
     } else {
         f->perm[0] = 2, f->perm[1] = 1, f->perm[2] = 0;
         f->sgn[0] = -s, f->sgn[1] = 1.0, f->sgn[2] = s;
+        f->e_kind = 2;
     }
     for (int i = 0; i < 3; i++)
         E[i][f->perm[i]] = f->sgn[i];
     f->e = quat_from_matrix(CONST_M3(E));
+}
+
+/* a e (quat_mul) without the products with e's zero components, which add
+ * exactly nothing: the same result for a fraction of the work. */
+static pd_quat times_e(const pd_flight *f, pd_quat a)
+{
+    double c = f->e.w, d = f->e.y;
+    switch (f->e_kind) {
+    case 0:
+        return a;
+    case 1:
+        return quat(-a.x, a.w, a.z, -a.y);
+    default:
+        return quat(a.w * c - a.y * d, a.x * c - a.z * d, a.w * d + a.y * c, a.x * d + a.z * c);
+    }
 }
 
 /* The principal axis u lies on within tol (its other components), or -1. */
@@ -176,6 +193,7 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     for (int i = 0; i < 3; i++) {
         uch[i] = F->sgn[i] * comp(u, F->perm[i]);
         F->J[i] = J[F->perm[i]];
+        F->wsc[i] = F->sgn[i] * F->lambda * F->J[i];
     }
     double J1 = F->J[0], J2 = F->J[1], J3 = F->J[2];
     /* D - J3 and J1 - D from the components: no cancellation near pure spin. */
@@ -329,10 +347,10 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
             phc = cos(0.5 * phi);
             phs = sin(0.5 * phi);
         }
-        s.q = quat_mul(quat_mul(f->Q0, chart_rotation(u, phc, phs)), f->e);
-        double wb[3] = {0};
+        s.q = times_e(f, quat_mul(f->Q0, chart_rotation(u, phc, phs)));
+        double wb[3];
         for (int i = 0; i < 3; i++)
-            wb[f->perm[i]] = f->sgn[i] * f->lambda * f->J[i] * u[i];
+            wb[f->perm[i]] = f->wsc[i] * u[i];
         s.w = v3(wb[0], wb[1], wb[2]);
     }
     *out = s;
