@@ -25,12 +25,13 @@
  *
  * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by Jacobi's
  * theta series, planned once per flight (flight_theta.c): there phi = rate t
- * + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so an evaluation
- * takes two sincos and a few series terms. On the separatrix itself (m = 1
- * in double precision), where the series would converge slowly and cancel,
- * by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is
- * built from u and e^(i phi/2) by half-angle formulas (chart_rotation), with
- * no arc tangent. */
+ * + arg Y(v) - arg Y(v0), the constant part taken into Q0, and only e^(i
+ * phi/2) is needed, so an evaluation takes two sincos and a few series
+ * terms. On the separatrix itself (m = 1 in double precision), where the
+ * series would converge slowly and cancel, by GSL's sn, cn, dn and
+ * Legendre's integrals. Either way the quaternion is built from u, the
+ * unnormalised Y (or 1) and e^(i rate t/2) by half-angle formulas
+ * (chart_rotation), with no arc tangent. */
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
@@ -48,45 +49,48 @@ static pd_vec3 body_L(const pd_body *b, pd_vec3 w)
 
 static double comp(pd_vec3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
-/* e^(i a/2) for a in (-pi, pi] from the unit e^(i a) = c + i s, without
- * trigonometry: the half-angle formulas, each on the side where it has no
- * cancellation. */
-static void half_angle(double c, double s, double *hc, double *hs)
+/* e^(i a/2), a = arg(x + i y) in (-pi, pi], (x, y) != 0 of any length,
+ * without trigonometry: the half-angle formulas, each on the side where it
+ * has no cancellation. */
+static void half_angle(double x, double y, double *hc, double *hs)
 {
-    if (c >= 0.0) {
-        *hc = sqrt(0.5 * (1.0 + c));
-        *hs = s / (2.0 * *hc);
+    double r = sqrt(x * x + y * y);
+    if (x >= 0.0) {
+        *hc = sqrt(0.5 * (1.0 + x / r));
+        *hs = y / (2.0 * r * *hc);
     } else {
-        *hs = copysign(sqrt(0.5 * (1.0 - c)), s);
-        *hc = s / (2.0 * *hs);
+        *hs = copysign(sqrt(0.5 * (1.0 - x / r)), y);
+        *hc = y / (2.0 * r * *hs);
     }
 }
 
-/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, in the
- * product form of the three half-angle rotations, with theta and psi the
- * chart angles of u (u = Rz(psi)^T Rx(theta)^T z / |u|: theta =
- * atan2(|u1, u2|, u3), psi = atan2(u1, u2)) and phi given as e^(i phi/2) =
- * phc + i phs. The half angles come from u algebraically (half_angle):
- * nothing here is an arc tangent or a sine. */
-static pd_quat chart_rotation(const double u[3], double phc, double phs)
+/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, with
+ * theta and psi the chart angles of u (u = Rz(psi)^T Rx(theta)^T z / |u|:
+ * theta = atan2(|u1, u2|, u3), psi = atan2(u1, u2)), u3 >= 0 (the chart's
+ * u3 is a3 dn), and phi = arg z + 2 a given as z (any length) and e^(i a)
+ * = ac + i as. The product of the three half-angle rotations is
+ *   w + i z = cos(theta/2) A,  x + i y = sin(theta/2) A e^(-i psi),
+ *   A = e^(i (phi + psi)/2),
+ * and A is e^(i a) times the half angle of z (u2 + i u1), whose argument is
+ * phi - 2a + psi: one square root for both half angles, and sin(theta/2)
+ * e^(-i psi) = (u2 - i u1) / (2 |u| cos(theta/2)) needs none. The half
+ * angle's branch only picks the quaternion's sign. Nothing here is an arc
+ * tangent or a sine. */
+static pd_quat chart_rotation(const double u[3], double zr, double zi, double ac, double as)
 {
-    double rho2 = u[0] * u[0] + u[1] * u[1], rho = sqrt(rho2);
+    double rho2 = u[0] * u[0] + u[1] * u[1];
     double r = sqrt(rho2 + u[2] * u[2]);
-    double ct, st; /* cos, sin theta/2 */
-    if (u[2] >= 0.0) {
-        ct = sqrt(0.5 * (1.0 + u[2] / r));
-        st = rho / (2.0 * r * ct);
-    } else {
-        st = sqrt(0.5 * (1.0 - u[2] / r));
-        ct = rho / (2.0 * r * st);
+    double ct = sqrt(0.5 * (1.0 + u[2] / r)); /* cos theta/2 */
+    double k = 1.0 / (2.0 * r * ct);          /* sin(theta/2) / |u1, u2| */
+    double pr = zr, pi = zi;                  /* psi = 0 on the axis itself */
+    if (rho2 > 0.0) {
+        pr = zr * u[1] - zi * u[0];
+        pi = zr * u[0] + zi * u[1];
     }
-    double hc = 1.0, hs = 0.0; /* e^(i psi/2); psi = 0 on the axis itself */
-    if (rho > 0.0)
-        half_angle(u[1] / rho, u[0] / rho, &hc, &hs);
-    /* e^(i (phi + psi)/2) and e^(i (phi - psi)/2) */
-    double spc = phc * hc - phs * hs, sps = phs * hc + phc * hs;
-    double dpc = phc * hc + phs * hs, dps = phs * hc - phc * hs;
-    return quat(ct * spc, st * dpc, st * dps, ct * sps);
+    double hc, hs;
+    half_angle(pr, pi, &hc, &hs);
+    double Ar = ac * hc - as * hs, Ai = as * hc + ac * hs;
+    return quat(ct * Ar, k * (Ar * u[1] + Ai * u[0]), k * (Ai * u[1] - Ar * u[0]), ct * Ai);
 }
 
 /* Elliptic state at argument tau: u in the chart, and the unrolled
@@ -208,22 +212,28 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     F->k = sqrt(F->m);
     F->n = (J1 - J2) / (J2 - J3);
     F->Omega = (J2 > J3 ? 1.0 : -1.0) * F->lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
-    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
-     * to round-off. */
-    F->Q0 = quat_mul(quat_mul(F->s0.q, quat_conj(F->e)), quat_conj(chart_rotation(uch, 1.0, 0.0)));
     F->kind = PD_FLIGHT_ELLIPTIC;
+    /* Q0 = q0 e^-1 B(0)^-1, B(0) from the actual u so that R(0) = q0 to
+     * round-off, and with phi(0) as the evaluation has it (below, or 0). */
+    pd_quat q0e = quat_mul(F->s0.q, quat_conj(F->e));
     /* The theta series where they converge fast (flight_theta.h), with
      * 1 - m = (J1 - J3)(J2 - D) / ((J2 - J3)(J1 - D)) free of cancellation.
      * phi = lambda (J3 t + (J1 - J3)(P(tau) - P(tau0)) / Omega), P = mu tau +
      * sigma arg X, and lambda (J1 - J3) sigma / Omega = 1 exactly (sigma^2 =
-     * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios). */
+     * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios); arg X(v) =
+     * arg Y(v) - v0 - nu t. So phi = rate t + arg Y(v) - arg Y(v0), the last
+     * term a constant rotation about L that Q0 takes up. */
     double mc = (J1 - J3) * -DmJ2 / ((J2 - J3) * J1mD);
     if (pd_theta_plan(&F->th, F->m, mc, F->n, uch[1] / F->alpha[1], uch[0] / F->alpha[0],
                       F->Omega) == PD_OK) {
+        double sn, cn, dn, y0[2];
+        pd_theta_eval(&F->th, 0.0, &sn, &cn, &dn, y0);
         F->theta = 1;
-        F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu);
+        F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu) - F->th.nu;
+        F->Q0 = quat_mul(q0e, quat_conj(chart_rotation(uch, y0[0], y0[1], 1.0, 0.0)));
         return PD_OK;
     }
+    F->Q0 = quat_mul(q0e, quat_conj(chart_rotation(uch, 1.0, 0.0, 1.0, 0.0)));
     pd_status st;
     double K = 0.0;
     if (F->m < 1.0) {
@@ -325,29 +335,22 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
             s.w = quat_rotate(back, f->s0.w);
         }
     } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
-        double u[3], phc, phs; /* e^(i phi/2) */
+        double u[3], z[2] = {1.0, 0.0}, a; /* phi = arg z + 2a */
         if (f->theta) {
-            double sn, cn, dn, ph[2], hc, hs;
-            pd_theta_eval(&f->th, t, &sn, &cn, &dn, ph);
+            double sn, cn, dn;
+            pd_theta_eval(&f->th, t, &sn, &cn, &dn, z);
             u[0] = f->alpha[0] * cn;
             u[1] = f->alpha[1] * sn;
             u[2] = f->alpha[2] * dn;
-            /* e^(i phi/2) = e^(i rate t/2) e^(i (arg X - arg X0)/2); the half
-             * angle's branch only picks the quaternion's sign. */
-            half_angle(ph[0], ph[1], &hc, &hs);
-            double a = 0.5 * f->rate * t, c = cos(a), sa = sin(a);
-            phc = c * hc - sa * hs;
-            phs = sa * hc + c * hs;
+            a = 0.5 * f->rate * t;
         } else {
             double P;
             pd_status st = elliptic_at(f, f->tau0 + f->Omega * t, u, &P);
             if (st != PD_OK)
                 return st;
-            double phi = f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
-            phc = cos(0.5 * phi);
-            phs = sin(0.5 * phi);
+            a = 0.5 * f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
         }
-        s.q = times_e(f, quat_mul(f->Q0, chart_rotation(u, phc, phs)));
+        s.q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], cos(a), sin(a))));
         double wb[3];
         for (int i = 0; i < 3; i++)
             wb[f->perm[i]] = f->wsc[i] * u[i];

@@ -47,7 +47,7 @@ typedef struct pd_flight {
     double K2;           /* the period 2K of dn (0 on the separatrix: no period) */
     double Pc;           /* complete integral of the third kind */
     double P0;           /* P(am tau0) with periods unrolled */
-    double rate;         /* phi(t) = rate t + arg X(v) - arg X(v0) (flight_theta.h) */
+    double rate;         /* phi(t) = rate t + arg Y(v) - arg Y(v0) (flight_theta.h) */
     pd_theta th;         /* last: pd_flight_plan zeroes only what precedes it */
 } pd_flight;
 

@@ -29,7 +29,10 @@
  *
  * Truncation: relative to the leading term, term k of every series is at
  * most q^(k^2) (e^(2w) <= e^(pi K'/K) = 1/q since gamma <= K'), so the
- * series stop at the first k with q^(k^2) <= PD_TOL_FLIGHT_SERIES. */
+ * series stop at the first k with q^(k^2) <= PD_TOL_FLIGHT_SERIES.
+ *
+ * The flight (flight.c) folds arg Y(v0) into its constant rotation, so
+ * evaluation needs Y(v) alone, unnormalised. */
 #include <math.h>
 #include "flight_theta.h"
 #include "gsl_adapter.h"
@@ -37,17 +40,19 @@
 
 static const double PI = 3.14159265358979323846;
 
-/* th1..th4 at v (th1, th2 without their factor 2 q^(1/4)) into f, and X(v)
- * (unnormalised) into X: one sincos, the multiples by complex rotation. */
-static void series(const pd_theta *th, double v, double f[4], double X[2])
+/* th1..th4 at v (th1, th2 without their factor 2 q^(1/4)) into f, and Y(v)
+ * into Y: one sincos, the odd multiples by complex rotation and each even
+ * one, whose cosine alone is used, as the real part of the odd one below
+ * it times e^(iv). */
+static void series(const pd_theta *th, double v, double f[4], double Y[2])
 {
     double s = sin(v), c = cos(v);
     double e2r = c * c - s * s, e2i = 2.0 * s * c;
-    double odr = c, odi = s;     /* e^(i (2k+1) v) */
-    double evr = e2r, evi = e2i; /* e^(i 2k v), from k = 1 */
+    double odr = c, odi = s; /* e^(i (2k+1) v) */
     double t1 = odi, t2 = odr, t3 = 0.0, t4 = 0.0;
     double yr = th->S[0] * odr, yi = th->C[0] * odi;
     for (int k = 1; k < th->nterms; k++) {
+        double ev = odr * c - odi * s; /* cos 2kv */
         double r = odr * e2r - odi * e2i;
         odi = odr * e2i + odi * e2r;
         odr = r;
@@ -55,18 +60,15 @@ static void series(const pd_theta *th, double v, double f[4], double X[2])
         t2 += th->qo[k] * odr;
         yr += th->S[k] * odr;
         yi += th->C[k] * odi;
-        t3 += th->qe[k] * evr;
-        t4 += th->qes[k] * evr;
-        r = evr * e2r - evi * e2i;
-        evi = evr * e2i + evi * e2r;
-        evr = r;
+        t3 += th->qe[k] * ev;
+        t4 += th->qes[k] * ev;
     }
     f[0] = t1;
     f[1] = t2;
     f[2] = 1.0 + 2.0 * t3;
     f[3] = 1.0 + 2.0 * t4;
-    X[0] = c * yr + s * yi; /* e^(-iv) Y */
-    X[1] = c * yi - s * yr;
+    Y[0] = yr;
+    Y[1] = yi;
 }
 
 /* Gauss's arithmetic-geometric mean of a >= b > 0, so that K(k) = pi / (2
@@ -152,27 +154,17 @@ pd_status pd_theta_plan(pd_theta *th, double m, double mc, double n, double sn0,
      * -1 + Y'(0)/(i Y(0)) = -1 + sum (2k+1) C_k / sum S_k. */
     double sigma = sqrt(n / ((m + n) * (1.0 + n)));
     th->mu = 1.0 - sigma * scale * (sumC / sumS - 1.0);
-    double f[4], X[2];
-    series(th, th->v0, f, X);
-    double a = 1.0 / sqrt(X[0] * X[0] + X[1] * X[1]);
-    th->x0[0] = X[0] * a;
-    th->x0[1] = -X[1] * a;
-    if (!isfinite(th->mu + th->x0[0] + th->x0[1] + th->v0 + th->nu + th->csn + th->ccn + th->cdn))
+    if (!isfinite(th->mu + th->v0 + th->nu + th->csn + th->ccn + th->cdn + sumS + sumC))
         return PD_ERR_NONFINITE;
     return PD_OK;
 }
 
-void pd_theta_eval(const pd_theta *th, double t, double *sn, double *cn, double *dn, double ph[2])
+void pd_theta_eval(const pd_theta *th, double t, double *sn, double *cn, double *dn, double y[2])
 {
-    double f[4], X[2];
-    series(th, th->v0 + th->nu * t, f, X);
+    double f[4];
+    series(th, th->v0 + th->nu * t, f, y);
     double r = 1.0 / f[3];
     *sn = th->csn * f[0] * r;
     *cn = th->ccn * f[1] * r;
     *dn = th->cdn * f[2] * r;
-    double zr = X[0] * th->x0[0] - X[1] * th->x0[1];
-    double zi = X[0] * th->x0[1] + X[1] * th->x0[0];
-    double a = 1.0 / sqrt(zr * zr + zi * zi);
-    ph[0] = zr * a;
-    ph[1] = zi * a;
 }
