@@ -312,27 +312,23 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
 
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
 {
-    pd_state s = f->s0;
     if (t == 0.0) {
         /* The start itself: exact, and free (impact searches begin here). */
-        *out = s;
+        *out = f->s0;
         return PD_OK;
     }
-    s.x = v3(f->s0.x.x + f->s0.v.x * t, f->s0.x.y + f->s0.v.y * t,
-             f->s0.x.z + f->s0.v.z * t - 0.5 * f->g * t * t);
-    s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
+    pd_quat q = f->s0.q;
+    pd_vec3 w = f->s0.w;
     if (f->kind == PD_FLIGHT_AXIAL) {
         /* omega_body(t) = rot(axis, -b t) omega_body(0): for equal moments J
          * commutes with that rotation (see the derivation in flight.h). A
          * spherical top or a steady spin (b = 0) turns about L alone: its
          * body rotation, the identity, is skipped (exactly what it gives). */
-        pd_quat about_L = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
-        if (f->b == 0.0) {
-            s.q = about_L;
-        } else {
+        q = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
+        if (f->b != 0.0) {
             pd_quat back = quat_axis_angle(f->axis, -f->b * t);
-            s.q = quat_mul(about_L, quat_conj(back));
-            s.w = quat_rotate(back, f->s0.w);
+            q = quat_mul(q, quat_conj(back));
+            w = quat_rotate(back, f->s0.w);
         }
     } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
         double u[3], z[2] = {1.0, 0.0}, a; /* phi = arg z + 2a */
@@ -350,13 +346,18 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
                 return st;
             a = 0.5 * f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
         }
-        s.q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], cos(a), sin(a))));
+        q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], cos(a), sin(a))));
         double wb[3];
         for (int i = 0; i < 3; i++)
             wb[f->perm[i]] = f->wsc[i] * u[i];
-        s.w = v3(wb[0], wb[1], wb[2]);
+        w = v3(wb[0], wb[1], wb[2]);
     }
-    *out = s;
+    const pd_state *s0 = &f->s0;
+    out->x = v3(s0->x.x + s0->v.x * t, s0->x.y + s0->v.y * t,
+                s0->x.z + s0->v.z * t - 0.5 * f->g * t * t);
+    out->v = v3(s0->v.x, s0->v.y, s0->v.z - f->g * t);
+    out->q = q;
+    out->w = w;
     return PD_OK;
 }
 
