@@ -33,8 +33,8 @@ typedef struct pd_theta {
  * at the point sn = sn0, cn = cn0 of the period (any scale: only their ratio
  * is used) and moving at d tau / dt = omega. PD_ERR_RANGE when the nome
  * exceeds PD_FLIGHT_NOME_MAX (near the separatrix), where the caller uses
- * Legendre's integrals instead; PD_ERR_NONFINITE if GSL's RF fails or a
- * planned value is not finite. */
+ * Legendre's integrals instead; PD_ERR_NONFINITE if a planned value is not
+ * finite. */
 pd_status pd_theta_plan(pd_theta *th, double m, double mc, double n, double sn0, double cn0,
                         double omega);
 
