@@ -38,6 +38,7 @@
 #include "flight.h"
 #include "gsl_adapter.h"
 #include "posedrop/tolerances.h"
+#include "sincos.h"
 #include "vec3.h"
 
 static const double PI = 3.14159265358979323846;
@@ -135,6 +136,14 @@ static void set_chart(pd_flight *f, int c, double s)
     for (int i = 0; i < 3; i++)
         E[i][f->perm[i]] = f->sgn[i];
     f->e = quat_from_matrix(CONST_M3(E));
+}
+
+/* quat_axis_angle by pd_sincos. */
+static pd_quat turn(pd_vec3 axis, double angle)
+{
+    double s, c;
+    pd_sincos(0.5 * angle, &s, &c);
+    return quat(c, axis.x * s, axis.y * s, axis.z * s);
 }
 
 /* a e (quat_mul) without the products with e's zero components, which add
@@ -324,9 +333,9 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
          * commutes with that rotation (see the derivation in flight.h). A
          * spherical top or a steady spin (b = 0) turns about L alone: its
          * body rotation, the identity, is skipped (exactly what it gives). */
-        q = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
+        q = quat_mul(turn(f->lhat, f->a * t), f->s0.q);
         if (f->b != 0.0) {
-            pd_quat back = quat_axis_angle(f->axis, -f->b * t);
+            pd_quat back = turn(f->axis, -f->b * t);
             q = quat_mul(q, quat_conj(back));
             w = quat_rotate(back, f->s0.w);
         }
@@ -346,7 +355,9 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
                 return st;
             a = 0.5 * f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
         }
-        q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], cos(a), sin(a))));
+        double ac, as;
+        pd_sincos(a, &as, &ac);
+        q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], ac, as)));
         double wb[3];
         for (int i = 0; i < 3; i++)
             wb[f->perm[i]] = f->wsc[i] * u[i];

@@ -40,6 +40,7 @@
  * alone, unnormalised. */
 #include <math.h>
 #include "flight_theta.h"
+#include "sincos.h"
 #include "posedrop/tolerances.h"
 
 static const double PI = 3.14159265358979323846;
@@ -50,7 +51,8 @@ static const double PI = 3.14159265358979323846;
  * it times e^(iv). */
 static void series(const pd_theta *th, double v, double f[4], double Y[2])
 {
-    double s = sin(v), c = cos(v);
+    double s, c;
+    pd_sincos(v, &s, &c);
     double e2r = c * c - s * s, e2i = 2.0 * s * c;
     double odr = c, odi = s; /* e^(i (2k+1) v) */
     double t1 = odi, t2 = odr, t3 = 0.0, t4 = 0.0;
