@@ -25,18 +25,20 @@
  *
  * Evaluation. Off the separatrix (nome q <= PD_FLIGHT_NOME_MAX) by Jacobi's
  * theta series, planned once per flight (flight_theta.c): there phi = rate t
- * + arg X(tau) - arg X(tau0) and only e^(i phi/2) is needed, so an evaluation
- * takes two sincos and a few series terms. On the separatrix itself (m = 1
- * in double precision), where the series would converge slowly and cancel,
- * by GSL's sn, cn, dn and Legendre's integrals. Either way the quaternion is
- * built from u and e^(i phi/2) by half-angle formulas (chart_rotation), with
- * no arc tangent. */
+ * + arg Y(v) - arg Y(v0), the constant part taken into Q0, and only e^(i
+ * phi/2) is needed, so an evaluation takes two sincos and a few series
+ * terms. On the separatrix itself (m = 1 in double precision), where the
+ * series would converge slowly and cancel, by GSL's sn, cn, dn and
+ * Legendre's integrals. Either way the quaternion is built from u, the
+ * unnormalised Y (or 1) and e^(i rate t/2) by half-angle formulas
+ * (chart_rotation), with no arc tangent. */
 #include <math.h>
 #include <stddef.h>
 #include <string.h>
 #include "flight.h"
 #include "gsl_adapter.h"
 #include "posedrop/tolerances.h"
+#include "sincos.h"
 #include "vec3.h"
 
 static const double PI = 3.14159265358979323846;
@@ -48,45 +50,48 @@ static pd_vec3 body_L(const pd_body *b, pd_vec3 w)
 
 static double comp(pd_vec3 v, int i) { return i == 0 ? v.x : i == 1 ? v.y : v.z; }
 
-/* e^(i a/2) for a in (-pi, pi] from the unit e^(i a) = c + i s, without
- * trigonometry: the half-angle formulas, each on the side where it has no
- * cancellation. */
-static void half_angle(double c, double s, double *hc, double *hs)
+/* e^(i a/2), a = arg(x + i y) in (-pi, pi], (x, y) != 0 of any length,
+ * without trigonometry: the half-angle formulas, each on the side where it
+ * has no cancellation. */
+static void half_angle(double x, double y, double *hc, double *hs)
 {
-    if (c >= 0.0) {
-        *hc = sqrt(0.5 * (1.0 + c));
-        *hs = s / (2.0 * *hc);
+    double r = sqrt(x * x + y * y);
+    if (x >= 0.0) {
+        *hc = sqrt(0.5 * (1.0 + x / r));
+        *hs = y / (2.0 * r * *hc);
     } else {
-        *hs = copysign(sqrt(0.5 * (1.0 - c)), s);
-        *hc = s / (2.0 * *hs);
+        *hs = copysign(sqrt(0.5 * (1.0 - x / r)), y);
+        *hc = y / (2.0 * r * *hs);
     }
 }
 
-/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, in the
- * product form of the three half-angle rotations, with theta and psi the
- * chart angles of u (u = Rz(psi)^T Rx(theta)^T z / |u|: theta =
- * atan2(|u1, u2|, u3), psi = atan2(u1, u2)) and phi given as e^(i phi/2) =
- * phc + i phs. The half angles come from u algebraically (half_angle):
- * nothing here is an arc tangent or a sine. */
-static pd_quat chart_rotation(const double u[3], double phc, double phs)
+/* Chart -> L-frame rotation Rz(phi) Rx(theta) Rz(psi) as a quaternion, with
+ * theta and psi the chart angles of u (u = Rz(psi)^T Rx(theta)^T z / |u|:
+ * theta = atan2(|u1, u2|, u3), psi = atan2(u1, u2)), u3 >= 0 (the chart's
+ * u3 is a3 dn), and phi = arg z + 2 a given as z (any length) and e^(i a)
+ * = ac + i as. The product of the three half-angle rotations is
+ *   w + i z = cos(theta/2) A,  x + i y = sin(theta/2) A e^(-i psi),
+ *   A = e^(i (phi + psi)/2),
+ * and A is e^(i a) times the half angle of z (u2 + i u1), whose argument is
+ * phi - 2a + psi: one square root for both half angles, and sin(theta/2)
+ * e^(-i psi) = (u2 - i u1) / (2 |u| cos(theta/2)) needs none. The half
+ * angle's branch only picks the quaternion's sign. Nothing here is an arc
+ * tangent or a sine. */
+static pd_quat chart_rotation(const double u[3], double zr, double zi, double ac, double as)
 {
-    double rho2 = u[0] * u[0] + u[1] * u[1], rho = sqrt(rho2);
+    double rho2 = u[0] * u[0] + u[1] * u[1];
     double r = sqrt(rho2 + u[2] * u[2]);
-    double ct, st; /* cos, sin theta/2 */
-    if (u[2] >= 0.0) {
-        ct = sqrt(0.5 * (1.0 + u[2] / r));
-        st = rho / (2.0 * r * ct);
-    } else {
-        st = sqrt(0.5 * (1.0 - u[2] / r));
-        ct = rho / (2.0 * r * st);
+    double ct = sqrt(0.5 * (1.0 + u[2] / r)); /* cos theta/2 */
+    double k = 1.0 / (2.0 * r * ct);          /* sin(theta/2) / |u1, u2| */
+    double pr = zr, pi = zi;                  /* psi = 0 on the axis itself */
+    if (rho2 > 0.0) {
+        pr = zr * u[1] - zi * u[0];
+        pi = zr * u[0] + zi * u[1];
     }
-    double hc = 1.0, hs = 0.0; /* e^(i psi/2); psi = 0 on the axis itself */
-    if (rho > 0.0)
-        half_angle(u[1] / rho, u[0] / rho, &hc, &hs);
-    /* e^(i (phi + psi)/2) and e^(i (phi - psi)/2) */
-    double spc = phc * hc - phs * hs, sps = phs * hc + phc * hs;
-    double dpc = phc * hc + phs * hs, dps = phs * hc - phc * hs;
-    return quat(ct * spc, st * dpc, st * dps, ct * sps);
+    double hc, hs;
+    half_angle(pr, pi, &hc, &hs);
+    double Ar = ac * hc - as * hs, Ai = as * hc + ac * hs;
+    return quat(ct * Ar, k * (Ar * u[1] + Ai * u[0]), k * (Ai * u[1] - Ar * u[0]), ct * Ai);
 }
 
 /* Elliptic state at argument tau: u in the chart, and the unrolled
@@ -122,13 +127,38 @@ static void set_chart(pd_flight *f, int c, double s)
     if (c == 2) {
         f->perm[0] = 0, f->perm[1] = 1, f->perm[2] = 2;
         f->sgn[0] = 1.0, f->sgn[1] = s, f->sgn[2] = s;
+        f->e_kind = s > 0.0 ? 0 : 1;
     } else {
         f->perm[0] = 2, f->perm[1] = 1, f->perm[2] = 0;
         f->sgn[0] = -s, f->sgn[1] = 1.0, f->sgn[2] = s;
+        f->e_kind = 2;
     }
     for (int i = 0; i < 3; i++)
         E[i][f->perm[i]] = f->sgn[i];
     f->e = quat_from_matrix(CONST_M3(E));
+}
+
+/* quat_axis_angle by pd_sincos. */
+static pd_quat turn(pd_vec3 axis, double angle)
+{
+    double s, c;
+    pd_sincos(0.5 * angle, &s, &c);
+    return quat(c, axis.x * s, axis.y * s, axis.z * s);
+}
+
+/* a e (quat_mul) without the products with e's zero components, which add
+ * exactly nothing: the same result for a fraction of the work. */
+static pd_quat times_e(const pd_flight *f, pd_quat a)
+{
+    double c = f->e.w, d = f->e.y;
+    switch (f->e_kind) {
+    case 0:
+        return a;
+    case 1:
+        return quat(-a.x, a.w, a.z, -a.y);
+    default:
+        return quat(a.w * c - a.y * d, a.x * c - a.z * d, a.w * d + a.y * c, a.x * d + a.z * c);
+    }
 }
 
 /* The principal axis u lies on within tol (its other components), or -1. */
@@ -176,6 +206,7 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     for (int i = 0; i < 3; i++) {
         uch[i] = F->sgn[i] * comp(u, F->perm[i]);
         F->J[i] = J[F->perm[i]];
+        F->wsc[i] = F->sgn[i] * F->lambda * F->J[i];
     }
     double J1 = F->J[0], J2 = F->J[1], J3 = F->J[2];
     /* D - J3 and J1 - D from the components: no cancellation near pure spin. */
@@ -190,22 +221,28 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     F->k = sqrt(F->m);
     F->n = (J1 - J2) / (J2 - J3);
     F->Omega = (J2 > J3 ? 1.0 : -1.0) * F->lambda * sqrt(fabs(J2 - J3) * fabs(J1mD));
-    /* Q0 = q0 e^-1 B(0)^-1 with phi(0) = 0, from the actual u so that R(0) = q0
-     * to round-off. */
-    F->Q0 = quat_mul(quat_mul(F->s0.q, quat_conj(F->e)), quat_conj(chart_rotation(uch, 1.0, 0.0)));
     F->kind = PD_FLIGHT_ELLIPTIC;
+    /* Q0 = q0 e^-1 B(0)^-1, B(0) from the actual u so that R(0) = q0 to
+     * round-off, and with phi(0) as the evaluation has it (below, or 0). */
+    pd_quat q0e = quat_mul(F->s0.q, quat_conj(F->e));
     /* The theta series where they converge fast (flight_theta.h), with
      * 1 - m = (J1 - J3)(J2 - D) / ((J2 - J3)(J1 - D)) free of cancellation.
      * phi = lambda (J3 t + (J1 - J3)(P(tau) - P(tau0)) / Omega), P = mu tau +
      * sigma arg X, and lambda (J1 - J3) sigma / Omega = 1 exactly (sigma^2 =
-     * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios). */
+     * (J1 - D)(J2 - J3) / (J1 - J3)^2 from the header's ratios); arg X(v) =
+     * arg Y(v) - v0 - nu t. So phi = rate t + arg Y(v) - arg Y(v0), the last
+     * term a constant rotation about L that Q0 takes up. */
     double mc = (J1 - J3) * -DmJ2 / ((J2 - J3) * J1mD);
     if (pd_theta_plan(&F->th, F->m, mc, F->n, uch[1] / F->alpha[1], uch[0] / F->alpha[0],
                       F->Omega) == PD_OK) {
+        double sn, cn, dn, y0[2];
+        pd_theta_eval(&F->th, 0.0, &sn, &cn, &dn, y0);
         F->theta = 1;
-        F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu);
+        F->rate = F->lambda * (J3 + (J1 - J3) * F->th.mu) - F->th.nu;
+        F->Q0 = quat_mul(q0e, quat_conj(chart_rotation(uch, y0[0], y0[1], 1.0, 0.0)));
         return PD_OK;
     }
+    F->Q0 = quat_mul(q0e, quat_conj(chart_rotation(uch, 1.0, 0.0, 1.0, 0.0)));
     pd_status st;
     double K = 0.0;
     if (F->m < 1.0) {
@@ -284,58 +321,54 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
 
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
 {
-    pd_state s = f->s0;
     if (t == 0.0) {
         /* The start itself: exact, and free (impact searches begin here). */
-        *out = s;
+        *out = f->s0;
         return PD_OK;
     }
-    s.x = v3(f->s0.x.x + f->s0.v.x * t, f->s0.x.y + f->s0.v.y * t,
-             f->s0.x.z + f->s0.v.z * t - 0.5 * f->g * t * t);
-    s.v = v3(f->s0.v.x, f->s0.v.y, f->s0.v.z - f->g * t);
+    pd_quat q = f->s0.q;
+    pd_vec3 w = f->s0.w;
     if (f->kind == PD_FLIGHT_AXIAL) {
         /* omega_body(t) = rot(axis, -b t) omega_body(0): for equal moments J
          * commutes with that rotation (see the derivation in flight.h). A
          * spherical top or a steady spin (b = 0) turns about L alone: its
          * body rotation, the identity, is skipped (exactly what it gives). */
-        pd_quat about_L = quat_mul(quat_axis_angle(f->lhat, f->a * t), f->s0.q);
-        if (f->b == 0.0) {
-            s.q = about_L;
-        } else {
-            pd_quat back = quat_axis_angle(f->axis, -f->b * t);
-            s.q = quat_mul(about_L, quat_conj(back));
-            s.w = quat_rotate(back, f->s0.w);
+        q = quat_mul(turn(f->lhat, f->a * t), f->s0.q);
+        if (f->b != 0.0) {
+            pd_quat back = turn(f->axis, -f->b * t);
+            q = quat_mul(q, quat_conj(back));
+            w = quat_rotate(back, f->s0.w);
         }
     } else if (f->kind == PD_FLIGHT_ELLIPTIC) {
-        double u[3], phc, phs; /* e^(i phi/2) */
+        double u[3], z[2] = {1.0, 0.0}, a; /* phi = arg z + 2a */
         if (f->theta) {
-            double sn, cn, dn, ph[2], hc, hs;
-            pd_theta_eval(&f->th, t, &sn, &cn, &dn, ph);
+            double sn, cn, dn;
+            pd_theta_eval(&f->th, t, &sn, &cn, &dn, z);
             u[0] = f->alpha[0] * cn;
             u[1] = f->alpha[1] * sn;
             u[2] = f->alpha[2] * dn;
-            /* e^(i phi/2) = e^(i rate t/2) e^(i (arg X - arg X0)/2); the half
-             * angle's branch only picks the quaternion's sign. */
-            half_angle(ph[0], ph[1], &hc, &hs);
-            double a = 0.5 * f->rate * t, c = cos(a), sa = sin(a);
-            phc = c * hc - sa * hs;
-            phs = sa * hc + c * hs;
+            a = 0.5 * f->rate * t;
         } else {
             double P;
             pd_status st = elliptic_at(f, f->tau0 + f->Omega * t, u, &P);
             if (st != PD_OK)
                 return st;
-            double phi = f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
-            phc = cos(0.5 * phi);
-            phs = sin(0.5 * phi);
+            a = 0.5 * f->lambda * (f->J[2] * t + (f->J[0] - f->J[2]) * (P - f->P0) / f->Omega);
         }
-        s.q = quat_mul(quat_mul(f->Q0, chart_rotation(u, phc, phs)), f->e);
-        double wb[3] = {0};
+        double ac, as;
+        pd_sincos(a, &as, &ac);
+        q = times_e(f, quat_mul(f->Q0, chart_rotation(u, z[0], z[1], ac, as)));
+        double wb[3];
         for (int i = 0; i < 3; i++)
-            wb[f->perm[i]] = f->sgn[i] * f->lambda * f->J[i] * u[i];
-        s.w = v3(wb[0], wb[1], wb[2]);
+            wb[f->perm[i]] = f->wsc[i] * u[i];
+        w = v3(wb[0], wb[1], wb[2]);
     }
-    *out = s;
+    const pd_state *s0 = &f->s0;
+    out->x = v3(s0->x.x + s0->v.x * t, s0->x.y + s0->v.y * t,
+                s0->x.z + s0->v.z * t - 0.5 * f->g * t * t);
+    out->v = v3(s0->v.x, s0->v.y, s0->v.z - f->g * t);
+    out->q = q;
+    out->w = w;
     return PD_OK;
 }
 

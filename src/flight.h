@@ -33,7 +33,9 @@ typedef struct pd_flight {
     /* ELLIPTIC: see flight.c for the derivation */
     int perm[3];         /* chart axis i is body axis perm[i] ... */
     double sgn[3];       /* ... times sgn[i] */
-    pd_quat e;           /* body -> chart rotation */
+    pd_quat e;           /* body -> chart rotation ... */
+    int e_kind;          /* ... 0 identity, 1 half turn about x, 2 quarter turn about y */
+    double wsc[3];       /* body rate component perm[i] = wsc[i] u[i] (sgn lambda J) */
     pd_quat Q0;          /* the angular-momentum frame: L-frame -> world */
     double J[3];         /* inverse moments in chart order */
     double alpha[3];     /* amplitudes of u = L/|L| in the chart: cn, sn, dn */
@@ -45,7 +47,7 @@ typedef struct pd_flight {
     double K2;           /* the period 2K of dn (0 on the separatrix: no period) */
     double Pc;           /* complete integral of the third kind */
     double P0;           /* P(am tau0) with periods unrolled */
-    double rate;         /* phi(t) = rate t + arg X(v) - arg X(v0) (flight_theta.h) */
+    double rate;         /* phi(t) = rate t + arg Y(v) - arg Y(v0) (flight_theta.h) */
     pd_theta th;         /* last: pd_flight_plan zeroes only what precedes it */
 } pd_flight;
 

@@ -26,7 +26,6 @@ typedef struct pd_theta {
     double S[PD_THETA_TERMS];      /* (-1)^k q^(k(k+1)) sinh((2k+1) w) */
     double C[PD_THETA_TERMS];      /* (-1)^k q^(k(k+1)) cosh((2k+1) w) */
     double csn, ccn, cdn;          /* theta-constant ratios of sn, cn, dn */
-    double x0[2];                  /* conj(X(v0)) / |X(v0)| */
 } pd_theta;
 
 /* Plans the functions of parameter m (0 < m < 1; mc = 1 - m, passed separately
@@ -34,13 +33,15 @@ typedef struct pd_theta {
  * at the point sn = sn0, cn = cn0 of the period (any scale: only their ratio
  * is used) and moving at d tau / dt = omega. PD_ERR_RANGE when the nome
  * exceeds PD_FLIGHT_NOME_MAX (near the separatrix), where the caller uses
- * Legendre's integrals instead; PD_ERR_NONFINITE if GSL's RF fails. */
+ * Legendre's integrals instead; PD_ERR_NONFINITE if a planned value is not
+ * finite. */
 pd_status pd_theta_plan(pd_theta *th, double m, double mc, double n, double sn0, double cn0,
                         double omega);
 
-/* sn, cn, dn at time t, and e^(i (arg X(v) - arg X(v0))) in ph[0] + i ph[1]
- * (unit), whose angle is P(tau) - P(tau0) - mu (tau - tau0) over sigma =
- * sqrt(n / ((m + n)(1 + n))). */
-void pd_theta_eval(const pd_theta *th, double t, double *sn, double *cn, double *dn, double ph[2]);
+/* sn, cn, dn at time t, and Y(v), e^(iv) X(v) up to a positive factor, in
+ * y[0] + i y[1] (only its argument is meant), so that arg Y(v) - arg Y(v0) -
+ * (v - v0) is P(tau) - P(tau0) - mu (tau - tau0) over sigma = sqrt(n / ((m
+ * + n)(1 + n))). */
+void pd_theta_eval(const pd_theta *th, double t, double *sn, double *cn, double *dn, double y[2]);
 
 #endif

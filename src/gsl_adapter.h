@@ -49,12 +49,6 @@ pd_status pd_ellint_P(double phi, double k, double n, double *result);
 /* Complete integrals K(k) = F(pi/2, k) and Pi(k, n) = P(pi/2, k, n); k < 1. */
 pd_status pd_ellint_Kcomp(double k, double *result);
 pd_status pd_ellint_Pcomp(double k, double n, double *result);
-
-/* Carlson's symmetric integral RF(x, y, z), x, y, z >= 0, at most one zero:
- * F(phi, k) = sin phi RF(cos^2 phi, 1 - k^2 sin^2 phi, 1) and K(k) = RF(0, k'^2, 1)
- * with the arguments formed by the caller, who may know them without the
- * cancellation 1 - k^2 suffers near k = 1. */
-pd_status pd_ellint_RF(double x, double y, double z, double *result);
 /* ==== end of elliptic functions ============================================= */
 /* --- ODE integration (used by impact.c and contact_phase.c) -----------------
  * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand
