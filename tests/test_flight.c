@@ -596,18 +596,28 @@ static void test_impact(void)
     pd_part_free(p);
 }
 
-static void test_support(void)
+/* A part of 1000 points drawn from r on an ellipsoid of semi-axes 3, 2 and
+ * 1 cm, through the library's hull (its facets: triangles); NULL on failure. */
+static pd_part *ellipsoid_part(test_rng *r)
 {
     enum { N = 1000 };
     pd_vec3 *pts = malloc(sizeof *pts * N);
-    test_rng r = {3};
     for (int i = 0; i < N; i++) {
-        pd_vec3 u = rng_unit_vector(&r);
+        pd_vec3 u = rng_unit_vector(r);
         pts[i] = v3(0.03 * u.x, 0.02 * u.y, 0.01 * u.z);
     }
     pd_hull *h = NULL;
     CHECK_STATUS(pd_hull_build(pts, N, &h, NULL), PD_OK);
     pd_part *p = h ? part_of_mesh(mesh_of_hull(h)) : NULL;
+    pd_hull_free(h);
+    free(pts);
+    return p;
+}
+
+static void test_support(void)
+{
+    test_rng r = {3};
+    pd_part *p = ellipsoid_part(&r);
     pd_body *b = p ? body_of(p) : NULL;
     if (b) {
         CHECK(b->nverts > 900);
@@ -627,8 +637,6 @@ static void test_support(void)
     }
     pd_body_free(b);
     pd_part_free(p);
-    pd_hull_free(h);
-    free(pts);
 }
 
 /* The polish at the end of the hill-climb is skipped where the facets around
@@ -675,6 +683,54 @@ static void test_support_flat(void)
     }
 }
 
+/* The impact search's per-vertex step, hill-climbed, against every vertex's
+ * root computed in the world frame: on a box, a 32-gon prism (exact and bent)
+ * and a 1000-point ellipsoid, spinning up to 100 rad/s at 1e-6 to 0.1 L above
+ * the floor, from random start vertices. */
+static void test_vertex_step(void)
+{
+    test_rng r = {13};
+    ring_spec exact = {32, 0, 0.0, 0.0, 0.0, 0, 0}, bent = {32, 0, 0.0, 0.0, 3e-8 / PD_TOL_SYMMETRY_REL, 0, 0};
+    pd_part *parts[4] = {part_of_mesh(mesh_box(0.01, 0.02, 0.03)), ring_part(&exact, NULL, 1.0, v3(0, 0, 0)),
+                         ring_part(&bent, NULL, 1.0, v3(0, 0, 0)), ellipsoid_part(&r)};
+    for (int k = 0; k < 4; k++) {
+        pd_body *b = parts[k] ? body_of(parts[k]) : NULL;
+        if (!b) {
+            CHECK(0);
+            pd_part_free(parts[k]);
+            continue;
+        }
+        double worst = 0.0;
+        for (int trial = 0; trial < 500; trial++) {
+            pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
+                                            rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+            double wn = trial % 10 ? rng_range(&r, 0.0, 100.0) : 0.0;
+            pd_state s = {v3(0, 0, 0), q, v3(0.1, 0, rng_range(&r, -2.0, 1.0)),
+                          v3_scale(rng_unit_vector(&r), wn)};
+            int low = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
+            double gap = b->size * pow(10.0, rng_range(&r, -6.0, -1.0));
+            s.x.z = -pd_body_vertex_world(b, &s, low).z + gap;
+            double B = (trial % 20 ? G : 0.0) + 2.0 * wn * wn * b->rmax;
+            double want = HUGE_VAL;
+            pd_vec3 ww = quat_rotate(s.q, s.w);
+            for (int i = 0; i < b->nverts; i++) {
+                pd_vec3 rel = quat_rotate(s.q, b->verts[i]);
+                double z = s.x.z + rel.z, dz = s.v.z + v3_cross(ww, rel).z;
+                double sq = sqrt(dz * dz + 2.0 * B * z); /* each root form where it does not cancel */
+                double root = dz < 0.0 ? 2.0 * z / (sq - dz) : B > 0.0 ? (dz + sq) / B : HUGE_VAL;
+                want = root < want ? root : want;
+            }
+            double got = pd_flight_vertex_step(b, &s, B, (int)(rng_next(&r) % (uint64_t)b->nverts));
+            /* The heights carry round-off ~1e-16 L: relative to the gap in the root. */
+            double e = want < HUGE_VAL ? fabs(got - want) / want * gap / b->size : (got < HUGE_VAL ? 1.0 : 0.0);
+            worst = e > worst ? e : worst;
+        }
+        CHECK_NEAR(worst, 0.0, 1e-14, "smallest root over all vertices, heights' round-off");
+        pd_body_free(b);
+        pd_part_free(parts[k]);
+    }
+}
+
 void suite_flight(void)
 {
     test_eigen();
@@ -683,4 +739,5 @@ void suite_flight(void)
     test_impact();
     test_support();
     test_support_flat();
+    test_vertex_step();
 }
