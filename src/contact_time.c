@@ -147,11 +147,12 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, d
 {
     if (!f)
         return PD_ERR_USAGE;
-    return pd_flight_impact_from(b, f, 0.0, &f->s0, t_max, window, contacts, ncap, out);
+    return pd_flight_impact_from(b, f, 0.0, &f->s0, 0, t_max, window, contacts, ncap, out);
 }
 
 pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
-                                double t_max, double window, int *contacts, int ncap, pd_impact *out)
+                                int start, double t_max, double window, int *contacts, int ncap,
+                                pd_impact *out)
 {
     if (!b || !f || !at || !out || !(t0 >= 0.0) || !(t_max >= t0) || !(window >= 0.0) || ncap < 0 ||
         (ncap > 0 && !contacts))
@@ -160,10 +161,8 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
     double W = f->wmax * b->rmax;
     double B = f->g + 2.0 * f->wmax * f->wmax * b->rmax;
     pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
-    sample p = {*at, {0.0, 0.0, 0.0}, 0, 0.0};
+    sample p = {*at, {0.0, 0.0, 0.0}, start, 0.0};
     double t = t0;
-    /* Start from the body's lowest vertex in the initial orientation: the scan
-     * is avoided by hill-climbing from vertex 0. */
     pd_status st = lowest_of(b, &p);
     if (st != PD_OK)
         return st;

@@ -489,12 +489,12 @@ static void test_impact(void)
         pd_impact again;
         double t0 = 0.5 * imp.t;
         CHECK_STATUS(pd_flight_eval(&f, t0, &mid), PD_OK);
-        CHECK_STATUS(pd_flight_impact_from(b, &f, t0, &mid, 1.0, 0.0, contacts, 16, &again), PD_OK);
+        CHECK_STATUS(pd_flight_impact_from(b, &f, t0, &mid, 0, 1.0, 0.0, contacts, 16, &again), PD_OK);
         CHECK_INT(again.kind, PD_IMPACT_AT);
         CHECK_NEAR(scan_height(b, &f, again.t), 0.0, tol, "impact tolerance");
         CHECK(again.t <= first);
         CHECK_STATUS(pd_flight_eval(&f, imp.t, &mid), PD_OK);
-        CHECK_STATUS(pd_flight_impact_from(b, &f, imp.t, &mid, 1.0, 0.0, contacts, 16, &again), PD_OK);
+        CHECK_STATUS(pd_flight_impact_from(b, &f, imp.t, &mid, 0, 1.0, 0.0, contacts, 16, &again), PD_OK);
         CHECK_INT(again.kind, PD_IMPACT_NOW);
         CHECK_NEAR(again.t, imp.t, 0.0, "touching at t0: the search stays there");
     }
