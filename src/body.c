@@ -271,6 +271,15 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag)
         b->moment[i] = eval[i];
         b->inv_moment[i] = 1.0 / eval[i];
     }
+    /* Euler's equations: |dw_i/dt| = |I_j - I_k| / I_i |w_j w_k|. The ratios
+     * are at most 1 (each moment is at most the sum of the other two) and
+     * sum over j < k of w_j^2 w_k^2 is at most |w|^4 / 3, so |dw/dt| is at
+     * most the largest ratio times |w|^2 / sqrt(3): 0 for a cube, whose
+     * spin never changes. */
+    double kappa = 0.0;
+    for (int i = 0; i < 3; i++)
+        kappa = fmax(kappa, fabs(eval[(i + 1) % 3] - eval[(i + 2) % 3]) / eval[i]);
+    b->spin_accel = kappa / sqrt(3.0);
     b->frame = quat_from_matrix(CONST_M3(V));
     b->com = part->com;
     b->size = part->size;

@@ -16,8 +16,9 @@
  * For hulls of up to VERTEX_BOUND_MAX vertices a second, per-vertex bound is
  * taken too, and the larger step of the two: each vertex height z_v(t) has
  * the exact rate z_v' at the sample and a second derivative no lower than
- * -B, B = g + 2 wmax^2 rmax (centripetal wmax^2 r, and |dw/dt| <= Jmax |L|
- * |w| <= wmax^2 for torque-free motion), so z_v stays positive while
+ * -B, B = g + (1 + k) wmax^2 rmax (centripetal wmax^2 r, and
+ * |dw/dt| <= k |w|^2 for torque-free motion, k = spin_accel from Euler's
+ * equations, at most 1/sqrt(3)), so z_v stays positive while
  * z_v + z_v' D - B D^2 / 2 > 0. Its smallest root over the vertices is a
  * step that cannot pass a contact either, and, being exact to first order,
  * it lands a vertex approaching at any speed in a step or two, where the
@@ -159,7 +160,7 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
         return PD_ERR_USAGE;
     double tol = PD_TOL_IMPACT_REL * b->size;
     double W = f->wmax * b->rmax;
-    double B = f->g + 2.0 * f->wmax * f->wmax * b->rmax;
+    double B = f->g + (1.0 + b->spin_accel) * f->wmax * f->wmax * b->rmax;
     pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
     sample p = {*at, {0.0, 0.0, 0.0}, start, 0.0};
     double t = t0;

@@ -639,6 +639,39 @@ static void test_support(void)
     pd_part_free(p);
 }
 
+/* The impact search's bound on the angular acceleration, |dw/dt| <=
+ * spin_accel |w|^2, against Euler's equations (rk4_deriv) at random w: never
+ * exceeded, approached within 15% (its worst case is that close to the
+ * largest reached), and 0 for a cube. */
+static void test_spin_accel(void)
+{
+    pd_mesh *meshes[3] = {mesh_box(0.01, 0.02, 0.03), mesh_prism(32, 0.01, 0.002), mesh_box(0.01, 0.01, 0.01)};
+    test_rng r = {29};
+    for (int k = 0; k < 3; k++) {
+        pd_part *p = part_of_mesh(meshes[k]);
+        pd_body *b = p ? body_of(p) : NULL;
+        if (!b) {
+            CHECK(0);
+            pd_part_free(p);
+            continue;
+        }
+        double worst = 0.0;
+        for (int i = 0; i < 20000; i++) {
+            pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 0.1, 100.0)), dw;
+            pd_quat dq;
+            rk4_deriv(b, quat_identity(), w, &dq, &dw);
+            worst = fmax(worst, v3_norm(dw) / v3_dot(w, w));
+        }
+        CHECK(worst <= b->spin_accel * (1.0 + 1e-12));
+        if (k < 2)
+            CHECK(worst >= 0.85 * b->spin_accel);
+        else
+            CHECK_NEAR(b->spin_accel, 0.0, 0.0, "equal moments, snapped");
+        pd_body_free(b);
+        pd_part_free(p);
+    }
+}
+
 /* The polish at the end of the hill-climb is skipped where the facets around
  * the answer are flat (PD_TOL_SUPPORT_FLAT_REL), and must still run where
  * they are bent: a 32-gon prism with exact coordinates needs it nowhere, the
@@ -738,6 +771,7 @@ void suite_flight(void)
     test_flight_reference();
     test_impact();
     test_support();
+    test_spin_accel();
     test_support_flat();
     test_vertex_step();
 }
