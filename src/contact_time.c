@@ -13,13 +13,12 @@
  * the fraction (true approach speed)/(bound) of the gap; a straight fall lands
  * in one step.
  *
- * For hulls of up to VERTEX_BOUND_MAX vertices a second, per-vertex bound is
- * taken too, and the larger step of the two: each vertex height z_v(t) has
- * the exact rate z_v' at the sample and a second derivative no lower than
- * -B, B = g + (1 + k) wmax^2 rmax (centripetal wmax^2 r, and
- * |dw/dt| <= k |w|^2 for torque-free motion, k = spin_accel from Euler's
- * equations, at most 1/sqrt(3)), so z_v stays positive while
- * z_v + z_v' D - B D^2 / 2 > 0. Its smallest root over the vertices is a
+ * A second, per-vertex bound is taken too, and the larger step of the two:
+ * each vertex height z_v(t) has the exact rate z_v' at the sample and a
+ * second derivative no lower than -B, B = g + (1 + k) wmax^2 rmax
+ * (centripetal wmax^2 r, and |dw/dt| <= k |w|^2 for torque-free motion,
+ * k = spin_accel from Euler's equations, at most 1/sqrt(3)), so z_v stays
+ * positive while z_v + z_v' D - B D^2 / 2 > 0. Its smallest root over the vertices is a
  * step that cannot pass a contact either, and, being exact to first order,
  * it lands a vertex approaching at any speed in a step or two, where the
  * worst-case speed bound creeps up on a spinning part in tens. That smallest
@@ -55,9 +54,6 @@ static pd_status sample_at(const pd_body *b, const pd_flight *f, double t, sampl
     pd_status st = pd_flight_eval(f, t, &p->s);
     return st != PD_OK ? st : lowest_of(b, p);
 }
-
-/* Per-vertex bound: taken for hulls of up to this many vertices. */
-enum { VERTEX_BOUND_MAX = 512 };
 
 /* Vertex v's root of z_v + z_v' D - B D^2 / 2 in state s (up: world up in
  * the body frame, a = up x w), in the form without cancellation; infinite
@@ -178,11 +174,9 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
             /* Root of g/2 D^2 + c D = h in the form without cancellation. */
             double disc = c * c + 2.0 * f->g * p.h;
             double D = disc > 0.0 ? 2.0 * p.h / (c + sqrt(disc)) : HUGE_VAL;
-            if (b->nverts <= VERTEX_BOUND_MAX) {
-                double Dv = vertex_step(b, &p.s, p.up, B, p.low);
-                if (Dv > D)
-                    D = Dv;
-            }
+            double Dv = vertex_step(b, &p.s, p.up, B, p.low);
+            if (Dv > D)
+                D = Dv;
             if (t + D >= t_max) {
                 /* The bound keeps the gap open up to t_max, but the last
                  * sample may still close it: look at t_max itself. */
