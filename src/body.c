@@ -182,6 +182,37 @@ static pd_status build_adjacency(pd_body *b, const pd_hull *h)
     return PD_OK;
 }
 
+/* Marks the vertices where pd_body_support must polish. Hill-climbing stops
+ * at a vertex v lower than its edge neighbours prev and next on a facet F;
+ * another corner u of F is u - v = a (prev - v) + b (next - v) + c n, n the
+ * unit normal of the plane through prev, v and next, so for a unit direction
+ * d it lies lower than v by at most |c| when a, b >= 0 (d . (prev - v) and
+ * d . (next - v) are >= 0). A planar convex facet has c = 0 and a, b >= 0 for
+ * every corner; polishing v is needed only where some facet around it has a
+ * corner with |c| above PD_TOL_SUPPORT_FLAT_REL or outside the angle at v. */
+static void mark_polish(pd_body *b, const pd_hull *h)
+{
+    double tau = PD_TOL_SUPPORT_FLAT_REL * b->size;
+    for (int f = 0; f < h->nfacets; f++) {
+        int k0 = h->facet_start[f], k1 = h->facet_start[f + 1];
+        for (int k = k0; k < k1 && k1 - k0 > 3; k++) {
+            int v = h->facet_vert[k];
+            pd_vec3 p = b->verts[v];
+            pd_vec3 e1 = v3_sub(b->verts[h->facet_vert[k > k0 ? k - 1 : k1 - 1]], p);
+            pd_vec3 e2 = v3_sub(b->verts[h->facet_vert[k + 1 < k1 ? k + 1 : k0]], p);
+            pd_vec3 n = v3_cross(e1, e2);
+            double nn = v3_norm(n);
+            /* The corners after next up to before prev. */
+            for (int j = 2; j < k1 - k0 - 1 && !b->polish[v]; j++) {
+                int m = k + j < k1 ? k + j : k + j - (k1 - k0);
+                pd_vec3 r = v3_sub(b->verts[h->facet_vert[m]], p);
+                double ca = v3_dot(v3_cross(r, e2), n), cb = v3_dot(v3_cross(e1, r), n);
+                b->polish[v] = !(ca >= 0.0 && cb >= 0.0 && fabs(v3_dot(r, n)) <= tau * nn);
+            }
+        }
+    }
+}
+
 void pd_body_free(pd_body *body)
 {
     if (!body)
@@ -191,6 +222,7 @@ void pd_body_free(pd_body *body)
     free(body->adj);
     free(body->vf_start);
     free(body->vf);
+    free(body->polish);
     free(body);
 }
 
@@ -239,6 +271,15 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag)
         b->moment[i] = eval[i];
         b->inv_moment[i] = 1.0 / eval[i];
     }
+    /* Euler's equations: |dw_i/dt| = |I_j - I_k| / I_i |w_j w_k|. The ratios
+     * are at most 1 (each moment is at most the sum of the other two) and
+     * sum over j < k of w_j^2 w_k^2 is at most |w|^4 / 3, so |dw/dt| is at
+     * most the largest ratio times |w|^2 / sqrt(3): 0 for a cube, whose
+     * spin never changes. */
+    double kappa = 0.0;
+    for (int i = 0; i < 3; i++)
+        kappa = fmax(kappa, fabs(eval[(i + 1) % 3] - eval[(i + 2) % 3]) / eval[i]);
+    b->spin_accel = kappa / sqrt(3.0);
     b->frame = quat_from_matrix(CONST_M3(V));
     b->com = part->com;
     b->size = part->size;
@@ -246,7 +287,8 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag)
     b->facet_start = h->facet_start;
     b->facet_vert = h->facet_vert;
     b->verts = malloc(sizeof *b->verts * (size_t)h->nverts);
-    if (!b->verts || build_adjacency(b, h) != PD_OK) {
+    b->polish = calloc((size_t)h->nverts, sizeof *b->polish);
+    if (!b->verts || !b->polish || build_adjacency(b, h) != PD_OK) {
         pd_body_free(b);
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory building the body");
     }
@@ -261,6 +303,7 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag)
         if (r > b->rmax)
             b->rmax = r;
     }
+    mark_polish(b, h);
     *body = b;
     return PD_OK;
 }
@@ -284,7 +327,10 @@ int pd_body_support(const pd_body *b, pd_vec3 dir, int start)
         if (next == best) {
             /* Polish: the corners of the facets around the minimum. A merged
              * facet may be bent by up to PD_TOL_PLANE_REL, which can hide a
-             * lower corner behind a non-edge diagonal. */
+             * lower corner behind a non-edge diagonal; where the facets
+             * around it are flat that cannot happen (mark_polish). */
+            if (!b->polish[best])
+                return best;
             for (int k = b->vf_start[best]; k < b->vf_start[best + 1]; k++) {
                 int f = b->vf[k];
                 for (int m = b->facet_start[f]; m < b->facet_start[f + 1]; m++) {

@@ -30,12 +30,16 @@ typedef struct pd_body {
     pd_vec3 com;          /* centre of mass in the part frame, m */
     double size;          /* the part's size L (bounding-box diagonal), m */
     double rmax;          /* largest distance of a hull vertex from the com, m */
+    double spin_accel;    /* |dw/dt| <= spin_accel |w|^2 in torque-free motion */
     int nverts;
     pd_vec3 *verts;       /* hull vertices, principal frame, relative to the com */
     int *adj_start;       /* nverts + 1 entries; edge neighbours of vertex i are */
     int *adj;             /*   adj[adj_start[i] .. adj_start[i+1]) */
     int *vf_start;        /* nverts + 1 entries; the facets around vertex i are */
     int *vf;              /*   vf[vf_start[i] .. vf_start[i+1]) */
+    unsigned char *polish; /* 1: a corner of a facet around vertex i may lie
+                              lower than i in a direction no edge neighbour
+                              of i does (pd_body_support) */
     const int *facet_start; /* the hull's facet loops (borrowed: the body must */
     const int *facet_vert;  /*   not outlive its part) */
 } pd_body;
@@ -68,7 +72,8 @@ void pd_sym_eigen3(const double A[3][3], double eval[3], double V[3][3]);
  * the vertex graph from vertex start (any valid index; pass the last answer
  * for O(1) work on a slowly turning body), then checks the other corners of
  * the facets around the minimum, since merged facets are planar only to
- * PD_TOL_PLANE_REL. */
+ * PD_TOL_PLANE_REL; where they are flat to PD_TOL_SUPPORT_FLAT_REL that check
+ * cannot change the answer and is skipped (polish[]). */
 int pd_body_support(const pd_body *b, pd_vec3 dir, int start);
 
 /* The same by scanning every vertex: the reference for tests and debug checks. */

@@ -13,67 +13,90 @@
  * the fraction (true approach speed)/(bound) of the gap; a straight fall lands
  * in one step.
  *
- * For hulls of up to VERTEX_BOUND_MAX vertices a second, per-vertex bound is
- * taken too, and the larger step of the two: each vertex height z_v(t) has
- * the exact rate z_v' at the sample and a second derivative no lower than
- * -B, B = g + 2 wmax^2 rmax (centripetal wmax^2 r, and |dw/dt| <= Jmax |L|
- * |w| <= wmax^2 for torque-free motion), so z_v stays positive while
- * z_v + z_v' D - B D^2 / 2 > 0. Its smallest root over the vertices is a
+ * A second, per-vertex bound is taken too, and the larger step of the two:
+ * each vertex height z_v(t) has the exact rate z_v' at the sample and a
+ * second derivative no lower than -B, B = g + (1 + k) wmax^2 rmax
+ * (centripetal wmax^2 r, and |dw/dt| <= k |w|^2 for torque-free motion,
+ * k = spin_accel from Euler's equations, at most 1/sqrt(3)), so z_v stays
+ * positive while z_v + z_v' D - B D^2 / 2 > 0. Its smallest root over the vertices is a
  * step that cannot pass a contact either, and, being exact to first order,
  * it lands a vertex approaching at any speed in a step or two, where the
- * worst-case speed bound creeps up on a spinning part in tens. */
+ * worst-case speed bound creeps up on a spinning part in tens. That smallest
+ * root is found by hill-climbing the hull, not by visiting every vertex:
+ * vertex_step. */
 #include <math.h>
 #include "flight.h"
 #include "posedrop/tolerances.h"
 #include "vec3.h"
 
-/* Support height of state s: the lowest vertex (hill-climbed from *hint)
- * and its z. */
-static pd_status support_of(const pd_body *b, const pd_state *s, int *hint, double *height)
+/* A sample of the flight: the state, world up in the body frame, and the
+ * lowest vertex with its height. */
+typedef struct sample {
+    pd_state s;
+    pd_vec3 up;
+    int low;
+    double h;
+} sample;
+
+/* Fills in p's up, lowest vertex (hill-climbed from p->low) and height from
+ * its state. */
+static pd_status lowest_of(const pd_body *b, sample *p)
 {
-    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
-    *hint = pd_body_support(b, up, *hint);
-    *height = s->x.z + v3_dot(up, b->verts[*hint]);
-    if (!isfinite(*height))
-        return PD_ERR_NONFINITE;
-    return PD_OK;
+    p->up = quat_rotate_inv(p->s.q, v3(0.0, 0.0, 1.0));
+    p->low = pd_body_support(b, p->up, p->low);
+    p->h = p->s.x.z + v3_dot(p->up, b->verts[p->low]);
+    return isfinite(p->h) ? PD_OK : PD_ERR_NONFINITE;
 }
 
-/* The same at time t of the flight, s receiving the state there. */
-static pd_status support_at(const pd_body *b, const pd_flight *f, double t, pd_state *s,
-                            int *hint, double *height)
+/* The same at time t of the flight. */
+static pd_status sample_at(const pd_body *b, const pd_flight *f, double t, sample *p)
 {
-    pd_status st = pd_flight_eval(f, t, s);
-    return st != PD_OK ? st : support_of(b, s, hint, height);
+    pd_status st = pd_flight_eval(f, t, &p->s);
+    return st != PD_OK ? st : lowest_of(b, p);
 }
 
-/* Per-vertex bound: above this many vertices the scan costs more than the
- * evaluations it saves, and the speed bound alone is used. */
-enum { VERTEX_BOUND_MAX = 512 };
-
-/* The per-vertex step from state s (header): the smallest positive root of
- * z_v + z_v' D - B D^2 / 2 over the vertices, z_v > 0 for all of them. A
- * vertex whose quadratic is still positive at the best step so far cannot
- * have a smaller root (the quadratic is concave and positive at 0): skipped
- * without a square root. */
-static double vertex_step(const pd_body *b, const pd_state *s, double B, int lowest)
+/* Vertex v's root of z_v + z_v' D - B D^2 / 2 in state s (up: world up in
+ * the body frame, a = up x w), in the form without cancellation; infinite
+ * when it has none (B = 0 and v not approaching). */
+static double vertex_root(const pd_body *b, const pd_state *s, pd_vec3 up, pd_vec3 a, double B,
+                          int v)
 {
-    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
-    pd_vec3 a = v3_cross(up, s->w); /* z_v' = v_z + b_v . (up x w), body frame */
-    double best = HUGE_VAL;
-    for (int k = -1; k < b->nverts; k++) {
-        int v = k < 0 ? lowest : k;
-        if (k == lowest)
-            continue;
-        double z = s->x.z + v3_dot(up, b->verts[v]);
-        double dz = s->v.z + v3_dot(a, b->verts[v]);
-        if (best < HUGE_VAL && z + best * (dz - 0.5 * B * best) > 0.0)
-            continue;
-        double root = 2.0 * z / (-dz + sqrt(dz * dz + 2.0 * B * z));
-        if (root < best)
-            best = root;
+    double z = s->x.z + v3_dot(up, b->verts[v]);
+    double dz = s->v.z + v3_dot(a, b->verts[v]); /* z_v' = v_z + b_v . (up x w) */
+    return 2.0 * z / (-dz + sqrt(dz * dz + 2.0 * B * z));
+}
+
+/* The per-vertex step (header, flight.h), without visiting every vertex.
+ * Vertex v's quadratic is below 0 at D exactly when
+ * (up + D a) . b_v < B D^2 / 2 - z - v_z D (b_v: v in the body frame), so the
+ * vertex whose quadratic is lowest at D is the support vertex in direction
+ * up + D a. From any vertex's root D, which is >= D* (the smallest), the
+ * support vertex w there either is the vertex whose root D is (then every
+ * quadratic is >= 0 at D: they are concave and positive at 0, so no root is
+ * below D, and D = D*) or has a quadratic below 0 at D, hence a smaller root,
+ * which the search moves to. D falls strictly, so no vertex comes twice; in
+ * practice one or two moves, each a short hill-climb from the last vertex.
+ * With no root (B = 0: no spin, no gravity) the direction is a alone, the
+ * limit. */
+static double vertex_step(const pd_body *b, const pd_state *s, pd_vec3 up, double B, int start)
+{
+    pd_vec3 a = v3_cross(up, s->w);
+    int v = start;
+    double D = vertex_root(b, s, up, a, B, v);
+    for (;;) {
+        int w = pd_body_support(b, D < HUGE_VAL ? v3_add(up, v3_scale(a, D)) : a, v);
+        double Dw = w == v ? D : vertex_root(b, s, up, a, B, w);
+        if (!(Dw < D)) /* w == v, or a tie within round-off */
+            break;
+        v = w;
+        D = Dw;
     }
-    return best > 0.0 ? best : 0.0;
+    return D > 0.0 ? D : 0.0;
+}
+
+double pd_flight_vertex_step(const pd_body *b, const pd_state *s, double B, int start)
+{
+    return vertex_step(b, s, quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)), B, start);
 }
 
 /* The contact set: vertices within tol of the floor, or that would reach it
@@ -87,10 +110,9 @@ static double vertex_step(const pd_body *b, const pd_state *s, double B, int low
  * neighbours. The list doubles as the queue; membership is a linear search,
  * cheap because contact sets are small (a face's corners). Beyond ncap the
  * set is counted, not listed. */
-static int contact_set(const pd_body *b, const pd_state *s, int lowest, double tol, double window,
-                       int *list, int ncap)
+static int contact_set(const pd_body *b, const pd_state *s, pd_vec3 up, int lowest, double tol,
+                       double window, int *list, int ncap)
 {
-    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     pd_vec3 a = v3_cross(up, s->w); /* z_v' = v_z + b_v . (up x w), body frame */
     if (ncap < 1 || !list)
         return 1;
@@ -122,28 +144,26 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, d
 {
     if (!f)
         return PD_ERR_USAGE;
-    return pd_flight_impact_from(b, f, 0.0, &f->s0, t_max, window, contacts, ncap, out);
+    return pd_flight_impact_from(b, f, 0.0, &f->s0, 0, t_max, window, contacts, ncap, out);
 }
 
 pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
-                                double t_max, double window, int *contacts, int ncap, pd_impact *out)
+                                int start, double t_max, double window, int *contacts, int ncap,
+                                pd_impact *out)
 {
     if (!b || !f || !at || !out || !(t0 >= 0.0) || !(t_max >= t0) || !(window >= 0.0) || ncap < 0 ||
         (ncap > 0 && !contacts))
         return PD_ERR_USAGE;
     double tol = PD_TOL_IMPACT_REL * b->size;
     double W = f->wmax * b->rmax;
-    double B = f->g + 2.0 * f->wmax * f->wmax * b->rmax;
+    double B = f->g + (1.0 + b->spin_accel) * f->wmax * f->wmax * b->rmax;
     pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
-    pd_state s = *at;
-    int hint = 0;
-    double t = t0, h;
-    /* Start from the body's lowest vertex in the initial orientation: the scan
-     * is avoided by hill-climbing from vertex 0. */
-    pd_status st = support_of(b, &s, &hint, &h);
+    sample p = {*at, {0.0, 0.0, 0.0}, start, 0.0};
+    double t = t0;
+    pd_status st = lowest_of(b, &p);
     if (st != PD_OK)
         return st;
-    if (h <= tol) {
+    if (p.h <= tol) {
         r.kind = PD_IMPACT_NOW;
     } else {
         for (;;) {
@@ -152,46 +172,40 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
             double vz = f->s0.v.z - f->g * t;
             double c = (vz < 0.0 ? -vz : 0.0) + W;
             /* Root of g/2 D^2 + c D = h in the form without cancellation. */
-            double disc = c * c + 2.0 * f->g * h;
-            double D = disc > 0.0 ? 2.0 * h / (c + sqrt(disc)) : HUGE_VAL;
-            if (b->nverts <= VERTEX_BOUND_MAX) {
-                double Dv = vertex_step(b, &s, B, hint);
-                if (Dv > D)
-                    D = Dv;
-            }
+            double disc = c * c + 2.0 * f->g * p.h;
+            double D = disc > 0.0 ? 2.0 * p.h / (c + sqrt(disc)) : HUGE_VAL;
+            double Dv = vertex_step(b, &p.s, p.up, B, p.low);
+            if (Dv > D)
+                D = Dv;
             if (t + D >= t_max) {
                 /* The bound keeps the gap open up to t_max, but the last
                  * sample may still close it: look at t_max itself. */
-                double hm;
-                int hm_hint = hint;
-                pd_state sm;
-                if ((st = support_at(b, f, t_max, &sm, &hm_hint, &hm)) != PD_OK)
+                sample m = p;
+                if ((st = sample_at(b, f, t_max, &m)) != PD_OK)
                     return st;
-                if (hm > tol) {
+                if (m.h > tol) {
                     r.t = t_max;
-                    r.vertex = hm_hint;
-                    r.height = hm;
+                    r.vertex = m.low;
+                    r.height = m.h;
                     *out = r;
                     return PD_OK;
                 }
                 t = t_max; /* touching at t_max itself, within the tolerance */
-                s = sm;
-                hint = hm_hint;
-                h = hm;
+                p = m;
                 break;
             }
             t += D;
-            if ((st = support_at(b, f, t, &s, &hint, &h)) != PD_OK)
+            if ((st = sample_at(b, f, t, &p)) != PD_OK)
                 return st;
-            if (h <= tol)
+            if (p.h <= tol)
                 break;
         }
         r.kind = PD_IMPACT_AT;
     }
     r.t = t;
-    r.vertex = hint;
-    r.height = h;
-    r.ncontacts = contact_set(b, &s, hint, PD_TOL_CONTACT_REL * b->size, window, contacts, ncap);
+    r.vertex = p.low;
+    r.height = p.h;
+    r.ncontacts = contact_set(b, &p.s, p.up, p.low, PD_TOL_CONTACT_REL * b->size, window, contacts, ncap);
     *out = r;
     return PD_OK;
 }

@@ -440,7 +440,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         if (!resolved) {
             pd_impact imp;
-            if (pd_flight_impact_from(m->body, &f, f_at, &s, f_at + (o->time_limit - t),
+            /* hint is the lowest vertex of s, as decided_at just found it. */
+            if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
                                       sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
             if (imp.kind == PD_IMPACT_NONE) {

@@ -95,8 +95,19 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, d
  * pd_flight_eval gives it): the first contact in (t0, t_max], or
  * PD_IMPACT_NOW if touching at t0; times are the flight's own (from its
  * plan). A flight stays valid until its next contact, so a caller that has
- * moved the state along it need not plan it again. */
+ * moved the state along it need not plan it again. The search for the lowest
+ * vertex starts from vertex start (any index; one near the lowest at t0
+ * saves the climb to it, pd_flight_impact starts from 0). */
 pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
-                                double t_max, double window, int *contacts, int ncap, pd_impact *out);
+                                int start, double t_max, double window, int *contacts, int ncap,
+                                pd_impact *out);
+
+/* The per-vertex step of the impact search (contact_time.c) from state s, all
+ * vertices above the floor: the smallest positive root D over the hull's
+ * vertices v of z_v + z_v' D - B D^2 / 2 (z_v, z_v': v's height and its rate
+ * in s; B >= 0 a bound on -z_v''), HUGE_VAL if none has one. Hill-climbs from
+ * vertex start (any; the lowest is a good one). For the impact search and its
+ * tests. */
+double pd_flight_vertex_step(const pd_body *b, const pd_state *s, double B, int start);
 
 #endif

@@ -235,6 +235,27 @@
  * search would chase round-off and stop on its iteration limit. */
 #define PD_TOL_IMPACT_REL 1e-9
 
+/* The lowest vertex (pd_body_support, src/body.c) is found by hill-climbing
+ * the hull's edges, then checking the other corners of the facets around it,
+ * since a facet bent by up to PD_TOL_PLANE_REL can hide a lower corner behind
+ * a diagonal. The check is skipped at a vertex whose facets all keep every
+ * corner within this distance (times L) of the plane through the vertex and
+ * its two neighbours on the facet, and inside their angle: no corner can then
+ * lie lower than the vertex by more than this. Further corners can, by this
+ * times a factor of the facets' shape: 22 measured on a 32-gon's cap bent on
+ * purpose (3e-8 L of bend left the climb 7e-7 L high without the check).
+ * Why 1e-13: exactly planar faces (a file's equal coordinates) come out of
+ * the principal-axes rotation bent by round-off, measured at most 6e-18 L on
+ * a 32-gon coin's caps and 4e-17 L on the shipped parts' flat faces, over
+ * 2000 times below; a face whose file prints 12 digits is bent by up to
+ * 1e-12 L and keeps its check. The height the impact search reads is then
+ * at most ~2e-12 L above the true lowest on such a cap, 400 times below
+ * PD_TOL_IMPACT_REL. Larger: a slightly bent face could hand the search a
+ * height off by a visible part of its tolerance. Smaller: round-off on faces
+ * of many corners (where it grows with the corners' count) would bring the
+ * check back where it cannot change the answer. */
+#define PD_TOL_SUPPORT_FLAT_REL 1e-13
+
 /* At impact, every hull vertex within this height of the floor belongs to the
  * contact set handed to the (multi-contact) collision resolver. Why 1e-6: a
  * face landing flat touches with all its corners at once, and a face landing
