@@ -72,19 +72,21 @@ DEMO_PART  := parts/cap.off
 
 all: $(LIB) $(CLI)
 
-$(BUILD)/%.o: %.c
+# Objects depend on this Makefile too: a change of flags (the optimisation
+# level, warnings) rebuilds them rather than linking old objects with new.
+$(BUILD)/%.o: %.c Makefile
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 
-$(BUILD)/src/%.o: src/%.cpp
+$(BUILD)/src/%.o: src/%.cpp Makefile
 	@mkdir -p $(dir $@)
 	$(CXX) $(CXXFLAGS_ALL) -MMD -MP -c $< -o $@
 
-$(BUILD)/tests/%.o: tests/%.c
+$(BUILD)/tests/%.o: tests/%.c Makefile
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -DPD_CLI_PATH='"$(CLI)"' -MMD -MP -c $< -o $@
 
-$(BUILD)/bench-%.o: %.c
+$(BUILD)/bench-%.o: %.c Makefile
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -MMD -MP -c $< -o $@
 
