@@ -151,7 +151,7 @@ static double height_of(const pd_phase *p, pd_vec3 up, int v, int w)
 }
 
 static double margins(const pd_phase *p, const pd_state *s, const pd_phase_forces *F,
-                      double slip_min, double g[NMARGIN], int *floor_v)
+                      double slip_min, double g[NMARGIN], int *floor_v, pd_vec3 *up_out)
 {
     const pd_body *b = p->b;
     double V0 = p->L / p->T, mg = b->mass * p->g;
@@ -162,6 +162,7 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
         g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg : (F->slip[i] - slip_min) / V0;
     }
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    *up_out = up;
     /* The contacts' own height defines the floor. */
     *floor_v = p->v[0];
     if (p->nc == 2 && v3_dot(up, b->verts[p->v[1]]) < v3_dot(up, b->verts[p->v[0]]))
@@ -189,7 +190,7 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
 typedef struct {
     double tau, y[NY], dydt[NY];
     pd_state s;
-    pd_vec3 wdot;
+    pd_vec3 wdot, up, up_w; /* up: the world's, body frame; up_w = up x w */
     int floor_v;
     double g[NMARGIN], dg[HEIGHT], least;
     int rated;
@@ -207,7 +208,8 @@ static void point_at(const motion *mo, double slip_min, double tau, const double
         return;
     }
     a->wdot = F.wdot;
-    a->least = margins(mo->p, &a->s, &F, slip_min, a->g, &a->floor_v);
+    a->least = margins(mo->p, &a->s, &F, slip_min, a->g, &a->floor_v, &a->up);
+    a->up_w = v3_cross(a->up, a->s.w);
 }
 
 /* The force margins' rates of change at a, by a forward difference along
@@ -236,13 +238,11 @@ static void rate(const motion *mo, double slip_min, point *a)
 static void height_jet(const pd_phase *p, const point *a, int w, double jet[3])
 {
     const pd_body *b = p->b;
-    pd_vec3 up = quat_rotate_inv(a->s.q, v3(0.0, 0.0, 1.0));
     pd_vec3 r = v3_sub(b->verts[w], b->verts[a->floor_v]);
-    jet[0] = height_of(p, up, a->floor_v, w);
+    jet[0] = height_of(p, a->up, a->floor_v, w);
     pd_vec3 wr = v3_cross(a->s.w, r);
-    jet[1] = v3_dot(up, wr) * p->T / p->L;
-    jet[2] = (v3_dot(v3_cross(up, a->s.w), wr) + v3_dot(up, v3_cross(a->wdot, r))) * p->T * p->T /
-             p->L;
+    jet[1] = v3_dot(a->up, wr) * p->T / p->L;
+    jet[2] = (v3_dot(a->up_w, wr) + v3_dot(a->up, v3_cross(a->wdot, r))) * p->T * p->T / p->L;
 }
 
 /* The polynomial c[0] + c[1] s + ... + c[5] s^5, and its slope, at s. */
@@ -264,23 +264,23 @@ static double poly_slope(const double c[NCOEF], double s)
     return f;
 }
 
-/* The polynomial's first zero in (0, 1], given c[0] > 0 and its value g1
- * <= 0 at 1 (passed as computed where it came from, not summed from the
- * coefficients, which may round it above zero): the first of 16 cells where
- * it reaches zero, then that cell narrowed to 2^-36 of itself, ~1e-12 of
- * the step: far below the event tolerance for any step the phase takes. The
+/* The polynomial's first zero in (s0, s1], given its values g0 > 0 at s0
+ * and g1 <= 0 at s1 (passed as computed where they came from, not from the
+ * coefficients, which may round them across zero): the first of 16 cells
+ * where it reaches zero, then that cell narrowed to 2^-36 of itself, ~1e-12
+ * of the step: far below the event tolerance for any step the phase takes. The
  * narrowing is Newton's method from the secant's point, kept inside the
  * cell (bisecting where it would leave it), and once its steps are below
  * the width, two points half the width either side close the cell: about 7
  * evaluations (values and slopes) where bisection took 36 (measured on
  * random cubics, the result within the width of bisection's). */
-static double poly_zero(const double c[NCOEF], double g1)
+static double poly_zero(const double c[NCOEF], double s0, double s1, double g0, double g1)
 {
     enum { CELLS = 16, MAX_NARROWINGS = 60 };
-    const double width = 0x1p-36 / CELLS;
-    double lo = 0.0, hi = 1.0, flo = c[0], fhi = g1;
+    const double width = 0x1p-36 / CELLS * (s1 - s0);
+    double lo = s0, hi = s1, flo = g0, fhi = g1;
     for (int i = 1; i < CELLS; i++) {
-        double s = (double)i / CELLS, f = poly(c, s);
+        double s = s0 + (s1 - s0) * i / CELLS, f = poly(c, s);
         if (f <= 0.0) {
             hi = s, fhi = f;
             break;
@@ -314,6 +314,32 @@ static double poly_zero(const double c[NCOEF], double g1)
     return lo;
 }
 
+/* The quintic in s (0 at a, 1 at b) of vertex w's height into c[0..NCOEF),
+ * matching its value, slope and curvature at both ends (height_jet); the
+ * height at b into c[NCOEF]; returns the height at a. */
+static double height_model(const pd_phase *p, const point *a, const point *b, int w,
+                           double c[NCOEF + 1])
+{
+    double len = b->tau - a->tau, ja[3], jb[3];
+    height_jet(p, a, w, ja);
+    height_jet(p, b, w, jb);
+    /* g0 + m0 s + c0/2 s^2 plus the cubic, quartic and quintic terms that
+     * take up the misfits e0, e1, e2 of that quadratic's value, slope and
+     * curvature at 1. */
+    double m0 = len * ja[1], c0 = len * len * ja[2];
+    double e0 = jb[0] - (ja[0] + m0 + 0.5 * c0), e1 = len * jb[1] - (m0 + c0);
+    double e2 = len * len * jb[2] - c0;
+    const double cc[NCOEF + 1] = {ja[0],
+                                  m0,
+                                  0.5 * c0,
+                                  10.0 * e0 - 4.0 * e1 + 0.5 * e2,
+                                  -15.0 * e0 + 7.0 * e1 - e2,
+                                  6.0 * e0 - 3.0 * e1 + 0.5 * e2,
+                                  jb[0]};
+    memcpy(c, cc, sizeof cc);
+    return ja[0];
+}
+
 /* The time from a to the first event before b (where some margin is not
  * positive). A force margin's model is the cubic Hermite interpolant of its
  * values and rates at both ends (a secant where a rate is unknown): its
@@ -342,36 +368,47 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
             m0 = m1 = g1 - g0;
         const double c[NCOEF] = {g0, m0, 3.0 * (g1 - g0) - 2.0 * m0 - m1, 2.0 * (g0 - g1) + m0 + m1,
                                  0.0, 0.0};
-        frac = fmin(frac, poly_zero(c, g1));
+        frac = fmin(frac, poly_zero(c, 0.0, 1.0, g0, g1));
     }
     if (!(b->g[HEIGHT] <= 0.0))
         return len * frac;
-    pd_vec3 up = quat_rotate_inv(b->s.q, v3(0.0, 0.0, 1.0));
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
             if (w == p->v[0] || (p->nc == 2 && w == p->v[1]) ||
-                !(height_of(p, up, b->floor_v, w) <= 0.0))
+                !(height_of(p, b->up, b->floor_v, w) <= 0.0))
                 continue;
-            double ja[3], jb[3];
-            height_jet(p, a, w, ja);
-            height_jet(p, b, w, jb);
-            /* The quintic matching value, slope (per unit of the interval)
-             * and curvature at both ends, as g0 + m0 s + c0/2 s^2 plus the
-             * cubic, quartic and quintic terms that take up the misfits
-             * e0, e1, e2 of that quadratic's value, slope and curvature at 1. */
-            double m0 = len * ja[1], c0 = len * len * ja[2];
-            double e0 = jb[0] - (ja[0] + m0 + 0.5 * c0), e1 = len * jb[1] - (m0 + c0);
-            double e2 = len * len * jb[2] - c0;
-            const double c[NCOEF] = {ja[0],
-                                     m0,
-                                     0.5 * c0,
-                                     10.0 * e0 - 4.0 * e1 + 0.5 * e2,
-                                     -15.0 * e0 + 7.0 * e1 - e2,
-                                     6.0 * e0 - 3.0 * e1 + 0.5 * e2};
-            frac = fmin(frac, poly_zero(c, jb[0]));
+            double c[NCOEF + 1], g0 = height_model(p, a, b, w, c);
+            frac = fmin(frac, poly_zero(c, 0.0, 1.0, g0, c[NCOEF]));
         }
     return len * frac;
+}
+
+/* The time from b to the first height event within horizon after it,
+ * predicted by extrapolating each vertex's quintic through a and b (a
+ * neighbour of the contacts, as in margins); INFINITY if none. It only aims
+ * steps: each one's end is still checked (margins), and an event missed is
+ * found as before, from the step past it. Where it ends the phase (the
+ * event predicted within the tolerance), it extrapolates by at most that
+ * tolerance beyond b, which the quintic matches to the same order as
+ * within. */
+static double predicted_event(const pd_phase *p, const point *a, const point *b, double horizon)
+{
+    const pd_body *bd = p->b;
+    double len = b->tau - a->tau, s1 = 1.0 + horizon / len, best = INFINITY;
+    for (int i = 0; i < p->nc; i++)
+        for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
+            int w = bd->adj[k];
+            if (w == p->v[0] || (p->nc == 2 && w == p->v[1]))
+                continue;
+            double c[NCOEF + 1];
+            height_model(p, a, b, w, c);
+            double g1 = poly(c, s1);
+            if (!(g1 <= 0.0))
+                continue;
+            best = fmin(best, len * (poly_zero(c, 1.0, s1, c[NCOEF], g1) - 1.0));
+        }
+    return best;
 }
 
 /* The contacts and modes of the phase for contacts[0..nc) of state s,
@@ -422,6 +459,7 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     double g[NMARGIN], slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     pd_phase_forces F;
     pd_pivot pv;
+    pd_vec3 up;
     int floor_v, pivot = pd_pivot_init(&pv, &p, s);
     double w = 0.0;
     if (pivot) {
@@ -450,7 +488,7 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     } else if (pd_phase_forces_of(&p, &t, &F)) {
         return 0;
     }
-    if (!(margins(&p, &t, &F, slip_min, g, &floor_v) > 0.0))
+    if (!(margins(&p, &t, &F, slip_min, g, &floor_v, &up) > 0.0))
         return 0;
     /* The phase goes on with the modes the projection was for: taken
      * afresh from t, a contact that slid above the start threshold and
@@ -483,35 +521,58 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, pd_ode *pivot_ode
     double tau_max = t_max / p.T, h = 0.05, target = INFINITY;
     double y[NY];
     int hint = 0, pose, bracket = 0;
-    point cur, next, end; /* the phase so far; a step's end; the nearest end past an event */
+    /* The phase's last two points (prev NULL until there are two), a
+     * step's end, and the nearest end past an event: four buffers, passed
+     * round rather than copied. */
+    point buf[4], *prev = NULL, *cur = &buf[0], *next = &buf[1], *end = &buf[2];
+    point *spare = &buf[3];
     to_y(&mo, s, y);
-    point_at(&mo, slip_min, 0.0, y, &cur);
-    for (int step = 0; step < PD_PHASE_MAX_STEPS && cur.tau < tau_max && cur.least > 0.0; step++) {
-        double tau = cur.tau, h_try = h;
-        memcpy(y, cur.y, sizeof y);
+    point_at(&mo, slip_min, 0.0, y, cur);
+    for (int step = 0; step < PD_PHASE_MAX_STEPS && cur->tau < tau_max && cur->least > 0.0; step++) {
+        double tau = cur->tau, h_try = h;
+        memcpy(y, cur->y, sizeof y);
         double t1 = fmin(tau_max, fmin(target, tau + 10.0 * h));
-        pd_status st = pd_ode_step_from(ode, phase_rhs, &mo, &tau, t1, &h, y, cur.dydt);
-        double len = st == PD_OK ? tau - cur.tau : fmin(t1 - cur.tau, h_try);
-        next.least = -1.0;
+        pd_status st = pd_ode_step_from(ode, phase_rhs, &mo, &tau, t1, &h, y, cur->dydt);
+        double len = st == PD_OK ? tau - cur->tau : fmin(t1 - cur->tau, h_try);
+        next->least = -1.0;
         if (st == PD_OK) {
             if (!mo.pv) {
                 /* Keep the quaternion on the unit sphere between steps. */
                 pd_quat q = quat_normalize(quat(y[Q], y[Q + 1], y[Q + 2], y[Q + 3]));
                 y[Q] = q.w, y[Q + 1] = q.x, y[Q + 2] = q.y, y[Q + 3] = q.z;
             }
-            point_at(&mo, slip_min, tau, y, &next);
+            point_at(&mo, slip_min, tau, y, next);
         }
-        if (next.least > 0.0) {
-            cur = next;
-            *s = cur.s;
+        if (next->least > 0.0) {
+            point *old = prev ? prev : spare;
+            prev = cur, cur = next, next = old;
+            *s = cur->s;
             target = INFINITY;
-            if (bracket) {
-                /* Landed short of a known event: aim again, from here. */
-                double dt = time_to_event(&mo, slip_min, &cur, &end);
-                if (dt <= tol)
-                    break;
-                target = cur.tau + dt - 0.5 * tol;
-                h = target - cur.tau;
+            /* Landed short of a known event: aim again, from here. Else
+             * look ahead for a vertex coming down within the next step
+             * (predicted_event) and aim at it: the step lands within the
+             * tolerance of it, or close enough that the next one does, and
+             * the step past it and the retry from before it are saved.
+             * Ahead at most 1.3 suggested steps (further, aiming costs
+             * steps the controller rejects) and two of the intervals the
+             * model comes from (further, its extrapolation misses by more
+             * than the steps it would save). Measured on the median-band
+             * drops, steps and instructions in phases, not looking ahead:
+             * cube 379, 2.89M; box 332, 2.52M; coin 1492, 11.49M; looking
+             * 1 step or 1 interval ahead: 325, 2.67M; 289, 2.37M; 1296,
+             * 10.69M; 1 step or 2 intervals: 317, 2.62M; 287, 2.35M; 1283,
+             * 10.61M; 1.3 or 2: 309, 2.58M; 281, 2.33M; 1253, 10.49M; 1.6
+             * or 2: 309, 2.66M; 280, 2.36M; 1251, 10.64M. */
+            const double ahead_steps = 1.3, ahead_intervals = 2.0;
+            double dt = bracket ? time_to_event(&mo, slip_min, cur, end)
+                                : predicted_event(&p, prev, cur,
+                                                  fmin(ahead_steps * h,
+                                                       ahead_intervals * (cur->tau - prev->tau)));
+            if (dt <= tol)
+                break;
+            if (isfinite(dt)) {
+                target = cur->tau + dt - 0.5 * tol;
+                h = target - cur->tau;
             }
             if (pd_drop_decided(m, s, sc->gravity, &hint, &pose) > 0)
                 break;
@@ -527,16 +588,18 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, pd_ode *pivot_ode
          * model failure halves the step. When the event is within the
          * tolerance, hand over. */
         double dt = 0.5 * len;
-        if (next.least > -1.0) {
-            end = next;
+        int modelled = next->least > -1.0;
+        if (modelled) {
+            point *old = end;
+            end = next, next = old;
             bracket = 1;
-            dt = time_to_event(&mo, slip_min, &cur, &end);
+            dt = time_to_event(&mo, slip_min, cur, end);
         }
         if (dt <= tol)
             break;
-        target = cur.tau + (next.least > -1.0 ? dt - 0.5 * tol : dt);
-        h = target - cur.tau;
+        target = cur->tau + (modelled ? dt - 0.5 * tol : dt);
+        h = target - cur->tau;
     }
-    *t_used = cur.tau * p.T;
+    *t_used = cur->tau * p.T;
     return PD_OK;
 }
