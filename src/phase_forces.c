@@ -1,9 +1,10 @@
 /* phase_forces.c: a contact phase's forces (see phase_forces.h; the model
  * is described in contact_phase.c).
  *
- * The right-hand side of the phase's ODE solves the force system a dozen
- * times per step, so the common layouts skip the general assembly: one
- * sliding contact is a 1 x 1 system, and contacts that all stick (a pivot, a
+ * The right-hand side of the phase's ODE solves the force system six times
+ * per step, so the common layouts skip the general assembly: one sliding
+ * contact, nine phases in ten, is a 1 x 1 system written out (slide_one; so
+ * is its velocity projection), and contacts that all stick (a pivot, a
  * rotation about an edge) have a constant system in the body frame, so
  * their solution is a constant map computed once per phase. Contacts that
  * all slide have one unknown each (1 x 1 or 2 x 2); one of each (rare)
@@ -241,6 +242,37 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     pd_phase_map(p);
 }
 
+/* One sliding contact, the commonest phase (314 of the coin's 334
+ * median-band phases), written out: the force is lambda d, d = n - mu s the
+ * sliding direction (body frame), lambda from the one row n . (a_free +
+ * M d lambda) = 0; its normal component is lambda itself, and in the world
+ * d is (-mu s_x, -mu s_y, 1), so the centre's acceleration needs no
+ * rotation. */
+static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s, pd_vec3 a0,
+                     pd_phase_forces *out)
+{
+    const pd_body *b = p->b;
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), w = s->w;
+    pd_vec3 wr, vel = contact_velocity(p, R, s, 0, &wr);
+    double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
+    if (!(sl > 0.0))
+        return 1;
+    pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
+    double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+    pd_vec3 d = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
+                   up.z - cx * R[0][2] - cy * R[1][2]);
+    double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d));
+    if (!(fabs(k) > 0.0))
+        return 1;
+    double lambda = -v3_dot(up, af) / k, lm = lambda / b->mass;
+    out->wdot = v3_add(a0, inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
+    out->acc = v3(-cx * lm, -cy * lm, lm - p->g);
+    out->fn[0] = lambda;
+    out->cone[0] = HUGE_VAL;
+    out->slip[0] = sl;
+    return 0;
+}
+
 static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_forces *out)
 {
     const pd_body *b = p->b;
@@ -252,6 +284,8 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
     pd_vec3 w = s->w;
     pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
     pd_vec3 a0 = v3_neg(inv_inertia(b, v3_cross(w, Iw)));
+    if (!general && p->nc == 1 && p->mode[0] == SLIDE)
+        return slide_one(p, CONST_M3(R), s, a0, out);
     /* Per contact: its slip, its sliding force direction n - mu s (body
      * frame), and its free acceleration (body frame): gravity, the
      * gyroscopic angular acceleration and the centripetal term. */
@@ -353,6 +387,18 @@ int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
     if (!p->mapped)
         return 0;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    if (p->nc == 1 && p->mode[0] == SLIDE) {
+        /* One sliding contact, written out: the impulse x n that stops
+         * the normal speed u, x = -u / (n . M n), moves the centre along
+         * the world's z. */
+        double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), up));
+        if (!(fabs(k) > 0.0))
+            return 0;
+        double x = -(s->v.z + v3_dot(up, v3_cross(s->w, p->r[0]))) / k;
+        s->v.z += x / b->mass;
+        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[0], v3_scale(up, x))));
+        return 1;
+    }
     const pd_vec3 dir[2] = {up, up};
     layout L;
     make_layout(p, up, dir, body_axes, &L);
