@@ -185,8 +185,11 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
     for (int i = 0; i < p->nc; i++)
         for (int k = b->adj_start[p->v[i]]; k < b->adj_start[p->v[i] + 1]; k++) {
             int w = b->adj[k];
-            if (w != p->v[0] && (p->nc == 1 || w != p->v[1]))
-                g[HEIGHT] = fmin(g[HEIGHT], height_of(p, up, *floor_v, w));
+            if (w == p->v[0] || (p->nc == 2 && w == p->v[1]))
+                continue;
+            double h = height_of(p, up, *floor_v, w);
+            if (h < g[HEIGHT]) /* as fmin, NaN aside, without its call */
+                g[HEIGHT] = h;
         }
     double least = HUGE_VAL;
     for (int k = 0; k < NMARGIN; k++)
