@@ -56,6 +56,7 @@ void pd_sim_model_free(pd_sim_model *m)
     pd_static_result_free(m->descent);
     free(m->barrier);
     free(m->flat);
+    pd_descent_map_free(&m->map);
     pd_star_free(&m->star);
     free(m->pose_of);
     free(m);
@@ -91,6 +92,8 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
         st = pd_static_estimate(part, &so, &m->descent, diag);
     if (st == PD_OK)
         st = pd_star_build(part->hull, &m->star);
+    if (st == PD_OK)
+        st = pd_descent_map_build(part->hull, &m->star, part->com, &m->map);
     int nf = part->hull->nfacets;
     if (st == PD_OK) {
         m->barrier = malloc(sizeof *m->barrier * (size_t)nf);
@@ -361,7 +364,7 @@ static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *h
         return 0;
     pd_vec3 down = gravity_in_part(m, s);
     int f;
-    if (pd_descend(m->hull, &m->star, m->com, down, &f, hint) != PD_OK)
+    if (pd_descent_lookup(&m->map, down, &f, hint) != PD_OK)
         return -1;
     *facet = f;
     /* A resting vertex may be up to rest_fall below the floor, so the part's

@@ -5,6 +5,7 @@
 #define PD_DROP_INTERNAL_H
 
 #include "basin.h"
+#include "descent_map.h"
 #include "drop.h"
 #include "engine.h"
 #include "gsl_adapter.h"
@@ -26,6 +27,7 @@ struct pd_sim_model {
     struct pd_flat_facet *flat; /* per facet: what lying flat on it takes (flat_rest.h) */
     double flat_height;         /* m: with the centre of mass this high, flat on none */
     pd_star star;
+    pd_descent_map map;         /* the decision test's descent, looked up */
     int *pose_of;               /* facet -> pose index in the caller's table, or -1 */
     const pd_static_result *poses;
     const pd_engine *engine;    /* NULL: the impulse simulator */

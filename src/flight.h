@@ -110,4 +110,14 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
  * tests. */
 double pd_flight_vertex_step(const pd_body *b, const pd_state *s, double B, int start);
 
+/* The impact search's curvature step (contact_time.c) from state s, all
+ * vertices above the floor: the smallest root D in (0, H] over the hull's
+ * vertices v of z_v + z_v' D - (B0 - b_v . c) D^2 / 2, or H if none is
+ * smaller, where c is the second derivative of world up in the body frame and
+ * B0 = max(g + C H / 3, |c| rmax), C bounding every vertex's third derivative
+ * while |w| <= wmax: a time the part cannot reach the floor before. For the
+ * impact search and its tests. */
+double pd_flight_curvature_step(const pd_body *b, const pd_state *s, double g, double wmax,
+                                double H, int start);
+
 #endif

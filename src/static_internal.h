@@ -57,6 +57,18 @@ typedef struct pd_star {
 pd_status pd_star_build(const pd_hull *hull, pd_star *star); /* PD_ERR_NOMEM */
 void pd_star_free(pd_star *star);
 
+/* The hull vertex farthest along g, hill-climbed from vertex start. */
+int pd_star_support(const pd_hull *hull, const pd_star *star, pd_vec3 g, int start);
+
+/* Where the foot of com on the line of star edge e of vertex v falls: 0 at v,
+ * 1 at e->to. Pivoting about v onto e's arc, the part rolls about the edge
+ * when this is below 1, else pivots on about e->to. */
+double pd_star_lambda(const pd_hull *hull, pd_vec3 com, int v, const pd_star_edge *e);
+
+/* Rolling about star edge e of vertex v from gravity g on its arc: the facet
+ * (e->left or e->right) at the end of the arc the centre of mass descends to. */
+int pd_star_roll(const pd_hull *hull, pd_vec3 com, int v, const pd_star_edge *e, pd_vec3 g);
+
 /* Steepest descent of the centre of mass height from any gravity direction g
  * (unit, part frame): the facet the part first lands on (whose rest[] then
  * names the stable pose). hint (may be NULL) is a vertex to start the support

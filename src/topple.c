@@ -69,16 +69,19 @@ static pd_vec3 tangential(pd_vec3 x, pd_vec3 g)
     return v3_sub(x, v3_scale(g, v3_dot(x, g)));
 }
 
-/* Rotation about edge (v, w), gravity g on its arc between the normals of
- * facets left and right: the facet at the end the centre of mass descends to. */
-static int roll_abpd_star_edge(const pd_hull *h, pd_vec3 com, pd_vec3 v, pd_vec3 w, pd_vec3 g,
-                           int left, int right)
+int pd_star_roll(const pd_hull *h, pd_vec3 com, int v, const pd_star_edge *e, pd_vec3 g)
 {
-    pd_vec3 tau = v3_unit(v3_cross(v3_sub(w, v), g));
+    pd_vec3 pv = h->verts[v], pw = h->verts[e->to];
+    pd_vec3 tau = v3_unit(v3_cross(v3_sub(pw, pv), g));
     /* dh/ds moving along +tau: both edge ends are support points on the arc. */
-    if (v3_dot(v3_sub(v, com), tau) > 0.0)
+    if (v3_dot(v3_sub(pv, com), tau) > 0.0)
         tau = v3_neg(tau);
-    return v3_dot(h->normal[left], tau) >= v3_dot(h->normal[right], tau) ? left : right;
+    return v3_dot(h->normal[e->left], tau) >= v3_dot(h->normal[e->right], tau) ? e->left : e->right;
+}
+
+double pd_star_lambda(const pd_hull *h, pd_vec3 com, int v, const pd_star_edge *e)
+{
+    return -v3_dot(v3_sub(com, h->verts[v]), e->u) / (e->len * e->len);
 }
 
 /* 1 if g is within PD_TOL_ANGLE of the unit vector n (chord ~ angle there). */
@@ -133,15 +136,14 @@ static pd_status walk(const pd_hull *h, const pd_star *s, pd_vec3 com, int f, in
             *next = exit->right;
             return PD_OK;
         }
-        pd_vec3 pv = h->verts[v], pw = h->verts[exit->to];
-        double lambda = -v3_dot(v3_sub(com, pv), exit->u) / (exit->len * exit->len);
-        pd_vec3 dw = tangential(v3_sub(com, pw), g1);
+        double lambda = pd_star_lambda(h, com, v, exit);
+        pd_vec3 dw = tangential(v3_sub(com, h->verts[exit->to]), g1);
         double ndw = v3_norm(dw);
         if (lambda < 1.0 || ndw <= PD_TOL_ANGLE * exit->len) {
             /* Centre of mass over the segment (lambda > 0 whenever the edge
              * was reached by pivoting about v; round-off below 0 is clamped
              * here too): roll about the edge to the lower end of its arc. */
-            *next = roll_abpd_star_edge(h, com, pv, pw, g1, exit->left, exit->right);
+            *next = pd_star_roll(h, com, v, exit, g1);
             return PD_OK;
         }
         /* Beyond w: w takes over as the pivot. */
@@ -152,10 +154,10 @@ static pd_status walk(const pd_hull *h, const pd_star *s, pd_vec3 com, int f, in
     return PD_ERR_NO_CONVERGENCE;
 }
 
-/* The hull vertex farthest along g: hill-climbing over the vertex graph finds
- * it, because on a convex polytope a vertex no neighbour of which is farther
- * along g is the farthest of all. */
-static int support_vertex(const pd_hull *h, const pd_star *s, pd_vec3 g, int start)
+/* Hill-climbing over the vertex graph finds the support vertex, because on a
+ * convex polytope a vertex no neighbour of which is farther along g is the
+ * farthest of all. */
+int pd_star_support(const pd_hull *h, const pd_star *s, pd_vec3 g, int start)
 {
     int v = start;
     double best = v3_dot(h->verts[v], g);
@@ -177,7 +179,7 @@ static int support_vertex(const pd_hull *h, const pd_star *s, pd_vec3 g, int sta
 pd_status pd_descend(const pd_hull *h, const pd_star *s, pd_vec3 com, pd_vec3 g, int *facet,
                      int *hint)
 {
-    int v = support_vertex(h, s, g, hint && *hint >= 0 && *hint < h->nverts ? *hint : 0);
+    int v = pd_star_support(h, s, g, hint && *hint >= 0 && *hint < h->nverts ? *hint : 0);
     if (hint)
         *hint = v;
     /* Resting on a facet already (g at its normal): no motion from there

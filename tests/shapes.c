@@ -317,6 +317,19 @@ pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
     return st == PD_OK ? part : NULL;
 }
 
+pd_part *part_random_ellipsoid(test_rng *rng, int n, double ay, double az, double cx, double cy)
+{
+    pd_vec3 pts[64];
+    if (n > 64)
+        n = 64;
+    for (int i = 0; i < n; i++) {
+        pd_vec3 u = rng_unit_vector(rng);
+        pts[i] = v3(u.x, ay * u.y, az * u.z);
+    }
+    pd_vec3 com = v3(rng_range(rng, -cx, cx), rng_range(rng, -cy, cy), 0.0);
+    return part_of(convex_mesh(pts, n), &com, NULL);
+}
+
 /* x rounded to float. Through a volatile: GCC 12.2 at -O2 compiles
  * v3((float)x, (float)y, (float)z) into one conversion, of z, and leaves x
  * and y unrounded (its SLP vectorizer; -fno-tree-slp-vectorize or -O1 do

@@ -58,6 +58,12 @@ struct pd_part;
 struct pd_diag;
 struct pd_part *part_of(pd_mesh *m, const pd_vec3 *com, struct pd_diag *diag);
 
+/* The part of the hull of n (<= 64) random points on the ellipsoid of
+ * half-axes 1, ay, az, its centre of mass drawn from [-cx, cx] x [-cy, cy] x
+ * {0} (points first, then the centre, from rng). */
+struct pd_part *part_random_ellipsoid(test_rng *rng, int n, double ay, double az, double cx,
+                                      double cy);
+
 /* Points of a regular n-gon prism (radius 1, height 1) or pyramid (apex at
  * z = 1 over the base ring at z = -0.5), for n beyond the fixtures' 32, and
  * their distortions. */

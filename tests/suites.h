@@ -10,6 +10,7 @@
     PD_SUITE(part)   \
     PD_SUITE(static) \
     PD_SUITE(basin)  \
+    PD_SUITE(descent_map) \
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
     PD_SUITE(scene)  \

@@ -99,13 +99,7 @@ static void test_random(void)
     test_rng rng = {31337};
     int compared = 0, agree = 0, paths = 0, below = 0;
     for (int trial = 0; trial < 4; trial++) {
-        pd_vec3 pts[20];
-        for (int i = 0; i < 20; i++) {
-            pd_vec3 u = rng_unit_vector(&rng);
-            pts[i] = v3(u.x, 0.7 * u.y, 0.5 * u.z);
-        }
-        pd_vec3 com = v3(rng_range(&rng, -0.2, 0.2), rng_range(&rng, -0.15, 0.15), 0.0);
-        pd_part *p = part_of(convex_mesh(pts, 20), &com, NULL);
+        pd_part *p = part_random_ellipsoid(&rng, 20, 0.7, 0.5, 0.2, 0.15);
         pd_static_result *r = p ? descent_result(p) : NULL;
         if (!r) {
             pd_part_free(p);

@@ -31,6 +31,31 @@ static pd_body *body_of(const pd_part *p)
     return b;
 }
 
+/* A random unit quaternion (not uniform over rotations). */
+static pd_quat random_quat(test_rng *r)
+{
+    return quat_normalize(quat(rng_range(r, -1, 1), rng_range(r, -1, 1), rng_range(r, -1, 1),
+                               rng_range(r, -1, 1)));
+}
+
+/* Raises or lowers s so that its lowest vertex is gap above the floor. */
+static void lift(const pd_body *b, pd_state *s, double gap)
+{
+    int low = pd_body_support_scan(b, quat_rotate_inv(s->q, v3(0, 0, 1)));
+    s->x.z = -pd_body_vertex_world(b, s, low).z + gap;
+}
+
+/* p's body; NULL, a failed check and p freed when p is NULL or has none. */
+static pd_body *body_or_free(pd_part *p)
+{
+    pd_body *b = p ? body_of(p) : NULL;
+    if (!b) {
+        CHECK(0);
+        pd_part_free(p);
+    }
+    return b;
+}
+
 static pd_vec3 world_L(const pd_body *b, const pd_state *s)
 {
     return quat_rotate(s->q, v3(b->moment[0] * s->w.x, b->moment[1] * s->w.y,
@@ -213,8 +238,7 @@ static void test_flight(void)
     test_rng r = {11};
     for (int i = 0; i < 6; i++) {
         pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 5.0, 50.0));
-        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
-                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        pd_quat q = random_quat(&r);
         check_conservation(b, state_at(v3(0, 0, 1), q, v3(0, 0, 0), w), 2.0, "random omega");
         if (i < 2)
             check_vs_rk4(b, state_at(v3(0, 0, 1), q, v3(0, 0, 0), v3_scale(w, 0.2)), 0.5);
@@ -379,8 +403,7 @@ static void test_flight_reference(void)
         double sc = pow(10.0, rng_range(&r, -8.0, -4.0));
         double I[3] = {sc, sc * rng_range(&r, 1.2, 3.0), 0.0};
         I[2] = I[1] * rng_range(&r, 1.2, 3.0);
-        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
-                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        pd_quat q = random_quat(&r);
         /* Generic: omega mostly along an extreme axis, so that both charts occur. */
         pd_vec3 d = rng_unit_vector(&r);
         pd_vec3 w = i % 2 ? v3(d.x, d.y, 2.0 * copysign(1.0, d.z) + d.z)
@@ -467,8 +490,7 @@ static void test_impact(void)
      * the lowest vertex is within tol of the floor. */
     test_rng r = {5};
     for (int trial = 0; trial < 20; trial++) {
-        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
-                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        pd_quat q = random_quat(&r);
         pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 5.0, 50.0));
         pd_state st = {v3(0, 0, rng_range(&r, 0.03, 0.15)), q, v3(0.05, 0, rng_range(&r, -0.5, 0.5)), w};
         CHECK_STATUS(pd_flight_plan(b, &st, G, &f), PD_OK);
@@ -508,8 +530,7 @@ static void test_impact(void)
     long steps = 0;
     int ntrials = 0;
     for (int trial = 0; trial < 60; trial++) {
-        pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
-                                        rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+        pd_quat q = random_quat(&r);
         pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 10.0, 100.0));
         pd_state st = {v3(0, 0, 0), q, v3(0.1, 0, rng_range(&r, -0.05, 0.05)), w};
         int low = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
@@ -728,22 +749,17 @@ static void test_vertex_step(void)
     pd_part *parts[4] = {part_of_mesh(mesh_box(0.01, 0.02, 0.03)), ring_part(&exact, NULL, 1.0, v3(0, 0, 0)),
                          ring_part(&bent, NULL, 1.0, v3(0, 0, 0)), ellipsoid_part(&r)};
     for (int k = 0; k < 4; k++) {
-        pd_body *b = parts[k] ? body_of(parts[k]) : NULL;
-        if (!b) {
-            CHECK(0);
-            pd_part_free(parts[k]);
+        pd_body *b = body_or_free(parts[k]);
+        if (!b)
             continue;
-        }
         double worst = 0.0;
         for (int trial = 0; trial < 500; trial++) {
-            pd_quat q = quat_normalize(quat(rng_range(&r, -1, 1), rng_range(&r, -1, 1),
-                                            rng_range(&r, -1, 1), rng_range(&r, -1, 1)));
+            pd_quat q = random_quat(&r);
             double wn = trial % 10 ? rng_range(&r, 0.0, 100.0) : 0.0;
             pd_state s = {v3(0, 0, 0), q, v3(0.1, 0, rng_range(&r, -2.0, 1.0)),
                           v3_scale(rng_unit_vector(&r), wn)};
-            int low = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
             double gap = b->size * pow(10.0, rng_range(&r, -6.0, -1.0));
-            s.x.z = -pd_body_vertex_world(b, &s, low).z + gap;
+            lift(b, &s, gap);
             double B = (trial % 20 ? G : 0.0) + 2.0 * wn * wn * b->rmax;
             double want = HUGE_VAL;
             pd_vec3 ww = quat_rotate(s.q, s.w);
@@ -763,6 +779,77 @@ static void test_vertex_step(void)
         pd_body_free(b);
         pd_part_free(parts[k]);
     }
+}
+
+/* The impact search's curvature step (contact_time.c). Its bound first:
+ * along the closed-form flight, every vertex of a box, a 32-gon coin, a cube
+ * (no angular acceleration) and a 1000-point ellipsoid, spinning up to
+ * 100 rad/s, stays above its Taylor polynomial of degree 2 at the sample
+ * (derivatives from Euler's equations in the world frame) less C D^3 / 6, up
+ * to rotations of 1 rad; and C is not loose by more than a factor of 20 on
+ * the worst of them. Then the step: the smallest root over all vertices of
+ * the quadratics it takes, capped at H, computed here vertex by vertex in the
+ * world frame, from random start vertices. */
+static void test_curvature_step(void)
+{
+    test_rng r = {17};
+    pd_part *parts[4] = {part_of_mesh(mesh_box(0.01, 0.02, 0.03)), part_of_mesh(mesh_prism(32, 0.01, 0.002)),
+                         part_of_mesh(mesh_box(0.01, 0.01, 0.01)), ellipsoid_part(&r)};
+    double worst_below = 0.0, tightest = 0.0, worst_step = 0.0;
+    for (int k = 0; k < 4; k++) {
+        pd_body *b = body_or_free(parts[k]);
+        if (!b)
+            continue;
+        double kk = b->spin_accel;
+        for (int trial = 0; trial < 200; trial++) {
+            pd_quat q = random_quat(&r);
+            double wn = rng_range(&r, 1.0, 100.0);
+            pd_state s = {v3(0, 0, 0), q, v3(0.1, 0, rng_range(&r, -2.0, 1.0)),
+                          v3_scale(rng_unit_vector(&r), wn)};
+            double gap = b->size * pow(10.0, rng_range(&r, -6.0, -1.0));
+            lift(b, &s, gap);
+            pd_flight f;
+            CHECK_STATUS(pd_flight_plan(b, &s, G, &f), PD_OK);
+            double H = rng_range(&r, 0.01, 1.0) / f.wmax;
+            double C = (1.0 + 3.0 * kk + 3.0 * kk * kk) * f.wmax * f.wmax * f.wmax * b->rmax;
+            pd_vec3 dw;
+            pd_quat dq;
+            rk4_deriv(b, s.q, s.w, &dq, &dw);
+            pd_vec3 ww = quat_rotate(s.q, s.w), aw = quat_rotate(s.q, dw);
+            pd_vec3 up = quat_rotate_inv(s.q, v3(0, 0, 1));
+            pd_vec3 c = v3_add(v3_cross(v3_cross(up, s.w), s.w), v3_cross(up, dw));
+            double B0 = fmax(G + C * H / 3.0, v3_norm(c) * b->rmax);
+            double want = H;
+            for (int i = 0; i < b->nverts; i++) {
+                pd_vec3 rel = quat_rotate(s.q, b->verts[i]);
+                double z = s.x.z + rel.z, dz = s.v.z + v3_cross(ww, rel).z;
+                double ddz = -G + v3_add(v3_cross(aw, rel), v3_cross(ww, v3_cross(ww, rel))).z;
+                double Bi = fmax(B0 - (ddz + G), 0.0);
+                double sq = sqrt(dz * dz + 2.0 * Bi * z);
+                double root = dz < 0.0 ? 2.0 * z / (sq - dz) : Bi > 0.0 ? (dz + sq) / Bi : HUGE_VAL;
+                want = root < want ? root : want;
+                if (i % 3 == 0)
+                    for (int j = 1; j <= 16; j++) {
+                        double D = H * j / 16.0;
+                        pd_state at;
+                        pd_flight_eval(&f, D, &at);
+                        double zt = pd_body_vertex_world(b, &at, i).z;
+                        double taylor = z + dz * D + 0.5 * ddz * D * D, cubic = C * D * D * D / 6.0;
+                        worst_below = fmax(worst_below, (taylor - cubic - zt) / b->size);
+                        tightest = fmax(tightest, (taylor - zt) / cubic);
+                    }
+            }
+            double got = pd_flight_curvature_step(b, &s, G, f.wmax, H, (int)(rng_next(&r) % (uint64_t)b->nverts));
+            /* The heights carry round-off ~1e-16 L: relative to the gap in the root. */
+            worst_step = fmax(worst_step, fabs(got - want) / want * gap / b->size);
+        }
+        pd_body_free(b);
+        pd_part_free(parts[k]);
+    }
+    CHECK_NEAR(worst_below, 0.0, 1e-14, "never below the bound, the flight's round-off");
+    CHECK(tightest <= 1.0 && tightest > 0.05);
+    CHECK_NEAR(worst_step, 0.0, 1e-14, "smallest root over all vertices, heights' round-off");
+    printf("flight: curvature bound: the worst vertex used %.2f of its C D^3 / 6\n", tightest);
 }
 
 /* ulps of |y|'s binade, for the sine and cosine. */
@@ -814,4 +901,5 @@ void suite_flight(void)
     test_spin_accel();
     test_support_flat();
     test_vertex_step();
+    test_curvature_step();
 }

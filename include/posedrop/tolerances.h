@@ -98,6 +98,18 @@
  * that must stay distinct differ by 1e-7 rad or more (see PD_TOL_PLANE_REL). */
 #define PD_TOL_ANGLE 1e-12
 
+/* The drop's decision test looks up where quasi-static descent lands
+ * (src/descent_map.c) and answers only when gravity's direction lies at least
+ * this angle inside the region that answer holds for; nearer a boundary it
+ * runs the descent itself. Why 1e-9 rad: the walk's decisions are computed
+ * with round-off of ~1e-16 (the map's margins are scaled by each region's
+ * conditioning), so 1e-9 leaves seven orders between a looked-up answer and
+ * one the walk could decide otherwise; a direction within 1e-9 of a boundary
+ * is rare (a tilt at rest is ~1e-4, PD_TOL_REST_FALL_REL), so nearly every
+ * lookup answers. Larger: more walks, no other effect; much smaller: the map
+ * could answer where round-off flips the walk's answer. */
+#define PD_TOL_DESCENT_MAP 1e-9
+
 /* Descent must lower the centre of mass along every quasi-static link. A rise
  * smaller than this (relative to L) is accepted as error of the facet planes;
  * a larger one is reported as PD_ERR_INTERNAL. Why 2 PD_TOL_PLANE_REL: a
