@@ -277,8 +277,10 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag)
      * most the largest ratio times |w|^2 / sqrt(3): 0 for a cube, whose
      * spin never changes. */
     double kappa = 0.0;
-    for (int i = 0; i < 3; i++)
-        kappa = fmax(kappa, fabs(eval[(i + 1) % 3] - eval[(i + 2) % 3]) / eval[i]);
+    for (int i = 0; i < 3; i++) {
+        b->euler[i] = (eval[(i + 1) % 3] - eval[(i + 2) % 3]) / eval[i];
+        kappa = fmax(kappa, fabs(b->euler[i]));
+    }
     b->spin_accel = kappa / sqrt(3.0);
     b->frame = quat_from_matrix(CONST_M3(V));
     b->com = part->com;

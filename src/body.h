@@ -30,6 +30,7 @@ typedef struct pd_body {
     pd_vec3 com;          /* centre of mass in the part frame, m */
     double size;          /* the part's size L (bounding-box diagonal), m */
     double rmax;          /* largest distance of a hull vertex from the com, m */
+    double euler[3];      /* (I_j - I_k) / I_i: torque-free, dw_i/dt = euler[i] w_j w_k */
     double spin_accel;    /* |dw/dt| <= spin_accel |w|^2 in torque-free motion */
     int nverts;
     pd_vec3 *verts;       /* hull vertices, principal frame, relative to the com */

@@ -23,7 +23,7 @@
  * it lands a vertex approaching at any speed in a step or two, where the
  * worst-case speed bound creeps up on a spinning part in tens. That smallest
  * root is found by hill-climbing the hull, not by visiting every vertex:
- * vertex_step.
+ * lowest_root.
  *
  * From a search's second step on, the per-vertex bound takes each vertex's
  * exact second derivative at the sample instead of B, and bounds the third.
@@ -40,7 +40,7 @@
  * the max making every vertex's quadratic concave (b_v . c <= |c| rmax)
  * while it stays a lower bound. As B0 - b_v . c is linear in b_v, the vertex
  * whose quadratic is lowest at D is the support vertex in direction
- * up + D a + D^2 c / 2, and vertex_step's search applies, run on each root
+ * up + D a + D^2 c / 2, and the same search (lowest_root) applies, run on each root
  * capped at H (where the bound ends): a vertex lowest at H whose quadratic is
  * not below 0 there leaves no root before H. The result is a step that
  * cannot pass a contact. Exact to second order, it closes the gap near
@@ -90,34 +90,6 @@ static double vertex_root(const pd_body *b, const pd_state *s, pd_vec3 up, pd_ve
     return 2.0 * z / (-dz + sqrt(dz * dz + 2.0 * B * z));
 }
 
-/* The per-vertex step (header, flight.h), without visiting every vertex.
- * Vertex v's quadratic is below 0 at D exactly when
- * (up + D a) . b_v < B D^2 / 2 - z - v_z D (b_v: v in the body frame), so the
- * vertex whose quadratic is lowest at D is the support vertex in direction
- * up + D a. From any vertex's root D, which is >= D* (the smallest), the
- * support vertex w there either is the vertex whose root D is (then every
- * quadratic is >= 0 at D: they are concave and positive at 0, so no root is
- * below D, and D = D*) or has a quadratic below 0 at D, hence a smaller root,
- * which the search moves to. D falls strictly, so no vertex comes twice; in
- * practice one or two moves, each a short hill-climb from the last vertex.
- * With no root (B = 0: no spin, no gravity) the direction is a alone, the
- * limit. */
-static double vertex_step(const pd_body *b, const pd_state *s, pd_vec3 up, double B, int start)
-{
-    pd_vec3 a = v3_cross(up, s->w);
-    int v = start;
-    double D = vertex_root(b, s, up, a, B, v);
-    for (;;) {
-        int w = pd_body_support(b, D < HUGE_VAL ? v3_add(up, v3_scale(a, D)) : a, v);
-        double Dw = w == v ? D : vertex_root(b, s, up, a, B, w);
-        if (!(Dw < D)) /* w == v, or a tie within round-off */
-            break;
-        v = w;
-        D = Dw;
-    }
-    return D > 0.0 ? D : 0.0;
-}
-
 /* Vertex v's root of z_v + z_v' D - (B0 - b_v . c) D^2 / 2, the coefficient
  * kept from going below 0 by the round-off of B0's bound. */
 static double curvature_root(const pd_body *b, const pd_state *s, pd_vec3 up, pd_vec3 a,
@@ -127,31 +99,56 @@ static double curvature_root(const pd_body *b, const pd_state *s, pd_vec3 up, pd
     return vertex_root(b, s, up, a, Bv > 0.0 ? Bv : 0.0, v);
 }
 
-/* The curvature step (header): the per-vertex search of vertex_step on the
- * quadratics with each vertex's own curvature, capped at H. accel holds the
- * Euler ratios (I_j - I_k) / I_i, so that dw_i/dt = accel_i w_j w_k. */
-static double curvature_step(const pd_body *b, const pd_state *s, pd_vec3 up, pd_vec3 accel,
-                             double g, double C, double H, int start)
+/* The smallest root, capped at H, over the vertices of z_v + z_v' D -
+ * (B0 - b_v . c) D^2 / 2, without visiting every vertex. Vertex v's
+ * quadratic is below 0 at D exactly when (up + D a + D^2 c / 2) . b_v <
+ * B0 D^2 / 2 - z - v_z D (b_v: v in the body frame), so the vertex whose
+ * quadratic is lowest at D is the support vertex in that direction. From any
+ * vertex's root D, which is >= D* (the smallest), the support vertex w there
+ * either is the vertex whose root D is (then every quadratic is >= 0 at D:
+ * they are concave and positive at 0, so no root is below D, and D = D*) or
+ * has a quadratic below 0 at D, hence a smaller root, which the search moves
+ * to. D falls strictly, so no vertex comes twice; in practice one or two
+ * moves, each a short hill-climb from the last vertex. With no root (c = 0,
+ * B0 = 0: no spin, no gravity; H infinite) the direction is a alone, the
+ * limit. */
+static double lowest_root(const pd_body *b, const pd_state *s, pd_vec3 up, pd_vec3 a, pd_vec3 c,
+                          double B0, double H, int start)
 {
-    pd_vec3 w = s->w, a = v3_cross(up, w);
-    pd_vec3 dw = v3(accel.x * w.y * w.z, accel.y * w.z * w.x, accel.z * w.x * w.y);
-    pd_vec3 c = v3_add(v3_cross(a, w), v3_cross(up, dw));
-    double B0 = g + C * H / 3.0, Bc = v3_norm(c) * b->rmax;
-    if (Bc > B0)
-        B0 = Bc;
     int v = start;
     double D = curvature_root(b, s, up, a, c, B0, v);
     D = D < H ? D : H;
     for (;;) {
-        int u = pd_body_support(b, v3_add(up, v3_scale(v3_add(a, v3_scale(c, 0.5 * D)), D)), v);
-        double Du = u == v ? D : curvature_root(b, s, up, a, c, B0, u);
-        Du = Du < H ? Du : H;
-        if (!(Du < D)) /* u == v, or a tie within round-off */
+        pd_vec3 dir = D < HUGE_VAL ? v3_add(up, v3_scale(v3_add(a, v3_scale(c, 0.5 * D)), D)) : a;
+        int w = pd_body_support(b, dir, v);
+        double Dw = w == v ? D : curvature_root(b, s, up, a, c, B0, w);
+        Dw = Dw < H ? Dw : H;
+        if (!(Dw < D)) /* w == v, or a tie within round-off */
             break;
-        v = u;
-        D = Du;
+        v = w;
+        D = Dw;
     }
     return D > 0.0 ? D : 0.0;
+}
+
+/* The per-vertex step (header, flight.h): every vertex's curvature bounded
+ * by the same B. */
+static double vertex_step(const pd_body *b, const pd_state *s, pd_vec3 up, double B, int start)
+{
+    return lowest_root(b, s, up, v3_cross(up, s->w), v3(0.0, 0.0, 0.0), B, HUGE_VAL, start);
+}
+
+/* The curvature step (header): each vertex's own curvature, capped at H;
+ * b->euler gives dw_i/dt = euler_i w_j w_k. */
+static double curvature_step(const pd_body *b, const pd_state *s, pd_vec3 up, double g, double C,
+                             double H, int start)
+{
+    pd_vec3 w = s->w, a = v3_cross(up, w);
+    const double *e = b->euler;
+    pd_vec3 dw = v3(e[0] * w.y * w.z, e[1] * w.z * w.x, e[2] * w.x * w.y);
+    pd_vec3 c = v3_add(v3_cross(a, w), v3_cross(up, dw));
+    double B0 = g + C * H / 3.0, Bc = v3_norm(c) * b->rmax;
+    return lowest_root(b, s, up, a, c, Bc > B0 ? Bc : B0, H, start);
 }
 
 double pd_flight_vertex_step(const pd_body *b, const pd_state *s, double B, int start)
@@ -159,12 +156,9 @@ double pd_flight_vertex_step(const pd_body *b, const pd_state *s, double B, int 
     return vertex_step(b, s, quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)), B, start);
 }
 
-/* The bound C on every vertex's third derivative (header), and the Euler
- * ratios curvature_step takes. */
-static double third_bound(const pd_body *b, double wmax, pd_vec3 *accel)
+/* The bound C on every vertex's third derivative (header). */
+static double third_bound(const pd_body *b, double wmax)
 {
-    const double *I = b->moment;
-    *accel = v3((I[1] - I[2]) / I[0], (I[2] - I[0]) / I[1], (I[0] - I[1]) / I[2]);
     double k = b->spin_accel;
     return (1.0 + 3.0 * k + 3.0 * k * k) * wmax * wmax * wmax * b->rmax;
 }
@@ -172,9 +166,8 @@ static double third_bound(const pd_body *b, double wmax, pd_vec3 *accel)
 double pd_flight_curvature_step(const pd_body *b, const pd_state *s, double g, double wmax,
                                 double H, int start)
 {
-    pd_vec3 accel;
-    double C = third_bound(b, wmax, &accel);
-    return curvature_step(b, s, quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)), accel, g, C, H, start);
+    return curvature_step(b, s, quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)), g, third_bound(b, wmax), H,
+                          start);
 }
 
 /* The contact set: vertices within tol of the floor, or that would reach it
@@ -235,8 +228,7 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
     double tol = PD_TOL_IMPACT_REL * b->size;
     double W = f->wmax * b->rmax;
     double B = f->g + (1.0 + b->spin_accel) * f->wmax * f->wmax * b->rmax;
-    pd_vec3 accel;
-    double C = third_bound(b, f->wmax, &accel);
+    double C = third_bound(b, f->wmax);
     pd_impact r = {PD_IMPACT_NONE, 0.0, 0, 0.0, 0, 0};
     sample p = {*at, {0.0, 0.0, 0.0}, start, 0.0};
     double t = t0, D_last = 0.0; /* the search's last step, 0 before its first */
@@ -254,7 +246,7 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
             /* Root of g/2 D^2 + c D = h in the form without cancellation. */
             double disc = c * c + 2.0 * f->g * p.h;
             double D = disc > 0.0 ? 2.0 * p.h / (c + sqrt(disc)) : HUGE_VAL;
-            double Dv = D_last > 0.0 ? curvature_step(b, &p.s, p.up, accel, f->g, C, 2.0 * D_last, p.low)
+            double Dv = D_last > 0.0 ? curvature_step(b, &p.s, p.up, f->g, C, 2.0 * D_last, p.low)
                                      : vertex_step(b, &p.s, p.up, B, p.low);
             if (Dv > D)
                 D = Dv;

@@ -63,9 +63,9 @@ void pd_flat_build(const pd_body *b, const pd_hull *hull, const pd_static_result
     }
 }
 
-/* The share of PD_FLAT_SAFETY at which pd_flat_settled refuses before its
- * pass over the corners (below): shared by pd_flat_height_max. */
-#define EARLY_SAFETY (0.99 * PD_FLAT_SAFETY)
+/* The factor at which pd_flat_settled refuses before its pass over the
+ * corners (below), shared by pd_flat_height_max (tolerances.h). */
+#define EARLY_SAFETY (PD_FLAT_EARLY_SHARE * PD_FLAT_SAFETY)
 
 double pd_flat_height_max(const pd_flat_facet *ff, int nfacets)
 {
@@ -106,9 +106,9 @@ int pd_flat_settled(const pd_flat_facet *ff, const pd_body *b, const pd_state *s
      * corner, any height of that corner above the floor, and the kinetic
      * energy beyond the flat motion's. The first two sum to at least
      * s->x.z - h whatever the lowest corner's height, so most refusals need
-     * no pass over the corners (a coin's cap has 32). Refused here only 1%
-     * beyond the bound, so that the round-off of the two sums never refuses
-     * what the exact test below would take. */
+     * no pass over the corners (a coin's cap has 32). Refused here only
+     * beyond the bound by PD_FLAT_EARLY_SHARE, so that the round-off of the
+     * two sums never refuses what the exact test below would take. */
     double rock_least = (s->x.z - F->h) + (ke - ke_flat) / mg;
     if (!(barrier > EARLY_SAFETY * (fmax(rock_least, 0.0) + rest_fall)))
         return 0;
