@@ -52,7 +52,10 @@ typedef struct pd_flight {
 } pd_flight;
 
 /* Plans the flight of body b from state s0 under gravity g (m/s^2, >= 0).
- * PD_ERR_USAGE (NULL, g < 0), PD_ERR_NONFINITE (a non-finite state). */
+ * PD_ERR_USAGE (NULL, g < 0), PD_ERR_NONFINITE (a non-finite state, or an
+ * elliptic phase that overflows away from the middle axis). On failure *f
+ * may be partly written (it is planned in place): it holds no flight and
+ * must not be evaluated. */
 pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f);
 
 /* The state at time t (s, may be negative) after the start. The com is
