@@ -161,6 +161,14 @@ static double height_of(const pd_phase *p, pd_vec3 up, int v, int w)
     return v3_dot(up, v3_sub(p->b->verts[w], p->b->verts[v])) / p->L;
 }
 
+/* 1 if body vertex w is one of the phase's contacts. The next vertex to
+ * touch is looked for among the contacts' edge neighbours less these
+ * (margins, time_to_event, predicted_event). */
+static int is_contact(const pd_phase *p, int w)
+{
+    return w == p->v[0] || (p->nc == 2 && w == p->v[1]);
+}
+
 static double margins(const pd_phase *p, const pd_state *s, const pd_phase_forces *F,
                       double slip_min, double g[NMARGIN], int *floor_v, pd_vec3 *up_out)
 {
@@ -185,7 +193,7 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
     for (int i = 0; i < p->nc; i++)
         for (int k = b->adj_start[p->v[i]]; k < b->adj_start[p->v[i] + 1]; k++) {
             int w = b->adj[k];
-            if (w == p->v[0] || (p->nc == 2 && w == p->v[1]))
+            if (is_contact(p, w))
                 continue;
             double h = height_of(p, up, *floor_v, w);
             if (h < g[HEIGHT]) /* as fmin, NaN aside, without its call */
@@ -389,8 +397,7 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
-            if (w == p->v[0] || (p->nc == 2 && w == p->v[1]) ||
-                !(height_of(p, b->up, b->floor_v, w) <= 0.0))
+            if (is_contact(p, w) || !(height_of(p, b->up, b->floor_v, w) <= 0.0))
                 continue;
             double c[NCOEF + 1], g0 = height_model(p, a, b, w, c);
             frac = fmin(frac, poly_zero(c, 0.0, 1.0, g0, c[NCOEF]));
@@ -413,7 +420,7 @@ static double predicted_event(const pd_phase *p, const point *a, const point *b,
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
-            if (w == p->v[0] || (p->nc == 2 && w == p->v[1]))
+            if (is_contact(p, w))
                 continue;
             double c[NCOEF + 1];
             height_model(p, a, b, w, c);

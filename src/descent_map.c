@@ -57,7 +57,8 @@
 
 /* The facet the walk rolls to from the part of arc e between unit vectors x
  * and y on it (both on one side of s0), or -1 when that part is too short to
- * hold a point farther than margin from both ends. */
+ * hold a point farther than margin from both ends (a chord of 2 margins
+ * would just hold its midpoint; the second factor 2 is slack). */
 static int roll_between(const pd_hull *h, pd_vec3 com, int v, const pd_star_edge *e, pd_vec3 x,
                         pd_vec3 y, double margin)
 {

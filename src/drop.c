@@ -443,7 +443,9 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         if (!resolved) {
             pd_impact imp;
-            /* hint is the lowest vertex of s, as decided_at just found it. */
+            /* hint: the lowest vertex of s where decided_at looked the
+             * descent up, else of an earlier state; a start for the search's
+             * hill-climb either way. */
             if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
                                       sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;

@@ -30,7 +30,7 @@ typedef struct {
     int on_ray;       /* sliding stopped on that ray */
     pd_rays in;       /* the incoming rays */
     unsigned built;   /* bit k: ser[k] is built (once the slip comes near ray k) */
-    pd_ray_series *ser; /* [4], the slide's: left out of the collision's zeroing */
+    pd_ray_series *ser; /* [PD_RAYS_MAX], the slide's: left out of the collision's zeroing */
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;

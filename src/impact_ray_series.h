@@ -11,7 +11,7 @@
  * delta = phi - phi* has a recursion of its own (the derivation is at the
  * definition); it converges up to the nearest other root of b, so the tail
  * can take over at any slip and at angles where the third-order expansion
- * of impact_rays.c could not. The series depends on K, mu and the ray only:
+ * it replaced could not. The series depends on K, mu and the ray only:
  * it is built once per collision and ray, and evaluated by Horner. */
 #ifndef PD_IMPACT_RAY_SERIES_H
 #define PD_IMPACT_RAY_SERIES_H

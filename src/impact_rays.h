@@ -17,11 +17,14 @@
 
 #include "posedrop/types.h"
 
-/* The incoming rays of one K and mu: at most 4. */
+/* The incoming rays of one K and mu: the roots of a trigonometric
+ * polynomial of degree 2 (impact_rays.c), so at most PD_RAYS_MAX. */
+enum { PD_RAYS_MAX = 4 };
+
 typedef struct pd_rays {
     int n;
-    double tx[4], ty[4]; /* unit directions */
-    double rate[4];      /* lambda = d|u_t|/dpz along each, < 0 */
+    double tx[PD_RAYS_MAX], ty[PD_RAYS_MAX]; /* unit directions */
+    double rate[PD_RAYS_MAX];                /* lambda = d|u_t|/dpz along each, < 0 */
 } pd_rays;
 
 /* The diverging ray's unit direction (*tx, *ty), or 0 when there is none

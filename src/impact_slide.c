@@ -271,7 +271,7 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
     int cap_event = EV_NONE;
     int henon = 1; /* cleared if a step onto an event ever fails */
     c->in.n = -1;  /* not looked for yet */
-    pd_ray_series ser[4];
+    pd_ray_series ser[PD_RAYS_MAX];
     c->ser = ser;
     for (;;) {
         pd_vec3 u = coll_u(c, c->y);

@@ -57,12 +57,25 @@ double kinetic_energy(const pd_body *b, const pd_state *s)
                   b->moment[2] * s->w.z * s->w.z);
 }
 
+pd_quat quat_onto_down(pd_vec3 n)
+{
+    pd_vec3 down = v3(0, 0, -1), axis = v3_cross(n, down);
+    double s = v3_norm(axis), c = v3_dot(n, down);
+    if (s > 1e-12)
+        return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
+    return c > 0 ? quat_identity() : quat_axis_angle(v3(1, 0, 0), M_PI);
+}
+
+double total_energy(const pd_body *b, double g, const pd_state *s)
+{
+    return kinetic_energy(b, s) + b->mass * g * s->x.z;
+}
+
 void state_gap_add(state_gap *gap, const pd_body *b, double g, const pd_state *a,
                    const pd_state *r)
 {
     double L = b->size, T = sqrt(L / g), V0 = L / T, mgL = b->mass * g * L;
-    double Ea = kinetic_energy(b, a) + b->mass * g * a->x.z;
-    double Er = kinetic_energy(b, r) + b->mass * g * r->x.z;
+    double Ea = total_energy(b, g, a), Er = total_energy(b, g, r);
     gap->x = fmax(gap->x, v3_dist(a->x, r->x) / L);
     gap->v = fmax(gap->v, v3_dist(a->v, r->v) / V0);
     gap->q = fmax(gap->q, fmax(fmax(fabs(a->q.w - r->q.w), fabs(a->q.x - r->q.x)),

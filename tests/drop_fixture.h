@@ -27,6 +27,13 @@ int lowest_vertices(const pd_body *b, pd_quat q, int *out);
 
 double kinetic_energy(const pd_body *b, const pd_state *s);
 
+/* The shortest turn taking unit vector n onto the world's down, -z (a half
+ * turn about x when n is up). */
+pd_quat quat_onto_down(pd_vec3 n);
+
+/* Kinetic plus potential energy under gravity g, J. */
+double total_energy(const pd_body *b, double g, const pd_state *s);
+
 /* The largest differences between pairs of states of one body, in its
  * units: position per L, velocity per sqrt(g L), quaternion components,
  * rate of turn per 1/sqrt(L/g), energy (gravity g) per m g L. */

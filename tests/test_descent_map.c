@@ -85,7 +85,9 @@ static void check_part(const pd_part *p, test_rng *rng, tally *rand_t, tally *ed
             if (!isfinite(a->margin))
                 continue;
             /* Points on each plane of the lune (and the saddle's), part of
-             * the way from u to the cone, pushed off it either way. */
+             * the way from u to the cone, pushed off it either way, and the
+             * point across u on the same plane, on it (the map must walk
+             * there or agree). */
             const pd_vec3 m[3] = {a->ma, a->mb, a->ms};
             for (int j = 0; j < 3; j++) {
                 pd_vec3 c = v3_cross(m[j], u); /* in the plane, perpendicular to u */
@@ -109,9 +111,10 @@ static void test_agrees(void)
      * the map leaves to the walk. */
     tally rt = {0, 0, 0, 0}, rt_pivot = {0, 0, 0, 0}, et = {0, 0, 0, 0};
     long parts = 0;
-    /* Exact hulls: the cube, a 1x2x3 box, a 32-gon coin, the same with the
-     * centre of mass moved off centre (vertices where the part pivots on,
-     * lambda >= 1, and balance points inside a vertex's cone). */
+    /* Exact hulls: the cube, a 1x2x3 box, a thin plate and a 32-gon coin,
+     * each also with the centre of mass moved off centre (vertices where the
+     * part pivots on, lambda >= 1, and balance points inside a vertex's
+     * cone). */
     const double boxes[][3] = {{1, 1, 1}, {1, 2, 3}, {0.3, 1, 0.05}};
     for (int i = 0; i < 3; i++)
         for (int off = 0; off < 2; off++) {
@@ -163,13 +166,14 @@ static void test_agrees(void)
     /* Random hulls with the centre of mass anywhere well inside. */
     for (int trial = 0; trial < 6; trial++) {
         pd_part *p = part_random_ellipsoid(&rng, 24, 0.6, 0.4, 0.25, 0.1);
+        CHECK(p != NULL);
         if (p) {
             check_part(p, &rng, &rt_pivot, &et);
             parts++;
         }
         pd_part_free(p);
     }
-    CHECK(parts >= 20);
+    CHECK_INT(parts, 26); /* every part above built */
     CHECK_INT(rt.disagree, 0);
     CHECK_INT(rt_pivot.disagree, 0);
     CHECK_INT(et.disagree, 0);
@@ -178,7 +182,8 @@ static void test_agrees(void)
     CHECK_INT(et.hint_differs, 0);
     /* On parts like the drop's the map must answer nearly always, or the
      * drop gains nothing; elsewhere often enough to have been tested; and the
-     * probes near boundaries must have reached both answers and walks. */
+     * probes near boundaries must have reached both answers and walks
+     * (measured: all, 60%, 48%). */
     CHECK(rt.answered > 0.99 * (double)rt.asked);
     CHECK(rt_pivot.answered > 0.3 * (double)rt_pivot.asked);
     CHECK(et.answered > 0.2 * (double)et.asked && et.answered < 0.9 * (double)et.asked);

@@ -733,8 +733,8 @@ static void test_ray_tail(void)
                 continue; /* a ray that repels nearby directions has no tail */
             /* On the ray: p' = (-mu t, 1) for pz = s / |rate|, u_z linear in pz. */
             double alpha = pow(10.0, rng_range(&rng, -3.0, 0.0));
-            pd_vec3 u = v3(alpha * tx, alpha * ty, -1.0), dp;
-            double dw;
+            pd_vec3 u = v3(alpha * tx, alpha * ty, -1.0), dp = {NAN, NAN, NAN};
+            double dw = NAN; /* read by the checks below even if the tail is refused */
             CHECK(pd_ray_series_tail(CR(K), mu, &sr, u, PD_TOL_IMPACT_SERIES_ANGLE, 1e-9, 1, &dp, &dw));
             double pz = alpha / -r, q = K[2][2] - mu * (K[2][0] * tx + K[2][1] * ty);
             double on = v3_norm(v3_sub(dp, v3(-mu * tx * pz, -mu * ty * pz, pz))) / pz;
@@ -757,9 +757,10 @@ static void test_ray_tail(void)
             worst = fmax(worst, err);
             worst_w = fmax(worst_w, fabs(dw - y[5]) / fmax(1.0, fabs(y[5])));
             CHECK_NEAR(err, 0.0, max_err, "the bound the tail accepted; RK4 in steps of 0.002 of the flow's rate adds < 1e-11");
-            /* relative beyond 1: a slowly closing ray's work reaches 1e3 and
-             * RK4's 1e7 steps sum round-off of 1e-12 of it */
-            CHECK_NEAR(dw, y[5], max_err * fmax(1.0, fabs(y[5])), "the work's bound");
+            /* the tail's bound plus RK4's: a slowly closing ray's work
+             * reaches 1e3 and RK4's 1e7 steps sum round-off of ~1e-12 of it
+             * (measured 2.5e-12), allowed 1e-11 of it as above */
+            CHECK_NEAR(dw, y[5], max_err + 1e-11 * fabs(y[5]), "the work's bound");
             /* u_t after it: u_t + B dp_t + a dp_z = 0 to round-off */
             double rx = u.x + K[0][0] * dp.x + K[0][1] * dp.y + K[0][2] * dp.z;
             double ry = u.y + K[1][0] * dp.x + K[1][1] * dp.y + K[1][2] * dp.z;
@@ -767,7 +768,7 @@ static void test_ray_tail(void)
         }
     }
     CHECK(taken >= 40);
-    CHECK(wide >= 5);
+    CHECK(wide >= 5); /* measured 12: tails where the third-order one could not go */
     printf("impact: ray tails (series): %d of %d offered taken (%d beyond 0.1 rad at slip > 0.1), "
            "impulse within %.2g and work within %.2g (relative beyond 1) of RK4 to the origin; "
            "on the ray within %.2g\n",
