@@ -67,7 +67,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo paper install uninstall clean help deps
+.PHONY: all check test bench demo paper install uninstall clean help deps golden
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI)
@@ -126,6 +126,11 @@ paper: deps
 	@$(MAKE) --no-print-directory all
 	scripts/paper.sh
 
+# Re-pins the golden outcomes (tests/test_golden.c) on purpose, printing each
+# case whose hash moved; the commit that does it says why.
+golden: $(TEST_BIN)
+	PD_GOLDEN_WRITE=tests/golden.csv $(TEST_BIN) golden
+
 bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
 	$(BENCH_BIN)
@@ -154,6 +159,7 @@ help:
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
+	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"

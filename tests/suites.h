@@ -26,7 +26,8 @@
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
     PD_SUITE(symmetry) \
-    PD_SUITE(cli)
+    PD_SUITE(cli)    \
+    PD_SUITE(golden)
 
 #define PD_SUITE(name) void suite_##name(void);
 PD_SUITES
