@@ -99,7 +99,7 @@
 #define PD_TOL_ANGLE 1e-12
 
 /* The drop's decision test looks up where quasi-static descent lands
- * (src/descent_map.c) and answers only when gravity's direction lies at least
+ * (src/settle/descent_map.c) and answers only when gravity's direction lies at least
  * this angle inside the region that answer holds for; nearer a boundary it
  * runs the descent itself. Why 1e-9 rad: the walk's decisions are computed
  * with round-off of ~1e-16 (the map's margins are scaled by each region's
@@ -126,7 +126,7 @@
  * transfers, above what GSL's 21-point rule reaches on smooth integrands. */
 #define PD_TOL_BAND_QUAD_REL 1e-10
 
-/* Pose classes (src/symmetry.c): a rotation about the centre of mass maps the
+/* Pose classes (src/symmetry/symmetry.c): a rotation about the centre of mass maps the
  * hull onto itself when every vertex lands within this distance (times L) of
  * a vertex; the candidate rotations are found by matching distances from the
  * centre and between two reference vertices to the same accuracy, and two
@@ -247,7 +247,7 @@
  * search would chase round-off and stop on its iteration limit. */
 #define PD_TOL_IMPACT_REL 1e-9
 
-/* The lowest vertex (pd_body_support, src/body.c) is found by hill-climbing
+/* The lowest vertex (pd_body_support, src/dynamics/body.c) is found by hill-climbing
  * the hull's edges, then checking the other corners of the facets around it,
  * since a facet bent by up to PD_TOL_PLANE_REL can hide a lower corner behind
  * a diagonal. The check is skipped at a vertex whose facets all keep every
@@ -314,7 +314,7 @@
 
 /* A part lying on a stable facet is settled when its rocking energy plus
  * the rest fall, times this, is below the barrier its nearest edge keeps
- * against friction and spin (src/flat_rest.c). Why 2: a safety factor on an
+ * against friction and spin (src/settle/flat_rest.c). Why 2: a safety factor on an
  * argument that is not a proof; measured, deciding at factor 1 instead of
  * running each drop to its energy test changed no outcome in 2000 cube
  * drops (and 1000 each of box, coin, cap and button drops at 2), while the
@@ -334,7 +334,7 @@
  * gain; smaller: fewer early refusals. */
 #define PD_FLAT_EARLY_SHARE 0.99
 
-/* --- sliding contact phases (src/contact_phase.c) --------------------------- *
+/* --- sliding contact phases (src/contact/contact_phase.c) --------------------------- *
  * One vertex or edge sliding on the floor is integrated as an ODE in units
  * of the part: length L, time sqrt(L/g), speed sqrt(g L). */
 
@@ -488,7 +488,7 @@
  * means a caller's bug, e.g. a transposed inertia. */
 #define PD_TOL_IMPACT_K_SYM_REL 1e-12
 
-/* --- engines (src/engine_ode.c, src/engine_bullet.cpp, src/drop_step.c) -- *
+/* --- engines (src/engines/engine_ode.c, src/engines/engine_bullet.cpp, src/sim/drop_step.c) -- *
  * The stepping engines that cross-check the impulse simulator. Their contacts
  * are soft (a penetration spring) and resolved once per fixed time step, so
  * they need guards the event-driven simulator does not. */
@@ -562,7 +562,7 @@
  * smaller: resting contacts chatter. */
 #define PD_BULLET_BOUNCE_STEPS 2.0
 
-/* --- initial stationary (src/montecarlo.c, src/markov.c) ----------------- */
+/* --- initial stationary (src/sim/montecarlo.c, src/sim/markov.c) ----------------- */
 
 /* Fewest drops started resting on each stable pose. Each row of the
  * estimated transition matrix rests on this many drops, and a transition the

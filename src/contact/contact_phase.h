@@ -1,0 +1,36 @@
+/* contact_phase.h (private): one vertex or one edge sliding on the floor,
+ * integrated as a continuous motion instead of microcollisions (see
+ * contact_phase.c for the model and when it hands back). */
+#ifndef PD_CONTACT_PHASE_H
+#define PD_CONTACT_PHASE_H
+
+#include "sim/drop.h"
+#include "base/gsl_adapter.h"
+#include "contact/phase_forces.h"
+
+/* The phase's integrators, one each per thread: the full motion's (13
+ * unknowns) and a pivot's (2: two sticking contacts turning about their
+ * edge, contact_pivot.h). NULL if out of memory. */
+pd_ode *pd_contact_phase_ode_alloc(void);
+pd_ode *pd_contact_pivot_ode_alloc(void);
+
+/* 1 if state s, touching the floor at body vertices contacts[0..nc), is a
+ * contact the phase can take: one or two contacts moving normally no faster
+ * than the microcollisions' rest speed, each sliding or sticking, pressed by
+ * positive forces, no other vertex down. Then s's constrained velocities are
+ * zeroed (a sliding contact's normal one, a sticking contact's whole one),
+ * without adding energy, for the phase to start from, and *phase is the
+ * phase; otherwise s is left alone. */
+int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_state *s,
+                           const int *contacts, int nc, pd_phase *phase);
+
+/* Runs phase (from pd_contact_phase_start) from s for at most t_max
+ * seconds, or until the energy test decides the drop; s becomes the state
+ * where it ended and *t_used the time it took. Two sticking contacts turn
+ * about their edge by pivot_ode, or by ode in full where pivot_ode is NULL
+ * (the reference the reduced motion is tested against). */
+pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, pd_ode *pivot_ode,
+                           const pd_scene *scene, const pd_phase *phase, pd_state *s,
+                           double t_max, double *t_used);
+
+#endif

@@ -1,0 +1,417 @@
+/* phase_forces.c: a contact phase's forces (see phase_forces.h; the model
+ * is described in contact_phase.c).
+ *
+ * The right-hand side of the phase's ODE solves the force system six times
+ * per step, so the common layouts skip the general assembly: one sliding
+ * contact, nine phases in ten, is a 1 x 1 system written out (slide_one; so
+ * is its velocity projection), and contacts that all stick (a pivot, a
+ * rotation about an edge) have a constant system in the body frame, so
+ * their solution is a constant map computed once per phase. Contacts that
+ * all slide have one unknown each (1 x 1 or 2 x 2); one of each (rare)
+ * takes the general layout. Every system is assembled from the contacts'
+ * constant response matrices. */
+#include <math.h>
+#include <string.h>
+#include "base/mat3.h"
+#include "contact/phase_forces.h"
+#include "posedrop/tolerances.h"
+#include "base/quat.h"
+#include "base/vec3.h"
+
+enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
+
+static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 t)
+{
+    return v3(b->inv_moment[0] * t.x, b->inv_moment[1] * t.y, b->inv_moment[2] * t.z);
+}
+
+/* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
+ * n + m columns) and B's columns become X's, by Gaussian elimination with
+ * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of A's
+ * largest entry. */
+enum { AUG = 12 };
+
+static int solve_dense(int n, int m, double Ab[6][AUG])
+{
+    double scale = 0.0;
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            if (fabs(Ab[i][j]) > scale) /* as fmax, NaN aside, without its call */
+                scale = fabs(Ab[i][j]);
+    for (int k = 0; k < n; k++) {
+        int piv = k;
+        for (int i = k + 1; i < n; i++)
+            if (fabs(Ab[i][k]) > fabs(Ab[piv][k]))
+                piv = i;
+        if (!(fabs(Ab[piv][k]) > PD_TOL_PHASE_PIVOT_REL * scale))
+            return 0;
+        for (int j = 0; j < n + m; j++) {
+            double t = Ab[k][j];
+            Ab[k][j] = Ab[piv][j];
+            Ab[piv][j] = t;
+        }
+        for (int i = k + 1; i < n; i++) {
+            double f = Ab[i][k] / Ab[k][k];
+            for (int j = k; j < n + m; j++)
+                Ab[i][j] -= f * Ab[k][j];
+        }
+    }
+    for (int c = n; c < n + m; c++)
+        for (int i = n - 1; i >= 0; i--) {
+            for (int j = i + 1; j < n; j++)
+                Ab[i][c] -= Ab[i][j] * Ab[j][c];
+            Ab[i][c] /= Ab[i][i];
+        }
+    return 1;
+}
+
+/* solve_dense for n = 1 or 2 and one right-hand side, written out: the
+ * same pivoting, test and arithmetic without the loops, for the sliding
+ * contacts that solve it at every right-hand side. A 1 x 1 system is
+ * singular only at 0 (the test is relative to the entry itself). */
+static int solve_small(int n, double A[6][AUG])
+{
+    if (n == 1) {
+        if (!(fabs(A[0][0]) > 0.0))
+            return 0;
+        A[0][1] /= A[0][0];
+        return 1;
+    }
+    double scale = 0.0;
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2; j++)
+            if (fabs(A[i][j]) > scale)
+                scale = fabs(A[i][j]);
+    if (fabs(A[1][0]) > fabs(A[0][0]))
+        for (int j = 0; j < 3; j++) {
+            double t = A[0][j];
+            A[0][j] = A[1][j];
+            A[1][j] = t;
+        }
+    if (!(fabs(A[0][0]) > PD_TOL_PHASE_PIVOT_REL * scale))
+        return 0;
+    double f = A[1][0] / A[0][0];
+    A[1][1] -= f * A[0][1];
+    A[1][2] -= f * A[0][2];
+    if (!(fabs(A[1][1]) > PD_TOL_PHASE_PIVOT_REL * scale))
+        return 0;
+    A[1][2] /= A[1][1];
+    A[0][2] = (A[0][2] - A[0][1] * A[1][2]) / A[0][0];
+    return 1;
+}
+
+/* The constrained directions of the contacts, body frame: a sliding contact
+ * constrains its normal n (one row); a sticking one its whole acceleration,
+ * along axes[0..3) (three rows). The unknowns follow the same layout, a
+ * sliding contact's along its force direction dir[i] (n - mu s for forces,
+ * n for the impulses of the velocity projection). */
+typedef struct {
+    int n;
+    int c[6];       /* contact of each row / unknown */
+    pd_vec3 row[6]; /* constrained direction */
+    pd_vec3 col[6]; /* direction of the unknown force */
+} layout;
+
+static void make_layout(const pd_phase *p, pd_vec3 up, const pd_vec3 dir[2], const pd_vec3 axes[3],
+                        layout *L)
+{
+    L->n = 0;
+    for (int i = 0; i < p->nc; i++) {
+        if (p->mode[i] == SLIDE) {
+            L->c[L->n] = i, L->row[L->n] = up, L->col[L->n] = dir[i], L->n++;
+        } else {
+            for (int k = 0; k < 3; k++)
+                L->c[L->n] = i, L->row[L->n] = axes[k], L->col[L->n] = axes[k], L->n++;
+        }
+    }
+}
+
+static const pd_vec3 body_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+
+/* The unknowns X of layout L such that each constrained component of the
+ * contacts' acceleration (or velocity) change K X equals B, for m
+ * right-hand sides (columns of B; X's replace them). For two sticking
+ * contacts K is singular (the squeeze along the edge moves nothing): the
+ * least-norm solution is taken, from the normal equations with the squeeze
+ * set to zero by one more row. 0 if singular. */
+static int solve_layout(const pd_phase *p, const layout *L, int m, double B[6][6])
+{
+    int n = L->n;
+    double K[7][6], Ab[6][AUG];
+    for (int i = 0; i < n; i++)
+        for (int j = 0; j < n; j++)
+            K[i][j] = v3_dot(L->row[i], m3_vec(CONST_M3(p->M[L->c[i]][L->c[j]]), L->col[j]));
+    if (!(p->nc == 2 && p->mode[0] == STICK && p->mode[1] == STICK)) {
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++)
+                Ab[i][j] = K[i][j];
+            for (int c = 0; c < m; c++)
+                Ab[i][n + c] = B[i][c];
+        }
+    } else {
+        /* Squeeze row: (f0 - f1) . e = 0, e the edge, scaled like K's rows;
+         * its right-hand side is 0. */
+        pd_vec3 e = v3_unit(v3_sub(p->r[1], p->r[0]));
+        for (int j = 0; j < 6; j++)
+            K[6][j] = (j < 3 ? 1.0 : -1.0) * v3_dot(L->col[j], e) / p->b->mass;
+        for (int i = 0; i < 6; i++) {
+            for (int j = 0; j < 6; j++) {
+                Ab[i][j] = 0.0;
+                for (int k = 0; k < 7; k++)
+                    Ab[i][j] += K[k][i] * K[k][j];
+            }
+            for (int c = 0; c < m; c++) {
+                Ab[i][6 + c] = 0.0;
+                for (int k = 0; k < 6; k++)
+                    Ab[i][6 + c] += K[k][i] * B[k][c];
+            }
+        }
+    }
+    if (!solve_dense(n, m, Ab))
+        return 0;
+    for (int i = 0; i < n; i++)
+        for (int c = 0; c < m; c++)
+            B[i][c] = Ab[i][n + c];
+    return 1;
+}
+
+static int all_stick(const pd_phase *p)
+{
+    return p->mode[0] == STICK && (p->nc == 1 || p->mode[1] == STICK);
+}
+
+/* The velocity of contact j of state s (world), R the body-to-world matrix;
+ * *wr = w x r, body frame. */
+static inline pd_vec3 contact_velocity(const pd_phase *p, const double R[3][3], const pd_state *s, int j,
+                                pd_vec3 *wr)
+{
+    *wr = v3_cross(s->w, p->r[j]);
+    return v3_add(s->v, m3_vec(R, *wr));
+}
+
+void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                    const int *contacts, int nc, double slip_start)
+{
+    memset(p, 0, sizeof *p);
+    p->b = b, p->nc = nc, p->mu = mu, p->g = g, p->L = b->size, p->T = sqrt(b->size / g);
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    for (int i = 0; i < nc; i++) {
+        p->v[i] = contacts[i];
+        p->r[i] = b->verts[contacts[i]];
+        pd_vec3 wr, vel = contact_velocity(p, CONST_M3(R), s, i, &wr);
+        p->mode[i] = sqrt(vel.x * vel.x + vel.y * vel.y) > slip_start ? SLIDE : STICK;
+    }
+    if (nc == 1)
+        p->v[1] = -1;
+}
+
+void pd_phase_map(pd_phase *p)
+{
+    const pd_body *b = p->b;
+    int nc = p->nc;
+    p->mapped = 1;
+    /* Column k of M[i][j]: contact i's acceleration by a unit force along
+     * body axis k at contact j, f / m + (I^-1 (r_j x f)) x r_i. */
+    for (int i = 0; i < nc; i++)
+        for (int j = 0; j < nc; j++)
+            for (int k = 0; k < 3; k++) {
+                pd_vec3 f = body_axes[k];
+                pd_vec3 a = v3_add(v3_scale(f, 1.0 / b->mass),
+                                   v3_cross(inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
+                p->M[i][j][0][k] = a.x, p->M[i][j][1][k] = a.y, p->M[i][j][2][k] = a.z;
+            }
+    if (!all_stick(p))
+        return;
+    /* Every contact sticks: the rows and unknowns are the body axes, K is
+     * constant, and the solution is linear in the right-hand side: column k
+     * of P is the solution for the k-th unit right-hand side. */
+    layout L;
+    const pd_vec3 unused[2] = {v3(0, 0, 1), v3(0, 0, 1)};
+    make_layout(p, v3(0, 0, 1), unused, body_axes, &L);
+    for (int i = 0; i < L.n; i++)
+        for (int k = 0; k < L.n; k++)
+            p->P[i][k] = i == k;
+    p->singular = !solve_layout(p, &L, L.n, p->P);
+}
+
+void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                   const int *contacts, int nc, double slip_start)
+{
+    pd_phase_modes(p, b, g, mu, s, contacts, nc, slip_start);
+    pd_phase_map(p);
+}
+
+/* One sliding contact, the commonest phase (314 of the coin's 334
+ * median-band phases), written out: the force is lambda d, d = n - mu s the
+ * sliding direction (body frame), lambda from the one row n . (a_free +
+ * M d lambda) = 0; its normal component is lambda itself, and in the world
+ * d is (-mu s_x, -mu s_y, 1), so the centre's acceleration needs no
+ * rotation. */
+static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s, pd_vec3 a0,
+                     pd_phase_forces *out)
+{
+    const pd_body *b = p->b;
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), w = s->w;
+    pd_vec3 wr, vel = contact_velocity(p, R, s, 0, &wr);
+    double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
+    if (!(sl > 0.0))
+        return 1;
+    pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
+    double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+    pd_vec3 d = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
+                   up.z - cx * R[0][2] - cy * R[1][2]);
+    double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d));
+    if (!(fabs(k) > 0.0))
+        return 1;
+    double lambda = -v3_dot(up, af) / k, lm = lambda / b->mass;
+    out->wdot = v3_add(a0, inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
+    out->acc = v3(-cx * lm, -cy * lm, lm - p->g);
+    out->fn[0] = lambda;
+    out->cone[0] = HUGE_VAL;
+    out->slip[0] = sl;
+    return 0;
+}
+
+static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_forces *out)
+{
+    const pd_body *b = p->b;
+    if (!p->mapped)
+        return 1;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
+    pd_vec3 w = s->w;
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(inv_inertia(b, v3_cross(w, Iw)));
+    if (!general && p->nc == 1 && p->mode[0] == SLIDE)
+        return slide_one(p, CONST_M3(R), s, a0, out);
+    /* Per contact: its slip, its sliding force direction n - mu s (body
+     * frame), and its free acceleration (body frame): gravity, the
+     * gyroscopic angular acceleration and the centripetal term. */
+    pd_vec3 dir[2], af[2];
+    for (int j = 0; j < p->nc; j++) {
+        pd_vec3 wr, vel = contact_velocity(p, CONST_M3(R), s, j, &wr);
+        double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
+        out->slip[j] = sl;
+        af[j] = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[j]), v3_cross(w, wr)));
+        dir[j] = up;
+        if (p->mode[j] == SLIDE) {
+            if (!(sl > 0.0))
+                return 1;
+            /* R^T (-mu s_x, -mu s_y, 1): rows 0 and 1 of R are the world's
+             * x and y axes in the body frame. */
+            double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+            dir[j] = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
+                        up.z - cx * R[0][2] - cy * R[1][2]);
+        }
+    }
+    pd_vec3 f[2] = {v3(0, 0, 0), v3(0, 0, 0)};
+    if (!general && all_stick(p)) {
+        if (p->singular)
+            return 1;
+        double rhs[6] = {0}, x[6];
+        int n = 3 * p->nc;
+        for (int j = 0; j < p->nc; j++)
+            rhs[3 * j] = -af[j].x, rhs[3 * j + 1] = -af[j].y, rhs[3 * j + 2] = -af[j].z;
+        for (int i = 0; i < n; i++) {
+            x[i] = 0.0;
+            for (int k = 0; k < n; k++)
+                x[i] += p->P[i][k] * rhs[k];
+        }
+        for (int j = 0; j < p->nc; j++)
+            f[j] = v3(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
+    } else if (!general && p->mode[0] == SLIDE && (p->nc == 1 || p->mode[1] == SLIDE)) {
+        /* Every contact slides: one unknown per contact, along its force
+         * direction, and one row, its normal. */
+        int n = p->nc;
+        double A[6][AUG];
+        for (int i = 0; i < n; i++) {
+            for (int j = 0; j < n; j++)
+                A[i][j] = v3_dot(up, m3_vec(CONST_M3(p->M[i][j]), dir[j]));
+            A[i][n] = -v3_dot(up, af[i]);
+        }
+        if (!solve_small(n, A))
+            return 1;
+        for (int j = 0; j < n; j++)
+            f[j] = v3_scale(dir[j], A[j][n]);
+    } else {
+        pd_vec3 axes[3] = {body_axes[0], body_axes[1], body_axes[2]};
+        if (general) {
+            /* The contact's own tangent axes, as a check that the
+             * body axes of the specialised solves lose nothing. */
+            axes[0] = up;
+            axes[1] = v3_unit(v3_cross(up, fabs(up.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0)));
+            axes[2] = v3_cross(up, axes[1]);
+        }
+        layout L;
+        make_layout(p, up, dir, axes, &L);
+        double x[6][6];
+        for (int i = 0; i < L.n; i++)
+            x[i][0] = -v3_dot(L.row[i], af[L.c[i]]);
+        if (!solve_layout(p, &L, 1, x))
+            return 1;
+        for (int k = 0; k < L.n; k++)
+            f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
+    }
+    pd_vec3 F = v3(0.0, 0.0, 0.0);
+    out->wdot = a0;
+    for (int j = 0; j < p->nc; j++) {
+        out->wdot = v3_add(out->wdot, inv_inertia(b, v3_cross(p->r[j], f[j])));
+        F = v3_add(F, f[j]);
+        double fn = v3_dot(f[j], up);
+        out->fn[j] = fn;
+        out->cone[j] = p->mode[j] == STICK ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+                                            : HUGE_VAL;
+    }
+    out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));
+    return 0;
+}
+
+int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out)
+{
+    return forces(p, s, 0, out);
+}
+
+int pd_phase_forces_general(const pd_phase *p, const pd_state *s, pd_phase_forces *out)
+{
+    return forces(p, s, 1, out);
+}
+
+/* The impulses along the constrained components that change the kinetic
+ * energy least: an orthogonal projection in the mass metric, so the energy
+ * cannot rise whatever the impulses' signs. */
+int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
+{
+    const pd_body *b = p->b;
+    if (!p->mapped)
+        return 0;
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
+    if (p->nc == 1 && p->mode[0] == SLIDE) {
+        /* One sliding contact, written out: the impulse x n that stops
+         * the normal speed u, x = -u / (n . M n), moves the centre along
+         * the world's z. */
+        double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), up));
+        if (!(fabs(k) > 0.0))
+            return 0;
+        double x = -(s->v.z + v3_dot(up, v3_cross(s->w, p->r[0]))) / k;
+        s->v.z += x / b->mass;
+        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[0], v3_scale(up, x))));
+        return 1;
+    }
+    const pd_vec3 dir[2] = {up, up};
+    layout L;
+    make_layout(p, up, dir, body_axes, &L);
+    double x[6][6];
+    pd_vec3 vb = quat_rotate_inv(s->q, s->v);
+    for (int i = 0; i < L.n; i++)
+        x[i][0] = -v3_dot(L.row[i], v3_add(vb, v3_cross(s->w, p->r[L.c[i]])));
+    if (!solve_layout(p, &L, 1, x))
+        return 0;
+    for (int k = 0; k < L.n; k++) {
+        pd_vec3 P = v3_scale(L.col[k], x[k][0]);
+        s->v = v3_add(s->v, quat_rotate(s->q, v3_scale(P, 1.0 / b->mass)));
+        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[L.c[k]], P)));
+    }
+    return 1;
+}

@@ -1,0 +1,65 @@
+/* phase_forces.h (private): the contact forces of a contact phase (see
+ * contact_phase.c for the model), split from the phase's stepping so that
+ * what is constant over a phase is computed once, at its start. */
+#ifndef PD_PHASE_FORCES_H
+#define PD_PHASE_FORCES_H
+
+#include "dynamics/body.h"
+
+enum { PD_PHASE_SLIDE, PD_PHASE_STICK };
+
+/* One phase's contacts and what its force solve needs. In the body frame a
+ * contact's response to a force is a constant 3 x 3 matrix, and a sticking
+ * contact constrains its whole acceleration, which the body axes span as
+ * well as any other basis: so while every contact sticks, the solve is one
+ * constant linear map, set up once. */
+typedef struct {
+    const pd_body *b;
+    int nc;
+    int v[2];          /* contact vertices */
+    int mode[2];       /* PD_PHASE_SLIDE or PD_PHASE_STICK */
+    double mu, g;      /* SI */
+    double L, T;       /* units: length, time */
+    pd_vec3 r[2];      /* contact vertices, body frame */
+    double M[2][2][3][3]; /* M[i][j] f: acceleration of contact i by force f at j */
+    int singular;      /* every contact sticks and the constant system is singular */
+    double P[6][6];    /* every contact sticks: forces = P (minus free accelerations) */
+    int mapped;        /* M, singular and P set (pd_phase_map) */
+} pd_phase;
+
+/* What the forces of a state give: the com's acceleration (world), wdot
+ * (body), and per contact its normal force, its margin inside the friction
+ * cone (sticking: mu fn - |ft|; sliding: infinite) and its slip speed. */
+typedef struct {
+    pd_vec3 acc, wdot;
+    double fn[2], cone[2], slip[2];
+} pd_phase_forces;
+
+/* The phase of contacts[0..nc) (1 or 2) of state s: each contact slides if
+ * it slips faster than slip_start, else sticks; gravity g, friction mu.
+ * pd_phase_modes sets the contacts and their modes alone, for a caller that
+ * may refuse the phase on them or needs no force solve (a pivot,
+ * contact_pivot.h); pd_phase_map then sets up the solves, which
+ * pd_phase_forces_of and pd_phase_project_velocity need (they fail
+ * without); pd_phase_init does both. */
+void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                    const int *contacts, int nc, double slip_start);
+void pd_phase_map(pd_phase *p);
+void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
+                   const int *contacts, int nc, double slip_start);
+
+/* The forces of state s (SI). 0, or 1 where the model does not hold (a
+ * sliding contact with no slip to give friction a direction, a singular
+ * system). */
+int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out);
+
+/* The same by the general solve: every layout assembled and solved densely
+ * on the contacts' own tangent axes, as a reference for the specialised one. */
+int pd_phase_forces_general(const pd_phase *p, const pd_state *s, pd_phase_forces *out);
+
+/* Brings the constrained velocity components of s to zero (a sliding
+ * contact's normal speed, a sticking contact's whole velocity) by the
+ * impulses that change the kinetic energy least. 0 if singular. */
+int pd_phase_project_velocity(const pd_phase *p, pd_state *s);
+
+#endif

@@ -1,0 +1,264 @@
+/* mesh.c: units, reading a mesh file whole, telling its format, and the small
+ * operations on a pd_mesh (clone, size, free). */
+#include <errno.h>
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "mesh/mesh_internal.h"
+#include "mesh/mesh_reader.h"
+#include "posedrop/mesh.h"
+#include "base/vec3.h"
+
+double pd_units_scale(pd_units units)
+{
+    switch (units) {
+    case PD_UNITS_CM:
+        return 0.01;
+    case PD_UNITS_MM:
+        return 0.001;
+    case PD_UNITS_IN:
+        return 0.0254;
+    case PD_UNITS_M:
+    default:
+        return 1.0;
+    }
+}
+
+pd_status pd_units_parse(const char *text, pd_units *units)
+{
+    static const struct {
+        const char *name;
+        pd_units units;
+    } table[] = {{"m", PD_UNITS_M}, {"cm", PD_UNITS_CM}, {"mm", PD_UNITS_MM}, {"in", PD_UNITS_IN}};
+    if (!text || !units)
+        return PD_ERR_USAGE;
+    for (size_t i = 0; i < sizeof table / sizeof table[0]; i++)
+        if (strcmp(text, table[i].name) == 0) {
+            *units = table[i].units;
+            return PD_OK;
+        }
+    return PD_ERR_USAGE;
+}
+
+void pd_mesh_read_options_default(pd_mesh_read_options *options)
+{
+    options->format = PD_FORMAT_AUTO;
+    options->units = PD_UNITS_M;
+}
+
+/* --- format detection ----------------------------------------------------- */
+
+static pd_mesh_format by_extension(const char *name)
+{
+    const char *dot = strrchr(name, '.');
+    if (!dot)
+        return PD_FORMAT_AUTO;
+    size_t n = strlen(dot + 1);
+    if (pd_text_is(dot + 1, n, "off"))
+        return PD_FORMAT_OFF;
+    if (pd_text_is(dot + 1, n, "stl"))
+        return PD_FORMAT_STL;
+    if (pd_text_is(dot + 1, n, "obj"))
+        return PD_FORMAT_OBJ;
+    return PD_FORMAT_AUTO;
+}
+
+static pd_mesh_format by_content(const unsigned char *d, size_t size)
+{
+    /* Binary STL has no magic number; its size formula is the signature. */
+    if (size >= 84) {
+        uint32_t n = (uint32_t)d[80] | (uint32_t)d[81] << 8 | (uint32_t)d[82] << 16 |
+                     (uint32_t)d[83] << 24;
+        if (84 + 50 * (uint64_t)n == size && pd_stl_is_binary(d, size))
+            return PD_FORMAT_STL;
+    }
+    /* The first word of the text, past '#' comments (which STL lacks, but its
+     * first word "solid" is on a line without one). */
+    pd_text t;
+    pd_text_init(&t, d, size, "", '#', 0);
+    const char *s;
+    size_t n;
+    if (pd_text_token_any(&t, &s, &n)) {
+        if (pd_off_is_keyword(s, n))
+            return PD_FORMAT_OFF;
+        if (pd_text_is(s, n, "solid"))
+            return PD_FORMAT_STL;
+        if (pd_obj_is_keyword(s, n))
+            return PD_FORMAT_OBJ;
+    }
+    return PD_FORMAT_AUTO;
+}
+
+static pd_mesh_format detect(const unsigned char *d, size_t size, const char *name)
+{
+    pd_mesh_format f = by_content(d, size);
+    if (f == PD_FORMAT_AUTO)
+        f = by_extension(name);
+    /* Bytes no text format contains: the only binary format read is STL, so
+     * a damaged one gets STL's message (a size that does not add up). */
+    if (f == PD_FORMAT_AUTO && size > 0 && memchr(d, 0, size < 84 ? size : 84))
+        f = PD_FORMAT_STL;
+    return f;
+}
+
+/* --- reading ---------------------------------------------------------------- */
+
+pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
+                        const pd_mesh_read_options *options, pd_mesh **mesh, pd_diag *diag)
+{
+    if (!mesh || (!data && size > 0))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_mesh_parse: NULL %s", mesh ? "data" : "mesh");
+    pd_mesh_read_options defaults;
+    if (!options) {
+        pd_mesh_read_options_default(&defaults);
+        options = &defaults;
+    }
+    if (!name)
+        name = "<memory>";
+    double scale = pd_units_scale(options->units);
+    const unsigned char *d = data;
+    pd_mesh_format f = options->format;
+    if (f == PD_FORMAT_AUTO)
+        f = detect(d, size, name);
+    switch (f) {
+    case PD_FORMAT_OFF:
+        return pd_off_read((const char *)d, size, name, scale, mesh, diag);
+    case PD_FORMAT_STL:
+        return pd_stl_read(d, size, name, scale, mesh, diag);
+    case PD_FORMAT_OBJ:
+        return pd_obj_read((const char *)d, size, name, scale, mesh, diag);
+    case PD_FORMAT_AUTO:
+    default:
+        break;
+    }
+    if (size == 0)
+        return pd_fail(diag, PD_ERR_FORMAT,
+                       "%s: empty file of unknown format (name it .off, .stl or .obj)", name);
+    return pd_fail(diag, PD_ERR_FORMAT,
+                   "%s: unknown format: neither OFF, STL nor OBJ (use --format to say which)",
+                   name);
+}
+
+/* Reads the whole file; works for pipes too, which have no size to ask for. */
+static pd_status slurp(FILE *f, const char *path, unsigned char **out, size_t *size,
+                       pd_diag *diag)
+{
+    size_t cap = 1 << 16, n = 0;
+    unsigned char *buf = malloc(cap);
+    if (!buf)
+        return pd_fail(diag, PD_ERR_NOMEM, "%s: out of memory", path);
+    for (;;) {
+        if (n == cap) {
+            unsigned char *q = cap <= SIZE_MAX / 2 ? realloc(buf, cap * 2) : NULL;
+            if (!q) {
+                free(buf);
+                return pd_fail(diag, PD_ERR_NOMEM, "%s: out of memory after %zu bytes", path, n);
+            }
+            buf = q;
+            cap *= 2;
+        }
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (got == 0) {
+            if (ferror(f)) {
+                int err = errno;
+                free(buf);
+                return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path,
+                               err ? strerror(err) : "read error");
+            }
+            break;
+        }
+    }
+    *out = buf;
+    *size = n;
+    return PD_OK;
+}
+
+pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options, pd_mesh **mesh,
+                       pd_diag *diag)
+{
+    if (!path || !mesh)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_mesh_read: NULL %s", path ? "mesh" : "path");
+    errno = 0;
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return pd_fail(diag, PD_ERR_IO, "%s: cannot open: %s", path,
+                       errno ? strerror(errno) : "unknown error");
+    unsigned char *data = NULL;
+    size_t size = 0;
+    errno = 0;
+    pd_status st = slurp(f, path, &data, &size, diag);
+    fclose(f);
+    if (st != PD_OK)
+        return st;
+    st = pd_mesh_parse(data, size, path, options, mesh, diag);
+    free(data);
+    return st;
+}
+
+/* --- the mesh itself -------------------------------------------------------- */
+
+pd_mesh *pd_mesh_clone(const pd_mesh *mesh)
+{
+    if (!mesh || mesh->nverts < 0 || mesh->ntris < 0)
+        return NULL;
+    pd_mesh *c = malloc(sizeof *c);
+    if (!c)
+        return NULL;
+    /* malloc(0) may return NULL; one spare element keeps NULL meaning failure. */
+    c->verts = malloc(sizeof *c->verts * ((size_t)mesh->nverts + 1));
+    c->tris = malloc(sizeof *c->tris * ((size_t)mesh->ntris + 1));
+    if (!c->verts || !c->tris) {
+        pd_mesh_free(c);
+        return NULL;
+    }
+    c->nverts = mesh->nverts;
+    c->ntris = mesh->ntris;
+    if (mesh->nverts)
+        memcpy(c->verts, mesh->verts, sizeof *c->verts * (size_t)mesh->nverts);
+    if (mesh->ntris)
+        memcpy(c->tris, mesh->tris, sizeof *c->tris * (size_t)mesh->ntris);
+    return c;
+}
+
+double pd_mesh_size(const pd_mesh *mesh)
+{
+    if (!mesh || mesh->nverts <= 0)
+        return 0.0;
+    pd_vec3 lo = mesh->verts[0], hi = lo;
+    for (int i = 1; i < mesh->nverts; i++) {
+        pd_vec3 v = mesh->verts[i];
+        lo = v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
+        hi = v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
+    }
+    return v3_dist(lo, hi);
+}
+
+void pd_mesh_free(pd_mesh *mesh)
+{
+    if (!mesh)
+        return;
+    free(mesh->verts);
+    free(mesh->tris);
+    free(mesh);
+}
+
+pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag)
+{
+    if (!m)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: mesh is NULL", who);
+    if (m->nverts < 0 || m->ntris < 0 || (m->ntris > 0 && !m->tris) || (m->nverts > 0 && !m->verts))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: invalid mesh (%d vertices, %d triangles)", who,
+                       m->nverts, m->ntris);
+    for (int t = 0; t < m->ntris; t++)
+        for (int c = 0; c < 3; c++)
+            if (m->tris[t][c] < 0 || m->tris[t][c] >= m->nverts)
+                return pd_fail(diag, PD_ERR_RANGE, "%s: triangle %d: vertex index %d out of range 0..%d",
+                               who, t, m->tris[t][c], m->nverts - 1);
+    for (int v = 0; v < m->nverts; v++)
+        if (!v3_isfinite(m->verts[v]))
+            return pd_fail(diag, PD_ERR_NONFINITE, "%s: vertex %d is not finite", who, v);
+    return PD_OK;
+}

@@ -1,0 +1,129 @@
+/* part.c: building the immutable part model from a mesh (see posedrop/part.h).
+ *
+ * Order matters for the messages a user sees: the hull comes right after
+ * welding because it classifies degenerate geometry most precisely (too few,
+ * co-located, collinear, coplanar points); closedness and orientation come
+ * next, then mass properties, then the centre of mass is checked against the
+ * hull. */
+#include <stdlib.h>
+#include "base/fail.h"
+#include "posedrop/part.h"
+#include "posedrop/tolerances.h"
+#include "base/vec3.h"
+
+void pd_part_options_default(pd_part_options *options)
+{
+    options->com_given = 0;
+    options->com = v3(0.0, 0.0, 0.0);
+}
+
+void pd_part_free(pd_part *part)
+{
+    if (!part)
+        return;
+    pd_mesh_free(part->mesh);
+    pd_hull_free(part->hull);
+    free(part);
+}
+
+/* The centre of mass must lie strictly inside every facet plane, or the part
+ * would balance on a facet through its own centre and no pose is defined. */
+static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
+{
+    const pd_hull *h = p->hull;
+    double tol = PD_TOL_COM_INSIDE_REL * p->size;
+    int worst = 0;
+    double worst_gap = 0.0;
+    for (int f = 0; f < h->nfacets; f++) {
+        double gap = h->offset[f] - v3_dot(h->normal[f], p->com);
+        if (f == 0 || gap < worst_gap) {
+            worst_gap = gap;
+            worst = f;
+        }
+    }
+    if (worst_gap > tol)
+        return PD_OK;
+    pd_vec3 n = h->normal[worst];
+    if (worst_gap >= -tol)
+        return pd_fail(diag, PD_ERR_COM_OUTSIDE,
+                       "centre of mass (%.9g, %.9g, %.9g) m lies on the convex hull (on the "
+                       "facet with normal %.6g, %.6g, %.6g): no pose can rest on it",
+                       p->com.x, p->com.y, p->com.z, n.x, n.y, n.z);
+    return pd_fail(diag, PD_ERR_COM_OUTSIDE,
+                   "centre of mass (%.9g, %.9g, %.9g) m lies outside the convex hull, %.3g m "
+                   "beyond the facet with normal %.6g, %.6g, %.6g",
+                   p->com.x, p->com.y, p->com.z, -worst_gap, n.x, n.y, n.z);
+}
+
+static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
+{
+    /* Every size-relative tolerance below needs a finite size. */
+    for (int i = 0; i < p->mesh->nverts; i++)
+        if (!v3_isfinite(p->mesh->verts[i]))
+            return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
+    p->size = pd_mesh_size(p->mesh);
+    if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
+        return PD_ERR_NOMEM;
+    p->size = pd_mesh_size(p->mesh);
+    pd_status st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
+    if (st != PD_OK)
+        return st;
+
+    int flipped = 0;
+    st = pd_mesh_orient(p->mesh, &flipped, diag);
+    if (st == PD_OK) {
+        p->closed = 1;
+        if (flipped > 0)
+            pd_warn(diag, "%d of %d faces were oriented inconsistently with their neighbours "
+                          "and have been flipped", flipped, p->mesh->ntris);
+    } else if ((st == PD_ERR_NOT_CLOSED || st == PD_ERR_ORIENTATION) && opt->com_given) {
+        /* Only the hull and the centre of mass matter to the static
+         * estimators, so a given centre of mass makes an open mesh usable. */
+        pd_warn(diag, "%s; its mass properties are unknown, the given centre of mass is used",
+                diag ? diag->message : "mesh not closed");
+        if (diag)
+            diag->message[0] = '\0';
+    } else {
+        return st;
+    }
+
+    if (p->closed) {
+        st = pd_mass_compute(p->mesh, &p->mass, diag);
+        if (st == PD_OK)
+            p->mass_known = 1;
+        else if (!opt->com_given)
+            return st;
+        else if (diag)
+            diag->message[0] = '\0';
+    }
+    p->com = opt->com_given ? opt->com : p->mass.com;
+    if (!v3_isfinite(p->com))
+        return pd_fail(diag, PD_ERR_NONFINITE, "centre of mass is not finite");
+    return check_com_inside(p, diag);
+}
+
+pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_part **part,
+                        pd_diag *diag)
+{
+    pd_part_options opt;
+    if (options)
+        opt = *options;
+    else
+        pd_part_options_default(&opt);
+    if (!mesh || !part)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL argument");
+    pd_part *p = calloc(1, sizeof *p);
+    if (!p || !(p->mesh = pd_mesh_clone(mesh))) {
+        free(p);
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory copying the mesh");
+    }
+    pd_status st = build(p, &opt, diag);
+    if (st != PD_OK) {
+        if (st == PD_ERR_NOMEM)
+            pd_fail(diag, st, "out of memory building the part");
+        pd_part_free(p);
+        return st;
+    }
+    *part = p;
+    return PD_OK;
+}

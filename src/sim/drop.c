@@ -1,0 +1,508 @@
+/* drop.c: one simulated drop (paper, section 5), from release to the moment
+ * its outcome can no longer change.
+ *
+ * Flight is closed form (flight.c) and the next impact is found by
+ * conservative advancement (flight_impact.c), so there is no time step. Each
+ * impact is resolved by the frictional impulse law (impact.c). When several
+ * vertices touch at once (a face or an edge landing), the approaching ones are
+ * resolved as one collision at their centroid weighted by approach speed, and
+ * the set is checked again until no contact approaches: a face landing flat
+ * without spin gets the single impulse through its centre that Poisson's law
+ * gives a flat landing (rebound e times the approach speed, no spurious
+ * rotation), and uneven landings put the impulse nearer the faster contact,
+ * as a sequence of Mirtich's microcollisions would, in one step. The scene's
+ * impact_time widens "at once" to the contacts that would arrive within it
+ * (flight_impact.c): a stand-in for the compliance that makes a nearly flat
+ * landing strike its face as a whole.
+ *
+ * Contact that lasts is simulated two ways. One vertex or one edge on the
+ * floor, sliding or sticking, is a contact phase (contact_phase.c): the
+ * exact continuous motion under its contact forces, until a contact lifts,
+ * slips, sticks or another vertex lands. Everything else (faces, contacts
+ * that chatter too much to enter a phase losslessly, hand-overs) is
+ * microcollisions: the contact falls a rest fall and is stopped, which sinks
+ * and damps the part slightly per step (README: "Known limit").
+ *
+ * A drop ends when its energy per unit weight (a height) falls below the
+ * barrier of the basin it is in (basin.c): then no future can leave the
+ * basin, so its stable pose is the outcome. That needs collisions that never
+ * add energy: a Poisson collision that would (possible with friction in 3-D)
+ * is redone by the energetic law, which cannot, and counted. It also ends
+ * when the part lies on a stable facet that sliding and spinning cannot tip
+ * it from (flat_rest.c): then only the rocking energy must be below a
+ * barrier, not the energy of the slide. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "settle/basin.h"
+#include "dynamics/body.h"
+#include "contact/contact_phase.h"
+#include "base/fail.h"
+#include "sim/drop_internal.h"
+#include "settle/flat_rest.h"
+#include "dynamics/flight.h"
+#include "impact/impact.h"
+#include "posedrop/tolerances.h"
+#include "base/rng.h"
+#include "static/static_internal.h"
+#include "base/vec3.h"
+
+
+void pd_sim_model_free(pd_sim_model *m)
+{
+    if (!m)
+        return;
+    pd_body_free(m->body);
+    pd_static_result_free(m->descent);
+    free(m->barrier);
+    free(m->flat);
+    pd_descent_map_free(&m->map);
+    pd_star_free(&m->star);
+    free(m->pose_of);
+    free(m);
+}
+
+pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
+                             const pd_scene *scene, const pd_sim_options *options,
+                             pd_sim_model **model, pd_diag *diag)
+{
+    pd_sim_model *m = calloc(1, sizeof *m);
+    if (!m)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
+    /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
+     * frame cut into 16 substeps. */
+    if (options->engine == PD_ENGINE_ODE) {
+        m->engine = &pd_engine_ode;
+        m->dt = options->dt > 0 ? options->dt : 1e-3;
+    } else if (options->engine == PD_ENGINE_BULLET) {
+        m->engine = &pd_engine_bullet;
+        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    }
+    m->hull = part->hull;
+    m->com = part->com;
+    m->poses = poses;
+    /* Basins follow the exact motion whatever rule the static table used;
+     * stability, hence the set of poses, is the same under both rules. */
+    pd_static_options so;
+    pd_static_options_default(&so);
+    so.topple = PD_TOPPLE_DESCENT;
+    so.epsilon = 0.0;
+    pd_status st = pd_body_build(part, &m->body, diag);
+    if (st == PD_OK)
+        st = pd_static_estimate(part, &so, &m->descent, diag);
+    if (st == PD_OK)
+        st = pd_star_build(part->hull, &m->star);
+    if (st == PD_OK)
+        st = pd_descent_map_build(part->hull, &m->star, part->com, &m->map);
+    int nf = part->hull->nfacets;
+    if (st == PD_OK) {
+        m->barrier = malloc(sizeof *m->barrier * (size_t)nf);
+        m->pose_of = malloc(sizeof *m->pose_of * (size_t)nf);
+        m->flat = malloc(sizeof *m->flat * (size_t)nf);
+        if (!m->barrier || !m->pose_of || !m->flat)
+            st = PD_ERR_NOMEM;
+    }
+    if (st == PD_OK) {
+        pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
+        pd_flat_build(m->body, part->hull, m->descent, m->flat);
+        m->flat_height = pd_flat_height_max(m->flat, nf);
+        m->barrier_max = -INFINITY;
+        for (int f = 0; f < nf; f++) {
+            m->pose_of[f] = -1;
+            m->barrier_max = fmax(m->barrier_max, m->barrier[f]);
+        }
+        for (int k = 0; k < poses->nposes; k++)
+            m->pose_of[poses->poses[k].facet] = k;
+        /* A speed scale of the part: sqrt(g L), the speed of falling its own
+         * size. Approaches slower by PD_TOL_APPROACH_REL are round-off of a
+         * resolved contact, not a new impact. */
+        m->v_eps = PD_TOL_APPROACH_REL * sqrt(scene->gravity * m->body->size);
+        /* A resting vertex meets the floor at the speed of falling rest_fall;
+         * twice that leaves room for what the part's rotation adds. */
+        m->rest_fall = PD_TOL_REST_FALL_REL * m->body->size;
+        m->v_rest = 2.0 * sqrt(2.0 * scene->gravity * m->rest_fall);
+    }
+    if (st != PD_OK) {
+        if (st == PD_ERR_NOMEM)
+            pd_fail(diag, st, "out of memory for the drop model");
+        pd_sim_model_free(m);
+        return st;
+    }
+    *model = m;
+    return PD_OK;
+}
+
+const pd_body *pd_sim_model_body(const pd_sim_model *model) { return model->body; }
+
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene)
+{
+    pd_drop_work *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    if (model->engine)
+        w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
+    else {
+        w->impact = pd_impact_work_alloc();
+        w->phase = pd_contact_phase_ode_alloc();
+        w->pivot = pd_contact_pivot_ode_alloc();
+    }
+    if ((!w->impact || !w->phase || !w->pivot) && !w->world) {
+        pd_impact_work_free(w->impact);
+        pd_ode_free(w->phase);
+        pd_ode_free(w->pivot);
+        free(w);
+        return NULL;
+    }
+    w->engine = model->engine;
+    return w;
+}
+
+void pd_drop_work_free(pd_drop_work *w)
+{
+    if (!w)
+        return;
+    pd_impact_work_free(w->impact);
+    pd_ode_free(w->phase);
+    pd_ode_free(w->pivot);
+    if (w->world)
+        w->engine->world_free(w->world);
+    free(w);
+}
+
+/* --- initial state ----------------------------------------------------------- */
+
+/* The rotation turning unit vector a onto unit vector b by the shortest arc. */
+static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
+{
+    pd_vec3 axis = v3_cross(a, b);
+    double s = v3_norm(axis), c = v3_dot(a, b);
+    if (s < PD_TOL_ANGLE) { /* parallel or opposite within round-off */
+        if (c > 0.0)
+            return quat_identity();
+        pd_vec3 any = fabs(a.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
+        return quat_axis_angle(v3_unit(v3_cross(a, any)), M_PI);
+    }
+    return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
+}
+
+static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
+                          const double *init_cdf, pd_state *s, double q0[4])
+{
+    const pd_body *b = m->body;
+    pd_quat q;
+    if (init_cdf) {
+        /* The paper's belt: resting on a pose drawn from the estimate, turned
+         * at random about the vertical. */
+        double u = pd_rng_uniform(rng);
+        int k = 0;
+        while (k + 1 < m->poses->nposes && u >= init_cdf[k])
+            k++;
+        pd_vec3 n = quat_rotate_inv(b->frame, m->poses->poses[k].normal);
+        pd_quat down = quat_between(n, v3(0, 0, -1));
+        q = quat_mul(quat_axis_angle(v3(0, 0, 1), 2.0 * M_PI * pd_rng_uniform(rng)), down);
+    } else {
+        double r[4];
+        pd_rng_quaternion(rng, r);
+        q = quat(r[0], r[1], r[2], r[3]);
+    }
+    if (sc->vibration > 0.0) {
+        pd_vec3 axis = pd_rng_unit_vector(rng);
+        q = quat_mul(quat_axis_angle(axis, sc->vibration * pd_rng_uniform(rng)), q);
+    }
+    q = quat_normalize(q);
+    s->q = q;
+    s->x = v3(0, 0, 0);
+    s->v = v3(sc->belt_speed, 0, 0);
+    s->w = v3(0, 0, 0);
+    /* Lowest point at the drop height. */
+    int low = pd_body_support(b, quat_rotate_inv(q, v3(0, 0, 1)), 0);
+    s->x.z = sc->height - pd_body_vertex_world(b, s, low).z;
+    /* The orientation of the part's own (file) frame, for --trials. */
+    pd_quat qp = quat_mul(q, quat_conj(b->frame));
+    q0[0] = qp.w;
+    q0[1] = qp.x;
+    q0[2] = qp.y;
+    q0[3] = qp.z;
+}
+
+void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_options *o,
+                     long index, const double *init_cdf, pd_state *s, pd_trial *out)
+{
+    pd_rng rng;
+    pd_rng_init(&rng, o->seed, (uint64_t)index);
+    initial_state(m, sc, &rng, init_cdf, s, out->q0);
+    out->pose = -1;
+    out->collisions = 0;
+    out->end = PD_END_FAILED;
+    out->time = 0.0;
+}
+
+/* --- collisions ------------------------------------------------------------- */
+
+/* World inverse inertia R diag(1/I) R^T. */
+static void inv_inertia_world(const pd_body *b, pd_quat q, double J[3][3])
+{
+    double R[3][3];
+    quat_to_matrix(q, R);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            double s = 0.0;
+            for (int k = 0; k < 3; k++)
+                s += R[i][k] * b->inv_moment[k] * R[j][k];
+            J[i][j] = s;
+        }
+}
+
+/* Solves K p = b for symmetric positive definite K (Cramer's rule: K is
+ * 3 x 3 and well conditioned, its eigenvalues within a few units of 1/m). */
+static pd_vec3 solve3(const double K[3][3], pd_vec3 b)
+{
+    pd_vec3 c0 = v3(K[0][0], K[1][0], K[2][0]), c1 = v3(K[0][1], K[1][1], K[2][1]),
+            c2 = v3(K[0][2], K[1][2], K[2][2]);
+    double det = v3_dot(c0, v3_cross(c1, c2));
+    return v3(v3_dot(b, v3_cross(c1, c2)) / det, v3_dot(c0, v3_cross(b, c2)) / det,
+              v3_dot(c0, v3_cross(c1, b)) / det);
+}
+
+/* The impulse when the sliding integrator cannot finish (a slow approach to
+ * sticking makes eq. 14 stiff; impact.h): stop the contact dead (K p = -u0),
+ * which is inside the friction cone or is projected onto it along its own
+ * tangential direction, then apply restitution to the normal part only.
+ * Kinetic energy cannot rise: if the projection would make it, the normal
+ * inelastic impulse alone is used. Counted, never silent. */
+static pd_vec3 fallback_impulse(const double K[3][3], pd_vec3 u0, double mu, double e)
+{
+    pd_vec3 p = solve3(K, v3_neg(u0));
+    double pt = hypot(p.x, p.y);
+    if (pt > mu * p.z) {
+        double dx = pt > 0 ? p.x / pt : 0, dy = pt > 0 ? p.y / pt : 0;
+        pd_vec3 dir = v3(mu * dx, mu * dy, 1.0); /* on the cone, towards the stick impulse */
+        double kz = K[2][0] * dir.x + K[2][1] * dir.y + K[2][2];
+        p = v3_scale(dir, -u0.z / kz);
+    }
+    p.z *= 1.0 + e;
+    pd_vec3 u1 = v3_add(u0, v3(K[0][0] * p.x + K[0][1] * p.y + K[0][2] * p.z,
+                               K[1][0] * p.x + K[1][1] * p.y + K[1][2] * p.z,
+                               K[2][0] * p.x + K[2][1] * p.y + K[2][2] * p.z));
+    if (v3_dot(p, v3_add(u0, u1)) > 0.0)
+        p = v3(0, 0, -(1.0 + e) * u0.z / K[2][2]);
+    return p;
+}
+
+pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
+                          pd_state *s, const int *contacts, int nc, int *impacts, long *gain,
+                          long *fallbacks)
+{
+    const pd_body *b = m->body;
+    double J[3][3];
+    inv_inertia_world(b, s->q, J);
+    pd_impact_law law = sc->law == PD_RESTITUTION_ENERGETIC ? PD_IMPACT_ENERGETIC : PD_IMPACT_POISSON;
+    for (int round = 0; round < PD_MAX_ROUNDS; round++) {
+        pd_vec3 ww = quat_rotate(s->q, s->w), c = v3(0, 0, 0);
+        double wsum = 0.0;
+        for (int i = 0; i < nc; i++) {
+            pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
+            double uz = s->v.z + v3_cross(ww, r).z;
+            if (uz < -m->v_eps) {
+                c = v3_add(c, v3_scale(r, -uz));
+                wsum -= uz;
+            }
+        }
+        if (wsum == 0.0)
+            return PD_OK;
+        c = v3_scale(c, 1.0 / wsum);
+        pd_vec3 u0 = v3_add(s->v, v3_cross(ww, c));
+        double e = -u0.z <= m->v_rest ? 0.0 : sc->restitution;
+        double K[3][3];
+        pd_impact_K(1.0 / b->mass, CONST_M3(J), c, K);
+        pd_impact_result res;
+        pd_status st = pd_impact_solve(w->impact, CONST_M3(K), u0, sc->mu, e, law, &res);
+        if (st == PD_OK && res.energy_gain && law == PD_IMPACT_POISSON) {
+            (*gain)++;
+            st = pd_impact_solve(w->impact, CONST_M3(K), u0, sc->mu, e, PD_IMPACT_ENERGETIC, &res);
+        }
+        if (st == PD_ERR_NO_CONVERGENCE) {
+            (*fallbacks)++;
+            res.p = fallback_impulse(CONST_M3(K), u0, sc->mu, e);
+        } else if (st != PD_OK) {
+            return st;
+        }
+        s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
+        ww = v3_add(ww, m3_vec(CONST_M3(J), v3_cross(c, res.p)));
+        s->w = quat_rotate_inv(s->q, ww);
+        (*impacts)++;
+    }
+    return PD_OK;
+}
+
+/* --- the drop ----------------------------------------------------------------- */
+
+/* Energy per unit weight: the height the part could reach, m. */
+static double energy_height(const pd_body *b, const pd_state *s, double g)
+{
+    double rot = b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                 b->moment[2] * s->w.z * s->w.z;
+    return s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
+}
+
+/* Gravity's direction in the part's (file) frame. */
+static pd_vec3 gravity_in_part(const pd_sim_model *m, const pd_state *s)
+{
+    return quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
+}
+
+/* pd_drop_decided, also giving the facet the part would land on, or -1
+ * when neither that test nor pd_flat_settled can pass (the energy above
+ * every barrier, the centre of mass above every flat rest's reach), where
+ * the descent is skipped. */
+static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose,
+                      int *facet)
+{
+    *facet = -1;
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max) &&
+        !(s->x.z < m->flat_height))
+        return 0;
+    pd_vec3 down = gravity_in_part(m, s);
+    int f;
+    if (pd_descent_lookup(&m->map, down, &f, hint) != PD_OK)
+        return -1;
+    *facet = f;
+    /* A resting vertex may be up to rest_fall below the floor, so the part's
+     * potential energy may read that much low: count it. */
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier[f]))
+        return 0;
+    *pose = m->pose_of[m->descent->facets[f].rest];
+    return *pose >= 0 ? 1 : -1;
+}
+
+int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
+{
+    /* Above every barrier nothing is decided, whichever basin s is in: the
+     * descent, most of the test's cost, is left out (most of a contact
+     * phase's tests, which come after every step, are up there). */
+    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max))
+        return 0;
+    int f;
+    return decided_at(m, s, g, hint, pose, &f);
+}
+
+double pd_drop_tilt(const pd_sim_model *m, const pd_state *s, int pose)
+{
+    return v3_angle(gravity_in_part(m, s), m->poses->poses[pose].normal);
+}
+
+void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
+                 const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
+                 long *energy_gain, long *fallbacks)
+{
+    if (m->engine) {
+        pd_drop_run_stepping(m, w, sc, o, index, init_cdf, out);
+        return;
+    }
+    pd_state s;
+    pd_drop_release(m, sc, o, index, init_cdf, &s, out);
+    double t = 0.0, g = sc->gravity;
+    /* Resting contact advances by the time to fall rest_fall, so that a
+     * vertex pressed on the floor by gravity meets it again with the speed
+     * that fall gives (a microcollision) rather than at speed 0. */
+    double dt_rest = sqrt(2.0 * m->rest_fall / g);
+    int hint = 0, phase_ok = 1, nc = 0;
+    pd_flight f;
+    double f_at = -1.0; /* time on f at which s lies; < 0: plan from s */
+    /* 1 right after pd_drop_collide stopped because no contact approached:
+     * s then sits where the last search found it, touching at
+     * w->contacts[0..nc), and a new search and a new pass of the collision
+     * would find the same set (without an impact window it depends on
+     * positions alone, which an impulse leaves as they were) and nothing to
+     * resolve, so both are skipped. */
+    int resolved = 0;
+    for (;;) {
+        int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
+        if (d == 0 && facet >= 0 && m->pose_of[facet] >= 0 &&
+            pd_flat_settled(m->flat, m->body, &s, facet, g, sc->mu, m->rest_fall)) {
+            d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
+            pose = m->pose_of[facet];
+        }
+        if (d < 0)
+            break;
+        if (d > 0) {
+            out->pose = pose;
+            out->end = PD_END_SETTLED;
+            break;
+        }
+        if (out->collisions >= o->max_collisions) {
+            out->end = PD_END_COLLISION_LIMIT;
+            break;
+        }
+        /* The flight from s: planned afresh after anything that changed the
+         * motion, else the one s already lies on, at its time f_at. */
+        if (f_at < 0.0) {
+            if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
+                break;
+            f_at = 0.0;
+        }
+        if (!resolved) {
+            pd_impact imp;
+            /* hint: the lowest vertex of s where decided_at looked the
+             * descent up, else of an earlier state; a start for the search's
+             * hill-climb either way. */
+            if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
+                                      sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+                break;
+            if (imp.kind == PD_IMPACT_NONE) {
+                t = o->time_limit;
+                out->end = PD_END_TIME_LIMIT;
+                break;
+            }
+            if (imp.kind == PD_IMPACT_AT) {
+                if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
+                    break;
+                t += imp.t - f_at;
+                f_at = imp.t;
+            }
+            nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
+            int before = out->collisions;
+            if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
+                                fallbacks) != PD_OK)
+                break;
+            if (out->collisions != before) {
+                /* Each round applies one impulse, so fewer than
+                 * PD_MAX_ROUNDS means a round found nothing approaching. */
+                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->impact_time == 0.0;
+                f_at = -1.0;
+                continue;
+            }
+        }
+        resolved = 0;
+        pd_phase phase;
+        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc, &phase)) {
+            /* One vertex or one edge in lasting contact, sliding or
+             * sticking: the exact continuous motion. It ends at an event the
+             * microcollisions must resolve, so the next rest step is theirs
+             * (no phase can start and stop at once forever). */
+            double dt;
+            f_at = -1.0;
+            if (pd_contact_phase(m, w->phase, w->pivot, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
+                break;
+            t += dt;
+            phase_ok = 0;
+            if (t >= o->time_limit) {
+                out->end = PD_END_TIME_LIMIT;
+                break;
+            }
+            continue;
+        }
+        /* Touching but not approaching: separating, or resting. Nothing
+         * changed the motion, so s goes on along f. */
+        phase_ok = 1;
+        f_at += dt_rest;
+        if (pd_flight_eval(&f, f_at, &s) != PD_OK)
+            break;
+        t += dt_rest;
+        if (t >= o->time_limit) {
+            out->end = PD_END_TIME_LIMIT;
+            break;
+        }
+    }
+    out->time = t;
+}

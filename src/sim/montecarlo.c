@@ -1,0 +1,433 @@
+/* montecarlo.c: running many drops on all cores, deterministically.
+ *
+ * Work is cut into batches of drop indices. Within a batch, threads take
+ * indices from a shared counter and write each outcome at its index; the
+ * batch is tallied in index order after all threads finish. Each drop's
+ * randomness comes from its own stream (seed, index), so neither the thread
+ * count nor the scheduling can change a byte of the result. What depends on
+ * earlier outcomes (the bootstrap's initial distribution, the --ci stopping
+ * rule) is decided between batches, on tallies of whole batches only; the
+ * stationary estimator's phases depend on nothing but the drop index. */
+#include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "base/fail.h"
+#include "sim/drop.h"
+#include "sim/markov.h"
+#include "posedrop/tolerances.h"
+#include "base/stats.h"
+
+/* The paper's bootstrap: 20 uniform drops, then drops resting on poses drawn
+ * from the running estimate. Rounds of fixed size keep it deterministic; the
+ * estimate is updated between rounds. */
+enum { BOOTSTRAP_FIRST = 20, BOOTSTRAP_ROUND = 100 };
+/* --ci: drops between checks of the stopping rule. Plain runs go in batches
+ * of at most BATCH_MAX, so the outcome buffer stays small for any -n. */
+enum { CI_BATCH = 1000, BATCH_MAX = 65536 };
+/* Two-sided 95% normal quantile for the Wilson intervals. */
+static const double Z95 = PD_Z95;
+
+void pd_sim_options_default(pd_sim_options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->engine = PD_ENGINE_IMPULSE;
+    o->dt = 0.0;
+    o->ndrops = 2000;
+    o->seed = 1;
+    o->threads = 0;
+    o->ci_halfwidth = 0.0;
+    o->max_drops = 10000000;
+    o->time_limit = 20.0;
+    o->max_collisions = 100000;
+    o->keep_trials = 0;
+    o->cancel = NULL;
+}
+
+void pd_sim_result_free(pd_sim_result *r)
+{
+    if (!r)
+        return;
+    free(r->count);
+    free(r->p);
+    free(r->ci_lo);
+    free(r->ci_hi);
+    free(r->trials);
+    free(r->first_count);
+    free(r->transitions);
+    free(r);
+}
+
+typedef struct batch {
+    const pd_sim_model *model;
+    const pd_scene *scene;
+    const pd_sim_options *opt;
+    const double *init_cdf;
+    const double *pose_cdfs; /* not NULL: drop i starts resting on pose
+                               (i - pose_first) mod nposes, whose point-mass cdf
+                               is that row of pose_cdfs (instead of init_cdf) */
+    long pose_first;
+    int nposes;
+    long first, last;       /* drop indices [first, last) */
+    pd_trial *out;          /* out[i - first] */
+    atomic_long next;
+    atomic_long energy_gain;
+    atomic_long fallbacks;
+    atomic_int failed;      /* a thread could not get its work area */
+} batch;
+
+static int cancelled(const pd_sim_options *o) { return o->cancel && *o->cancel; }
+
+static void *worker(void *arg)
+{
+    batch *b = arg;
+    pd_drop_work *w = pd_drop_work_alloc(b->model, b->scene);
+    if (!w) {
+        atomic_store(&b->failed, 1);
+        return NULL;
+    }
+    long gain = 0, fallbacks = 0;
+    for (;;) {
+        long i = atomic_fetch_add(&b->next, 1);
+        if (i >= b->last || cancelled(b->opt))
+            break;
+        const double *cdf = b->init_cdf;
+        if (b->pose_cdfs)
+            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((i - b->pose_first) % b->nposes);
+        pd_drop_run(b->model, w, b->scene, b->opt, i, cdf, &b->out[i - b->first], &gain,
+                    &fallbacks);
+    }
+    atomic_fetch_add(&b->energy_gain, gain);
+    atomic_fetch_add(&b->fallbacks, fallbacks);
+    pd_drop_work_free(w);
+    return NULL;
+}
+
+/* Runs drops [first, last) into out; returns the number completed in index
+ * order before any cancellation (a cancelled batch keeps its prefix only, so
+ * that a partial result is still the first n drops of the run). */
+static long run_batch(batch *b, int nthreads, pd_sim_result *r)
+{
+    atomic_store(&b->next, b->first);
+    atomic_store(&b->energy_gain, 0);
+    atomic_store(&b->fallbacks, 0);
+    atomic_store(&b->failed, 0);
+    /* Zeroed first, padding included, so records compare byte for byte. */
+    memset(b->out, 0, sizeof *b->out * (size_t)(b->last - b->first));
+    for (long i = 0; i < b->last - b->first; i++)
+        b->out[i].end = (pd_drop_end)-1; /* not run */
+    pthread_t tid[256];
+    int started = 0;
+    for (int t = 1; t < nthreads; t++)
+        if (pthread_create(&tid[started], NULL, worker, b) == 0)
+            started++;
+    worker(b); /* the calling thread works too */
+    for (int t = 0; t < started; t++)
+        pthread_join(tid[t], NULL);
+    r->energy_gain += atomic_load(&b->energy_gain);
+    r->fallbacks += atomic_load(&b->fallbacks);
+    long done = 0;
+    while (b->first + done < b->last && (int)b->out[done].end >= 0)
+        done++;
+    return atomic_load(&b->failed) && done < b->last - b->first ? -1 : done;
+}
+
+/* Counts drops r->n .. r->n + n - 1, whose records are t[0..n). The
+ * stationary estimator also files each settled drop under its phase: mu0's
+ * counts, or the row of the pose it started on. */
+static void tally(pd_sim_result *r, const pd_trial *t, long n)
+{
+    for (long i = 0; i < n; i++) {
+        r->collisions += t[i].collisions;
+        if (t[i].end != PD_END_SETTLED || t[i].pose < 0) {
+            r->unsettled++;
+            continue;
+        }
+        r->count[t[i].pose]++;
+        if (!r->transitions)
+            continue;
+        long phase2 = r->n + i - r->first_drops;
+        if (phase2 < 0)
+            r->first_count[t[i].pose]++;
+        else
+            r->transitions[(size_t)(phase2 % r->nposes) * (size_t)r->nposes + (size_t)t[i].pose]++;
+    }
+    r->n += n;
+}
+
+/* Cumulative distribution of the settled outcomes so far (bootstrap). */
+static void estimate_cdf(const pd_sim_result *r, double *cdf)
+{
+    long settled = 0;
+    for (int k = 0; k < r->nposes; k++)
+        settled += r->count[k];
+    double acc = 0.0;
+    for (int k = 0; k < r->nposes; k++) {
+        acc += settled ? (double)r->count[k] / (double)settled : 1.0 / r->nposes;
+        cdf[k] = acc;
+    }
+    cdf[r->nposes - 1] = 1.0;
+}
+
+static int ci_reached(const pd_sim_result *r, double delta)
+{
+    for (int k = 0; k < r->nposes; k++) {
+        double lo, hi;
+        pd_wilson(r->count[k], r->n, Z95, &lo, &hi);
+        double p = r->n ? (double)r->count[k] / (double)r->n : 0.0;
+        if (p - lo > delta || hi - p > delta)
+            return 0;
+    }
+    return 1;
+}
+
+static int default_threads(void)
+{
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+    return n < 1 ? 1 : n > 256 ? 256 : (int)n;
+}
+
+/* Total variation between the distribution a bootstrap round started from
+ * (cdf) and where its drops ended (counts): how far from stationary it is. */
+static double round_distance(const double *cdf, const long *before, const long *after, int k)
+{
+    long n = 0;
+    for (int i = 0; i < k; i++)
+        n += after[i] - before[i];
+    if (n == 0)
+        return 1.0;
+    double tv = 0.0, prev = 0.0;
+    for (int i = 0; i < k; i++) {
+        tv += fabs((cdf[i] - prev) - (double)(after[i] - before[i]) / (double)n);
+        prev = cdf[i];
+    }
+    return 0.5 * tv;
+}
+
+/* Size of the next batch: the bootstrap's rounds, --ci's checks, or what is
+ * left of -n; never past the cap. */
+static long next_batch(const pd_sim_result *r, const pd_scene *scene, const pd_sim_options *o,
+                       long want, long cap)
+{
+    long size = r->n < want ? want - r->n : CI_BATCH;
+    if (scene->initial == PD_INITIAL_BOOTSTRAP)
+        size = r->n < BOOTSTRAP_FIRST ? BOOTSTRAP_FIRST - r->n : BOOTSTRAP_ROUND;
+    if (o->ci_halfwidth <= 0 && size > want - r->n)
+        size = want - r->n;
+    if (size > cap - r->n)
+        size = cap - r->n;
+    return size > BATCH_MAX ? BATCH_MAX : size;
+}
+
+/* Runs batch b, appends its records to r->trials when they are kept, and
+ * tallies them (a batch cut short by cancellation marks r partial). Returns
+ * the drops done, or -1 with *st set. */
+static long run_recorded(batch *b, int nthreads, const pd_sim_options *o, pd_sim_result *r,
+                         pd_status *st, pd_diag *diag)
+{
+    long done = run_batch(b, nthreads, r);
+    if (done < 0) {
+        *st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for a thread's work area");
+        return -1;
+    }
+    if (o->keep_trials && done > 0) {
+        pd_trial *t = realloc(r->trials, sizeof *t * (size_t)(r->n + done));
+        if (!t) {
+            *st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for %ld trial records", r->n + done);
+            return -1;
+        }
+        memcpy(t + r->n, b->out, sizeof *t * (size_t)done);
+        r->trials = t;
+    }
+    tally(r, b->out, done);
+    if (done < b->last - b->first)
+        r->partial = 1;
+    return done;
+}
+
+static int thread_count(const pd_sim_options *o)
+{
+    return o->threads > 0 ? (o->threads > 256 ? 256 : o->threads) : default_threads();
+}
+
+static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const pd_sim_options *o,
+                       pd_sim_result *r, pd_diag *diag)
+{
+    int nthreads = thread_count(o);
+    /* --ci starts from the drops that guarantee the half-width for every pose
+     * at once in the worst case (p = 1/2, Bonferroni over the poses: the
+     * corrected eq. 17), then adds batches while an interval is still wider. */
+    long want = o->ndrops;
+    if (o->ci_halfwidth > 0) {
+        long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
+        want = bound > want ? bound : want;
+    }
+    long cap = o->ci_halfwidth > 0 ? (o->max_drops > want ? o->max_drops : want) : want;
+    pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
+    double *cdf = malloc(sizeof *cdf * (size_t)r->nposes);
+    long *before = malloc(sizeof *before * (size_t)r->nposes);
+    pd_status st = PD_OK;
+    if (!buf || !cdf || !before)
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
+    while (st == PD_OK && r->n < cap && !r->partial) {
+        if (r->n >= want && (o->ci_halfwidth <= 0 || ci_reached(r, o->ci_halfwidth)))
+            break;
+        long size = next_batch(r, scene, o, want, cap);
+        const double *init = NULL;
+        if (scene->initial == PD_INITIAL_BOOTSTRAP && r->n >= BOOTSTRAP_FIRST) {
+            estimate_cdf(r, cdf);
+            init = cdf;
+        }
+        batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .first = r->n,
+                   .last = r->n + size, .out = buf};
+        memcpy(before, r->count, sizeof *before * (size_t)r->nposes);
+        if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
+            break;
+        if (init) {
+            r->bootstrap_rounds++;
+            r->stationarity = round_distance(init, before, r->count, r->nposes);
+        }
+    }
+    free(buf);
+    free(cdf);
+    free(before);
+    return st;
+}
+
+/* --initial stationary: drops [0, first_drops) from uniform orientations,
+ * then the rest resting on the poses in turn. Interleaved rather than pose
+ * after pose, so that a run stopped early has drops from every pose and can
+ * still give pi. */
+static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
+                                  const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)
+{
+    int k = r->nposes;
+    size_t K = (size_t)k;
+    pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
+    /* Row i: the cumulative distribution of a point mass on pose i, so the
+     * bootstrap's own release (drop.c) starts the drop resting on pose i. */
+    double *point = malloc(sizeof *point * K * K);
+    pd_status st = PD_OK;
+    if (!buf || !point)
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
+    for (size_t i = 0; point && i < K; i++)
+        for (size_t j = 0; j < K; j++)
+            point[i * K + j] = j >= i ? 1.0 : 0.0;
+    int nthreads = thread_count(o);
+    while (st == PD_OK && r->n < o->ndrops && !r->partial) {
+        int resting = r->n >= r->first_drops;
+        long end = resting ? o->ndrops : r->first_drops;
+        long size = end - r->n > BATCH_MAX ? BATCH_MAX : end - r->n;
+        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = resting ? point : NULL,
+                   .pose_first = r->first_drops, .nposes = k, .first = r->n,
+                   .last = r->n + size, .out = buf};
+        if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
+            break;
+    }
+    free(buf);
+    free(point);
+    return st;
+}
+
+/* p and its intervals become pi of the estimated chain and its resampled
+ * intervals, when the counts define the chain; otherwise they stay count / n
+ * and Wilson's (closed_classes 0 says which). */
+static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
+{
+    pd_markov_counts c = {r->nposes, r->first_count, r->transitions};
+    pd_markov_summary s = {r->p, r->ci_lo, r->ci_hi, 0, 0.0};
+    pd_status st = pd_markov_estimate(&c, NULL, r->nposes, r->seed, &s);
+    if (st != PD_OK)
+        return pd_fail(diag, st, "the long-run distribution of the pose chain: %s",
+                       pd_status_str(st));
+    r->closed_classes = s.nclosed;
+    r->stationary_shift = s.shift;
+    return PD_OK;
+}
+
+/* The stationary estimator's split of the drops, refused when it cannot
+ * give every pose its minimum or --ci asks for a stopping rule. */
+static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
+{
+    if (o->ci_halfwidth > 0)
+        return pd_fail(diag, PD_ERR_USAGE, "initial stationary splits a fixed number of drops "
+                       "over the poses in advance; it does not go with a confidence half-width "
+                       "(give the number of drops)");
+    long need = (long)(k + 1) * PD_STATIONARY_MIN_POSE_DROPS;
+    if (o->ndrops < need)
+        return pd_fail(diag, PD_ERR_USAGE, "initial stationary: %ld drops are too few for %d "
+                       "stable poses: each pose needs %d drops started resting on it and the "
+                       "uniform start as many, at least %ld drops in all", o->ndrops, k,
+                       PD_STATIONARY_MIN_POSE_DROPS, need);
+    return PD_OK;
+}
+
+pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const pd_scene *scene,
+                     const pd_sim_options *options, pd_sim_result **result, pd_diag *diag)
+{
+    pd_scene sc;
+    pd_sim_options o;
+    if (scene)
+        sc = *scene;
+    else
+        pd_scene_default(&sc);
+    if (options)
+        o = *options;
+    else
+        pd_sim_options_default(&o);
+    if (!part || !poses || !result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL argument");
+    if (o.ndrops < 0 || o.max_drops < 0 || !(o.ci_halfwidth >= 0) || !(o.time_limit > 0) ||
+        o.max_collisions < 1 || !(o.dt >= 0 && o.dt < 1) ||
+        (unsigned)o.engine > (unsigned)PD_ENGINE_BULLET)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
+    if (poses->nposes < 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
+    int stationary = sc.initial == PD_INITIAL_STATIONARY;
+    if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
+        return PD_ERR_USAGE;
+    pd_sim_model *model = NULL;
+    pd_status st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
+    if (st != PD_OK)
+        return st;
+    pd_sim_result *r = calloc(1, sizeof *r);
+    int k = poses->nposes;
+    if (r) {
+        r->nposes = k;
+        r->count = calloc((size_t)k, sizeof *r->count);
+        r->p = calloc((size_t)k, sizeof *r->p);
+        r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
+        r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
+        r->seed = o.seed;
+        if (stationary) {
+            r->first_count = calloc((size_t)k, sizeof *r->first_count);
+            r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
+            r->pose_drops = o.ndrops / (k + 1);
+            r->first_drops = o.ndrops - k * r->pose_drops;
+        }
+    }
+    if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi ||
+        (stationary && (!r->first_count || !r->transitions)))
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the results");
+    else if (stationary)
+        st = drive_stationary(model, &sc, &o, r, diag);
+    else
+        st = drive(model, &sc, &o, r, diag);
+    pd_sim_model_free(model);
+    if (st != PD_OK) {
+        pd_sim_result_free(r);
+        return st;
+    }
+    for (int i = 0; i < k; i++) {
+        r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
+        pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
+    }
+    if (stationary && (st = finish_stationary(r, diag)) != PD_OK) {
+        pd_sim_result_free(r);
+        return st;
+    }
+    *result = r;
+    return PD_OK;
+}

@@ -1,0 +1,518 @@
+/* test_contact_phase.c: sustained contact as a continuous motion: closed
+ * forms for a box sliding along an edge and toppling about one, energy that
+ * never rises, and a hand-over that leaves no vertex below the floor. */
+#include <math.h>
+#include <string.h>
+#include "check.h"
+#include "contact/contact_phase.h"
+#include "drop_fixture.h"
+#include "base/gsl_adapter.h"
+#include "contact/phase_forces.h"
+#include "posedrop/tolerances.h"
+#include "base/quat.h"
+#include "shapes.h"
+#include "suites.h"
+#include "base/vec3.h"
+
+static const double G = 9.81;
+
+/* Body-frame half extents of a box body. */
+static pd_vec3 half_extents(const pd_body *b)
+{
+    pd_vec3 e = v3(0, 0, 0);
+    for (int i = 0; i < b->nverts; i++)
+        e = v3(fmax(e.x, fabs(b->verts[i].x)), fmax(e.y, fabs(b->verts[i].y)),
+               fmax(e.z, fabs(b->verts[i].z)));
+    return e;
+}
+
+/* The box standing on its edge along body x at (y, z) = (-Y, -Z), turned
+ * about x so that the arm from the edge to the centre of mass leans `tilt`
+ * rad past the vertical, the edge on the floor, at rest. */
+static pd_state on_edge(const pd_body *b, double tilt, int *contacts, int *nc)
+{
+    pd_vec3 h = half_extents(b);
+    double a = atan2(h.y, h.z) + tilt;
+    pd_state s = {v3(0, 0, 0), quat_axis_angle(v3(1, 0, 0), a), v3(0, 0, 0), v3(0, 0, 0)};
+    *nc = lowest_vertices(b, s.q, contacts);
+    s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
+    return s;
+}
+
+/* Sliding along the edge, balanced over it: friction mu m g brakes the box
+ * along x and its pitching moment is carried by the two ends' normal forces
+ * (mu h < X, so both stay positive); nothing turns. Closed form until the
+ * slip falls to the phase's end threshold: v = v0 - mu g t,
+ * x = v0 t - mu g t^2 / 2. */
+static void test_edge_slide(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    int contacts[8], nc;
+    pd_state s = on_edge(b, 0.0, contacts, &nc);
+    CHECK_INT(nc, 2);
+    double v0 = 0.2, z0 = s.x.z, L = b->size;
+    s.v = v3(v0, 0, 0);
+    pd_phase phase;
+    CHECK(pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase));
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    double t = 0.0;
+    CHECK_STATUS(pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &s, 1.0, &t), PD_OK);
+    /* It hands over as the slip falls to the end threshold, at most the
+     * event tolerance early; late only by the ODE error of the slip
+     * (1e-8 v0, above), 1e-8 sqrt(L/g) in time. The motion is quadratic in
+     * t, which the integrator's pair follows to round-off: measured 2e-17. */
+    double T = sqrt(L / G), slip_min = PD_TOL_PHASE_SLIP_REL * sqrt(G * L);
+    double stop = (v0 - slip_min) / (sc.mu * G);
+    CHECK(t <= stop + 1e-8 * T);
+    CHECK(t >= stop - (PD_TOL_PHASE_EVENT_REL + 1e-8) * T);
+    CHECK_NEAR(s.v.x, v0 - sc.mu * G * t, 1e-8 * v0, "closed form, exact for the pair");
+    CHECK_NEAR(s.x.x, v0 * t - 0.5 * sc.mu * G * t * t, 1e-9 * L, "closed form, exact for the pair");
+    CHECK_NEAR(s.x.z, z0, 1e-9 * L, "balanced over the edge: the height holds");
+    CHECK_NEAR(v3_norm(s.w), 0.0, 1e-6, "no turn: measured 0, the balanced start excites none (the balance's instability would grow a turn ~12x)");
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* Turning about a fixed edge: the rate at turn a (about body x) from the
+ * energy, w^2 = w0^2 + 2 m g (zc(a0) - zc(a)) / I_e, zc(a) = Y sin a +
+ * Z cos a the centre's height above the edge; 1 / w is the time per
+ * radian. */
+typedef struct {
+    double w0sq, k, Y, Z, a0;
+} topple_rate;
+
+static double topple_dt_da(double a, void *user)
+{
+    const topple_rate *r = user;
+    double zc0 = r->Y * sin(r->a0) + r->Z * cos(r->a0), zc = r->Y * sin(a) + r->Z * cos(a);
+    return 1.0 / sqrt(r->w0sq + r->k * (zc0 - zc));
+}
+
+/* Toppling about the edge: started 0.05 rad short of balance and turning
+ * towards it with 1.5 times the energy it needs to pass, so the outcome is
+ * open (a part leaning past balance from rest is decided at once, which ends
+ * a phase), and friction enough to hold the edge. A rotation about a fixed
+ * axis: the reaction does no work, the energy is conserved, the edge does not
+ * move, the next face comes down, and then the box turns about the edge at
+ * w = sqrt(w0^2 + 2 m g dh / I_e). */
+static void edge_topple(const drop_fixture *fx, const pd_scene *sc, const pd_body *b,
+                        pd_ode *ode, pd_ode *pivot)
+{
+    int contacts[8], nc;
+    pd_state s = on_edge(b, -0.05, contacts, &nc);
+    CHECK_INT(nc, 2);
+    pd_vec3 h = half_extents(b);
+    double Ie = b->moment[0] + b->mass * (h.y * h.y + h.z * h.z), L = b->size;
+    double w0 = sqrt(1.5 * 2.0 * b->mass * G * (hypot(h.y, h.z) - s.x.z) / Ie);
+    pd_vec3 e0 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    s.w = v3(w0, 0, 0);
+    s.v = v3_cross(quat_rotate(s.q, s.w), v3_sub(s.x, e0)); /* the edge at rest */
+    double E0 = total_energy(b, G, &s), z0 = s.x.z;
+    pd_phase phase;
+    CHECK(pd_contact_phase_start(fx->model, sc, &s, contacts, nc, &phase));
+    CHECK_NEAR(total_energy(b, G, &s), E0, 1e-12 * E0, "already on the constraint: the start changes nothing");
+    double t = 0.0;
+    CHECK_STATUS(pd_contact_phase(fx->model, ode, pivot, sc, &phase, &s, 1.0, &t), PD_OK);
+    CHECK(t > 0.0);
+    CHECK_NEAR(total_energy(b, G, &s), E0, 1e-8 * b->mass * G * L, "conservation: the ODE error alone, measured 3.7e-9 m g L at 1e-8 per step (pivot: 5e-10)");
+    pd_vec3 e1 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    CHECK_NEAR(v3_norm(v3_sub(e1, e0)), 0.0, 1e-8 * L, "a sticking contact stays put: ODE error, measured 7.7e-9 L (pivot: on its axis, round-off)");
+    /* It ends as the next face lands: some other vertex at the floor. */
+    double low = 1e300;
+    for (int i = 0; i < b->nverts; i++)
+        if (i != contacts[0] && i != contacts[1])
+            low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
+    CHECK_NEAR(low, 0.0, 1e-5 * L, "event located to 1e-6 sqrt(L/g), arriving at a few sqrt(g L): a few 1e-6 L");
+    /* The next face lands at a = pi/2 (its far edge reaches the floor): the
+     * time to it by quadrature of dt/da. The phase hands over at most the
+     * event tolerance early, late only by the ODE error. */
+    topple_rate rate = {w0 * w0, 2.0 * b->mass * G / Ie, h.y, h.z, atan2(h.y, h.z) - 0.05};
+    double t_land, T = sqrt(L / G);
+    CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, rate.a0, 0.5 * M_PI, 1e-13, &t_land), PD_OK);
+    CHECK(t <= t_land + 1e-8 * T);
+    CHECK(t >= t_land - (PD_TOL_PHASE_EVENT_REL + 1e-8) * T);
+    double w = sqrt(w0 * w0 + 2.0 * b->mass * G * (z0 - s.x.z) / Ie);
+    CHECK_NEAR(fabs(s.w.x), w, 1e-7 * w, "energy about a fixed axis: ODE error, measured 7.6e-8 w (pivot: 7.8e-9 w)");
+    CHECK_NEAR(hypot(s.w.y, s.w.z), 0.0, 1e-7 * w, "the axis is the edge (pivot: by construction)");
+}
+
+/* Both ways the phase can run it: the full 13-unknown motion (no pivot
+ * integrator), whose ODE error the tolerances above were measured on, and
+ * the pivot (contact_pivot.c), which a drop takes for two sticking
+ * contacts. */
+static void test_edge_topple(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 1.0);
+    if (!b)
+        return;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    edge_topple(&fx, &sc, b, ode, NULL);
+    edge_topple(&fx, &sc, b, ode, pivot);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* A random state of body b touching the floor at its lowest vertices
+ * contacts (their count returned), sliding at up to 0.5 m/s and spinning
+ * at up to 20 rad/s, the first contact moving along the floor, not into or
+ * out of it; a random friction coefficient in sc. */
+static int random_contact(const pd_body *b, test_rng *rng, pd_scene *sc, pd_state *s,
+                          int *contacts)
+{
+    double r[3][3];
+    rng_rotation(rng, r);
+    sc->mu = rng_range(rng, 0.1, 1.0);
+    *s = (pd_state){v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                    v3(rng_range(rng, -0.5, 0.5), rng_range(rng, -0.5, 0.5), 0.0),
+                    v3_scale(rng_unit_vector(rng), rng_range(rng, 0.0, 20.0))};
+    int nc = lowest_vertices(b, s->q, contacts);
+    s->x.z = -quat_rotate(s->q, b->verts[contacts[0]]).z;
+    s->v.z = -v3_cross(quat_rotate(s->q, s->w), quat_rotate(s->q, b->verts[contacts[0]])).z;
+    return nc;
+}
+
+/* Random phases of a box on a vertex or an edge, sliding and spinning: the
+ * start (a projection) and the phase never add energy beyond the
+ * integration error, and the hand-over leaves every other vertex above the
+ * contacts. */
+static void test_random_phases(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    double L = b->size, mgL = b->mass * G * L;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    test_rng rng = {31};
+    int started = 0, rises = 0, below = 0;
+    for (int k = 0; k < 300; k++) {
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
+        double E0 = total_energy(b, G, &s);
+        pd_phase phase;
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase))
+            continue;
+        started++;
+        double E1 = total_energy(b, G, &s), t;
+        rises += E1 > E0 + 1e-14 * mgL;
+        if (pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &s, 0.5, &t) != PD_OK)
+            continue;
+        rises += total_energy(b, G, &s) > E1 + 1e-8 * mgL;
+        double floor_z = 1e300, low = 1e300;
+        for (int i = 0; i < nc; i++)
+            floor_z = fmin(floor_z, s.x.z + quat_rotate(s.q, b->verts[contacts[i]]).z);
+        for (int i = 0; i < b->nverts; i++)
+            if (i != contacts[0] && (nc < 2 || i != contacts[1]))
+                low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
+        below += low < floor_z - 1e-12 * L;
+    }
+    CHECK(started >= 100);
+    CHECK_INT(rises, 0);
+    CHECK_INT(below, 0);
+    printf("contact_phase: %d of 300 random sliding or spinning contacts started a phase\n", started);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* The velocity of body vertex v of state s (world; s.w is body frame). */
+static pd_vec3 contact_speed(const pd_body *b, const pd_state *s, int v)
+{
+    return v3_add(s->v, quat_rotate(s->q, v3_cross(s->w, b->verts[v])));
+}
+
+/* A start near the slip threshold: the phase's modes are those its start
+ * projected for, so every sticking contact starts at rest and every sliding
+ * one above the end threshold, and the energy never rises in the phase. The
+ * box on a vertex or an edge, at random or on an edge at a random tilt
+ * (where the other end of the edge moves normally), its velocities scaled so that the
+ * first contact slips at 0.5-4 times the end threshold, where the start's
+ * projection can carry a slip across the start threshold (2x). */
+static void test_start_modes(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.5);
+    if (!b)
+        return;
+    double L = b->size, V0 = sqrt(G * L), mgL = b->mass * G * L;
+    double slip_min = PD_TOL_PHASE_SLIP_REL * V0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    test_rng rng = {97};
+    int started = 0, moving = 0, slow = 0;
+    double worst = -HUGE_VAL; /* the largest energy rise, per m g L */
+    for (int k = 0; k < 2000; k++) {
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
+        if (k % 2) { /* on an edge, where the projection takes an impulse */
+            pd_state r = s;
+            s = on_edge(b, rng_range(&rng, -0.3, 0.3), contacts, &nc);
+            s.v = r.v, s.w = quat_rotate_inv(s.q, r.w);
+            s.v.z -= contact_speed(b, &s, contacts[0]).z;
+        }
+        pd_vec3 u = contact_speed(b, &s, contacts[0]);
+        double c = rng_range(&rng, 0.5, 4.0) * slip_min / hypot(u.x, u.y);
+        s.v = v3_scale(s.v, c), s.w = v3_scale(s.w, c);
+        pd_phase p;
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &p))
+            continue;
+        started++;
+        for (int i = 0; i < nc; i++) {
+            pd_vec3 ui = contact_speed(b, &s, contacts[i]);
+            if (p.mode[i] == PD_PHASE_STICK)
+                moving += v3_norm(ui) > 1e-12 * V0; /* round-off of the projection */
+            else
+                slow += !(hypot(ui.x, ui.y) > slip_min);
+        }
+        double E0 = total_energy(b, G, &s), t;
+        if (pd_contact_phase(fx.model, ode, pivot, &sc, &p, &s, 0.5, &t) == PD_OK)
+            worst = fmax(worst, (total_energy(b, G, &s) - E0) / mgL);
+    }
+    CHECK(started >= 300);
+    CHECK_INT(moving, 0);
+    CHECK_INT(slow, 0);
+    /* Sticking phases of up to 1.7 sqrt(L/g) conserve energy to the ODE
+     * error: measured 1.2e-8 m g L (2e-4 when the phase took its modes
+     * afresh from the projected state). */
+    CHECK_NEAR(fmax(worst, 0.0), 0.0, 10.0 * PD_TOL_PHASE_ODE_REL, "ODE error over a phase");
+    printf("contact_phase: %d starts near the slip threshold, energy rising at most %.1e m g L\n",
+           started, worst);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* The phase's integrator (rkck at PD_TOL_PHASE_ODE_REL) against rk8pd at
+ * 1e-14 on random phases of the box, each run to a time limit short of any
+ * event so that both end at the same time: the states agree to the error a
+ * few steps of local error PD_TOL_PHASE_ODE_REL leave, and so does the
+ * energy, which is what the energy test reads. The limit of 0.1 sqrt(L/g) is
+ * 2-6 steps. Measured worst: 8e-10 L in position, 6e-9 sqrt(g L) in
+ * velocity, 6e-8 in the rate of turn (the spin reaches 1.2 per sqrt(L/g)),
+ * 1e-9 m g L in energy. */
+static void test_reference_agreement(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    double t_max = 0.1 * sqrt(b->size / G);
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    pd_ode *ref = pd_ode_alloc_method(PD_ODE_RK8PD, 13, 1e-14, 1e-14);
+    test_rng rng = {71};
+    int compared = 0;
+    state_gap gap = {0};
+    for (int k = 0; k < 300; k++) {
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
+        pd_phase phase;
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase))
+            continue;
+        pd_state a = s, r = s;
+        double ta, tr;
+        if (pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &a, t_max, &ta) != PD_OK ||
+            pd_contact_phase(fx.model, ref, NULL, &sc, &phase, &r, t_max, &tr) != PD_OK ||
+            ta < t_max * (1.0 - 1e-12) || tr < t_max * (1.0 - 1e-12))
+            continue; /* an event or the energy test ended one of them */
+        compared++;
+        state_gap_add(&gap, b, G, &a, &r);
+    }
+    CHECK(compared >= 50);
+    double tol = 10.0 * PD_TOL_PHASE_ODE_REL; /* a few steps of local error each */
+    state_gap_check(&gap, tol);
+    printf("contact_phase: rkck vs rk8pd on %d phases: x %.1e v %.1e q %.1e w %.1e E %.1e\n",
+           compared, gap.x, gap.v, gap.q, gap.w, gap.E);
+    pd_ode_free(ref);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* The specialised force solves (one sliding contact's 1 x 1 system, the
+ * constant maps of sticking contacts, the body-axis rows of the rest)
+ * against the general dense solve on the contacts' own tangent axes, on
+ * random states of the box, every layout: equal to round-off. The least-norm
+ * solve of two sticking contacts goes through the normal equations, which
+ * square K's condition number (~1e3 for the box), so round-off ~1e-16 * 1e6:
+ * 1e-9 of each quantity's scale. */
+static void test_specialised_forces(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.5);
+    if (!b)
+        return;
+    test_rng rng = {7};
+    int layouts[2][3] = {{0}}, differ = 0;
+    double worst = 0.0;
+    for (int k = 0; k < 3000; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 0.5)),
+                      v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 30.0))};
+        int contacts[2] = {(int)(rng_uniform(&rng) * b->nverts), 0}, nc = 1 + (k % 2);
+        int v = contacts[0], deg = b->adj_start[v + 1] - b->adj_start[v];
+        contacts[1] = b->adj[b->adj_start[v] + (int)(rng_uniform(&rng) * deg)];
+        /* Slip threshold: all slide, all stick, or between two slips. */
+        double slip_start = (k / 2) % 3 == 0 ? 0.0 : (k / 2) % 3 == 1 ? HUGE_VAL : -1.0;
+        if (slip_start < 0.0) {
+            pd_phase p;
+            pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, HUGE_VAL);
+            pd_phase_forces F;
+            pd_phase_forces_general(&p, &s, &F);
+            slip_start = nc == 2 ? 0.5 * (F.slip[0] + F.slip[1]) : F.slip[0] * rng_range(&rng, 0.5, 1.5);
+        }
+        pd_phase p;
+        pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+        pd_phase_forces A, B;
+        int fa = pd_phase_forces_of(&p, &s, &A), fb = pd_phase_forces_general(&p, &s, &B);
+        if (fa || fb) {
+            differ += fa != fb;
+            continue;
+        }
+        layouts[nc - 1][p.mode[0] + (nc == 2 ? p.mode[1] : 0)]++;
+        double acc = G + v3_dot(s.w, s.w) * b->size, force = b->mass * acc;
+        double d = fmax(v3_dist(A.acc, B.acc) / acc, v3_dist(A.wdot, B.wdot) * b->size / acc);
+        for (int i = 0; i < nc; i++) {
+            d = fmax(d, fabs(A.fn[i] - B.fn[i]) / force);
+            d = fmax(d, fabs(A.slip[i] - B.slip[i]) / sqrt(acc * b->size));
+            if (isfinite(B.cone[i]))
+                d = fmax(d, fabs(A.cone[i] - B.cone[i]) / force);
+            else
+                differ += isfinite(A.cone[i]);
+        }
+        worst = fmax(worst, d);
+    }
+    CHECK_INT(differ, 0);
+    CHECK_NEAR(worst, 0.0, 1e-9, "round-off through the normal equations (see above)");
+    for (int i = 0; i < 2; i++)
+        for (int j = 0; j < 2 + i; j++)
+            CHECK(layouts[i][j] >= 100);
+    drop_teardown(&fx);
+}
+
+/* The phase's margins at s as the test reads them (contact_phase.c): normal
+ * forces per weight, sticking cone margins per weight, slips above the end
+ * threshold per sqrt(g L), the lowest other vertex above the contacts per L;
+ * the smallest, or -1 where the model fails. */
+static double least_margin(const pd_phase *p, const pd_state *s)
+{
+    const pd_body *b = p->b;
+    pd_phase_forces F;
+    if (pd_phase_forces_of(p, s, &F))
+        return -1.0;
+    double mg = b->mass * G, V0 = sqrt(G * b->size), least = HUGE_VAL, floor_z = HUGE_VAL;
+    for (int i = 0; i < p->nc; i++) {
+        least = fmin(least, F.fn[i] / mg);
+        least = fmin(least, p->mode[i] == PD_PHASE_STICK
+                                ? F.cone[i] / mg
+                                : (F.slip[i] - PD_TOL_PHASE_SLIP_REL * V0) / V0);
+        floor_z = fmin(floor_z, s->x.z + quat_rotate(s->q, b->verts[p->v[i]]).z);
+    }
+    for (int i = 0; i < b->nverts; i++)
+        if (i != p->v[0] && i != p->v[1])
+            least = fmin(least, (s->x.z + quat_rotate(s->q, b->verts[i]).z - floor_z) / b->size);
+    return least;
+}
+
+/* One classical Runge-Kutta step of the phase's motion (SI). */
+static void rk4_step(const pd_phase *p, pd_state *s, double dt)
+{
+    double y[13], k[4][13];
+    const double c[4] = {0.0, 0.5, 0.5, 1.0}, wgt[4] = {1.0, 2.0, 2.0, 1.0};
+    for (int stage = 0; stage < 4; stage++) {
+        pd_state u = *s;
+        if (stage > 0) {
+            double *d = k[stage - 1], a = c[stage] * dt;
+            u.x = v3_add(s->x, v3_scale(v3(d[0], d[1], d[2]), a));
+            u.v = v3_add(s->v, v3_scale(v3(d[3], d[4], d[5]), a));
+            u.q = quat_normalize(quat(s->q.w + a * d[6], s->q.x + a * d[7], s->q.y + a * d[8],
+                                      s->q.z + a * d[9]));
+            u.w = v3_add(s->w, v3_scale(v3(d[10], d[11], d[12]), a));
+        }
+        pd_phase_forces F;
+        pd_phase_forces_of(p, &u, &F);
+        pd_quat dq = quat_mul(u.q, quat(0.0, u.w.x, u.w.y, u.w.z));
+        const double d[13] = {u.v.x, u.v.y, u.v.z, F.acc.x, F.acc.y, F.acc.z, 0.5 * dq.w,
+                              0.5 * dq.x, 0.5 * dq.y, 0.5 * dq.z, F.wdot.x, F.wdot.y, F.wdot.z};
+        memcpy(k[stage], d, sizeof d);
+    }
+    const double y0[13] = {s->x.x, s->x.y, s->x.z, s->v.x, s->v.y, s->v.z, s->q.w,
+                           s->q.x, s->q.y, s->q.z, s->w.x, s->w.y, s->w.z};
+    for (int i = 0; i < 13; i++) {
+        y[i] = y0[i];
+        for (int st = 0; st < 4; st++)
+            y[i] += dt / 6.0 * wgt[st] * k[st][i];
+    }
+    *s = (pd_state){v3(y[0], y[1], y[2]), quat_normalize(quat(y[6], y[7], y[8], y[9])),
+                    v3(y[3], y[4], y[5]), v3(y[10], y[11], y[12])};
+}
+
+/* Where a phase of random contacts of the box ends at an event (not the
+ * energy test, not the time limit), it hands over with every margin still
+ * positive and the event at most PD_TOL_PHASE_EVENT_REL sqrt(L/g) ahead:
+ * continued by RK4 in steps of a fiftieth of that (error ~1e-30 L), some
+ * margin reaches zero within it. */
+static void test_event_location(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    double T = sqrt(b->size / G), tol = PD_TOL_PHASE_EVENT_REL * T;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    test_rng rng = {53};
+    int events = 0, early = 0, late = 0, hint = 0, pose;
+    double worst = 0.0;
+    for (int k = 0; k < 300; k++) {
+        pd_state s;
+        int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
+        pd_phase p;
+        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &p))
+            continue;
+        double t;
+        if (pd_contact_phase(fx.model, ode, pivot, &sc, &p, &s, 0.5, &t) != PD_OK || t >= 0.5 ||
+            pd_drop_decided(fx.model, &s, G, &hint, &pose) > 0)
+            continue;
+        events++;
+        if (!p.mapped)
+            pd_phase_map(&p); /* a pivot's start leaves the solves out */
+        early += !(least_margin(&p, &s) > 0.0);
+        int steps = 0; /* of tol / 50 */
+        while (steps < 100 && least_margin(&p, &s) > 0.0) {
+            rk4_step(&p, &s, tol / 50.0);
+            steps++;
+        }
+        late += steps > 50;
+        worst = fmax(worst, steps / 50.0);
+    }
+    CHECK(events >= 100);
+    CHECK_INT(early, 0);
+    CHECK_INT(late, 0);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+void suite_contact_phase(void)
+{
+    test_event_location();
+    test_specialised_forces();
+    test_edge_slide();
+    test_edge_topple();
+    test_random_phases();
+    test_reference_agreement();
+    test_start_modes();
+}
