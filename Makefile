@@ -70,7 +70,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo paper install uninstall clean help deps golden
+.PHONY: all check test bench demo paper install uninstall clean help deps golden lint
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI)
@@ -117,7 +117,12 @@ deps:
 test: $(TEST_BIN) $(CLI)
 	$(TEST_BIN) $(SUITES)
 
-check: deps
+# A file may include only its own layer's headers and those of the layers
+# below it (scripts/lint-layers.sh holds the table).
+lint:
+	@scripts/lint-layers.sh
+
+check: deps lint
 	@$(MAKE) --no-print-directory test
 
 demo: deps
@@ -162,6 +167,7 @@ help:
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
+	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"

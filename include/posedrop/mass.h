@@ -22,16 +22,6 @@ typedef struct pd_mass {
     double inertia[3][3];   /* inertia tensor about com per unit density, m^5 */
 } pd_mass;
 
-/* Makes the faces of a welded mesh consistently oriented with outward normals.
- * Works shell by shell (connected components): flips the faces that disagree
- * with their neighbours, then turns each shell so that it encloses positive
- * volume if it lies inside an even number of other shells (an outer surface)
- * and negative volume otherwise (a void). *nflipped (may be NULL) receives the
- * number of faces flipped. PD_ERR_NOT_CLOSED if an edge is not shared by exactly
- * two faces (boundary or non-manifold), PD_ERR_ORIENTATION if no consistent
- * orientation exists. The mesh is unchanged on failure. */
-pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag);
-
 /* Mass properties of a closed, consistently oriented mesh (see pd_mesh_orient).
  * PD_ERR_COPLANAR if the volume is not positive beyond round-off. */
 pd_status pd_mass_compute(const pd_mesh *mesh, pd_mass *mass, pd_diag *diag);

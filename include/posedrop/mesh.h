@@ -68,6 +68,16 @@ pd_mesh *pd_mesh_clone(const pd_mesh *mesh);
  * NULL) receives the number of vertices removed. Returns PD_OK, PD_ERR_NOMEM. */
 pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged);
 
+/* Makes the faces of a welded mesh consistently oriented with outward normals.
+ * Works shell by shell (connected components): flips the faces that disagree
+ * with their neighbours, then turns each shell so that it encloses positive
+ * volume if it lies inside an even number of other shells (an outer surface)
+ * and negative volume otherwise (a void). *nflipped (may be NULL) receives the
+ * number of faces flipped. PD_ERR_NOT_CLOSED if an edge is not shared by exactly
+ * two faces (boundary or non-manifold), PD_ERR_ORIENTATION if no consistent
+ * orientation exists. The mesh is unchanged on failure. */
+pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag);
+
 /* Diagonal of the bounding box of the vertices: the part's length scale. */
 double pd_mesh_size(const pd_mesh *mesh);
 

@@ -32,7 +32,7 @@
 #include <string.h>
 #include "contact/contact_phase.h"
 #include "contact/contact_pivot.h"
-#include "sim/drop_internal.h"
+#include "settle/settle.h"
 #include "base/gsl_adapter.h"
 #include "contact/phase_forces.h"
 #include "posedrop/tolerances.h"
@@ -435,26 +435,26 @@ static double predicted_event(const pd_phase *p, const point *a, const point *b,
 /* The contacts and modes of the phase for contacts[0..nc) of state s,
  * each contact sliding if its slip is above twice the end threshold, else
  * sticking; no force solve set up yet (pd_phase_map). */
-static void phase_of(pd_phase *p, const pd_sim_model *m, const pd_scene *sc, const pd_state *s,
+static void phase_of(pd_phase *p, const pd_settle *st, const pd_scene *sc, const pd_state *s,
                      const int *contacts, int nc)
 {
-    const pd_body *b = m->body;
+    const pd_body *b = st->body;
     double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     pd_phase_modes(p, b, sc->gravity, sc->mu, s, contacts, nc, slip_start);
 }
 
-int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *s,
+int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase)
 {
     if (nc < 1 || nc > 2)
         return 0;
-    const pd_body *b = m->body;
+    const pd_body *b = st->body;
     double lost_max = PD_TOL_PHASE_ENTRY_REL * b->mass * sc->gravity * b->size;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)); /* body frame, as r and w */
     for (int i = 0; i < nc; i++) {
         pd_vec3 r = b->verts[contacts[i]];
         double vn = s->v.z + v3_dot(up, v3_cross(s->w, r));
-        if (fabs(vn) > m->v_rest)
+        if (fabs(vn) > st->v_rest)
             return 0; /* a flight or an impact, not chatter */
         /* The entry's projection (below) stops at least this contact's
          * normal speed, and a projection onto fewer constraints loses less
@@ -472,7 +472,7 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
             return 0;
     }
     pd_phase p;
-    phase_of(&p, m, sc, s, contacts, nc);
+    phase_of(&p, st, sc, s, contacts, nc);
     for (int i = 0; i < nc; i++)
         if (p.mode[i] == PD_PHASE_STICK && sc->mu == 0.0)
             return 0; /* nothing holds a contact without friction */
@@ -519,11 +519,11 @@ int pd_contact_phase_start(const pd_sim_model *m, const pd_scene *sc, pd_state *
     return 1;
 }
 
-pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, pd_ode *pivot_ode,
+pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_ode,
                            const pd_scene *sc, const pd_phase *phase, pd_state *s, double t_max,
                            double *t_used)
 {
-    const pd_body *b = m->body;
+    const pd_body *b = settle->body;
     pd_phase p = *phase;
     pd_pivot pv;
     motion mo = motion_of(&p); /* the right-hand side takes it as void * */
@@ -595,7 +595,7 @@ pd_status pd_contact_phase(const pd_sim_model *m, pd_ode *ode, pd_ode *pivot_ode
                 target = cur->tau + dt - 0.5 * tol;
                 h = target - cur->tau;
             }
-            if (pd_drop_decided(m, s, sc->gravity, &hint, &pose) > 0)
+            if (pd_settle_decided(settle, s, sc->gravity, &hint, &pose) > 0)
                 break;
             continue;
         }

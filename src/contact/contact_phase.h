@@ -4,7 +4,8 @@
 #ifndef PD_CONTACT_PHASE_H
 #define PD_CONTACT_PHASE_H
 
-#include "sim/drop.h"
+#include "posedrop/sim.h"
+#include "settle/settle.h"
 #include "base/gsl_adapter.h"
 #include "contact/phase_forces.h"
 
@@ -20,8 +21,9 @@ pd_ode *pd_contact_pivot_ode_alloc(void);
  * positive forces, no other vertex down. Then s's constrained velocities are
  * zeroed (a sliding contact's normal one, a sticking contact's whole one),
  * without adding energy, for the phase to start from, and *phase is the
- * phase; otherwise s is left alone. */
-int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_state *s,
+ * phase; otherwise s is left alone. settle gives the body, what resting
+ * contact is, and the test that ends the drop. */
+int pd_contact_phase_start(const pd_settle *settle, const pd_scene *scene, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase);
 
 /* Runs phase (from pd_contact_phase_start) from s for at most t_max
@@ -29,7 +31,7 @@ int pd_contact_phase_start(const pd_sim_model *model, const pd_scene *scene, pd_
  * where it ended and *t_used the time it took. Two sticking contacts turn
  * about their edge by pivot_ode, or by ode in full where pivot_ode is NULL
  * (the reference the reduced motion is tested against). */
-pd_status pd_contact_phase(const pd_sim_model *model, pd_ode *ode, pd_ode *pivot_ode,
+pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_ode,
                            const pd_scene *scene, const pd_phase *phase, pd_state *s,
                            double t_max, double *t_used);
 

@@ -34,208 +34,17 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include "settle/basin.h"
 #include "dynamics/body.h"
 #include "contact/contact_phase.h"
 #include "base/fail.h"
-#include "sim/drop_internal.h"
 #include "settle/flat_rest.h"
+#include "settle/settle.h"
+#include "sim/drop.h"
+#include "sim/drop_step.h"
 #include "dynamics/flight.h"
 #include "impact/impact.h"
 #include "posedrop/tolerances.h"
-#include "base/rng.h"
-#include "static/static_internal.h"
 #include "base/vec3.h"
-
-
-void pd_sim_model_free(pd_sim_model *m)
-{
-    if (!m)
-        return;
-    pd_body_free(m->body);
-    pd_static_result_free(m->descent);
-    free(m->barrier);
-    free(m->flat);
-    pd_descent_map_free(&m->map);
-    pd_star_free(&m->star);
-    free(m->pose_of);
-    free(m);
-}
-
-pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
-                             const pd_scene *scene, const pd_sim_options *options,
-                             pd_sim_model **model, pd_diag *diag)
-{
-    pd_sim_model *m = calloc(1, sizeof *m);
-    if (!m)
-        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
-    /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
-     * frame cut into 16 substeps. */
-    if (options->engine == PD_ENGINE_ODE) {
-        m->engine = &pd_engine_ode;
-        m->dt = options->dt > 0 ? options->dt : 1e-3;
-    } else if (options->engine == PD_ENGINE_BULLET) {
-        m->engine = &pd_engine_bullet;
-        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
-    }
-    m->hull = part->hull;
-    m->com = part->com;
-    m->poses = poses;
-    /* Basins follow the exact motion whatever rule the static table used;
-     * stability, hence the set of poses, is the same under both rules. */
-    pd_static_options so;
-    pd_static_options_default(&so);
-    so.topple = PD_TOPPLE_DESCENT;
-    so.epsilon = 0.0;
-    pd_status st = pd_body_build(part, &m->body, diag);
-    if (st == PD_OK)
-        st = pd_static_estimate(part, &so, &m->descent, diag);
-    if (st == PD_OK)
-        st = pd_star_build(part->hull, &m->star);
-    if (st == PD_OK)
-        st = pd_descent_map_build(part->hull, &m->star, part->com, &m->map);
-    int nf = part->hull->nfacets;
-    if (st == PD_OK) {
-        m->barrier = malloc(sizeof *m->barrier * (size_t)nf);
-        m->pose_of = malloc(sizeof *m->pose_of * (size_t)nf);
-        m->flat = malloc(sizeof *m->flat * (size_t)nf);
-        if (!m->barrier || !m->pose_of || !m->flat)
-            st = PD_ERR_NOMEM;
-    }
-    if (st == PD_OK) {
-        pd_basin_barriers(part->hull, part->com, m->descent, m->barrier);
-        pd_flat_build(m->body, part->hull, m->descent, m->flat);
-        m->flat_height = pd_flat_height_max(m->flat, nf);
-        m->barrier_max = -INFINITY;
-        for (int f = 0; f < nf; f++) {
-            m->pose_of[f] = -1;
-            m->barrier_max = fmax(m->barrier_max, m->barrier[f]);
-        }
-        for (int k = 0; k < poses->nposes; k++)
-            m->pose_of[poses->poses[k].facet] = k;
-        /* A speed scale of the part: sqrt(g L), the speed of falling its own
-         * size. Approaches slower by PD_TOL_APPROACH_REL are round-off of a
-         * resolved contact, not a new impact. */
-        m->v_eps = PD_TOL_APPROACH_REL * sqrt(scene->gravity * m->body->size);
-        /* A resting vertex meets the floor at the speed of falling rest_fall;
-         * twice that leaves room for what the part's rotation adds. */
-        m->rest_fall = PD_TOL_REST_FALL_REL * m->body->size;
-        m->v_rest = 2.0 * sqrt(2.0 * scene->gravity * m->rest_fall);
-    }
-    if (st != PD_OK) {
-        if (st == PD_ERR_NOMEM)
-            pd_fail(diag, st, "out of memory for the drop model");
-        pd_sim_model_free(m);
-        return st;
-    }
-    *model = m;
-    return PD_OK;
-}
-
-const pd_body *pd_sim_model_body(const pd_sim_model *model) { return model->body; }
-
-pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene)
-{
-    pd_drop_work *w = calloc(1, sizeof *w);
-    if (!w)
-        return NULL;
-    if (model->engine)
-        w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
-    else {
-        w->impact = pd_impact_work_alloc();
-        w->phase = pd_contact_phase_ode_alloc();
-        w->pivot = pd_contact_pivot_ode_alloc();
-    }
-    if ((!w->impact || !w->phase || !w->pivot) && !w->world) {
-        pd_impact_work_free(w->impact);
-        pd_ode_free(w->phase);
-        pd_ode_free(w->pivot);
-        free(w);
-        return NULL;
-    }
-    w->engine = model->engine;
-    return w;
-}
-
-void pd_drop_work_free(pd_drop_work *w)
-{
-    if (!w)
-        return;
-    pd_impact_work_free(w->impact);
-    pd_ode_free(w->phase);
-    pd_ode_free(w->pivot);
-    if (w->world)
-        w->engine->world_free(w->world);
-    free(w);
-}
-
-/* --- initial state ----------------------------------------------------------- */
-
-/* The rotation turning unit vector a onto unit vector b by the shortest arc. */
-static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
-{
-    pd_vec3 axis = v3_cross(a, b);
-    double s = v3_norm(axis), c = v3_dot(a, b);
-    if (s < PD_TOL_ANGLE) { /* parallel or opposite within round-off */
-        if (c > 0.0)
-            return quat_identity();
-        pd_vec3 any = fabs(a.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
-        return quat_axis_angle(v3_unit(v3_cross(a, any)), M_PI);
-    }
-    return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
-}
-
-static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
-                          const double *init_cdf, pd_state *s, double q0[4])
-{
-    const pd_body *b = m->body;
-    pd_quat q;
-    if (init_cdf) {
-        /* The paper's belt: resting on a pose drawn from the estimate, turned
-         * at random about the vertical. */
-        double u = pd_rng_uniform(rng);
-        int k = 0;
-        while (k + 1 < m->poses->nposes && u >= init_cdf[k])
-            k++;
-        pd_vec3 n = quat_rotate_inv(b->frame, m->poses->poses[k].normal);
-        pd_quat down = quat_between(n, v3(0, 0, -1));
-        q = quat_mul(quat_axis_angle(v3(0, 0, 1), 2.0 * M_PI * pd_rng_uniform(rng)), down);
-    } else {
-        double r[4];
-        pd_rng_quaternion(rng, r);
-        q = quat(r[0], r[1], r[2], r[3]);
-    }
-    if (sc->vibration > 0.0) {
-        pd_vec3 axis = pd_rng_unit_vector(rng);
-        q = quat_mul(quat_axis_angle(axis, sc->vibration * pd_rng_uniform(rng)), q);
-    }
-    q = quat_normalize(q);
-    s->q = q;
-    s->x = v3(0, 0, 0);
-    s->v = v3(sc->belt_speed, 0, 0);
-    s->w = v3(0, 0, 0);
-    /* Lowest point at the drop height. */
-    int low = pd_body_support(b, quat_rotate_inv(q, v3(0, 0, 1)), 0);
-    s->x.z = sc->height - pd_body_vertex_world(b, s, low).z;
-    /* The orientation of the part's own (file) frame, for --trials. */
-    pd_quat qp = quat_mul(q, quat_conj(b->frame));
-    q0[0] = qp.w;
-    q0[1] = qp.x;
-    q0[2] = qp.y;
-    q0[3] = qp.z;
-}
-
-void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_options *o,
-                     long index, const double *init_cdf, pd_state *s, pd_trial *out)
-{
-    pd_rng rng;
-    pd_rng_init(&rng, o->seed, (uint64_t)index);
-    initial_state(m, sc, &rng, init_cdf, s, out->q0);
-    out->pose = -1;
-    out->collisions = 0;
-    out->end = PD_END_FAILED;
-    out->time = 0.0;
-}
 
 /* --- collisions ------------------------------------------------------------- */
 
@@ -312,7 +121,7 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
             return PD_OK;
         c = v3_scale(c, 1.0 / wsum);
         pd_vec3 u0 = v3_add(s->v, v3_cross(ww, c));
-        double e = -u0.z <= m->v_rest ? 0.0 : sc->restitution;
+        double e = -u0.z <= m->settle.v_rest ? 0.0 : sc->restitution;
         double K[3][3];
         pd_impact_K(1.0 / b->mass, CONST_M3(J), c, K);
         pd_impact_result res;
@@ -337,60 +146,6 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 
 /* --- the drop ----------------------------------------------------------------- */
 
-/* Energy per unit weight: the height the part could reach, m. */
-static double energy_height(const pd_body *b, const pd_state *s, double g)
-{
-    double rot = b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
-                 b->moment[2] * s->w.z * s->w.z;
-    return s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
-}
-
-/* Gravity's direction in the part's (file) frame. */
-static pd_vec3 gravity_in_part(const pd_sim_model *m, const pd_state *s)
-{
-    return quat_rotate(m->body->frame, quat_rotate_inv(s->q, v3(0, 0, -1)));
-}
-
-/* pd_drop_decided, also giving the facet the part would land on, or -1
- * when neither that test nor pd_flat_settled can pass (the energy above
- * every barrier, the centre of mass above every flat rest's reach), where
- * the descent is skipped. */
-static int decided_at(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose,
-                      int *facet)
-{
-    *facet = -1;
-    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max) &&
-        !(s->x.z < m->flat_height))
-        return 0;
-    pd_vec3 down = gravity_in_part(m, s);
-    int f;
-    if (pd_descent_lookup(&m->map, down, &f, hint) != PD_OK)
-        return -1;
-    *facet = f;
-    /* A resting vertex may be up to rest_fall below the floor, so the part's
-     * potential energy may read that much low: count it. */
-    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier[f]))
-        return 0;
-    *pose = m->pose_of[m->descent->facets[f].rest];
-    return *pose >= 0 ? 1 : -1;
-}
-
-int pd_drop_decided(const pd_sim_model *m, const pd_state *s, double g, int *hint, int *pose)
-{
-    /* Above every barrier nothing is decided, whichever basin s is in: the
-     * descent, most of the test's cost, is left out (most of a contact
-     * phase's tests, which come after every step, are up there). */
-    if (!(energy_height(m->body, s, g) + m->rest_fall < m->barrier_max))
-        return 0;
-    int f;
-    return decided_at(m, s, g, hint, pose, &f);
-}
-
-double pd_drop_tilt(const pd_sim_model *m, const pd_state *s, int pose)
-{
-    return v3_angle(gravity_in_part(m, s), m->poses->poses[pose].normal);
-}
-
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
@@ -405,7 +160,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     /* Resting contact advances by the time to fall rest_fall, so that a
      * vertex pressed on the floor by gravity meets it again with the speed
      * that fall gives (a microcollision) rather than at speed 0. */
-    double dt_rest = sqrt(2.0 * m->rest_fall / g);
+    double dt_rest = sqrt(2.0 * m->settle.rest_fall / g);
     int hint = 0, phase_ok = 1, nc = 0;
     pd_flight f;
     double f_at = -1.0; /* time on f at which s lies; < 0: plan from s */
@@ -417,11 +172,11 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * resolve, so both are skipped. */
     int resolved = 0;
     for (;;) {
-        int pose, facet, d = decided_at(m, &s, g, &hint, &pose, &facet);
-        if (d == 0 && facet >= 0 && m->pose_of[facet] >= 0 &&
-            pd_flat_settled(m->flat, m->body, &s, facet, g, sc->mu, m->rest_fall)) {
+        int pose, facet, d = pd_settle_decided_at(&m->settle, &s, g, &hint, &pose, &facet);
+        if (d == 0 && facet >= 0 && m->settle.pose_of[facet] >= 0 &&
+            pd_flat_settled(m->settle.flat, m->body, &s, facet, g, sc->mu, m->settle.rest_fall)) {
             d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
-            pose = m->pose_of[facet];
+            pose = m->settle.pose_of[facet];
         }
         if (d < 0)
             break;
@@ -475,14 +230,14 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         resolved = 0;
         pd_phase phase;
-        if (phase_ok && pd_contact_phase_start(m, sc, &s, w->contacts, nc, &phase)) {
+        if (phase_ok && pd_contact_phase_start(&m->settle, sc, &s, w->contacts, nc, &phase)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
              * microcollisions must resolve, so the next rest step is theirs
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if (pd_contact_phase(m, w->phase, w->pivot, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
+            if (pd_contact_phase(&m->settle, w->phase, w->pivot, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
                 break;
             t += dt;
             phase_ok = 0;

@@ -5,7 +5,8 @@
  * back, so the energy test alone is not trusted: the part must also lie on
  * the facet of its basin, tilted less than PD_TOL_REST_TILT. */
 #include "base/fail.h"
-#include "sim/drop_internal.h"
+#include "settle/settle.h"
+#include "sim/drop_step.h"
 #include "posedrop/tolerances.h"
 
 void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
@@ -19,10 +20,10 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
     long steps = (long)(o->time_limit / m->dt) + 1;
     int hint = 0;
     for (long k = 0; k < steps; k++) {
-        int pose, d = pd_drop_decided(m, &s, sc->gravity, &hint, &pose);
+        int pose, d = pd_settle_decided(&m->settle, &s, sc->gravity, &hint, &pose);
         if (d < 0)
             return;
-        if (d > 0 && pd_drop_tilt(m, &s, pose) < PD_TOL_REST_TILT) {
+        if (d > 0 && pd_settle_tilt(&m->settle, &s, pose) < PD_TOL_REST_TILT) {
             out->pose = pose;
             out->end = PD_END_SETTLED;
             return;

@@ -6,7 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/fail.h"
-#include "mesh/mesh_reader.h"
+#include "base/text.h"
 #include "posedrop/sim.h"
 
 void pd_scene_default(pd_scene *s)

@@ -27,7 +27,7 @@ const pd_body *drop_setup_box(drop_fixture *fx, pd_scene *sc, double mu)
     sc->mu = mu;
     if (!drop_setup(fx, mesh_box(0.01, 0.02, 0.03), sc))
         return NULL;
-    return pd_sim_model_body(fx->model);
+    return (fx->model)->body;
 }
 
 void drop_teardown(drop_fixture *fx)

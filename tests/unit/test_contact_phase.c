@@ -57,10 +57,10 @@ static void test_edge_slide(void)
     double v0 = 0.2, z0 = s.x.z, L = b->size;
     s.v = v3(v0, 0, 0);
     pd_phase phase;
-    CHECK(pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase));
+    CHECK(pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &phase));
     pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
     double t = 0.0;
-    CHECK_STATUS(pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &s, 1.0, &t), PD_OK);
+    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &s, 1.0, &t), PD_OK);
     /* It hands over as the slip falls to the end threshold, at most the
      * event tolerance early; late only by the ODE error of the slip
      * (1e-8 v0, above), 1e-8 sqrt(L/g) in time. The motion is quadratic in
@@ -114,10 +114,10 @@ static void edge_topple(const drop_fixture *fx, const pd_scene *sc, const pd_bod
     s.v = v3_cross(quat_rotate(s.q, s.w), v3_sub(s.x, e0)); /* the edge at rest */
     double E0 = total_energy(b, G, &s), z0 = s.x.z;
     pd_phase phase;
-    CHECK(pd_contact_phase_start(fx->model, sc, &s, contacts, nc, &phase));
+    CHECK(pd_contact_phase_start(&fx->model->settle, sc, &s, contacts, nc, &phase));
     CHECK_NEAR(total_energy(b, G, &s), E0, 1e-12 * E0, "already on the constraint: the start changes nothing");
     double t = 0.0;
-    CHECK_STATUS(pd_contact_phase(fx->model, ode, pivot, sc, &phase, &s, 1.0, &t), PD_OK);
+    CHECK_STATUS(pd_contact_phase(&fx->model->settle, ode, pivot, sc, &phase, &s, 1.0, &t), PD_OK);
     CHECK(t > 0.0);
     CHECK_NEAR(total_energy(b, G, &s), E0, 1e-8 * b->mass * G * L, "conservation: the ODE error alone, measured 3.7e-9 m g L at 1e-8 per step (pivot: 5e-10)");
     pd_vec3 e1 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
@@ -199,12 +199,12 @@ static void test_random_phases(void)
         int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
         double E0 = total_energy(b, G, &s);
         pd_phase phase;
-        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase))
+        if (!pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &phase))
             continue;
         started++;
         double E1 = total_energy(b, G, &s), t;
         rises += E1 > E0 + 1e-14 * mgL;
-        if (pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &s, 0.5, &t) != PD_OK)
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &s, 0.5, &t) != PD_OK)
             continue;
         rises += total_energy(b, G, &s) > E1 + 1e-8 * mgL;
         double floor_z = 1e300, low = 1e300;
@@ -263,7 +263,7 @@ static void test_start_modes(void)
         double c = rng_range(&rng, 0.5, 4.0) * slip_min / hypot(u.x, u.y);
         s.v = v3_scale(s.v, c), s.w = v3_scale(s.w, c);
         pd_phase p;
-        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &p))
+        if (!pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &p))
             continue;
         started++;
         for (int i = 0; i < nc; i++) {
@@ -274,7 +274,7 @@ static void test_start_modes(void)
                 slow += !(hypot(ui.x, ui.y) > slip_min);
         }
         double E0 = total_energy(b, G, &s), t;
-        if (pd_contact_phase(fx.model, ode, pivot, &sc, &p, &s, 0.5, &t) == PD_OK)
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &p, &s, 0.5, &t) == PD_OK)
             worst = fmax(worst, (total_energy(b, G, &s) - E0) / mgL);
     }
     CHECK(started >= 300);
@@ -316,12 +316,12 @@ static void test_reference_agreement(void)
         pd_state s;
         int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
         pd_phase phase;
-        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &phase))
+        if (!pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &phase))
             continue;
         pd_state a = s, r = s;
         double ta, tr;
-        if (pd_contact_phase(fx.model, ode, pivot, &sc, &phase, &a, t_max, &ta) != PD_OK ||
-            pd_contact_phase(fx.model, ref, NULL, &sc, &phase, &r, t_max, &tr) != PD_OK ||
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &a, t_max, &ta) != PD_OK ||
+            pd_contact_phase(&fx.model->settle, ref, NULL, &sc, &phase, &r, t_max, &tr) != PD_OK ||
             ta < t_max * (1.0 - 1e-12) || tr < t_max * (1.0 - 1e-12))
             continue; /* an event or the energy test ended one of them */
         compared++;
@@ -480,11 +480,11 @@ static void test_event_location(void)
         pd_state s;
         int contacts[8], nc = random_contact(b, &rng, &sc, &s, contacts);
         pd_phase p;
-        if (!pd_contact_phase_start(fx.model, &sc, &s, contacts, nc, &p))
+        if (!pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &p))
             continue;
         double t;
-        if (pd_contact_phase(fx.model, ode, pivot, &sc, &p, &s, 0.5, &t) != PD_OK || t >= 0.5 ||
-            pd_drop_decided(fx.model, &s, G, &hint, &pose) > 0)
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &p, &s, 0.5, &t) != PD_OK || t >= 0.5 ||
+            pd_settle_decided(&(fx.model)->settle, &s, G, &hint, &pose) > 0)
             continue;
         events++;
         if (!p.mapped)

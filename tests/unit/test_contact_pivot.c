@@ -125,7 +125,7 @@ static void check_forces(const pd_body *b, double mu, test_rng *rng)
  * the pivot's energy drift 6.1e-9; 4.4e-9 m g L. */
 static void check_motion(drop_fixture *fx, pd_scene *sc, test_rng *rng)
 {
-    const pd_body *b = pd_sim_model_body(fx->model);
+    const pd_body *b = (fx->model)->body;
     double L = b->size, T = sqrt(L / G), mgL = b->mass * G * L;
     double tol = 10.0 * PD_TOL_PHASE_ODE_REL, t_max = 2.0 * T;
     pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
@@ -138,17 +138,17 @@ static void check_motion(drop_fixture *fx, pd_scene *sc, test_rng *rng)
         if (!random_pivot(b, rng, &s, contacts))
             continue;
         pd_phase phase;
-        if (!pd_contact_phase_start(fx->model, sc, &s, contacts, 2, &phase) ||
+        if (!pd_contact_phase_start(&fx->model->settle, sc, &s, contacts, 2, &phase) ||
             phase.mode[0] != PD_PHASE_STICK || phase.mode[1] != PD_PHASE_STICK)
             continue;
         pd_state a = s, f = s;
         double ta, tf;
-        if (pd_contact_phase(fx->model, ode, pivot, sc, &phase, &a, t_max, &ta) != PD_OK ||
-            pd_contact_phase(fx->model, ode, NULL, sc, &phase, &f, t_max, &tf) != PD_OK)
+        if (pd_contact_phase(&fx->model->settle, ode, pivot, sc, &phase, &a, t_max, &ta) != PD_OK ||
+            pd_contact_phase(&fx->model->settle, ode, NULL, sc, &phase, &f, t_max, &tf) != PD_OK)
             continue;
         drift = fmax(drift, fabs(total_energy(b, G, &a) - total_energy(b, G, &s)) / mgL);
-        if (ta < t_max && tf < t_max && pd_drop_decided(fx->model, &a, G, &hint, &pose) <= 0 &&
-            pd_drop_decided(fx->model, &f, G, &hint, &pose) <= 0) {
+        if (ta < t_max && tf < t_max && pd_settle_decided(&(fx->model)->settle, &a, G, &hint, &pose) <= 0 &&
+            pd_settle_decided(&(fx->model)->settle, &f, G, &hint, &pose) <= 0) {
             pd_phase mapped = phase;
             pd_phase_map(&mapped);
             events++;
@@ -160,8 +160,8 @@ static void check_motion(drop_fixture *fx, pd_scene *sc, test_rng *rng)
         double t_c = 0.9 * fmin(ta, tf);
         a = s, f = s;
         if (!(t_c > 0.0) ||
-            pd_contact_phase(fx->model, ode, pivot, sc, &phase, &a, t_c, &ta) != PD_OK ||
-            pd_contact_phase(fx->model, ode, NULL, sc, &phase, &f, t_c, &tf) != PD_OK ||
+            pd_contact_phase(&fx->model->settle, ode, pivot, sc, &phase, &a, t_c, &ta) != PD_OK ||
+            pd_contact_phase(&fx->model->settle, ode, NULL, sc, &phase, &f, t_c, &tf) != PD_OK ||
             ta < t_c * (1.0 - 1e-12) || tf < t_c * (1.0 - 1e-12))
             continue;
         compared++;
@@ -194,7 +194,7 @@ void suite_contact_pivot(void)
     pd_scene_default(&sc);
     sc.mu = 1.0;
     if (drop_setup(&fx, mesh_prism(32, 0.01, 0.01), &sc)) {
-        b = pd_sim_model_body(fx.model);
+        b = (fx.model)->body;
         check_forces(b, sc.mu, &rng);
         check_motion(&fx, &sc, &rng);
         drop_teardown(&fx);

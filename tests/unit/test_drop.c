@@ -169,7 +169,7 @@ static void test_impact_window(void)
     pd_scene_default(&sc);
     if (!drop_setup(&fx, mesh_box(0.01, 0.01, 0.01), &sc))
         return;
-    const pd_body *b = pd_sim_model_body(fx.model);
+    const pd_body *b = (fx.model)->body;
     pd_quat q = quat_axis_angle(v3_unit(v3(1.0, 0.4, 0.0)), 1.5 * M_PI / 180.0);
     double spin[2];
     int ncs[2];

@@ -4,7 +4,7 @@
 #include <stdlib.h>
 #include "check.h"
 #include "drop_fixture.h"
-#include "sim/drop_internal.h"
+#include "sim/drop.h"
 #include "settle/flat_rest.h"
 #include "base/mat3.h"
 #include "posedrop/posedrop.h"
@@ -32,7 +32,7 @@ static void test_box_facets(void)
         pd_vec3 n = hull->normal[f];
         int k = fabs(n.x) > 0.5 ? 0 : fabs(n.y) > 0.5 ? 1 : 2;
         double a = edge[(k + 1) % 3], c = edge[(k + 2) % 3];
-        const pd_flat_facet *F = &fx.model->flat[f];
+        const pd_flat_facet *F = &fx.model->settle.flat[f];
         CHECK_NEAR(F->h, 0.5 * edge[k], 1e-12 * 0.03, "closed form, round-off");
         CHECK_NEAR(F->inside, 0.5 * fmin(a, c), 1e-12 * 0.03, "closed form, round-off");
         CHECK_NEAR(F->reach, 0.5 * hypot(a, c), 1e-12 * 0.03, "closed form, round-off");
@@ -53,11 +53,11 @@ static void flat_summary(pd_mesh *mesh, double L, double out[5])
         out[i] = NAN;
     if (!drop_setup(&fx, mesh, &sc))
         return;
-    const pd_body *b = pd_sim_model_body(fx.model);
+    const pd_body *b = (fx.model)->body;
     for (int i = 0; i < 5; i++)
         out[i] = 0.0;
     for (int f = 0; f < fx.model->hull->nfacets; f++) {
-        const pd_flat_facet *F = &fx.model->flat[f];
+        const pd_flat_facet *F = &fx.model->settle.flat[f];
         if (!(F->inside > 0.0))
             continue;
         out[0] += F->h / L;
@@ -101,7 +101,7 @@ static void test_placement(void)
  * the vertical at spin, plus a rocking rate about a horizontal axis. */
 static pd_state lying_flat(const pd_sim_model *m, int f, pd_vec3 v, double spin, double rock)
 {
-    const pd_flat_facet *F = &m->flat[f];
+    const pd_flat_facet *F = &m->settle.flat[f];
     pd_quat q = quat_onto_down(F->n);
     pd_state st = {v3(0, 0, F->h), q, v, quat_rotate_inv(q, v3(rock, 0, spin))};
     return st;
@@ -121,27 +121,27 @@ static void test_rule(void)
         return;
     const pd_sim_model *m = fx.model;
     const pd_body *b = m->body;
-    double g = sc.gravity, rf = m->rest_fall;
+    double g = sc.gravity, rf = m->settle.rest_fall;
     double barrier = sqrt(0.0035 * 0.0035 + 0.005 * 0.005) - 0.005;
     double allowed = barrier / PD_FLAT_SAFETY - rf;
     /* Rocking rate whose energy per unit weight is e: I w^2 / 2 = m g e. */
     double I = b->moment[0];
     for (int f = 0; f < 6; f++) {
         pd_state fast = lying_flat(m, f, v3(2.0, -1.0, 0.0), 300.0, 0.0);
-        CHECK(pd_flat_settled(m->flat, b, &fast, f, g, 0.3, rf));
-        CHECK(!pd_flat_settled(m->flat, b, &fast, f, g, 1.0, rf)); /* mu h = inside */
+        CHECK(pd_flat_settled(m->settle.flat, b, &fast, f, g, 0.3, rf));
+        CHECK(!pd_flat_settled(m->settle.flat, b, &fast, f, g, 1.0, rf)); /* mu h = inside */
         double w_in = sqrt(2.0 * b->mass * g * 0.99 * allowed / I);
         double w_out = sqrt(2.0 * b->mass * g * 1.01 * allowed / I);
         pd_state in = lying_flat(m, f, v3(0.5, 0, 0), 0.0, w_in);
         pd_state out = lying_flat(m, f, v3(0.5, 0, 0), 0.0, w_out);
-        CHECK(pd_flat_settled(m->flat, b, &in, f, g, 0.3, rf));
-        CHECK(!pd_flat_settled(m->flat, b, &out, f, g, 0.3, rf));
+        CHECK(pd_flat_settled(m->settle.flat, b, &in, f, g, 0.3, rf));
+        CHECK(!pd_flat_settled(m->settle.flat, b, &out, f, g, 0.3, rf));
         /* Lifted by the same energy: the same verdicts. */
         in.w = out.w = v3(0, 0, 0);
         in.x.z += 0.99 * allowed;
         out.x.z += 1.01 * allowed;
-        CHECK(pd_flat_settled(m->flat, b, &in, f, g, 0.3, rf));
-        CHECK(!pd_flat_settled(m->flat, b, &out, f, g, 0.3, rf));
+        CHECK(pd_flat_settled(m->settle.flat, b, &in, f, g, 0.3, rf));
+        CHECK(!pd_flat_settled(m->settle.flat, b, &out, f, g, 0.3, rf));
     }
     drop_teardown(&fx);
 }
@@ -164,7 +164,7 @@ static void height_max_check(pd_mesh *mesh)
     const pd_sim_model *m = fx.model;
     const pd_body *b = m->body;
     int nf = m->hull->nfacets;
-    double zmax = pd_flat_height_max(m->flat, nf), g = sc.gravity;
+    double zmax = pd_flat_height_max(m->settle.flat, nf), g = sc.gravity;
     CHECK(isfinite(zmax) && zmax > 0.0);
     test_rng rng = {7};
     int passed = 0;
@@ -177,18 +177,18 @@ static void height_max_check(pd_mesh *mesh)
                       v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 0.5)),
                       v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.0, 50.0))};
         for (int f = 0; f < nf; f++)
-            passed += pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+            passed += pd_flat_settled(m->settle.flat, b, &s, f, g, 0.0, 0.0);
     }
     int tight = 0;
     for (int f = 0; f < nf; f++) {
-        const pd_flat_facet *F = &m->flat[f];
+        const pd_flat_facet *F = &m->settle.flat[f];
         if (!(F->inside > 0.0))
             continue;
         pd_state s = lying_flat(m, f, v3(0, 0, 0), 0.0, 0.0);
         s.x.z = zmax;
-        passed += pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+        passed += pd_flat_settled(m->settle.flat, b, &s, f, g, 0.0, 0.0);
         s.x.z = F->h + 0.98 * (zmax - F->h);
-        tight |= pd_flat_settled(m->flat, b, &s, f, g, 0.0, 0.0);
+        tight |= pd_flat_settled(m->settle.flat, b, &s, f, g, 0.0, 0.0);
     }
     CHECK_INT(passed, 0);
     CHECK(tight);
@@ -228,8 +228,8 @@ static void agree(const char *name, pd_mesh *mesh, long n, long min_earlier)
     for (long d = 0; d < n; d++)
         pd_drop_run(fx.model, fx.work, &sc, &o, d, NULL, &with[d], &gain, &fb);
     for (int f = 0; f < nf; f++) {
-        inside[f] = fx.model->flat[f].inside;
-        fx.model->flat[f].inside = 0.0;
+        inside[f] = fx.model->settle.flat[f].inside;
+        fx.model->settle.flat[f].inside = 0.0;
     }
     for (long d = 0; d < n; d++) {
         pd_trial t;
@@ -245,7 +245,7 @@ static void agree(const char *name, pd_mesh *mesh, long n, long min_earlier)
            "(%ld); collisions per drop %.1f with it, %.1f without\n",
            name, n, earlier, differ, (double)coll[0] / n, (double)coll[1] / n);
     for (int f = 0; f < nf; f++)
-        fx.model->flat[f].inside = inside[f];
+        fx.model->settle.flat[f].inside = inside[f];
     free(inside);
     free(with);
     drop_teardown(&fx);

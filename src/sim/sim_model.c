@@ -1,0 +1,158 @@
+/* sim_model.c: the model a run of drops is built on, a thread's work area,
+ * and every engine's release of a drop (see sim_model.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/fail.h"
+#include "base/quat.h"
+#include "base/rng.h"
+#include "base/vec3.h"
+#include "contact/contact_phase.h"
+#include "posedrop/tolerances.h"
+#include "sim/sim_model.h"
+
+void pd_sim_model_free(pd_sim_model *m)
+{
+    if (!m)
+        return;
+    pd_settle_free(&m->settle);
+    pd_body_free(m->body);
+    free(m);
+}
+
+pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
+                             const pd_scene *scene, const pd_sim_options *options,
+                             pd_sim_model **model, pd_diag *diag)
+{
+    pd_sim_model *m = calloc(1, sizeof *m);
+    if (!m)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
+    /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
+     * frame cut into 16 substeps. */
+    if (options->engine == PD_ENGINE_ODE) {
+        m->engine = &pd_engine_ode;
+        m->dt = options->dt > 0 ? options->dt : 1e-3;
+    } else if (options->engine == PD_ENGINE_BULLET) {
+        m->engine = &pd_engine_bullet;
+        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    }
+    m->hull = part->hull;
+    m->com = part->com;
+    m->poses = poses;
+    pd_status st = pd_body_build(part, &m->body, diag);
+    if (st == PD_OK)
+        st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
+    if (st != PD_OK) {
+        pd_sim_model_free(m);
+        return st;
+    }
+    /* A speed scale of the part: sqrt(g L), the speed of falling its own
+     * size. Approaches slower by PD_TOL_APPROACH_REL are round-off of a
+     * resolved contact, not a new impact. */
+    m->v_eps = PD_TOL_APPROACH_REL * sqrt(scene->gravity * m->body->size);
+    *model = m;
+    return PD_OK;
+}
+
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene)
+{
+    pd_drop_work *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    if (model->engine)
+        w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
+    else {
+        w->impact = pd_impact_work_alloc();
+        w->phase = pd_contact_phase_ode_alloc();
+        w->pivot = pd_contact_pivot_ode_alloc();
+    }
+    if ((!w->impact || !w->phase || !w->pivot) && !w->world) {
+        pd_impact_work_free(w->impact);
+        pd_ode_free(w->phase);
+        pd_ode_free(w->pivot);
+        free(w);
+        return NULL;
+    }
+    w->engine = model->engine;
+    return w;
+}
+
+void pd_drop_work_free(pd_drop_work *w)
+{
+    if (!w)
+        return;
+    pd_impact_work_free(w->impact);
+    pd_ode_free(w->phase);
+    pd_ode_free(w->pivot);
+    if (w->world)
+        w->engine->world_free(w->world);
+    free(w);
+}
+
+/* --- initial state ----------------------------------------------------------- */
+
+/* The rotation turning unit vector a onto unit vector b by the shortest arc. */
+static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
+{
+    pd_vec3 axis = v3_cross(a, b);
+    double s = v3_norm(axis), c = v3_dot(a, b);
+    if (s < PD_TOL_ANGLE) { /* parallel or opposite within round-off */
+        if (c > 0.0)
+            return quat_identity();
+        pd_vec3 any = fabs(a.x) < 0.9 ? v3(1, 0, 0) : v3(0, 1, 0);
+        return quat_axis_angle(v3_unit(v3_cross(a, any)), M_PI);
+    }
+    return quat_axis_angle(v3_scale(axis, 1.0 / s), atan2(s, c));
+}
+
+static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
+                          const double *init_cdf, pd_state *s, double q0[4])
+{
+    const pd_body *b = m->body;
+    pd_quat q;
+    if (init_cdf) {
+        /* The paper's belt: resting on a pose drawn from the estimate, turned
+         * at random about the vertical. */
+        double u = pd_rng_uniform(rng);
+        int k = 0;
+        while (k + 1 < m->poses->nposes && u >= init_cdf[k])
+            k++;
+        pd_vec3 n = quat_rotate_inv(b->frame, m->poses->poses[k].normal);
+        pd_quat down = quat_between(n, v3(0, 0, -1));
+        q = quat_mul(quat_axis_angle(v3(0, 0, 1), 2.0 * M_PI * pd_rng_uniform(rng)), down);
+    } else {
+        double r[4];
+        pd_rng_quaternion(rng, r);
+        q = quat(r[0], r[1], r[2], r[3]);
+    }
+    if (sc->vibration > 0.0) {
+        pd_vec3 axis = pd_rng_unit_vector(rng);
+        q = quat_mul(quat_axis_angle(axis, sc->vibration * pd_rng_uniform(rng)), q);
+    }
+    q = quat_normalize(q);
+    s->q = q;
+    s->x = v3(0, 0, 0);
+    s->v = v3(sc->belt_speed, 0, 0);
+    s->w = v3(0, 0, 0);
+    /* Lowest point at the drop height. */
+    int low = pd_body_support(b, quat_rotate_inv(q, v3(0, 0, 1)), 0);
+    s->x.z = sc->height - pd_body_vertex_world(b, s, low).z;
+    /* The orientation of the part's own (file) frame, for --trials. */
+    pd_quat qp = quat_mul(q, quat_conj(b->frame));
+    q0[0] = qp.w;
+    q0[1] = qp.x;
+    q0[2] = qp.y;
+    q0[3] = qp.z;
+}
+
+void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_options *o,
+                     long index, const double *init_cdf, pd_state *s, pd_trial *out)
+{
+    pd_rng rng;
+    pd_rng_init(&rng, o->seed, (uint64_t)index);
+    initial_state(m, sc, &rng, init_cdf, s, out->q0);
+    out->pose = -1;
+    out->collisions = 0;
+    out->end = PD_END_FAILED;
+    out->time = 0.0;
+}

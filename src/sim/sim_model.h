@@ -1,0 +1,62 @@
+/* sim_model.h (private): what a run of drops is built on, whatever the
+ * engine: the model, built once per run from the part and shared read-only
+ * by all threads, a thread's work area (so the drop loops never allocate),
+ * and the release that starts every engine's drop of the same index from the
+ * same state, so engines can be compared drop by drop. */
+#ifndef PD_SIM_MODEL_H
+#define PD_SIM_MODEL_H
+
+#include <stdint.h>
+#include "base/gsl_adapter.h"
+#include "base/rng.h"
+#include "dynamics/body.h"
+#include "engines/engine.h"
+#include "impact/impact.h"
+#include "posedrop/sim.h"
+#include "settle/settle.h"
+
+/* Contacts considered at once, and resolution rounds per impact. A face of
+ * more corners than PD_MAX_CONTACTS touching at once is resolved through the
+ * lowest PD_MAX_CONTACTS of them, which the rounds then correct. */
+enum { PD_MAX_CONTACTS = 64, PD_MAX_ROUNDS = 64 };
+
+typedef struct pd_sim_model {
+    pd_body *body;
+    const pd_hull *hull;        /* the part's hull, part frame */
+    pd_vec3 com;                /* part frame */
+    const pd_static_result *poses;
+    pd_settle settle;           /* when a drop is decided; resting contact */
+    const pd_engine *engine;    /* NULL: the impulse simulator */
+    double dt;                  /* the stepping engine's fixed step */
+    double v_eps;               /* approach speeds below this are contact, not impact */
+} pd_sim_model;
+
+typedef struct pd_drop_work {
+    pd_impact_work *impact;
+    pd_ode *phase;              /* the sliding phases' integrator */
+    pd_ode *pivot;              /* and the pivots' (contact_pivot.h) */
+    pd_engine_world *world;     /* the stepping engine's, or NULL */
+    const pd_engine *engine;
+    int contacts[PD_MAX_CONTACTS];
+} pd_drop_work;
+
+pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
+                             const pd_scene *scene, const pd_sim_options *options,
+                             pd_sim_model **model, pd_diag *diag);
+void pd_sim_model_free(pd_sim_model *model);
+
+pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene);
+void pd_drop_work_free(pd_drop_work *work);
+
+/* The release of drop `index`: its state (uniform or resting pose,
+ * vibration, belt velocity, lowest point at the drop height) drawn from the
+ * drop's own stream (options->seed, index), and its record reset (out->q0 the
+ * part frame's orientation, no pose yet). init_cdf (nposes cumulative
+ * probabilities) makes it start resting on a pose drawn from it, turned at
+ * random about the vertical (the paper's bootstrap); NULL starts from a
+ * uniform orientation. */
+void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
+                     const pd_sim_options *options, long index, const double *init_cdf,
+                     pd_state *s, pd_trial *out);
+
+#endif
