@@ -2,7 +2,7 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t IMPACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV]
 #
 # For each of the paper's four parts (parts/<name>.off, rebuilt from the
 # paper's photographs; parts/README.md), runs posedrop's QS and PQS and the
@@ -10,8 +10,8 @@
 # mu = restitution = 0.3, vibration 1.5 degrees, the belt's initial poses:
 # INITIAL is stationary by default, the long run of the estimated pose-to-pose
 # chain, or bootstrap, the paper's own running estimate, for comparison;
-# IMPACT_TIME, s, is the impulse engine's simultaneity window, 0 by default,
-# the rigid model: --impact-time),
+# CONTACT_TIME, s, is the impulse engine's simultaneity window, 0 by default,
+# the rigid model: --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
 # (default results/) and prints each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
@@ -24,14 +24,14 @@
 set -u
 n=2000
 initial=stationary
-impact_time=0
+contact_time=0
 outdir=results
 tables=""
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) n=$2; shift 2 ;;
         -i) initial=$2; shift 2 ;;
-        -t) impact_time=$2; shift 2 ;;
+        -t) contact_time=$2; shift 2 ;;
         -o) outdir=$2; shift 2 ;;
         -d) tables=$2; shift 2 ;;
         --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
@@ -55,7 +55,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
         start=$(date +%s.%N)
-        "$bin" --group -n "$n" --initial "$initial" --impact-time "$impact_time" \
+        "$bin" --group -n "$n" --initial "$initial" --contact-time "$contact_time" \
             --engine "$engine" "$file" \
             > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
         end=$(date +%s.%N)

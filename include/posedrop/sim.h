@@ -43,11 +43,12 @@ typedef struct pd_scene {
     double vibration;       /* rad: each initial pose turned by up to this about a random axis; 1.5 deg */
     pd_initial initial;     /* PD_INITIAL_UNIFORM */
     double gravity;         /* m/s^2; 9.81 */
-    double impact_time;     /* s: contacts that would reach the floor within this
-                               time of the first are struck with it, as one impact
-                               (its duration, a property of the materials); 0:
-                               rigid, only contacts within PD_TOL_CONTACT_REL of the
-                               size (the paper's model). Impulse simulator only */
+    double contact_time;    /* s: how long one contact takes to compress and
+                               restore, a property of the materials; 0: rigid,
+                               only contacts within PD_TOL_CONTACT_REL of the size
+                               at once (the paper's model). For now the impulse
+                               simulator strikes the contacts that would reach the
+                               floor within this time of the first as one impact */
 } pd_scene;
 
 void pd_scene_default(pd_scene *scene);
@@ -55,7 +56,7 @@ void pd_scene_default(pd_scene *scene);
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed (or v), mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
- * (uniform|bootstrap|stationary), gravity, impact_time (s). PD_ERR_USAGE for
+ * (uniform|bootstrap|stationary), gravity, contact_time (s). PD_ERR_USAGE for
  * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
  * of range; the scene is unchanged on failure. */
 pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);

@@ -69,10 +69,8 @@ static void usage(FILE *out)
         "  --restitution E    coefficient of restitution (0.3)\n"
         "  --restitution-law L  poisson (default) or energetic\n"
         "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
-        "  --impact-time S    contacts that would reach the floor within S seconds of\n"
-        "                     the first are struck with it as one impact (the impact's\n"
-        "                     duration, a material property; default 0: rigid, the\n"
-        "                     paper's model; impulse engine only)\n"
+        "  --contact-time S   how long one contact takes to compress and restore, s\n"
+        "                     (a material property; 0: rigid, the paper's model)\n"
         "  --initial I        uniform (default): orientations uniform at random;\n"
         "                     bootstrap: the paper's belt, drops resting on poses drawn\n"
         "                     from the running estimate, rounds of 100 after 20 uniform;\n"
@@ -85,7 +83,7 @@ static void usage(FILE *out)
         "                     Needs N >= 10 (k+1); does not go with --ci\n"
         "  --scene FILE       'key = value' lines: height, belt_speed, mu, restitution,\n"
         "                     restitution_law, vibration, initial, gravity,\n"
-        "                     impact_time; options given after it override it\n"
+        "                     contact_time; options given after it override it\n"
         "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
         "                     (pose 0: unsettled); with --group, pose is the class\n"
         "                     number of the output and a last column member the pose\n"
@@ -335,7 +333,7 @@ typedef struct {
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_IMPACT_TIME };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -382,7 +380,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"restitution", required_argument, 0, OPT_RESTITUTION},
         {"restitution-law", required_argument, 0, OPT_LAW},
         {"vibration", required_argument, 0, OPT_VIBRATION},
-        {"impact-time", required_argument, 0, OPT_IMPACT_TIME},
+        {"contact-time", required_argument, 0, OPT_CONTACT_TIME},
         {"initial", required_argument, 0, OPT_INITIAL},
         {"scene", required_argument, 0, OPT_SCENE},
         {"trials", required_argument, 0, OPT_TRIALS},
@@ -477,7 +475,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
         case OPT_RESTITUTION: code = scene_option(a, "--restitution", "restitution", optarg); break;
         case OPT_LAW: code = scene_option(a, "--restitution-law", "restitution_law", optarg); break;
         case OPT_VIBRATION: code = scene_option(a, "--vibration", "vibration", optarg); break;
-        case OPT_IMPACT_TIME: code = scene_option(a, "--impact-time", "impact_time", optarg); break;
+        case OPT_CONTACT_TIME: code = scene_option(a, "--contact-time", "contact_time", optarg); break;
         case OPT_INITIAL: code = scene_option(a, "--initial", "initial", optarg); break;
         case OPT_SCENE: {
             pd_diag d;

@@ -11,7 +11,7 @@
  * gives a flat landing (rebound e times the approach speed, no spurious
  * rotation), and uneven landings put the impulse nearer the faster contact,
  * as a sequence of Mirtich's microcollisions would, in one step. The scene's
- * impact_time widens "at once" to the contacts that would arrive within it
+ * contact_time widens "at once" to the contacts that would arrive within it
  * (flight_impact.c): a stand-in for the compliance that makes a nearly flat
  * landing strike its face as a whole.
  *
@@ -202,7 +202,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
             if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                      sc->impact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+                                      sc->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
             if (imp.kind == PD_IMPACT_NONE) {
                 t = o->time_limit;
@@ -223,7 +223,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
-                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->impact_time == 0.0;
+                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->contact_time == 0.0;
                 f_at = -1.0;
                 continue;
             }

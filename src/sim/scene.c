@@ -19,7 +19,7 @@ void pd_scene_default(pd_scene *s)
     s->vibration = 1.5 * M_PI / 180.0;
     s->initial = PD_INITIAL_UNIFORM;
     s->gravity = 9.81;
-    s->impact_time = 0.0;
+    s->contact_time = 0.0;
 }
 
 typedef struct {
@@ -43,7 +43,7 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
         {"restitution", &s->restitution, 0.0, 1.0, 1.0, "a restitution from 0 to 1"},
         {"vibration", &s->vibration, 0.0, 180.0, M_PI / 180.0, "an angle in degrees, 0 to 180"},
         {"gravity", &s->gravity, 1e-3, 1e3, 1.0, "an acceleration in m/s^2, 0.001 to 1000"},
-        {"impact_time", &s->impact_time, 0.0, 1.0, 1.0, "a duration in s, 0 to 1"},
+        {"contact_time", &s->contact_time, 0.0, 1.0, 1.0, "a duration in s, 0 to 1"},
     };
     for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
         if (strcmp(key, keys[i].key) != 0)
@@ -80,7 +80,7 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
     }
     return pd_fail(diag, PD_ERR_USAGE,
                    "unknown scene setting '%s' (height, belt_speed, mu, restitution, "
-                   "restitution_law, vibration, initial, gravity, impact_time)", key);
+                   "restitution_law, vibration, initial, gravity, contact_time)", key);
 }
 
 /* Trims blanks at both ends in place. */

@@ -158,8 +158,8 @@ static void test_usage(void)
     expect_failure("--restitution 2 -n 10 parts/cap.off", 2, "--restitution");
     expect_failure("--restitution-law newton -n 10 parts/cap.off", 2, "--restitution-law");
     expect_failure("--initial sorted -n 10 parts/cap.off", 2, "--initial");
-    expect_failure("--impact-time -1e-4 -n 10 parts/cap.off", 2, "--impact-time");
-    expect_failure("--impact-time soon -n 10 parts/cap.off", 2, "--impact-time");
+    expect_failure("--contact-time -1e-4 -n 10 parts/cap.off", 2, "--contact-time");
+    expect_failure("--contact-time soon -n 10 parts/cap.off", 2, "--contact-time");
     expect_failure("--scene /nonexistent/scene -n 10 parts/cap.off", 2, "/nonexistent/scene");
     expect_failure("--trials /tmp/x.csv parts/cap.off", 2, "--trials");
     expect_failure("--facets -n 10 parts/cap.off", 2, "--facets");

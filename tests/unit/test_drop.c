@@ -157,7 +157,7 @@ static void test_limits(void)
 }
 
 /* A cube landing 1.5 deg off flat at the speed of a 0.12 m fall. Rigid
- * (impact_time 0), its first corner is struck alone and the impulse, far off
+ * (contact_time 0), its first corner is struck alone and the impulse, far off
  * the centre of mass, sets it spinning at ~1.4 v / a (here ~200 rad/s),
  * which turns it over; with a window spanning the face's arrival (0.27 mm
  * at 1.5 m/s: 0.2 ms) the four corners are struck as one, near the face's
@@ -174,13 +174,13 @@ static void test_impact_window(void)
     double spin[2];
     int ncs[2];
     for (int k = 0; k < 2; k++) {
-        sc.impact_time = k ? 3e-4 : 0.0;
+        sc.contact_time = k ? 3e-4 : 0.0;
         int contacts[64];
         pd_state s = {v3(0, 0, 0.01), q, v3(0, 0, -1.53), v3(0, 0, 0)};
         pd_flight f;
         pd_impact imp;
         CHECK_STATUS(pd_flight_plan(b, &s, sc.gravity, &f), PD_OK);
-        CHECK_STATUS(pd_flight_impact(b, &f, 1.0, sc.impact_time, contacts, 64, &imp), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &f, 1.0, sc.contact_time, contacts, 64, &imp), PD_OK);
         CHECK_STATUS(pd_flight_eval(&f, imp.t, &s), PD_OK);
         int impacts = 0;
         long gain = 0, fb = 0;

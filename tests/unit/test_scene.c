@@ -14,7 +14,7 @@ void suite_scene(void)
     CHECK(s.height == 0.12 && s.belt_speed == 0.05 && s.mu == 0.3 && s.restitution == 0.3);
     CHECK_NEAR(s.vibration, 1.5 * M_PI / 180, 1e-17, "1.5 degrees");
     CHECK(s.law == PD_RESTITUTION_POISSON && s.initial == PD_INITIAL_UNIFORM);
-    CHECK(s.impact_time == 0.0); /* rigid, as the paper's simulator */
+    CHECK(s.contact_time == 0.0); /* rigid, as the paper's simulator */
 
     pd_diag d;
     pd_diag_init(&d);
@@ -28,10 +28,10 @@ void suite_scene(void)
     CHECK(s.initial == PD_INITIAL_BOOTSTRAP);
     CHECK_STATUS(pd_scene_set(&s, "initial", "stationary", &d), PD_OK);
     CHECK(s.initial == PD_INITIAL_STATIONARY);
-    CHECK_STATUS(pd_scene_set(&s, "impact_time", "1e-4", &d), PD_OK);
-    CHECK(s.impact_time == 1e-4);
+    CHECK_STATUS(pd_scene_set(&s, "contact_time", "1e-4", &d), PD_OK);
+    CHECK(s.contact_time == 1e-4);
     pd_scene before = s;
-    CHECK_STATUS(pd_scene_set(&s, "impact_time", "-1e-4", &d), PD_ERR_RANGE);
+    CHECK_STATUS(pd_scene_set(&s, "contact_time", "-1e-4", &d), PD_ERR_RANGE);
     CHECK_STATUS(pd_scene_set(&s, "restitution", "1.5", &d), PD_ERR_RANGE);
     CHECK_STATUS(pd_scene_set(&s, "mu", "nan", &d), PD_ERR_PARSE);
     CHECK_STATUS(pd_scene_set(&s, "mu", "0.3x", &d), PD_ERR_PARSE);
