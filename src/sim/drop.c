@@ -37,7 +37,6 @@
 #include "dynamics/body.h"
 #include "contact/contact_phase.h"
 #include "base/fail.h"
-#include "settle/flat_rest.h"
 #include "settle/settle.h"
 #include "sim/drop.h"
 #include "sim/drop_step.h"
@@ -146,6 +145,19 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 
 /* --- the drop ----------------------------------------------------------------- */
 
+/* The slowest rate at which the contacts[0..nc) of s rise from the floor,
+ * m/s (negative when one approaches; HUGE_VAL for none). */
+static double touching_rise(const pd_body *b, const pd_state *s, const int *contacts, int nc)
+{
+    pd_vec3 ww = quat_rotate(s->q, s->w);
+    double rise = HUGE_VAL;
+    for (int i = 0; i < nc; i++) {
+        pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
+        rise = fmin(rise, s->v.z + v3_cross(ww, r).z);
+    }
+    return rise;
+}
+
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
@@ -172,12 +184,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * resolve, so both are skipped. */
     int resolved = 0;
     for (;;) {
-        int pose, facet, d = pd_settle_decided_at(&m->settle, &s, g, &hint, &pose, &facet);
-        if (d == 0 && facet >= 0 && m->settle.pose_of[facet] >= 0 &&
-            pd_flat_settled(m->settle.flat, m->body, &s, facet, g, sc->mu, m->settle.rest_fall)) {
-            d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
-            pose = m->settle.pose_of[facet];
-        }
+        int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
         if (d < 0)
             break;
         if (d > 0) {
@@ -248,12 +255,20 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             continue;
         }
         /* Touching but not approaching: separating, or resting. Nothing
-         * changed the motion, so s goes on along f. */
+         * changed the motion, so s goes on along f. When every touching
+         * contact leaves the floor faster than resting contact falls onto
+         * it, the step is only as long as lifting them clear of the contact
+         * tolerance takes: a full rest step would pass over whatever else
+         * lands meanwhile (a face's other corners after its first one
+         * rebounds), which then starts below the floor. */
         phase_ok = 1;
-        f_at += dt_rest;
+        double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
+        if (rise > m->settle.v_rest)
+            dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
+        f_at += dt;
         if (pd_flight_eval(&f, f_at, &s) != PD_OK)
             break;
-        t += dt_rest;
+        t += dt;
         if (t >= o->time_limit) {
             out->end = PD_END_TIME_LIMIT;
             break;
