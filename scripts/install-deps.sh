@@ -18,9 +18,14 @@ check_pc ccd libccd-dev
 check_pc bullet libbullet-dev
 check_pc qhull_r libqhull-dev
 command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
-# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart).
-for pkg in "$@"; do
-    dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
+# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart);
+# 'mpi' stands for OpenMPI's compiler wrappers and launcher (make MPI=1).
+for arg in "$@"; do
+    pkgs=$arg
+    [ "$arg" = mpi ] && pkgs="libopenmpi-dev openmpi-bin"
+    for pkg in $pkgs; do
+        dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
+    done
 done
 
 [ -z "$missing" ] && exit 0

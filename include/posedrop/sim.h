@@ -95,6 +95,12 @@ typedef struct pd_sim_options {
     volatile sig_atomic_t *cancel; /* may be NULL; set non-zero (e.g. from a SIGINT
                                handler) to stop early: the result is then marked
                                partial and holds the first n drops */
+    int nshards;            /* 0 or 1: the whole run. N > 1: only the drops of one
+                               shard of N (pd_shard_of), to be summed with the
+                               other shards' by pd_sim_result_add; not with
+                               ci_halfwidth or PD_INITIAL_BOOTSTRAP, whose later
+                               drops depend on earlier outcomes */
+    int shard;              /* 0 .. nshards - 1: which shard; 0 */
 } pd_sim_options;
 
 void pd_sim_options_default(pd_sim_options *options);
@@ -140,7 +146,20 @@ typedef struct pd_sim_result {
                                chain reaches without one settled drop started on it) */
     double stationary_shift; /* total variation between mu0 and pi */
     uint64_t seed;          /* the run's seed (options->seed) */
+    int nshards, shard;     /* as in the options: a shard's result holds its own
+                               drops only; trials[t] is the run's drop
+                               shard + t * nshards; p is count / n with Wilson
+                               intervals even for PD_INITIAL_STATIONARY, whose
+                               chain is estimated once the shards are summed */
 } pd_sim_result;
+
+/* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
+ * shard gets the same mix of drops (for PD_INITIAL_STATIONARY, of phases and
+ * starting poses), so shards take about as long as each other. */
+int pd_shard_of(long drop, int nshards);
+
+/* How many of a run's ndrops drops shard (0-based) of nshards runs. */
+long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
  * (same numbering as its poses). options and scene may be NULL (defaults).
@@ -169,6 +188,20 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_result,
                      pd_sim_result **result, pd_diag *diag);
 
 void pd_sim_result_free(pd_sim_result *result);
+
+/* Summing shards. pd_sim_result_new makes an empty result of nposes poses
+ * for the whole run that scene and options describe (its nshards ignored);
+ * pd_sim_result_add adds one shard's counts to it (drops, counts, unsettled,
+ * collisions and corrections, the stationary estimator's counts; partial if
+ * the shard was); pd_sim_result_finish then computes p and its intervals from
+ * the sums exactly as pd_sim_run does, so the shards 0..N-1 of a run summed
+ * give the unsharded run's result, byte for byte (trials aside: none are
+ * kept). PD_ERR_USAGE when a shard does not fit (pose count, initial
+ * distribution, seed), PD_ERR_NOMEM. */
+pd_status pd_sim_result_new(int nposes, const pd_scene *scene, const pd_sim_options *options,
+                            pd_sim_result **result, pd_diag *diag);
+pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *shard, pd_diag *diag);
+pd_status pd_sim_result_finish(pd_sim_result *result, pd_diag *diag);
 
 #ifdef __cplusplus
 }

@@ -7,7 +7,9 @@
  * count nor the scheduling can change a byte of the result. What depends on
  * earlier outcomes (the bootstrap's initial distribution, the --ci stopping
  * rule) is decided between batches, on tallies of whole batches only; the
- * stationary estimator's phases depend on nothing but the drop index. */
+ * stationary estimator's phases depend on nothing but the drop index. A
+ * shard runs every nshards-th drop of the run (pd_shard_of): its batches hold
+ * its own drops, each run under its index in the whole run. */
 #include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
@@ -44,6 +46,26 @@ void pd_sim_options_default(pd_sim_options *o)
     o->max_collisions = 100000;
     o->keep_trials = 0;
     o->cancel = NULL;
+    o->nshards = 0;
+    o->shard = 0;
+}
+
+int pd_shard_of(long drop, int nshards)
+{
+    return nshards > 1 ? (int)(drop % nshards) : 0;
+}
+
+long pd_shard_drops(long ndrops, int shard, int nshards)
+{
+    if (nshards <= 1)
+        return ndrops;
+    return ndrops > shard ? (ndrops - shard + nshards - 1) / nshards : 0;
+}
+
+/* The run's index of a shard's drop number local. */
+static long run_index(const pd_sim_result *r, long local)
+{
+    return r->nshards > 1 ? r->shard + local * r->nshards : local;
 }
 
 void pd_sim_result_free(pd_sim_result *r)
@@ -65,12 +87,13 @@ typedef struct batch {
     const pd_scene *scene;
     const pd_sim_options *opt;
     const double *init_cdf;
-    const double *pose_cdfs; /* not NULL: drop i starts resting on pose
-                               (i - pose_first) mod nposes, whose point-mass cdf
-                               is that row of pose_cdfs (instead of init_cdf) */
+    const double *pose_cdfs; /* not NULL: drop i >= pose_first starts resting on
+                               pose (i - pose_first) mod nposes, whose point-mass
+                               cdf is that row of pose_cdfs (instead of init_cdf) */
     long pose_first;
     int nposes;
-    long first, last;       /* drop indices [first, last) */
+    const pd_sim_result *r; /* its shard (run_index) */
+    long first, last;       /* the shard's drop numbers [first, last) */
     pd_trial *out;          /* out[i - first] */
     atomic_long next;
     atomic_long energy_gain;
@@ -93,10 +116,11 @@ static void *worker(void *arg)
         long i = atomic_fetch_add(&b->next, 1);
         if (i >= b->last || cancelled(b->opt))
             break;
+        long drop = run_index(b->r, i);
         const double *cdf = b->init_cdf;
-        if (b->pose_cdfs)
-            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((i - b->pose_first) % b->nposes);
-        pd_drop_run(b->model, w, b->scene, b->opt, i, cdf, &b->out[i - b->first], &gain,
+        if (b->pose_cdfs && drop >= b->pose_first)
+            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((drop - b->pose_first) % b->nposes);
+        pd_drop_run(b->model, w, b->scene, b->opt, drop, cdf, &b->out[i - b->first], &gain,
                     &fallbacks);
     }
     atomic_fetch_add(&b->energy_gain, gain);
@@ -148,7 +172,7 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->count[t[i].pose]++;
         if (!r->transitions)
             continue;
-        long phase2 = r->n + i - r->first_drops;
+        long phase2 = run_index(r, r->n + i) - r->first_drops;
         if (phase2 < 0)
             r->first_count[t[i].pose]++;
         else
@@ -259,7 +283,7 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     /* --ci starts from the drops that guarantee the half-width for every pose
      * at once in the worst case (p = 1/2, Bonferroni over the poses: the
      * corrected eq. 17), then adds batches while an interval is still wider. */
-    long want = o->ndrops;
+    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards);
     if (o->ci_halfwidth > 0) {
         long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
         want = bound > want ? bound : want;
@@ -280,8 +304,8 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
             estimate_cdf(r, cdf);
             init = cdf;
         }
-        batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .first = r->n,
-                   .last = r->n + size, .out = buf};
+        batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .r = r,
+                   .first = r->n, .last = r->n + size, .out = buf};
         memcpy(before, r->count, sizeof *before * (size_t)r->nposes);
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
@@ -316,12 +340,11 @@ static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *sce
         for (size_t j = 0; j < K; j++)
             point[i * K + j] = j >= i ? 1.0 : 0.0;
     int nthreads = thread_count(o);
-    while (st == PD_OK && r->n < o->ndrops && !r->partial) {
-        int resting = r->n >= r->first_drops;
-        long end = resting ? o->ndrops : r->first_drops;
-        long size = end - r->n > BATCH_MAX ? BATCH_MAX : end - r->n;
-        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = resting ? point : NULL,
-                   .pose_first = r->first_drops, .nposes = k, .first = r->n,
+    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards);
+    while (st == PD_OK && r->n < want && !r->partial) {
+        long size = want - r->n > BATCH_MAX ? BATCH_MAX : want - r->n;
+        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = point,
+                   .pose_first = r->first_drops, .nposes = k, .r = r, .first = r->n,
                    .last = r->n + size, .out = buf};
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
@@ -347,6 +370,21 @@ static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
     return PD_OK;
 }
 
+pd_status pd_sim_result_finish(pd_sim_result *r, pd_diag *diag)
+{
+    if (!r)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_finish: NULL argument");
+    for (int i = 0; i < r->nposes; i++) {
+        r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
+        pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
+    }
+    /* A shard's chain would be estimated from a fraction of its rows' drops;
+     * only the sum of the shards defines the run's. */
+    if (r->transitions && r->nshards <= 1)
+        return finish_stationary(r, diag);
+    return PD_OK;
+}
+
 /* The stationary estimator's split of the drops, refused when it cannot
  * give every pose its minimum or --ci asks for a stopping rule. */
 static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
@@ -361,6 +399,62 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
                        "stable poses: each pose needs %d drops started resting on it and the "
                        "uniform start as many, at least %ld drops in all", o->ndrops, k,
                        PD_STATIONARY_MIN_POSE_DROPS, need);
+    return PD_OK;
+}
+
+pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *o,
+                            pd_sim_result **result, pd_diag *diag)
+{
+    *result = NULL;
+    if (k < 1 || !scene || !o || o->ndrops < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: invalid arguments");
+    int stationary = scene->initial == PD_INITIAL_STATIONARY;
+    pd_sim_result *r = calloc(1, sizeof *r);
+    if (r) {
+        r->nposes = k;
+        r->count = calloc((size_t)k, sizeof *r->count);
+        r->p = calloc((size_t)k, sizeof *r->p);
+        r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
+        r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
+        r->seed = o->seed;
+        if (stationary) {
+            r->first_count = calloc((size_t)k, sizeof *r->first_count);
+            r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
+            r->pose_drops = o->ndrops / (k + 1);
+            r->first_drops = o->ndrops - k * r->pose_drops;
+        }
+    }
+    if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi ||
+        (stationary && (!r->first_count || !r->transitions))) {
+        pd_sim_result_free(r);
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the results");
+    }
+    *result = r;
+    return PD_OK;
+}
+
+pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag *diag)
+{
+    if (!sum || !s)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: NULL argument");
+    if (s->nposes != sum->nposes || !s->transitions != !sum->transitions || s->seed != sum->seed ||
+        s->first_drops != sum->first_drops || s->pose_drops != sum->pose_drops)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: the shard is not of this run "
+                       "(%d poses, seed %llu; the run: %d poses, seed %llu)", s->nposes,
+                       (unsigned long long)s->seed, sum->nposes, (unsigned long long)sum->seed);
+    size_t k = (size_t)sum->nposes;
+    sum->n += s->n;
+    sum->unsettled += s->unsettled;
+    sum->energy_gain += s->energy_gain;
+    sum->fallbacks += s->fallbacks;
+    sum->collisions += s->collisions;
+    sum->partial |= s->partial;
+    for (size_t i = 0; i < k; i++)
+        sum->count[i] += s->count[i];
+    for (size_t i = 0; sum->transitions && i < k; i++)
+        sum->first_count[i] += s->first_count[i];
+    for (size_t i = 0; sum->transitions && i < k * k; i++)
+        sum->transitions[i] += s->transitions[i];
     return PD_OK;
 }
 
@@ -385,6 +479,12 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
     if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
+    if (o.nshards < 0 || (o.nshards > 1 && (o.shard < 0 || o.shard >= o.nshards)))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: shard %d of %d", o.shard + 1, o.nshards);
+    if (o.nshards > 1 && (o.ci_halfwidth > 0 || sc.initial == PD_INITIAL_BOOTSTRAP))
+        return pd_fail(diag, PD_ERR_USAGE, "a run split into shards needs a fixed number of "
+                       "drops, each independent of the others' outcomes: not a confidence "
+                       "half-width, nor the bootstrap start, which draws from the outcomes so far");
     int stationary = sc.initial == PD_INITIAL_STATIONARY;
     if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
         return PD_ERR_USAGE;
@@ -392,39 +492,19 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     pd_status st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
     if (st != PD_OK)
         return st;
-    pd_sim_result *r = calloc(1, sizeof *r);
-    int k = poses->nposes;
-    if (r) {
-        r->nposes = k;
-        r->count = calloc((size_t)k, sizeof *r->count);
-        r->p = calloc((size_t)k, sizeof *r->p);
-        r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
-        r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
-        r->seed = o.seed;
-        if (stationary) {
-            r->first_count = calloc((size_t)k, sizeof *r->first_count);
-            r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
-            r->pose_drops = o.ndrops / (k + 1);
-            r->first_drops = o.ndrops - k * r->pose_drops;
-        }
+    pd_sim_result *r = NULL;
+    st = pd_sim_result_new(poses->nposes, &sc, &o, &r, diag);
+    if (st == PD_OK) {
+        r->nshards = o.nshards > 1 ? o.nshards : 0;
+        r->shard = r->nshards ? o.shard : 0;
+        st = stationary ? drive_stationary(model, &sc, &o, r, diag) : drive(model, &sc, &o, r, diag);
     }
-    if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi ||
-        (stationary && (!r->first_count || !r->transitions)))
-        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the results");
-    else if (stationary)
-        st = drive_stationary(model, &sc, &o, r, diag);
-    else
-        st = drive(model, &sc, &o, r, diag);
     pd_sim_model_free(model);
     if (st != PD_OK) {
         pd_sim_result_free(r);
         return st;
     }
-    for (int i = 0; i < k; i++) {
-        r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
-        pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
-    }
-    if (stationary && (st = finish_stationary(r, diag)) != PD_OK) {
+    if ((st = pd_sim_result_finish(r, diag)) != PD_OK) {
         pd_sim_result_free(r);
         return st;
     }
