@@ -62,6 +62,13 @@ LIB_CXX_SRCS := $(wildcard src/*/*.cpp)
 LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 LIB        := $(BUILD)/libposedrop.a
 CLI        := $(BUILD)/posedrop
+# The command is every file of src/cli/; posedrop-mpi (MPI=1) swaps run.c,
+# which runs the drops in one process, for run_mpi.c.
+CLI_SRCS   := $(filter-out src/cli/run_mpi.c,$(wildcard src/cli/*.c))
+CLI_OBJS   := $(CLI_SRCS:%.c=$(BUILD)/%.o)
+CLI_MPI    := $(BUILD)/posedrop-mpi
+CLI_MPI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/mpi/%.o,$(filter-out src/cli/run.c,$(wildcard src/cli/*.c)))
+MPICC      ?= mpicc
 TEST_SRCS  := $(wildcard tests/unit/*.c tests/support/*.c)
 TEST_OBJS  := $(TEST_SRCS:%.c=$(BUILD)/%.o)
 TEST_BIN   := $(BUILD)/test_posedrop
@@ -73,7 +80,7 @@ DEMO_PART  := parts/cap.off
 .PHONY: all check test bench demo paper install uninstall clean help deps golden lint
 .DEFAULT_GOAL := all
 
-all: $(LIB) $(CLI)
+all: $(LIB) $(CLI) $(if $(filter 1,$(MPI)),$(CLI_MPI))
 
 # Objects depend on this Makefile too: a change of flags (the optimisation
 # level, warnings) rebuilds them rather than linking old objects with new.
@@ -99,8 +106,17 @@ $(LIB): $(LIB_OBJS)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-$(CLI): $(BUILD)/src/cli/cli.o $(LIB)
+$(CLI): $(CLI_OBJS) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
+
+# OpenMPI's wrappers give its include and library flags (mpicc --showme);
+# the objects are the command's, compiled again with mpi.h at hand.
+$(BUILD)/mpi/%.o: src/cli/%.c Makefile
+	@mkdir -p $(dir $@)
+	OMPI_CC=$(CC) $(MPICC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
+
+$(CLI_MPI): $(CLI_MPI_OBJS) $(LIB)
+	OMPI_CC=$(CXX) $(MPICC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) -lstdc++
 
 $(TEST_BIN): $(TEST_OBJS) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
@@ -173,4 +189,4 @@ help:
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d
+-include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(CLI_OBJS:.o=.d) $(CLI_MPI_OBJS:.o=.d)

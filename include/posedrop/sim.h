@@ -95,12 +95,17 @@ typedef struct pd_sim_options {
     volatile sig_atomic_t *cancel; /* may be NULL; set non-zero (e.g. from a SIGINT
                                handler) to stop early: the result is then marked
                                partial and holds the first n drops */
-    int nshards;            /* 0 or 1: the whole run. N > 1: only the drops of one
+    int nshards;            /* 0: the whole run. N >= 1: only the drops of one
                                shard of N (pd_shard_of), to be summed with the
                                other shards' by pd_sim_result_add; not with
                                ci_halfwidth or PD_INITIAL_BOOTSTRAP, whose later
                                drops depend on earlier outcomes */
     int shard;              /* 0 .. nshards - 1: which shard; 0 */
+    void (*progress)(void *user, long done, long total); /* may be NULL: called
+                               from the calling thread after each of its drops
+                               with the drops done so far (of the shard) and
+                               those planned; must return quickly */
+    void *progress_user;
 } pd_sim_options;
 
 void pd_sim_options_default(pd_sim_options *options);

@@ -2,25 +2,25 @@
  *
  * It only parses arguments, calls the library and prints: the results as CSV
  * on stdout, diagnostics on stderr. Exit codes: 0 success, 2 bad usage or
- * input (nothing is printed on stdout), 1 internal failure, 130 interrupted
- * (what was done is printed, marked partial). */
+ * input (nothing is printed on stdout), 1 internal failure, 130 or 143
+ * interrupted by SIGINT or SIGTERM (what was done is printed, marked
+ * partial). */
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include "posedrop/posedrop.h"
+#include <time.h>
+#include "cli/cli.h"
 
-enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
-
-static const char *prog = "posedrop";
+const char *prog = "posedrop";
 
 static void usage(FILE *out)
 {
     fprintf(out,
         "usage: %s [options] PART\n"
+        "       %s merge [--format csv|json] [--transitions FILE] [--verbose] SHARD...\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
         "flat surface and prints one CSV row per stable pose:\n"
@@ -39,7 +39,8 @@ static void usage(FILE *out)
         "\n"
         "part:\n"
         "  --units U          unit of the file's coordinates: m (default), cm, mm, in\n"
-        "  --format F         off, stl or obj (default: detect from content and name)\n"
+        "  --format F         off, stl or obj: the part's (default: detect from content\n"
+        "                     and name); csv (default) or json: the output's\n"
         "  --com X,Y,Z        centre of mass in the file's units (default: computed\n"
         "                     from the mesh, uniform density); required for meshes\n"
         "                     that are not closed\n"
@@ -53,7 +54,7 @@ static void usage(FILE *out)
         "                     probability is lower; qs: compare propagated QS values\n"
         "  --pqs-band B       rect (default): the paper's |a| x epsilon band clipped\n"
         "                     to its triangle; exact: exact spherical band area\n"
-        "dynamic estimator (simulated drops):\n", prog);
+        "dynamic estimator (simulated drops):\n", prog, prog);
     /* Two strings: C11 compilers need only take 4095 characters in one. */
     fprintf(out,
         "  -n N               drops to simulate (default: none)\n"
@@ -63,6 +64,10 @@ static void usage(FILE *out)
         "  --ci DELTA         drop until every pose's 95%% interval is within DELTA\n"
         "  --seed S           random seed (default 1); same seed, same bytes\n"
         "  -j THREADS         threads (default: all cores); never changes results\n"
+        "  --shard K/N        run only shard K of N: the drops i (from 0) with\n"
+        "                     i mod N = K - 1; prints their counts after a '#' line\n"
+        "                     naming the run, for 'posedrop merge' to sum into the\n"
+        "                     unsharded run's output, byte for byte (docs/batch.md)\n"
         "  -h H               drop height in m: lowest point above the floor (0.12)\n"
         "  -v V               horizontal belt velocity in m/s (0.05)\n"
         "  --mu MU            friction coefficient (0.3)\n"
@@ -108,7 +113,8 @@ static void usage(FILE *out)
         "  --version          version\n"
         "\n"
         "exit status: 0 success, 2 bad usage or input, 1 internal failure,\n"
-        "130 interrupted (the rows printed are marked partial)\n");
+        "130 (SIGINT) or 143 (SIGTERM): interrupted, the drops in flight finished\n"
+        "and the rows printed marked partial\n");
 }
 
 static int fail_usage(const char *fmt, const char *arg)
@@ -174,23 +180,33 @@ static void print_warning(void *user, const char *message)
 
 /* Axis-aligned normals come out with round-off components like 1e-17; print
  * them as 0 (and never as -0) so the CSV is stable and readable. */
-static double clean(double x)
+double cli_clean(double x)
 {
     return fabs(x) < PD_PRINT_ZERO ? 0.0 : x;
 }
 
+/* A stationary shard adds the counts its merge needs to estimate the chain:
+ * first (uniform drops settled in the row's pose) and to_J (drops started
+ * resting on the row's pose that settled in pose J). */
 static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
 {
-    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s\n",
-           sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    int chain = sim && sim->nshards > 0 && sim->transitions;
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s%s", sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "",
+           chain ? ",first" : "");
+    for (int j = 0; chain && j < res->nposes; j++)
+        printf(",to_%d", j + 1);
+    printf("\n");
     for (int i = 0; i < res->nposes; i++) {
         const pd_pose *p = &res->poses[i];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", i + 1, clean(p->normal.x),
-               clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(p->p_qs),
-               clean(p->p_pqs));
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", i + 1, cli_clean(p->normal.x),
+               cli_clean(p->normal.y), cli_clean(p->normal.z), p->area, p->height,
+               cli_clean(p->p_qs), cli_clean(p->p_pqs));
         if (sim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", sim->n, sim->count[i], sim->p[i],
                    sim->ci_lo[i], sim->ci_hi[i], sim->unsettled, sim->partial);
+        for (int j = -1; chain && j < res->nposes; j++)
+            printf(",%ld", j < 0 ? sim->first_count[i]
+                                 : sim->transitions[(size_t)i * (size_t)res->nposes + (size_t)j]);
         printf("\n");
     }
 }
@@ -214,8 +230,9 @@ static void print_classes(const pd_static_result *res, const pd_sim_result *gsim
                 pqs += res->poses[i].p_pqs;
             }
         const pd_pose *p = &res->poses[first];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", c + 1, clean(p->normal.x),
-               clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(qs), clean(pqs));
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", c + 1, cli_clean(p->normal.x),
+               cli_clean(p->normal.y), cli_clean(p->normal.z), p->area, p->height, cli_clean(qs),
+               cli_clean(pqs));
         if (gsim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", gsim->n, gsim->count[c], gsim->p[c],
                    gsim->ci_lo[c], gsim->ci_hi[c], gsim->unsettled, gsim->partial);
@@ -240,8 +257,8 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     for (int f = 0; f < res->nfacets; f++) {
         const pd_facet_result *r = &res->facets[f];
         pd_vec3 n = part->hull->normal[f];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%d,%d,%d\n", f + 1, clean(n.x),
-               clean(n.y), clean(n.z), r->area, r->height, r->p_raw, r->stable, r->knife,
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%d,%d,%d\n", f + 1, cli_clean(n.x),
+               cli_clean(n.y), cli_clean(n.z), r->area, r->height, r->p_raw, r->stable, r->knife,
                r->next + 1, r->rest + 1, pose_of ? pose_of[r->rest] : 0);
     }
     free(pose_of);
@@ -289,7 +306,8 @@ static int write_trials(const char *path, const pd_sim_result *sim, const int *c
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
-        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", i + 1, t->q0[0], t->q0[1],
+        long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", drop + 1, t->q0[0], t->q0[1],
                 t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
@@ -320,20 +338,10 @@ static int write_transitions(const char *path, const pd_sim_result *sim)
     return close_output(f, path);
 }
 
-typedef struct {
-    const char *path, *trials, *transitions, *com_text;
-    pd_mesh_read_options read;
-    pd_part_options part;
-    pd_static_options estimate;
-    pd_scene scene;
-    pd_sim_options sim;
-    int dynamic, facets, group, verbose;
-} cli_args;
-
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME, OPT_SHARD };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -392,14 +400,17 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"verbose", no_argument, 0, OPT_VERBOSE},
         {"help", no_argument, 0, OPT_HELP},
         {"version", no_argument, 0, OPT_VERSION},
+        {"shard", required_argument, 0, OPT_SHARD},
         {0, 0, 0, 0},
     };
-    static const char *const formats[] = {"off", "stl", "obj"};
+    static const char *const formats[] = {"off", "stl", "obj", "csv", "json"};
     static const char *const topples[] = {"descent", "edge"};
     static const char *const compares[] = {"raw", "qs"};
     static const char *const bands[] = {"rect", "exact"};
     static const char *const engines[] = {"impulse", "ode", "bullet"};
     memset(a, 0, sizeof *a);
+    a->argc = argc;
+    a->argv = argv;
     pd_mesh_read_options_default(&a->read);
     pd_part_options_default(&a->part);
     pd_static_options_default(&a->estimate);
@@ -416,9 +427,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
                 return fail_usage("--units: expected m, cm, mm or in, got '%s'", optarg);
             break;
         case OPT_FORMAT:
-            if (!choose("--format", optarg, formats, 3, &k))
+            if (!choose("--format", optarg, formats, 5, &k))
                 return EXIT_USAGE;
-            a->read.format = (pd_mesh_format)(PD_FORMAT_OFF + k);
+            if (k < 3)
+                a->read.format = (pd_mesh_format)(PD_FORMAT_OFF + k);
+            else
+                a->json = k == 4;
             break;
         case OPT_COM:
             if (!parse_vec3(optarg, &a->part.com))
@@ -508,6 +522,10 @@ static int parse_args(int argc, char **argv, cli_args *a)
         case OPT_FACETS:
             a->facets = 1;
             break;
+        case OPT_SHARD:
+            if (!shard_parse(optarg, &a->sim))
+                return fail_usage("--shard: expected K/N with 1 <= K <= N <= 100000, got '%s'", optarg);
+            break;
         case OPT_GROUP:
             a->group = 1;
             break;
@@ -542,6 +560,14 @@ static int parse_args(int argc, char **argv, cli_args *a)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
         return fail_usage("%s", "--facets lists hull facets; it does not go with --group");
+    if (a->facets && a->json)
+        return fail_usage("%s", "--format json lists poses; it does not go with --facets");
+    if (a->sim.nshards && (!a->dynamic || a->sim.ci_halfwidth > 0 || a->json || a->transitions ||
+                           a->scene.initial == PD_INITIAL_BOOTSTRAP))
+        return fail_usage("%s", "--shard splits the -n drops of a run: it needs -n, and does not go "
+                          "with --ci or --initial bootstrap (later drops depend on earlier "
+                          "outcomes), nor with --format json or --transitions (give those to "
+                          "'posedrop merge')");
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);
@@ -629,7 +655,7 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
                         "variation) from the distribution it started from%s\n", prog, a->path,
                 sim->bootstrap_rounds, sim->stationarity,
                 sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
-    if (sim->transitions)
+    if (sim->transitions && sim->nshards == 0)
         print_stationary_summary(a, sim);
     if (a->verbose && sim->n)
         fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
@@ -638,21 +664,17 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
-static volatile sig_atomic_t interrupted;
-
-static void on_sigint(int sig)
+static double seconds_since(const struct timespec *t0)
 {
-    (void)sig;
-    interrupted = 1;
+    struct timespec t;
+    clock_gettime(CLOCK_MONOTONIC, &t);
+    return (double)(t.tv_sec - t0->tv_sec) + 1e-9 * (double)(t.tv_nsec - t0->tv_nsec);
 }
 
-int main(int argc, char **argv)
+int cli_run(cli_args *a)
 {
-    cli_args a;
-    int code = parse_args(argc, argv, &a);
-    if (code >= 0)
-        return code;
-
+    struct timespec t0;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
     pd_diag diag;
     pd_diag_init(&diag);
     diag.warn = print_warning;
@@ -661,52 +683,57 @@ int main(int argc, char **argv)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
-    int *class_of = NULL, nclasses = 0;
-    pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
+    int *class_of = NULL, nclasses = 0, code;
+    pd_status st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
     }
-    st = pd_part_build(mesh, &a.part, &part, &diag);
+    st = pd_part_build(mesh, &a->part, &part, &diag);
     if (st == PD_OK)
-        st = pd_static_estimate(part, &a.estimate, &res, &diag);
-    if (st == PD_OK && a.dynamic) {
-        struct sigaction sa;
-        memset(&sa, 0, sizeof sa);
-        sa.sa_handler = on_sigint;
-        sigaction(SIGINT, &sa, NULL);
-        a.sim.cancel = &interrupted;
-        st = pd_sim_run(part, res, &a.scene, &a.sim, &sim, &diag);
+        st = pd_static_estimate(part, &a->estimate, &res, &diag);
+    if (st == PD_OK && a->dynamic)
+        st = cli_simulate(part, res, a, &sim, &diag);
+    if (!cli_writer()) {
+        code = st == PD_OK ? 0 : EXIT_INTERNAL;
+        goto done;
     }
-    if (st == PD_OK && a.group) {
+    /* A shard prints its poses' own counts; its merge groups them. */
+    if (st == PD_OK && a->group && !a->sim.nshards) {
         class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
         st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     }
     if (st != PD_OK) {
-        code = fail_status(st, &diag, a.path);
+        code = fail_status(st, &diag, a->path);
         goto done;
     }
-    if (a.verbose)
-        print_summary(&a, part, res);
+    if (a->verbose)
+        print_summary(a, part, res);
     if (sim)
-        print_sim_summary(&a, sim);
-    if (a.facets)
-        print_facets(part, res);
-    else if (a.group)
-        print_classes(res, gsim, class_of, nclasses);
-    else
-        print_poses(res, sim);
-    code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
-    if (code)
-        fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
-    if (sim && a.trials && !write_trials(a.trials, sim, class_of))
+        print_sim_summary(a, sim);
+    code = 0;
+    if (a->sim.nshards && !shard_write_identity(stdout, a, sim))
         code = EXIT_INTERNAL;
-    if (sim && a.transitions && !write_transitions(a.transitions, gsim ? gsim : sim))
+    if (code == 0 && a->json)
+        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses, seconds_since(&t0));
+    else if (a->facets)
+        print_facets(part, res);
+    else if (class_of)
+        print_classes(res, gsim, class_of, nclasses);
+    else if (code == 0)
+        print_poses(res, sim);
+    if (code == 0 && (fflush(stdout) != 0 || ferror(stdout))) {
+        fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
+        code = EXIT_INTERNAL;
+    }
+    if (sim && a->trials && !write_trials(a->trials, sim, class_of))
+        code = EXIT_INTERNAL;
+    if (sim && a->transitions && !write_transitions(a->transitions, gsim ? gsim : sim))
         code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
-        code = EXIT_INTERRUPTED;
+        code = cli_interrupt_code();
 done:
     free(class_of);
     pd_sim_result_free(gsim);
@@ -715,4 +742,14 @@ done:
     pd_part_free(part);
     pd_mesh_free(mesh);
     return code;
+}
+
+int main(int argc, char **argv)
+{
+    cli_start(&argc, &argv);
+    if (argc > 1 && strcmp(argv[1], "merge") == 0)
+        return cli_end(cli_merge(argc - 1, argv + 1));
+    cli_args a;
+    int code = parse_args(argc, argv, &a);
+    return cli_end(code >= 0 ? code : cli_run(&a));
 }

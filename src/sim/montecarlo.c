@@ -48,16 +48,18 @@ void pd_sim_options_default(pd_sim_options *o)
     o->cancel = NULL;
     o->nshards = 0;
     o->shard = 0;
+    o->progress = NULL;
+    o->progress_user = NULL;
 }
 
 int pd_shard_of(long drop, int nshards)
 {
-    return nshards > 1 ? (int)(drop % nshards) : 0;
+    return nshards > 0 ? (int)(drop % nshards) : 0;
 }
 
 long pd_shard_drops(long ndrops, int shard, int nshards)
 {
-    if (nshards <= 1)
+    if (nshards <= 0)
         return ndrops;
     return ndrops > shard ? (ndrops - shard + nshards - 1) / nshards : 0;
 }
@@ -65,7 +67,7 @@ long pd_shard_drops(long ndrops, int shard, int nshards)
 /* The run's index of a shard's drop number local. */
 static long run_index(const pd_sim_result *r, long local)
 {
-    return r->nshards > 1 ? r->shard + local * r->nshards : local;
+    return r->nshards > 0 ? r->shard + local * r->nshards : local;
 }
 
 void pd_sim_result_free(pd_sim_result *r)
@@ -95,7 +97,10 @@ typedef struct batch {
     const pd_sim_result *r; /* its shard (run_index) */
     long first, last;       /* the shard's drop numbers [first, last) */
     pd_trial *out;          /* out[i - first] */
+    long planned;           /* drops the run plans, for progress reports */
+    pthread_t caller;       /* the thread that reports progress */
     atomic_long next;
+    atomic_long done;
     atomic_long energy_gain;
     atomic_long fallbacks;
     atomic_int failed;      /* a thread could not get its work area */
@@ -122,6 +127,9 @@ static void *worker(void *arg)
             cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((drop - b->pose_first) % b->nposes);
         pd_drop_run(b->model, w, b->scene, b->opt, drop, cdf, &b->out[i - b->first], &gain,
                     &fallbacks);
+        long done = atomic_fetch_add(&b->done, 1) + 1;
+        if (b->opt->progress && pthread_equal(pthread_self(), b->caller))
+            b->opt->progress(b->opt->progress_user, b->r->n + done, b->planned);
     }
     atomic_fetch_add(&b->energy_gain, gain);
     atomic_fetch_add(&b->fallbacks, fallbacks);
@@ -135,6 +143,8 @@ static void *worker(void *arg)
 static long run_batch(batch *b, int nthreads, pd_sim_result *r)
 {
     atomic_store(&b->next, b->first);
+    atomic_store(&b->done, 0);
+    b->caller = pthread_self();
     atomic_store(&b->energy_gain, 0);
     atomic_store(&b->fallbacks, 0);
     atomic_store(&b->failed, 0);
@@ -305,7 +315,7 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
             init = cdf;
         }
         batch b = {.model = model, .scene = scene, .opt = o, .init_cdf = init, .r = r,
-                   .first = r->n, .last = r->n + size, .out = buf};
+                   .first = r->n, .last = r->n + size, .out = buf, .planned = want};
         memcpy(before, r->count, sizeof *before * (size_t)r->nposes);
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
@@ -345,7 +355,7 @@ static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *sce
         long size = want - r->n > BATCH_MAX ? BATCH_MAX : want - r->n;
         batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = point,
                    .pose_first = r->first_drops, .nposes = k, .r = r, .first = r->n,
-                   .last = r->n + size, .out = buf};
+                   .last = r->n + size, .out = buf, .planned = want};
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
     }
@@ -380,7 +390,7 @@ pd_status pd_sim_result_finish(pd_sim_result *r, pd_diag *diag)
     }
     /* A shard's chain would be estimated from a fraction of its rows' drops;
      * only the sum of the shards defines the run's. */
-    if (r->transitions && r->nshards <= 1)
+    if (r->transitions && r->nshards == 0)
         return finish_stationary(r, diag);
     return PD_OK;
 }
@@ -479,9 +489,9 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
     if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
-    if (o.nshards < 0 || (o.nshards > 1 && (o.shard < 0 || o.shard >= o.nshards)))
+    if (o.nshards < 0 || (o.nshards > 0 && (o.shard < 0 || o.shard >= o.nshards)))
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: shard %d of %d", o.shard + 1, o.nshards);
-    if (o.nshards > 1 && (o.ci_halfwidth > 0 || sc.initial == PD_INITIAL_BOOTSTRAP))
+    if (o.nshards > 0 && (o.ci_halfwidth > 0 || sc.initial == PD_INITIAL_BOOTSTRAP))
         return pd_fail(diag, PD_ERR_USAGE, "a run split into shards needs a fixed number of "
                        "drops, each independent of the others' outcomes: not a confidence "
                        "half-width, nor the bootstrap start, which draws from the outcomes so far");
@@ -495,8 +505,8 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     pd_sim_result *r = NULL;
     st = pd_sim_result_new(poses->nposes, &sc, &o, &r, diag);
     if (st == PD_OK) {
-        r->nshards = o.nshards > 1 ? o.nshards : 0;
-        r->shard = r->nshards ? o.shard : 0;
+        r->nshards = o.nshards;
+        r->shard = o.nshards ? o.shard : 0;
         st = stationary ? drive_stationary(model, &sc, &o, r, diag) : drive(model, &sc, &o, r, diag);
     }
     pd_sim_model_free(model);

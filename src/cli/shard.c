@@ -1,0 +1,654 @@
+/* shard.c: --shard K/N and posedrop merge.
+ *
+ * A shard prints two leading '#' lines before its CSV: the run's identity
+ *   # posedrop VERSION shard=K/N part=PATH sha256=HEX units=... group=0|1
+ * (every setting that changes a result, numbers as %.17g so they read back
+ * to the same double), then its totals that no column holds
+ *   # totals collisions=C energy_gain=G fallbacks=F
+ * and the per-pose CSV with, for --initial stationary, the chain's counts
+ * (first, to_1 .. to_k). merge checks that the shards are the N shards of
+ * one run, reads the part again (its SHA-256 must not have changed), sums
+ * the counts and prints through cli_run what the unsharded run prints. */
+#include <errno.h>
+#include <getopt.h>
+#include <inttypes.h>
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+#include "cli/cli.h"
+
+/* One more than the shard count a run can name (its K and N are ints). */
+#define SHARDS_MAX 100000L
+
+int shard_parse(const char *text, pd_sim_options *sim)
+{
+    char *end;
+    errno = 0;
+    long k = strtol(text, &end, 10);
+    if (end == text || *end != '/' || errno)
+        return 0;
+    const char *rest = end + 1;
+    long n = strtol(rest, &end, 10);
+    if (end == rest || *end != '\0' || errno || n < 1 || n > SHARDS_MAX || k < 1 || k > n)
+        return 0;
+    sim->nshards = (int)n;
+    sim->shard = (int)(k - 1);
+    return 1;
+}
+
+/* Names of the enumerations, in enum order. */
+static const char *const units_names[] = {"m", "cm", "mm", "in", NULL};
+static const char *const format_names[] = {"auto", "off", "stl", "obj", NULL};
+static const char *const topple_names[] = {"descent", "edge", NULL};
+static const char *const compare_names[] = {"raw", "qs", NULL};
+static const char *const band_names[] = {"rect", "exact", NULL};
+static const char *const engine_names[] = {"impulse", "ode", "bullet", NULL};
+static const char *const law_names[] = {"poisson", "energetic", NULL};
+static const char *const initial_names[] = {"uniform", "bootstrap", "stationary", NULL};
+
+/* The identity as key=value words, in a fixed order: write_identity prints
+ * it, and merge rebuilds the options from it and prints it again to prove
+ * that nothing was lost on the way. */
+typedef struct {
+    char text[4096];
+    size_t len;
+} words;
+
+static void word(words *w, const char *key, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void word(words *w, const char *key, const char *fmt, ...)
+{
+    if (w->len < sizeof w->text)
+        w->len += (size_t)snprintf(w->text + w->len, sizeof w->text - w->len, " %s=", key);
+    va_list ap;
+    va_start(ap, fmt);
+    if (w->len < sizeof w->text)
+        w->len += (size_t)vsnprintf(w->text + w->len, sizeof w->text - w->len, fmt, ap);
+    va_end(ap);
+}
+
+/* Paths may hold spaces: bytes outside '!'..'~', and '%' and '=', are
+ * written %XX. */
+static void escaped(words *w, const char *key, const char *s)
+{
+    char buf[3 * 1024 + 1];
+    size_t n = 0;
+    for (; *s && n + 4 < sizeof buf; s++) {
+        unsigned char c = (unsigned char)*s;
+        if (c <= ' ' || c > '~' || c == '%' || c == '=')
+            n += (size_t)snprintf(buf + n, sizeof buf - n, "%%%02X", c);
+        else
+            buf[n++] = (char)c;
+    }
+    buf[n] = '\0';
+    word(w, key, "%s", buf);
+}
+
+static void identity_words(const cli_args *a, const char *sha, words *w)
+{
+    w->len = 0;
+    w->text[0] = '\0';
+    escaped(w, "part", a->path);
+    word(w, "sha256", "%s", sha);
+    word(w, "units", "%s", units_names[a->read.units]);
+    word(w, "format", "%s", format_names[a->read.format]);
+    if (a->part.com_given)
+        word(w, "com", "%.17g,%.17g,%.17g", a->part.com.x, a->part.com.y, a->part.com.z);
+    else
+        word(w, "com", "mesh");
+    word(w, "topple", "%s", topple_names[a->estimate.topple]);
+    word(w, "epsilon_rad", "%.17g", a->estimate.epsilon);
+    word(w, "pqs_compare", "%s", compare_names[a->estimate.compare]);
+    word(w, "pqs_band", "%s", band_names[a->estimate.band]);
+    word(w, "engine", "%s", engine_names[a->sim.engine]);
+    word(w, "dt", "%.17g", a->sim.dt);
+    word(w, "n", "%ld", a->sim.ndrops);
+    word(w, "seed", "%" PRIu64, a->sim.seed);
+    const pd_scene *s = &a->scene;
+    word(w, "height", "%.17g", s->height);
+    word(w, "belt_speed", "%.17g", s->belt_speed);
+    word(w, "mu", "%.17g", s->mu);
+    word(w, "restitution", "%.17g", s->restitution);
+    word(w, "restitution_law", "%s", law_names[s->law]);
+    word(w, "vibration_rad", "%.17g", s->vibration);
+    word(w, "initial", "%s", initial_names[s->initial]);
+    word(w, "gravity", "%.17g", s->gravity);
+    word(w, "contact_time", "%.17g", s->contact_time);
+    word(w, "group", "%d", a->group);
+}
+
+int shard_write_identity(FILE *out, const cli_args *a, const pd_sim_result *sim)
+{
+    char sha[65];
+    if (!sha256_file(a->path, sha)) {
+        fprintf(stderr, "%s: %s: cannot read: %s\n", prog, a->path, strerror(errno));
+        return 0;
+    }
+    words w;
+    identity_words(a, sha, &w);
+    if (w.len >= sizeof w.text) {
+        fprintf(stderr, "%s: %s: the path is too long to name in a shard\n", prog, a->path);
+        return 0;
+    }
+    fprintf(out, "# posedrop %s shard=%d/%d%s\n", PD_VERSION_STRING, a->sim.shard + 1,
+            a->sim.nshards, w.text);
+    fprintf(out, "# totals collisions=%ld energy_gain=%ld fallbacks=%ld\n", sim->collisions,
+            sim->energy_gain, sim->fallbacks);
+    return 1;
+}
+
+/* ---- merge ---- */
+
+typedef struct {
+    const char *file;
+    char *identity;  /* line 1 after "shard=K/N" */
+    char *version;
+    int k, n;        /* shard k (1-based) of n */
+    long collisions, energy_gain, fallbacks;
+    int nposes;
+    long drops, unsettled;
+    int partial;
+    long *count, *first, *to; /* to: nposes * nposes, NULL unless stationary */
+} shard_file;
+
+static shard_file *shards;
+static int nshard_files;
+
+static int merge_fail(const char *file, int line, const char *what)
+{
+    if (line > 0)
+        fprintf(stderr, "%s: %s:%d: %s\n", prog, file, line, what);
+    else
+        fprintf(stderr, "%s: %s: %s\n", prog, file, what);
+    return 0;
+}
+
+static char *read_line(FILE *f)
+{
+    size_t cap = 256, n = 0;
+    char *buf = malloc(cap);
+    int c;
+    while (buf && (c = fgetc(f)) != EOF && c != '\n') {
+        if (n + 1 >= cap) {
+            char *b = realloc(buf, cap *= 2);
+            if (!b) {
+                free(buf);
+                return NULL;
+            }
+            buf = b;
+        }
+        buf[n++] = (char)c;
+    }
+    if (buf && n == 0 && feof(f)) {
+        free(buf);
+        return NULL;
+    }
+    if (buf)
+        buf[n] = '\0';
+    return buf;
+}
+
+static int parse_count(const char *s, long *out)
+{
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (end == s || (*end != '\0' && *end != ',') || errno || v < 0)
+        return 0;
+    *out = v;
+    return 1;
+}
+
+/* The value of key=... in a line of words, copied into buf; NULL if absent. */
+static const char *find_word(const char *line, const char *key, char *buf, size_t size)
+{
+    size_t kl = strlen(key);
+    for (const char *p = line; (p = strstr(p, key)) != NULL; p += kl) {
+        if ((p != line && p[-1] != ' ') || p[kl] != '=')
+            continue;
+        const char *v = p + kl + 1;
+        size_t len = strcspn(v, " ");
+        if (len >= size)
+            return NULL;
+        memcpy(buf, v, len);
+        buf[len] = '\0';
+        return buf;
+    }
+    return NULL;
+}
+
+/* Column index of name in a CSV header, -1 if absent. */
+static int column(const char *header, const char *name)
+{
+    size_t nl = strlen(name);
+    int col = 0;
+    for (const char *p = header;; col++) {
+        size_t len = strcspn(p, ",");
+        if (len == nl && strncmp(p, name, nl) == 0)
+            return col;
+        if (!p[len])
+            return -1;
+        p += len + 1;
+    }
+}
+
+/* The field of a CSV row at column col. */
+static const char *field(const char *row, int col)
+{
+    for (int c = 0; c < col; c++) {
+        row = strchr(row, ',');
+        if (!row)
+            return "";
+        row++;
+    }
+    return row;
+}
+
+static int read_rows(FILE *f, shard_file *s, const char *header, int *lineno)
+{
+    int cpose = column(header, "pose"), cn = column(header, "n"), ccount = column(header, "count"),
+        cuns = column(header, "unsettled"), cpart = column(header, "partial"),
+        cfirst = column(header, "first");
+    if (cpose < 0 || cn < 0 || ccount < 0 || cuns < 0 || cpart < 0)
+        return merge_fail(s->file, *lineno, "expected a header with the columns pose, n, count, "
+                          "unsettled and partial (a shard of a run with -n)");
+    char *rows[4096];
+    int nrows = 0;
+    char *line;
+    while (nrows < 4096 && (line = read_line(f)) != NULL)
+        rows[nrows++] = line;
+    int ok = nrows > 0 || merge_fail(s->file, *lineno, "no pose rows after the header");
+    s->nposes = nrows;
+    size_t k = (size_t)(nrows > 0 ? nrows : 1);
+    s->count = calloc(k, sizeof *s->count);
+    if (cfirst >= 0) {
+        s->first = calloc(k, sizeof *s->first);
+        s->to = calloc(k * k, sizeof *s->to);
+    }
+    if (!s->count || (cfirst >= 0 && (!s->first || !s->to)))
+        ok = merge_fail(s->file, 0, "out of memory");
+    char msg[160];
+    for (int i = 0; ok && i < nrows; i++) {
+        int ln = *lineno + 1 + i;
+        long pose = 0, n = 0, uns = 0, part = 0;
+        ok = parse_count(field(rows[i], cpose), &pose) && pose == i + 1 &&
+             parse_count(field(rows[i], cn), &n) && parse_count(field(rows[i], ccount), &s->count[i]) &&
+             parse_count(field(rows[i], cuns), &uns) && parse_count(field(rows[i], cpart), &part) &&
+             part <= 1 && (i == 0 || (n == s->drops && uns == s->unsettled && part == s->partial));
+        for (int j = -1; ok && cfirst >= 0 && j < nrows; j++)
+            ok = parse_count(field(rows[i], cfirst + 1 + j),
+                             j < 0 ? &s->first[i] : &s->to[(size_t)i * k + (size_t)j]);
+        if (!ok) {
+            snprintf(msg, sizeof msg, "expected pose %d's row: non-negative counts%s, n, "
+                     "unsettled and partial as in the first row", i + 1,
+                     cfirst >= 0 ? " (count, first, to_1 ..)" : "");
+            merge_fail(s->file, ln, msg);
+        }
+        s->drops = n;
+        s->unsettled = uns;
+        s->partial = (int)part;
+    }
+    for (int i = 0; i < nrows; i++)
+        free(rows[i]);
+    *lineno += nrows;
+    return ok;
+}
+
+/* Reads one shard file into s; 0 (with a message) if it is not one. */
+static int read_shard(const char *file, shard_file *s)
+{
+    memset(s, 0, sizeof *s);
+    s->file = file;
+    FILE *f = fopen(file, "r");
+    if (!f) {
+        fprintf(stderr, "%s: %s: cannot read: %s\n", prog, file, strerror(errno));
+        return 0;
+    }
+    char *l1 = read_line(f), *l2 = l1 ? read_line(f) : NULL, *hdr = l2 ? read_line(f) : NULL;
+    char version[64], buf[64];
+    int ok = 1, lineno = 3;
+    if (!l1 || strncmp(l1, "# posedrop ", 11) != 0 || sscanf(l1 + 11, "%63s", version) != 1 ||
+        !find_word(l1, "shard", buf, sizeof buf) || sscanf(buf, "%d/%d", &s->k, &s->n) != 2 ||
+        s->n < 1 || s->k < 1 || s->k > s->n)
+        ok = merge_fail(file, 1, "not a shard: expected a first line '# posedrop VERSION "
+                        "shard=K/N ...', as 'posedrop --shard K/N' prints");
+    if (ok && (!l2 || strncmp(l2, "# totals ", 9) != 0 ||
+               !find_word(l2, "collisions", buf, sizeof buf) || !parse_count(buf, &s->collisions) ||
+               !find_word(l2, "energy_gain", buf, sizeof buf) || !parse_count(buf, &s->energy_gain) ||
+               !find_word(l2, "fallbacks", buf, sizeof buf) || !parse_count(buf, &s->fallbacks)))
+        ok = merge_fail(file, 2, "expected '# totals collisions=C energy_gain=G fallbacks=F'");
+    if (ok && !hdr)
+        ok = merge_fail(file, 3, "expected the CSV header");
+    if (ok)
+        ok = read_rows(f, s, hdr, &lineno);
+    if (ok && s->partial) {
+        snprintf(buf, sizeof buf, "shard %d/%d was interrupted (partial)", s->k, s->n);
+        ok = merge_fail(file, 0, buf);
+        fprintf(stderr, "%s: run it again to the end before merging\n", prog);
+    }
+    if (ok) {
+        /* The identity after shard=K/N, to compare with the other shards'. */
+        s->identity = strdup(strstr(l1, " shard=") + 7 + strcspn(strstr(l1, " shard=") + 7, " "));
+        s->version = strdup(version);
+        ok = s->identity && s->version;
+    }
+    free(l1);
+    free(l2);
+    free(hdr);
+    fclose(f);
+    return ok;
+}
+
+static void free_shards(void)
+{
+    for (int i = 0; i < nshard_files; i++) {
+        free(shards[i].identity);
+        free(shards[i].version);
+        free(shards[i].count);
+        free(shards[i].first);
+        free(shards[i].to);
+    }
+    free(shards);
+    shards = NULL;
+    nshard_files = 0;
+}
+
+/* The first word where two identities differ, for the message. */
+static void first_difference(const char *x, const char *y, char *out, size_t size)
+{
+    while (*x == ' ' && *y == ' ') {
+        size_t lx = strcspn(x + 1, " "), ly = strcspn(y + 1, " ");
+        if (lx != ly || strncmp(x + 1, y + 1, lx) != 0) {
+            snprintf(out, size, "'%.*s' against '%.*s'", (int)ly, y + 1, (int)lx, x + 1);
+            return;
+        }
+        x += 1 + lx;
+        y += 1 + ly;
+    }
+    snprintf(out, size, "their settings");
+}
+
+/* The N shards of one run, each once, none partial. */
+static int check_shards(void)
+{
+    const shard_file *s0 = &shards[0];
+    char msg[1024], diff[600];
+    for (int i = 1; i < nshard_files; i++) {
+        const shard_file *s = &shards[i];
+        const char *what = NULL;
+        if (strcmp(s->version, s0->version) != 0)
+            what = "posedrop version";
+        else if (s->n != s0->n)
+            what = "shard count";
+        else if (strcmp(s->identity, s0->identity) != 0)
+            what = "run";
+        if (what) {
+            if (strcmp(what, "run") == 0)
+                first_difference(s->identity, s0->identity, diff, sizeof diff);
+            else if (strcmp(what, "shard count") == 0)
+                snprintf(diff, sizeof diff, "shard %d/%d against %d/%d", s0->k, s0->n, s->k, s->n);
+            else
+                snprintf(diff, sizeof diff, "'%s' against '%s'", s0->version, s->version);
+            snprintf(msg, sizeof msg, "not a shard of the same %s as %s: %s", what, s0->file,
+                     diff);
+            return merge_fail(s->file, 0, msg);
+        }
+        for (int j = 0; j < i; j++)
+            if (shards[j].k == s->k) {
+                snprintf(msg, sizeof msg, "shard %d/%d again (already in %s)", s->k, s->n,
+                         shards[j].file);
+                return merge_fail(s->file, 0, msg);
+            }
+    }
+    if (nshard_files != s0->n) {
+        for (int k = 1; k <= s0->n; k++) {
+            int found = 0;
+            for (int i = 0; i < nshard_files; i++)
+                found |= shards[i].k == k;
+            if (!found) {
+                fprintf(stderr, "%s: shard %d/%d is missing: the run has %d shards, %d given\n",
+                        prog, k, s0->n, s0->n, nshard_files);
+                return 0;
+            }
+        }
+    }
+    return 1;
+}
+
+static int pick(const char *value, const char *const *names, int *out)
+{
+    for (int i = 0; names[i]; i++)
+        if (strcmp(value, names[i]) == 0) {
+            *out = i;
+            return 1;
+        }
+    return 0;
+}
+
+static int unescape(const char *in, char *out, size_t size)
+{
+    size_t n = 0;
+    for (; *in; in++) {
+        unsigned v;
+        if (n + 1 >= size)
+            return 0;
+        if (*in == '%') {
+            if (sscanf(in + 1, "%2x", &v) != 1 || !in[1] || !in[2])
+                return 0;
+            out[n++] = (char)v;
+            in += 2;
+        } else {
+            out[n++] = *in;
+        }
+    }
+    out[n] = '\0';
+    return 1;
+}
+
+static int read_double(const char *text, double *out)
+{
+    char *end;
+    *out = strtod(text, &end);
+    return end != text && *end == '\0';
+}
+
+/* The options of the run the shards came from, from their identity. */
+static int options_from_identity(const shard_file *s, cli_args *a, char *path, size_t path_size,
+                                 char sha[65])
+{
+    const char *id = s->identity;
+    char v[1100];
+    int e[10], ok = 1;
+    uint64_t seed = 0;
+    double *doubles[] = {&a->estimate.epsilon, &a->sim.dt, &a->scene.height, &a->scene.belt_speed,
+                         &a->scene.mu, &a->scene.restitution, &a->scene.vibration,
+                         &a->scene.gravity, &a->scene.contact_time};
+    static const char *const dkeys[] = {"epsilon_rad", "dt", "height", "belt_speed", "mu",
+                                        "restitution", "vibration_rad", "gravity", "contact_time"};
+    for (int i = 0; ok && i < 9; i++)
+        ok = find_word(id, dkeys[i], v, sizeof v) && read_double(v, doubles[i]);
+    ok = ok && find_word(id, "part", v, sizeof v) && unescape(v, path, path_size) &&
+         find_word(id, "sha256", v, sizeof v) && strlen(v) == 64 && strcpy(sha, v) &&
+         find_word(id, "units", v, sizeof v) && pick(v, units_names, &e[0]) &&
+         find_word(id, "format", v, sizeof v) && pick(v, format_names, &e[1]) &&
+         find_word(id, "topple", v, sizeof v) && pick(v, topple_names, &e[2]) &&
+         find_word(id, "pqs_compare", v, sizeof v) && pick(v, compare_names, &e[3]) &&
+         find_word(id, "pqs_band", v, sizeof v) && pick(v, band_names, &e[4]) &&
+         find_word(id, "engine", v, sizeof v) && pick(v, engine_names, &e[5]) &&
+         find_word(id, "restitution_law", v, sizeof v) && pick(v, law_names, &e[6]) &&
+         find_word(id, "initial", v, sizeof v) && pick(v, initial_names, &e[7]) &&
+         find_word(id, "group", v, sizeof v) && sscanf(v, "%d", &e[8]) == 1 &&
+         find_word(id, "n", v, sizeof v) && sscanf(v, "%ld", &a->sim.ndrops) == 1 &&
+         find_word(id, "seed", v, sizeof v) && sscanf(v, "%" SCNu64, &seed) == 1 &&
+         find_word(id, "com", v, sizeof v);
+    if (ok && strcmp(v, "mesh") != 0) {
+        a->part.com_given = 1;
+        ok = sscanf(v, "%lf,%lf,%lf", &a->part.com.x, &a->part.com.y, &a->part.com.z) == 3;
+    }
+    if (!ok)
+        return merge_fail(s->file, 1, "the run's settings are incomplete or unreadable");
+    a->read.units = (pd_units)e[0];
+    a->read.format = (pd_mesh_format)e[1];
+    a->estimate.topple = (pd_topple_rule)e[2];
+    a->estimate.compare = (pd_pqs_compare)e[3];
+    a->estimate.band = (pd_pqs_band)e[4];
+    a->sim.engine = (pd_engine_kind)e[5];
+    a->scene.law = (pd_restitution_law)e[6];
+    a->scene.initial = (pd_initial)e[7];
+    a->group = e[8] != 0;
+    a->sim.seed = seed;
+    a->path = path;
+    /* Every word read back must print as it was written. */
+    words w;
+    identity_words(a, sha, &w);
+    if (strcmp(w.text, id) != 0)
+        return merge_fail(s->file, 1, "the run's settings do not read back as written (a shard "
+                          "of another posedrop version, or edited)");
+    return 1;
+}
+
+pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result **sum,
+                       pd_diag *diag)
+{
+    pd_sim_options o = a->sim;
+    o.nshards = 0;
+    pd_status st = pd_sim_result_new(res->nposes, &a->scene, &o, sum, diag);
+    for (int i = 0; st == PD_OK && i < nshard_files; i++) {
+        const shard_file *f = &shards[i];
+        if (f->nposes != res->nposes || !f->to != !(*sum)->transitions) {
+            snprintf(diag->message, sizeof diag->message, "%s: %d poses%s, but the part has %d%s",
+                     f->file, f->nposes, f->to ? " with the chain's counts" : "", res->nposes,
+                     (*sum)->transitions ? " and the run is stationary" : "");
+            st = PD_ERR_FORMAT;
+            break;
+        }
+        long want = pd_shard_drops(a->sim.ndrops, f->k - 1, f->n);
+        if (f->drops != want) {
+            snprintf(diag->message, sizeof diag->message, "%s: %ld drops, but shard %d/%d of a "
+                     "run of %ld drops has %ld", f->file, f->drops, f->k, f->n, a->sim.ndrops, want);
+            st = PD_ERR_FORMAT;
+            break;
+        }
+        pd_sim_result s = **sum;
+        s.n = f->drops;
+        s.unsettled = f->unsettled;
+        s.collisions = f->collisions;
+        s.energy_gain = f->energy_gain;
+        s.fallbacks = f->fallbacks;
+        s.partial = f->partial;
+        s.count = f->count;
+        s.first_count = f->first;
+        s.transitions = f->to;
+        st = pd_sim_result_add(*sum, &s, diag);
+    }
+    if (st == PD_OK)
+        st = pd_sim_result_finish(*sum, diag);
+    if (st != PD_OK) {
+        pd_sim_result_free(*sum);
+        *sum = NULL;
+    }
+    return st;
+}
+
+static void merge_usage(FILE *out)
+{
+    fprintf(out,
+        "usage: %s merge [options] SHARD...\n"
+        "\n"
+        "Sums the shards that 'posedrop --shard K/N' printed, K = 1..N of one run,\n"
+        "and prints exactly what the run without --shard prints. The part file\n"
+        "named in the shards must still be there, unchanged (its SHA-256).\n"
+        "\n"
+        "  --format F         csv (default) or json\n"
+        "  --transitions FILE with --initial stationary, the estimated chain as CSV\n"
+        "  --verbose          a summary of the part and of the drops on stderr\n"
+        "  --help             this help\n"
+        "\n"
+        "exit status: 0 success, 2 shards that do not make one whole run (other\n"
+        "parts, scenes, seeds, versions or shard counts, a shard missing, twice or\n"
+        "interrupted) or a bad file, 1 internal failure\n", prog);
+}
+
+int cli_merge(int argc, char **argv)
+{
+    enum { M_FORMAT = 256, M_TRANSITIONS, M_VERBOSE, M_HELP };
+    static const struct option longopts[] = {
+        {"format", required_argument, 0, M_FORMAT},
+        {"transitions", required_argument, 0, M_TRANSITIONS},
+        {"verbose", no_argument, 0, M_VERBOSE},
+        {"help", no_argument, 0, M_HELP},
+        {0, 0, 0, 0},
+    };
+    cli_args a;
+    memset(&a, 0, sizeof a);
+    pd_mesh_read_options_default(&a.read);
+    pd_part_options_default(&a.part);
+    pd_static_options_default(&a.estimate);
+    pd_scene_default(&a.scene);
+    pd_sim_options_default(&a.sim);
+    a.argc = argc;
+    a.argv = argv;
+    opterr = 0;
+    optind = 1;
+    int c;
+    while ((c = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
+        switch (c) {
+        case M_FORMAT:
+            if (strcmp(optarg, "csv") != 0 && strcmp(optarg, "json") != 0) {
+                fprintf(stderr, "%s: merge: --format: expected csv or json, got '%s'\n", prog,
+                        optarg);
+                return EXIT_USAGE;
+            }
+            a.json = strcmp(optarg, "json") == 0;
+            break;
+        case M_TRANSITIONS: a.transitions = optarg; break;
+        case M_VERBOSE: a.verbose = 1; break;
+        case M_HELP: merge_usage(stdout); return 0;
+        case ':':
+            fprintf(stderr, "%s: merge: option '%s' needs a value\n", prog, argv[optind - 1]);
+            return EXIT_USAGE;
+        default:
+            fprintf(stderr, "%s: merge: unknown option '%s'\n%s: see '%s merge --help'\n", prog,
+                    argv[optind - 1], prog, prog);
+            return EXIT_USAGE;
+        }
+    }
+    if (optind >= argc) {
+        fprintf(stderr, "%s: merge: expected the shard files\n%s: see '%s merge --help'\n", prog,
+                prog, prog);
+        return EXIT_USAGE;
+    }
+    nshard_files = argc - optind;
+    shards = calloc((size_t)nshard_files, sizeof *shards);
+    if (!shards) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return EXIT_INTERNAL;
+    }
+    static char path[1100];
+    char sha[65], now[65];
+    int ok = 1;
+    for (int i = 0; ok && i < nshard_files; i++)
+        ok = read_shard(argv[optind + i], &shards[i]);
+    ok = ok && check_shards() && options_from_identity(&shards[0], &a, path, sizeof path, sha);
+    if (ok && a.transitions && a.scene.initial != PD_INITIAL_STATIONARY)
+        ok = merge_fail(shards[0].file, 0, "--transitions needs the shards of a run with "
+                        "--initial stationary");
+    if (ok && !sha256_file(path, now)) {
+        fprintf(stderr, "%s: %s: cannot read the shards' part: %s\n", prog, path, strerror(errno));
+        ok = 0;
+    }
+    if (ok && strcmp(now, sha) != 0) {
+        fprintf(stderr, "%s: %s: the part has changed since the shards ran (SHA-256 %s, the "
+                "shards name %s)\n", prog, path, now, sha);
+        ok = 0;
+    }
+    int code = EXIT_USAGE;
+    if (ok) {
+        a.dynamic = 1;
+        a.merge = argv + optind;
+        code = cli_run(&a);
+    }
+    free_shards();
+    return code;
+}
