@@ -694,8 +694,8 @@ int cli_run(cli_args *a)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
     if (st == PD_OK && a->dynamic)
         st = cli_simulate(part, res, a, &sim, &diag);
-    if (!cli_writer()) {
-        code = st == PD_OK ? 0 : EXIT_INTERNAL;
+    if (st == PD_OK && !cli_writer()) {
+        code = 0;
         goto done;
     }
     /* A shard prints its poses' own counts; its merge groups them. */

@@ -3,7 +3,7 @@
  * byte for byte, for uniform and stationary starts; every refusal of merge;
  * SIGTERM; the progress line; --format json read back by a real JSON parser;
  * the Slurm script against a stub sbatch; posedrop-mpi under mpirun when
- * OpenMPI is installed (make builds it then). */
+ * OpenMPI is installed (make check builds it then). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -215,6 +215,110 @@ static void test_json(void)
     free(err);
 }
 
+/* scripts/slurm-array.sh against a stub sbatch that logs its arguments and
+ * runs each job at once as Slurm would (every task of an array with its
+ * SLURM_ARRAY_TASK_ID): the jobs it submits, their dependency, and a
+ * result.csv equal to the run on one machine, for a part whose path holds a
+ * space (the commands are quoted). */
+static void test_slurm(void)
+{
+    char cmd[2048], *out, *err, *one;
+    snprintf(cmd, sizeof cmd, "mkdir -p %s/bin && cp parts/cap.off '%s/my cap.off'", tmpdir, tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    snprintf(cmd, sizeof cmd, "%s/bin/sbatch", tmpdir);
+    char stub[1024];
+    snprintf(stub, sizeof stub,
+             "#!/usr/bin/env bash\n"
+             "printf '%%s\\n' \"$@\" -- >>%s/sbatch.log\n"
+             "n=$(( $(grep -c '^--$' %s/sbatch.log) ))\n"
+             "for a in \"$@\"; do case \"$a\" in --array=*) array=${a#--array=} ;;"
+             " --wrap=*) wrap=${a#--wrap=} ;; esac; done\n"
+             "if [ -n \"${array:-}\" ]; then\n"
+             "  for k in $(seq ${array%%-*} ${array#*-}); do SLURM_ARRAY_TASK_ID=$k bash -c \"$wrap\" || exit 1; done\n"
+             "else bash -c \"$wrap\" || exit 1; fi\n"
+             "echo \"$((1000 + n));cluster\"\n", tmpdir, tmpdir);
+    CHECK(write_file(cmd, stub));
+    snprintf(cmd, sizeof cmd, "chmod +x %s/bin/sbatch && PATH=%s/bin:$PATH scripts/slurm-array.sh "
+             "-N 3 -o %s/slurm -b " PD_CLI_PATH " -s '--time=10' -- -n 90 --seed 7 '%s/my cap.off'",
+             tmpdir, tmpdir, tmpdir, tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    CHECK(strstr(out, "shards: job 1001 (array 1-3); merge: job 1002") != NULL);
+    if (err[0])
+        printf("     %s", err);
+    free(out);
+    free(err);
+    snprintf(cmd, sizeof cmd, "%s/sbatch.log", tmpdir);
+    char *log = slurp(cmd);
+    CHECK(log && strstr(log, "--array=1-3\n") && strstr(log, "--time=10\n") &&
+          strstr(log, "--dependency=afterok:1001\n") && strstr(log, "--cpus-per-task=1\n"));
+    /* The merge job comes after the array, and names every shard. */
+    const char *dep = log ? strstr(log, "--dependency") : NULL;
+    CHECK(dep && strstr(dep, "merge") && strstr(dep, "shard_1.csv") && strstr(dep, "shard_3.csv"));
+    free(log);
+    snprintf(cmd, sizeof cmd, "-n 90 --seed 7 '%s/my cap.off'", tmpdir);
+    CHECK_INT(run(cmd, &one, &err), 0);
+    free(err);
+    snprintf(cmd, sizeof cmd, "%s/slurm/result.csv", tmpdir);
+    char *merged = slurp(cmd);
+    CHECK(merged && one[0] && strcmp(merged, one) == 0);
+    free(merged);
+    free(one);
+    /* Refused before anything is submitted. */
+    snprintf(cmd, sizeof cmd, "PATH=%s/bin:$PATH scripts/slurm-array.sh -N 0 -- -n 9 parts/cap.off",
+             tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 2);
+    CHECK(strstr(err, "-N") != NULL);
+    free(out);
+    free(err);
+}
+
+#ifndef PD_CLI_MPI_PATH
+#define PD_CLI_MPI_PATH "build/opt/posedrop-mpi"
+#endif
+#ifndef PD_MPIRUN
+#define PD_MPIRUN "mpirun"
+#endif
+/* As root, OpenMPI wants to be told; two ranks on fewer cores is fine here.
+ * OpenMPI's own allocations outlive MPI_Finalize, which LeakSanitizer would
+ * report under SANITIZE=1. */
+#define MPIRUN_2 PD_MPIRUN " -n 2 --allow-run-as-root --oversubscribe -x ASAN_OPTIONS=detect_leaks=0 "
+
+/* posedrop-mpi on two ranks prints the single process's bytes. */
+static void test_mpi(void)
+{
+    if (access(PD_CLI_MPI_PATH, X_OK) != 0 || system("command -v " PD_MPIRUN " >/dev/null") != 0) {
+        printf("     OpenMPI not installed: posedrop-mpi not checked (scripts/install-deps.sh mpi)\n");
+        return;
+    }
+    static const char *const runs[] = {
+        "-n 200 --seed 4 parts/cap.off",
+        "-n 140 --initial stationary --group " BOX,
+        "-n 30 --engine ode --units mm parts/block.stl",
+    };
+    for (int i = 0; i < 3; i++) {
+        char cmd[512], *one, *two, *err;
+        CHECK_INT(run(runs[i], &one, &err), 0);
+        free(err);
+        snprintf(cmd, sizeof cmd, MPIRUN_2 PD_CLI_MPI_PATH " %s", runs[i]);
+        CHECK_INT(run_cmd(cmd, 1, &two, &err), 0);
+        int same = strcmp(one, two) == 0 && one[0];
+        if (!same)
+            printf("     mpirun -n 2 %s differs from one process:\n%s---\n%s%s", runs[i], two, one,
+                   err);
+        CHECK(same);
+        free(one);
+        free(two);
+        free(err);
+    }
+    char *out, *err;
+    CHECK_INT(run_cmd(MPIRUN_2 PD_CLI_MPI_PATH " --ci 0.05 parts/cap.off", 1, &out, &err), 2);
+    CHECK(out[0] == '\0' && strstr(err, "--ci") != NULL);
+    free(out);
+    free(err);
+}
+
 void suite_batch(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-batch-XXXXXX");
@@ -227,6 +331,8 @@ void suite_batch(void)
     test_sigterm();
     test_progress();
     test_json();
+    test_slurm();
+    test_mpi();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)
