@@ -106,7 +106,8 @@ $(BUILD)/tests/%.o: tests/%.c Makefile
 
 $(BUILD)/bench-%.o: %.c Makefile
 	@mkdir -p $(dir $@)
-	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -MMD -MP -c $< -o $@
+	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -DPD_CLI_PATH='"$(CLI)"' -DPD_CLI_MPI_PATH='"$(CLI_MPI)"' \
+	    -DPD_MPIRUN='"$(MPIRUN)"' -MMD -MP -c $< -o $@
 
 # Binaries link with $(CXX): the archive holds the Bullet adapter, which needs
 # the C++ runtime.
@@ -164,8 +165,8 @@ golden: $(TEST_BIN)
 	PD_GOLDEN_WRITE=tests/golden.csv $(TEST_BIN) golden
 
 bench: deps
-	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
-	$(BENCH_BIN)
+	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
+	$(BENCH_BIN) $(BENCH)
 
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
