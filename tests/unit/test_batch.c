@@ -54,6 +54,28 @@ static void test_merge_equals_run(void)
     check_shards_merge("eng", "-n 40 --engine ode --mu 0.5 --units mm parts/block.stl", 3);
 }
 
+/* The side files: merge --transitions writes the unsharded run's chain; the
+ * shards' --trials rows, sorted by drop, are the unsharded run's. */
+static void test_side_files(void)
+{
+    char cmd[2048], *out, *err;
+    snprintf(cmd, sizeof cmd,
+             "(set -e; P=" BOX "; B=" PD_CLI_PATH "; D=%s\n"
+             "$B -n 140 --initial stationary --transitions $D/t.csv --trials $D/tr.csv $P >/dev/null\n"
+             "for k in 1 2 3; do\n"
+             "  $B -n 140 --initial stationary --shard $k/3 --trials $D/tr$k.csv $P >$D/ts$k.csv\n"
+             "done\n"
+             "$B merge --transitions $D/tm.csv $D/ts1.csv $D/ts2.csv $D/ts3.csv >/dev/null\n"
+             "cmp $D/t.csv $D/tm.csv\n"
+             "(head -n 1 $D/tr.csv; cat $D/tr1.csv $D/tr2.csv $D/tr3.csv | grep -v '^drop' |"
+             " sort -t, -k1,1n) | cmp - $D/tr.csv)", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    if (err[0])
+        printf("     %s", err);
+    free(out);
+    free(err);
+}
+
 /* A shard's file, made once, for the refusals. */
 static const char *shard(const char *name, const char *args)
 {
@@ -327,6 +349,7 @@ void suite_batch(void)
         return;
     }
     test_merge_equals_run();
+    test_side_files();
     test_merge_refusals();
     test_sigterm();
     test_progress();
