@@ -17,7 +17,8 @@
 #include <string.h>
 #include "cli/cli.h"
 
-/* One more than the shard count a run can name (its K and N are ints). */
+/* The largest shard count: far beyond a cluster's job array limits (Slurm's
+ * MaxArraySize defaults to 1001), so a larger N is a typo. */
 #define SHARDS_MAX 100000L
 
 int shard_parse(const char *text, pd_sim_options *sim)
@@ -253,12 +254,21 @@ static int read_rows(FILE *f, shard_file *s, const char *header, int *lineno)
     if (cpose < 0 || cn < 0 || ccount < 0 || cuns < 0 || cpart < 0)
         return merge_fail(s->file, *lineno, "expected a header with the columns pose, n, count, "
                           "unsettled and partial (a shard of a run with -n)");
-    char *rows[4096];
-    int nrows = 0;
-    char *line;
-    while (nrows < 4096 && (line = read_line(f)) != NULL)
+    char **rows = NULL, *line;
+    int nrows = 0, cap = 0, ok = 1;
+    while (ok && (line = read_line(f)) != NULL) {
+        if (nrows == cap) {
+            char **r = realloc(rows, sizeof *r * (size_t)(cap = 2 * cap + 64));
+            if (!r) {
+                free(line);
+                ok = merge_fail(s->file, 0, "out of memory");
+                break;
+            }
+            rows = r;
+        }
         rows[nrows++] = line;
-    int ok = nrows > 0 || merge_fail(s->file, *lineno, "no pose rows after the header");
+    }
+    ok = ok && (nrows > 0 || merge_fail(s->file, *lineno, "no pose rows after the header"));
     s->nposes = nrows;
     size_t k = (size_t)(nrows > 0 ? nrows : 1);
     s->count = calloc(k, sizeof *s->count);
@@ -291,6 +301,7 @@ static int read_rows(FILE *f, shard_file *s, const char *header, int *lineno)
     }
     for (int i = 0; i < nrows; i++)
         free(rows[i]);
+    free(rows);
     *lineno += nrows;
     return ok;
 }
