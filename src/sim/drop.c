@@ -145,6 +145,29 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 
 /* --- the drop ----------------------------------------------------------------- */
 
+/* Moves the contacts[0..nc) of s that touch the floor (within the impact
+ * search's contact tolerance) to the front, keeping their order, and returns
+ * how many; *approach is the fastest speed at which one of them approaches
+ * (0 if none does). The rest would only arrive within the search's window. */
+static int keep_touching(const pd_body *b, const pd_state *s, int *contacts, int nc,
+                         double *approach)
+{
+    pd_vec3 ww = quat_rotate(s->q, s->w);
+    double tol = PD_TOL_CONTACT_REL * b->size;
+    int n = 0;
+    *approach = 0.0;
+    for (int i = 0; i < nc; i++) {
+        pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
+        if (s->x.z + r.z > tol)
+            continue;
+        *approach = fmax(*approach, -(s->v.z + v3_cross(ww, r).z));
+        int c = contacts[i];
+        memmove(contacts + n + 1, contacts + n, (size_t)(i - n) * sizeof *contacts);
+        contacts[n++] = c;
+    }
+    return n;
+}
+
 /* The slowest rate at which the contacts[0..nc) of s rise from the floor,
  * m/s (negative when one approaches; HUGE_VAL for none). */
 static double touching_rise(const pd_body *b, const pd_state *s, const int *contacts, int nc)
@@ -223,6 +246,38 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 f_at = imp.t;
             }
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
+            if (m->compliant_on) {
+                /* More than one vertex touching or arriving within a contact
+                 * duration, one of them striking: a compliant impact, which
+                 * the arriving ones join. Else the exact rigid law at the
+                 * touching vertices alone (a single vertex's impact is its
+                 * limit as the duration shrinks). */
+                double approach;
+                int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
+                if (nc >= 2 && approach > m->settle.v_rest) {
+                    pd_compliant_result cr;
+                    pd_status cs = pd_compliant_run(&m->compliant, w->compliant, &m->settle, sc,
+                                                    &s, o->time_limit - t, &cr);
+                    if (cs != PD_OK)
+                        break;
+                    out->collisions++;
+                    *energy_gain += cr.energy_gain;
+                    t += cr.time;
+                    f_at = -1.0;
+                    phase_ok = 1;
+                    if (cr.end == PD_COMPLIANT_DECIDED) {
+                        out->pose = cr.pose;
+                        out->end = PD_END_SETTLED;
+                        break;
+                    }
+                    if (cr.end == PD_COMPLIANT_TIME) {
+                        out->end = PD_END_TIME_LIMIT;
+                        break;
+                    }
+                    continue;
+                }
+                nc = ntouch;
+            }
             int before = out->collisions;
             if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
                                 fallbacks) != PD_OK)
