@@ -70,8 +70,9 @@ CLI_MPI    := $(BUILD)/posedrop-mpi
 CLI_MPI_OBJS := $(patsubst src/cli/%.c,$(BUILD)/mpi/%.o,$(filter-out src/cli/run.c,$(wildcard src/cli/*.c)))
 MPICC      ?= mpicc
 MPIRUN     ?= mpirun
-# make check builds and tests posedrop-mpi whenever OpenMPI is installed;
-# MPI=1 asks for it (and fails without OpenMPI: scripts/install-deps.sh mpi).
+# make and make check build (and test) posedrop-mpi whenever OpenMPI is
+# installed, so it is never older than posedrop; MPI=1 asks for it (and fails
+# without OpenMPI: scripts/install-deps.sh mpi).
 HAVE_MPI   := $(shell command -v $(MPICC) >/dev/null 2>&1 && command -v $(MPIRUN) >/dev/null 2>&1 && echo 1)
 WITH_MPI   := $(if $(filter 1,$(MPI) $(HAVE_MPI)),1)
 TEST_SRCS  := $(wildcard tests/unit/*.c tests/support/*.c)
@@ -85,7 +86,7 @@ DEMO_PART  := parts/cap.off
 .PHONY: all check test bench demo paper install uninstall clean help deps golden lint mpi
 .DEFAULT_GOAL := all
 
-all: $(LIB) $(CLI) $(if $(filter 1,$(MPI)),$(CLI_MPI))
+all: $(LIB) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
 
 mpi: $(CLI_MPI)
 
