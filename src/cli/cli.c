@@ -192,8 +192,8 @@ double cli_clean(double x)
 static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
 {
     int chain = sim && sim->nshards > 0 && sim->transitions;
-    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s%s", sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "",
-           chain ? ",first" : "");
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s%s",
+           sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "", chain ? ",first" : "");
     for (int j = 0; chain && j < res->nposes; j++)
         printf(",to_%d", j + 1);
     printf("\n");
@@ -715,18 +715,20 @@ int cli_run(cli_args *a)
         print_summary(a, part, res);
     if (sim)
         print_sim_summary(a, sim);
-    code = 0;
-    if (a->sim.nshards && !shard_write_identity(stdout, a, sim))
+    if (a->sim.nshards && !shard_write_identity(stdout, a, sim)) {
         code = EXIT_INTERNAL;
-    if (code == 0 && a->json)
+        goto done;
+    }
+    code = 0;
+    if (a->json)
         json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses, seconds_since(&t0));
     else if (a->facets)
         print_facets(part, res);
     else if (class_of)
         print_classes(res, gsim, class_of, nclasses);
-    else if (code == 0)
+    else
         print_poses(res, sim);
-    if (code == 0 && (fflush(stdout) != 0 || ferror(stdout))) {
+    if (fflush(stdout) != 0 || ferror(stdout)) {
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
         code = EXIT_INTERNAL;
     }

@@ -341,6 +341,26 @@ static void test_mpi(void)
     free(err);
 }
 
+/* The part's SHA-256 (shards, JSON) against coreutils' sha256sum, for files
+ * whose length mod 64 falls on each side of the padding's boundaries (55,
+ * 56: the length fits the last block or not; 63, 0, 1: a block ends). */
+static void test_sha256(void)
+{
+    char cmd[1024], *out, *err;
+    snprintf(cmd, sizeof cmd,
+             "(set -e; for n in 119 120 127 128 129 183 184; do f=%s/pad$n.off\n"
+             "  { printf 'OFF\\n4 4 0\\n0 0 0\\n1 0 0\\n0 1 0\\n0 0 1\\n3 0 2 1\\n3 0 1 3\\n"
+             "3 0 3 2\\n3 1 2 3\\n#'; printf '%%0200d' 0; } | head -c $((n - 1)) >$f; echo >>$f\n"
+             "  test $(wc -c <$f) -eq $n\n"
+             "  " PD_CLI_PATH " --format json $f | grep -q \"\\\"sha256\\\": \\\"$(sha256sum $f | cut -c1-64)\\\"\"\n"
+             "done)", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    if (err[0])
+        printf("     %s", err);
+    free(out);
+    free(err);
+}
+
 void suite_batch(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-batch-XXXXXX");
@@ -354,6 +374,7 @@ void suite_batch(void)
     test_sigterm();
     test_progress();
     test_json();
+    test_sha256();
     test_slurm();
     test_mpi();
     char cmd[128];
