@@ -1,6 +1,6 @@
 /* test_sim.c: the Monte Carlo dynamic estimator: statistics of symmetric
  * parts, determinism whatever the thread count, scale, the run's contracts
- * (cancellation, bootstrap, --ci, trial records). */
+ * (cancellation, bootstrap, --ci, trial records), shards summed. */
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -195,8 +195,83 @@ static void test_contracts(void)
     free_part(&f);
 }
 
+/* The library's shards: N runs with nshards = N summed by
+ * pd_sim_result_add and finished give the whole run's result, every count
+ * and every double equal (the drops keep their indices; sums of integers),
+ * for a uniform and a stationary start; each shard runs pd_shard_drops of
+ * the drops, which add up to the run's. A shard that does not fit is
+ * refused. */
+static void test_shards(void)
+{
+    part_fixture f;
+    if (!make_part(&f, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    for (int stationary = 0; stationary < 2; stationary++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.initial = stationary ? PD_INITIAL_STATIONARY : PD_INITIAL_UNIFORM;
+        pd_sim_options o;
+        pd_sim_options_default(&o);
+        o.ndrops = 143; /* not a multiple of any N below */
+        o.seed = 11;
+        o.threads = 2;
+        pd_sim_result *whole = run(&f, &sc, &o), *sum = NULL;
+        CHECK(whole != NULL);
+        for (int n = 1; whole && n <= 5; n += 2) {
+            CHECK_STATUS(pd_sim_result_new(f.poses->nposes, &sc, &o, &sum, NULL), PD_OK);
+            long drops = 0;
+            for (int k = 0; sum && k < n; k++) {
+                pd_sim_options os = o;
+                os.nshards = n;
+                os.shard = k;
+                pd_sim_result *part = run(&f, &sc, &os);
+                CHECK(part != NULL);
+                if (!part)
+                    break;
+                CHECK_INT(part->n, pd_shard_drops(o.ndrops, k, n));
+                drops += part->n;
+                CHECK_STATUS(pd_sim_result_add(sum, part, NULL), PD_OK);
+                pd_sim_result_free(part);
+            }
+            CHECK_INT(drops, o.ndrops);
+            CHECK_STATUS(pd_sim_result_finish(sum, NULL), PD_OK);
+            size_t k = (size_t)whole->nposes;
+            CHECK(sum->n == whole->n && sum->unsettled == whole->unsettled &&
+                  sum->collisions == whole->collisions);
+            CHECK(memcmp(sum->count, whole->count, k * sizeof *sum->count) == 0);
+            CHECK(memcmp(sum->p, whole->p, k * sizeof *sum->p) == 0);
+            CHECK(memcmp(sum->ci_lo, whole->ci_lo, k * sizeof *sum->ci_lo) == 0);
+            CHECK(memcmp(sum->ci_hi, whole->ci_hi, k * sizeof *sum->ci_hi) == 0);
+            if (stationary)
+                CHECK(sum->closed_classes == whole->closed_classes &&
+                      memcmp(sum->transitions, whole->transitions,
+                             k * k * sizeof *sum->transitions) == 0);
+            pd_sim_result_free(sum);
+            sum = NULL;
+        }
+        /* Another seed's shard does not fit. */
+        CHECK_STATUS(pd_sim_result_new(f.poses->nposes, &sc, &o, &sum, NULL), PD_OK);
+        pd_sim_options other = o;
+        other.seed = 12;
+        other.nshards = 2;
+        pd_sim_result *wrong = run(&f, &sc, &other);
+        if (sum && wrong)
+            CHECK_STATUS(pd_sim_result_add(sum, wrong, NULL), PD_ERR_USAGE);
+        pd_sim_result_free(wrong);
+        pd_sim_result_free(sum);
+        pd_sim_result_free(whole);
+    }
+    /* Drop i belongs to shard i mod N. */
+    CHECK_INT(pd_shard_of(10, 3), 1);
+    CHECK_INT(pd_shard_drops(10, 0, 3), 4);
+    CHECK_INT(pd_shard_drops(10, 2, 3), 3);
+    CHECK_INT(pd_shard_drops(2, 2, 3), 0);
+    free_part(&f);
+}
+
 void suite_sim(void)
 {
+    test_shards();
     test_platonic_uniform();
     test_determinism_and_scale();
     test_contracts();
