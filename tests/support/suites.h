@@ -20,6 +20,7 @@
     PD_SUITE(flat_rest) \
     PD_SUITE(contact_phase) \
     PD_SUITE(contact_pivot) \
+    PD_SUITE(compliant) \
     PD_SUITE(sim)    \
     PD_SUITE(markov) \
     PD_SUITE(drop_step) \
