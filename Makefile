@@ -88,7 +88,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo paper install uninstall clean help deps golden lint
+.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI)
@@ -160,7 +160,14 @@ test: $(TEST_BIN) $(CLI)
 lint:
 	@scripts/lint-layers.sh
 
+# The library as a user gets it: installed into a temporary prefix, the
+# documented example built with plain pkg-config and run
+# (tests/install/check-install.sh, which says what it checks).
+check-install: all
+	+@MAKE="$(MAKE)" CC="$(CC)" EXAMPLE_FLAGS="$(LDFLAGS_SAN)" tests/install/check-install.sh
+
 check: deps lint
+	@$(MAKE) --no-print-directory check-install
 	@$(MAKE) --no-print-directory test
 
 demo: deps
@@ -181,31 +188,46 @@ bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
 	$(BENCH_BIN)
 
+# Both libraries, shared (with their soname and development links) and
+# static, the headers, the command and a pkg-config file for each library
+# (docs/library.md). Under /usr/local, run ldconfig afterwards.
+LIBDIR := $(DESTDIR)$(PREFIX)/lib
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
-	           $(DESTDIR)$(PREFIX)/include/posedrop
+	install -d $(DESTDIR)$(PREFIX)/bin $(LIBDIR)/pkgconfig $(DESTDIR)$(PREFIX)/include/posedrop
 	install -m 755 $(CLI) $(DESTDIR)$(PREFIX)/bin/posedrop
-	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/libposedrop.a
+	install -m 644 $(LIB) $(LIB_BULLET) $(LIBDIR)/
+	install -m 755 $(SO) $(SO_BULLET) $(LIBDIR)/
+	for l in libposedrop libposedrop-bullet; do \
+	    ln -sf $$l.so.$(VERSION) $(LIBDIR)/$$l.so.$(MAJOR) && ln -sf $$l.so.$(MAJOR) $(LIBDIR)/$$l.so; \
+	done
 	install -m 644 include/posedrop/*.h $(DESTDIR)$(PREFIX)/include/posedrop/
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(shell sed -n 's/.*PD_VERSION_STRING "\(.*\)"/\1/p' include/posedrop/posedrop.h)|' \
-	    -e 's|@REQUIRES@|$(LIB_PKGS)|' scripts/posedrop.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(LIB_PKGS)|' \
+	    scripts/posedrop.pc.in > $(LIBDIR)/pkgconfig/posedrop.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(BULLET_PKGS)|' \
+	    scripts/posedrop-bullet.pc.in > $(LIBDIR)/pkgconfig/posedrop-bullet.pc
 
 uninstall:
-	rm -f $(DESTDIR)$(PREFIX)/bin/posedrop $(DESTDIR)$(PREFIX)/lib/libposedrop.a \
-	      $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
+	rm -f $(DESTDIR)$(PREFIX)/bin/posedrop $(LIBDIR)/pkgconfig/posedrop.pc \
+	      $(LIBDIR)/pkgconfig/posedrop-bullet.pc
+	for l in libposedrop libposedrop-bullet; do \
+	    rm -f $(LIBDIR)/$$l.a $(LIBDIR)/$$l.so $(LIBDIR)/$$l.so.$(MAJOR) $(LIBDIR)/$$l.so.$(VERSION); \
+	done
 	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop
 
 clean:
 	rm -rf build
 
 help:
-	@echo "make            build libposedrop.a and the posedrop command ($(BUILD)/)"
+	@echo "make            build libposedrop (.so, .a), libposedrop-bullet and the"
+	@echo "                posedrop command ($(BUILD)/)"
 	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make lint       check that no layer of src/ includes one above it"
+	@echo "make check-install  install to a temporary prefix, build the library example"
+	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
