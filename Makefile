@@ -190,7 +190,8 @@ bench: deps
 
 # Both libraries, shared (with their soname and development links) and
 # static, the headers, the command and a pkg-config file for each library
-# (docs/library.md). Under /usr/local, run ldconfig afterwards.
+# (docs/library.md), and the licence with that page in share/doc/posedrop.
+# Under /usr/local, run ldconfig afterwards.
 LIBDIR := $(DESTDIR)$(PREFIX)/lib
 install: all
 	install -d $(DESTDIR)$(PREFIX)/bin $(LIBDIR)/pkgconfig $(DESTDIR)$(PREFIX)/include/posedrop
@@ -201,6 +202,8 @@ install: all
 	    ln -sf $$l.so.$(VERSION) $(LIBDIR)/$$l.so.$(MAJOR) && ln -sf $$l.so.$(MAJOR) $(LIBDIR)/$$l.so; \
 	done
 	install -m 644 include/posedrop/*.h $(DESTDIR)$(PREFIX)/include/posedrop/
+	install -d $(DESTDIR)$(PREFIX)/share/doc/posedrop
+	install -m 644 LICENSE NOTICE docs/library.md $(DESTDIR)$(PREFIX)/share/doc/posedrop/
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(LIB_PKGS)|' \
 	    scripts/posedrop.pc.in > $(LIBDIR)/pkgconfig/posedrop.pc
 	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(BULLET_PKGS)|' \
@@ -212,7 +215,7 @@ uninstall:
 	for l in libposedrop libposedrop-bullet; do \
 	    rm -f $(LIBDIR)/$$l.a $(LIBDIR)/$$l.so $(LIBDIR)/$$l.so.$(MAJOR) $(LIBDIR)/$$l.so.$(VERSION); \
 	done
-	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop
+	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop $(DESTDIR)$(PREFIX)/share/doc/posedrop
 
 clean:
 	rm -rf build

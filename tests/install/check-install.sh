@@ -51,6 +51,15 @@ if ! $MAKE --no-print-directory install PREFIX="$prefix" >"$tmp/install.log" 2>&
 fi
 ok
 
+# The program docs/library.md shows is the one built here.
+awk '/^## Example/ { e = 1 } e && /^```c$/ { p = 1; next } p && /^```$/ { exit } p' \
+    docs/library.md >"$tmp/doc.c"
+sed -n '/^#include/,$p' tests/install/example.c >"$tmp/example-body.c"
+check "docs/library.md's example is tests/install/example.c" \
+    sh -c "test -s '$tmp/doc.c' && cmp -s '$tmp/doc.c' '$tmp/example-body.c'"
+check "make install put LICENSE and NOTICE in share/doc/posedrop" \
+    test -s "$prefix/share/doc/posedrop/LICENSE" -a -s "$prefix/share/doc/posedrop/NOTICE"
+
 export PKG_CONFIG_PATH="$prefix/lib/pkgconfig"
 version=$(sed -n 's/^.define PD_VERSION_\(MAJOR\|MINOR\|PATCH\) \([0-9]*\)$/\2/p' \
           include/posedrop/version.h | paste -sd.)
