@@ -164,7 +164,7 @@ lint:
 # documented example built with plain pkg-config and run
 # (tests/install/check-install.sh, which says what it checks).
 check-install: all
-	+@MAKE="$(MAKE)" CC="$(CC)" EXAMPLE_FLAGS="$(LDFLAGS_SAN)" tests/install/check-install.sh
+	+@MAKE="$(MAKE)" CC="$(CC)" CXX="$(CXX)" EXAMPLE_FLAGS="$(LDFLAGS_SAN)" tests/install/check-install.sh
 
 check: deps lint
 	@$(MAKE) --no-print-directory check-install

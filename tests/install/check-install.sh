@@ -185,6 +185,43 @@ else
     fail "cc bullet.c \$(pkg-config --cflags --libs posedrop-bullet)"
 fi
 
+# Each installed header compiles on its own, as C11 and as C++ (the cancel
+# flag is std::atomic<int> there), also when wrapped in extern "C" (the
+# typedef: a file of macros alone would be an empty translation unit).
+CXX=${CXX:-c++}
+alone=0
+for h in "$prefix"/include/posedrop/*.h; do
+    name=posedrop/$(basename "$h")
+    printf '#include <%s>\ntypedef int not_empty;\n' "$name" >"$tmp/alone.c"
+    $CC -std=c11 -Wall -Wextra -Wpedantic -Werror -fsyntax-only -I"$prefix/include" "$tmp/alone.c" \
+        2>"$tmp/alone.log" || { alone=1; cat "$tmp/alone.log"; }
+    printf 'extern "C" {\n#include <%s>\n}\n' "$name" >"$tmp/alone.cpp"
+    $CXX -std=c++17 -Wall -Wextra -Werror -fsyntax-only -I"$prefix/include" "$tmp/alone.cpp" \
+        2>"$tmp/alone.log" || { alone=1; cat "$tmp/alone.log"; }
+done
+check "every installed header compiles alone as C11 and as C++17" test $alone -eq 0
+cat >"$tmp/cancel.cpp" <<'EOF'
+#include <atomic>
+#include <posedrop/posedrop.h>
+int main()
+{
+    static std::atomic<int> stop(1);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.cancel = &stop;
+    return o.cancel->load() == 1 ? 0 : 1;
+}
+EOF
+# shellcheck disable=SC2086
+if $CXX $EXAMPLE_FLAGS -std=c++17 -o "$tmp/cancel" "$tmp/cancel.cpp" \
+    $(pkg-config --cflags --libs posedrop) 2>"$tmp/cc.log" &&
+    LD_LIBRARY_PATH="$prefix/lib" "$tmp/cancel"; then
+    ok
+else
+    cat "$tmp/cc.log"
+    fail "a C++ program pointing the cancel flag at a std::atomic<int>"
+fi
+
 # Exported symbols: exactly the PD_API functions of the installed headers,
 # pd_bullet_register in libposedrop-bullet, every other one in libposedrop.
 sed -n 's/^PD_API [^(]*[ *]\(pd_[a-z0-9_]*\)(.*/\1/p' "$prefix"/include/posedrop/*.h | sort >"$tmp/api"
