@@ -145,7 +145,10 @@ int main(int argc, char **argv)
     pd_part *part = NULL;
     pd_static_result *poses = NULL;
     pd_sim_result *drops = NULL;
-    pd_status st = pd_bullet_register();
+    pd_status st = PD_OK;
+#ifndef NO_REGISTER
+    st = pd_bullet_register();
+#endif
     if (st == PD_OK)
         st = pd_mesh_read(argv[1], NULL, &mesh, &diag);
     if (st == PD_OK)
@@ -183,6 +186,22 @@ if $CC $EXAMPLE_FLAGS -o "$tmp/bullet" "$tmp/bullet.c" $(pkg-config --cflags --l
 else
     cat "$tmp/cc.log"
     fail "cc bullet.c \$(pkg-config --cflags --libs posedrop-bullet)"
+fi
+# The same program without libposedrop-bullet: a status that says what to
+# link, not a crash.
+# shellcheck disable=SC2046,SC2086
+if $CC $EXAMPLE_FLAGS -DNO_REGISTER -o "$tmp/no-bullet" "$tmp/bullet.c" \
+    $(pkg-config --cflags --libs posedrop) 2>"$tmp/cc.log"; then
+    LD_LIBRARY_PATH="$prefix/lib" "$tmp/no-bullet" $PART >"$tmp/no-bullet.out" 2>"$tmp/no-bullet.err"
+    code=$?
+    check "Bullet without libposedrop-bullet fails with status 1, not a crash (got $code)" \
+        test "$code" -eq 1
+    check "... saying: not available, link libposedrop-bullet" \
+        sh -c "grep -q 'not available in this program' '$tmp/no-bullet.err' &&
+               grep -q 'libposedrop-bullet' '$tmp/no-bullet.err' && test ! -s '$tmp/no-bullet.out'"
+else
+    cat "$tmp/cc.log"
+    fail "cc bullet.c -DNO_REGISTER \$(pkg-config --cflags --libs posedrop)"
 fi
 
 # Each installed header compiles on its own, as C11 and as C++ (the cancel
