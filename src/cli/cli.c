@@ -537,7 +537,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
             usage(stdout);
             return 0;
         case OPT_VERSION:
-            printf("posedrop %s\n", PD_VERSION_STRING);
+            printf("posedrop %s\n", pd_version());
             return 0;
         case ':':
             return fail_usage("option '%s' needs a value", argv[optind - 1]);
@@ -680,13 +680,19 @@ int cli_run(cli_args *a)
     pd_diag diag;
     pd_diag_init(&diag);
     diag.warn = print_warning;
+    /* The command offers every engine: it links libposedrop-bullet. */
+    pd_status st = pd_bullet_register();
+    if (st != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine: %s\n", prog, pd_status_str(st));
+        return EXIT_INTERNAL;
+    }
 
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
     int *class_of = NULL, nclasses = 0, code;
-    pd_status st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
+    st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;

@@ -66,7 +66,7 @@ static void run_json(FILE *out, const cli_args *a, const pd_sim_result *sim, dou
     static const char *const laws[] = {"poisson", "energetic"};
     static const char *const initials[] = {"uniform", "bootstrap", "stationary"};
     const pd_scene *s = &a->scene;
-    fprintf(out, "  \"posedrop\": {\"version\": \"%s\", \"command_line\": [", PD_VERSION_STRING);
+    fprintf(out, "  \"posedrop\": {\"version\": \"%s\", \"command_line\": [", pd_version());
     for (int i = 0; i < a->argc; i++) {
         fprintf(out, i ? ", " : "");
         string(out, a->argv[i]);

@@ -132,7 +132,7 @@ int shard_write_identity(FILE *out, const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: %s: the path is too long to name in a shard\n", prog, a->path);
         return 0;
     }
-    fprintf(out, "# posedrop %s shard=%d/%d%s\n", PD_VERSION_STRING, a->sim.shard + 1,
+    fprintf(out, "# posedrop %s shard=%d/%d%s\n", pd_version(), a->sim.shard + 1,
             a->sim.nshards, w.text);
     fprintf(out, "# totals collisions=%ld energy_gain=%ld fallbacks=%ld\n", sim->collisions,
             sim->energy_gain, sim->fallbacks);

@@ -4,11 +4,13 @@
 #include <string.h>
 #include "cli/cli.h"
 
-static volatile sig_atomic_t caught;
+/* The signal's number; the library reads it as its cancel flag (lock-free,
+ * so a handler may store into it). */
+static pd_cancel_flag caught;
 
 static void on_signal(int sig)
 {
-    caught = sig;
+    atomic_store(&caught, sig);
 }
 
 void signals_catch(pd_sim_options *options)
@@ -23,5 +25,6 @@ void signals_catch(pd_sim_options *options)
 
 int cli_interrupt_code(void)
 {
-    return 128 + (caught ? (int)caught : SIGINT);
+    int sig = atomic_load(&caught);
+    return 128 + (sig ? sig : SIGINT);
 }
