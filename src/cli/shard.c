@@ -185,6 +185,9 @@ static char *read_line(FILE *f)
         free(buf);
         return NULL;
     }
+    /* A shard copied through a Windows machine ends its lines in CR LF. */
+    if (buf && n > 0 && buf[n - 1] == '\r')
+        n--;
     if (buf)
         buf[n] = '\0';
     return buf;

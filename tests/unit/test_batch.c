@@ -55,18 +55,22 @@ static void test_merge_equals_run(void)
 }
 
 /* The side files: merge --transitions writes the unsharded run's chain; the
- * shards' --trials rows, sorted by drop, are the unsharded run's. */
+ * shards' --trials rows, sorted by drop, are the unsharded run's. A shard
+ * with CR LF line ends merges as well. */
 static void test_side_files(void)
 {
     char cmd[2048], *out, *err;
     snprintf(cmd, sizeof cmd,
              "(set -e; P=" BOX "; B=" PD_CLI_PATH "; D=%s\n"
              "$B -n 140 --initial stationary --transitions $D/t.csv --trials $D/tr.csv $P >/dev/null\n"
+             "$B -n 140 --initial stationary $P >$D/ts.csv\n"
              "for k in 1 2 3; do\n"
              "  $B -n 140 --initial stationary --shard $k/3 --trials $D/tr$k.csv $P >$D/ts$k.csv\n"
              "done\n"
              "$B merge --transitions $D/tm.csv $D/ts1.csv $D/ts2.csv $D/ts3.csv >/dev/null\n"
              "cmp $D/t.csv $D/tm.csv\n"
+             "sed 's/$/\\r/' $D/ts2.csv >$D/ts2crlf.csv\n"
+             "$B merge $D/ts1.csv $D/ts2crlf.csv $D/ts3.csv | cmp - $D/ts.csv\n"
              "(head -n 1 $D/tr.csv; cat $D/tr1.csv $D/tr2.csv $D/tr3.csv | grep -v '^drop' |"
              " sort -t, -k1,1n) | cmp - $D/tr.csv)", tmpdir);
     CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
