@@ -181,9 +181,14 @@ static void print_warning(void *user, const char *message)
 
 /* Axis-aligned normals come out with round-off components like 1e-17; print
  * them as 0 (and never as -0) so the CSV is stable and readable. */
-double cli_clean(double x)
+static double clean(double x)
 {
     return fabs(x) < PD_PRINT_ZERO ? 0.0 : x;
+}
+
+double cli_clean(double x)
+{
+    return clean(x);
 }
 
 /* A stationary shard adds the counts its merge needs to estimate the chain:
@@ -199,9 +204,9 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
     printf("\n");
     for (int i = 0; i < res->nposes; i++) {
         const pd_pose *p = &res->poses[i];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", i + 1, cli_clean(p->normal.x),
-               cli_clean(p->normal.y), cli_clean(p->normal.z), p->area, p->height,
-               cli_clean(p->p_qs), cli_clean(p->p_pqs));
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", i + 1, clean(p->normal.x),
+               clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(p->p_qs),
+               clean(p->p_pqs));
         if (sim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", sim->n, sim->count[i], sim->p[i],
                    sim->ci_lo[i], sim->ci_hi[i], sim->unsettled, sim->partial);
@@ -231,9 +236,8 @@ static void print_classes(const pd_static_result *res, const pd_sim_result *gsim
                 pqs += res->poses[i].p_pqs;
             }
         const pd_pose *p = &res->poses[first];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", c + 1, cli_clean(p->normal.x),
-               cli_clean(p->normal.y), cli_clean(p->normal.z), p->area, p->height, cli_clean(qs),
-               cli_clean(pqs));
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g", c + 1, clean(p->normal.x),
+               clean(p->normal.y), clean(p->normal.z), p->area, p->height, clean(qs), clean(pqs));
         if (gsim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", gsim->n, gsim->count[c], gsim->p[c],
                    gsim->ci_lo[c], gsim->ci_hi[c], gsim->unsettled, gsim->partial);
@@ -258,8 +262,8 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     for (int f = 0; f < res->nfacets; f++) {
         const pd_facet_result *r = &res->facets[f];
         pd_vec3 n = part->hull->normal[f];
-        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%d,%d,%d\n", f + 1, cli_clean(n.x),
-               cli_clean(n.y), cli_clean(n.z), r->area, r->height, r->p_raw, r->stable, r->knife,
+        printf("%d,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%d,%d,%d,%d,%d\n", f + 1, clean(n.x),
+               clean(n.y), clean(n.z), r->area, r->height, r->p_raw, r->stable, r->knife,
                r->next + 1, r->rest + 1, pose_of ? pose_of[r->rest] : 0);
     }
     free(pose_of);
