@@ -368,19 +368,21 @@ static void free_shards(void)
     nshard_files = 0;
 }
 
-/* The first word where two identities differ, for the message. */
-static void first_difference(const char *x, const char *y, char *out, size_t size)
+/* The first word where this shard's identity (x) differs from the first
+ * shard's (y), for the message. */
+static void first_difference(const char *x, const char *y, const char *yfile, char *out,
+                             size_t size)
 {
     while (*x == ' ' && *y == ' ') {
         size_t lx = strcspn(x + 1, " "), ly = strcspn(y + 1, " ");
         if (lx != ly || strncmp(x + 1, y + 1, lx) != 0) {
-            snprintf(out, size, "'%.*s' against '%.*s'", (int)ly, y + 1, (int)lx, x + 1);
+            snprintf(out, size, "it has '%.*s', %s '%.*s'", (int)lx, x + 1, yfile, (int)ly, y + 1);
             return;
         }
         x += 1 + lx;
         y += 1 + ly;
     }
-    snprintf(out, size, "their settings");
+    snprintf(out, size, "their settings differ");
 }
 
 /* The N shards of one run, each once, none partial. */
@@ -390,24 +392,19 @@ static int check_shards(void)
     char msg[1024], diff[600];
     for (int i = 1; i < nshard_files; i++) {
         const shard_file *s = &shards[i];
-        const char *what = NULL;
         if (strcmp(s->version, s0->version) != 0)
-            what = "posedrop version";
+            snprintf(msg, sizeof msg, "another posedrop version than %s: it is from posedrop %s, "
+                     "%s from %s", s0->file, s->version, s0->file, s0->version);
         else if (s->n != s0->n)
-            what = "shard count";
-        else if (strcmp(s->identity, s0->identity) != 0)
-            what = "run";
-        if (what) {
-            if (strcmp(what, "run") == 0)
-                first_difference(s->identity, s0->identity, diff, sizeof diff);
-            else if (strcmp(what, "shard count") == 0)
-                snprintf(diff, sizeof diff, "shard %d/%d against %d/%d", s0->k, s0->n, s->k, s->n);
-            else
-                snprintf(diff, sizeof diff, "'%s' against '%s'", s0->version, s->version);
-            snprintf(msg, sizeof msg, "not a shard of the same %s as %s: %s", what, s0->file,
-                     diff);
+            snprintf(msg, sizeof msg, "another shard count than %s: it is shard %d/%d, %s shard "
+                     "%d/%d", s0->file, s->k, s->n, s0->file, s0->k, s0->n);
+        else if (strcmp(s->identity, s0->identity) != 0) {
+            first_difference(s->identity, s0->identity, s0->file, diff, sizeof diff);
+            snprintf(msg, sizeof msg, "not a shard of the same run as %s: %s", s0->file, diff);
+        } else
+            msg[0] = '\0';
+        if (msg[0])
             return merge_fail(s->file, 0, msg);
-        }
         for (int j = 0; j < i; j++)
             if (shards[j].k == s->k) {
                 snprintf(msg, sizeof msg, "shard %d/%d again (already in %s)", s->k, s->n,
