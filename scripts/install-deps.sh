@@ -18,6 +18,8 @@ check_pc ccd libccd-dev
 check_pc bullet libbullet-dev
 check_pc qhull_r libqhull-dev
 command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
+# A JSON parser for the test of --format json: Python's json module, or jq.
+command -v python3 >/dev/null 2>&1 || command -v jq >/dev/null 2>&1 || missing="$missing jq"
 # Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart);
 # 'mpi' stands for OpenMPI's compiler wrappers and launcher (make MPI=1).
 for arg in "$@"; do
