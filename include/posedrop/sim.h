@@ -54,7 +54,7 @@ typedef struct pd_scene {
 void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
- * height, belt_speed (or v), mu, restitution, restitution_law
+ * height, belt_speed, mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
  * (uniform|bootstrap|stationary), gravity, contact_time (s). PD_ERR_USAGE for
  * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
@@ -62,7 +62,7 @@ void pd_scene_default(pd_scene *scene);
 pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
 
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
- * what it holds. Errors name the file and line. */
+ * what it holds; a key set twice is refused. Errors name the file and line. */
 pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag);
 
 /* How a drop ended. */

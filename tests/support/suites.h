@@ -13,6 +13,7 @@
     PD_SUITE(descent_map) \
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
+    PD_SUITE(number) \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \

@@ -137,6 +137,15 @@ static void test_usage(void)
     CHECK_INT(run("--help", &out, &err), 0);
     CHECK(strstr(out, "usage: posedrop") != NULL);
     CHECK(strstr(out, "--epsilon") != NULL);
+    /* The help is generated from the option table: each option listed once
+     * (a value counted as an option when getopt takes it). */
+    const char *listed[] = {"--units U", "--com X,Y,Z", "-n N", "-j THREADS", "-h H", "-v V",
+                            "--seed S", "--scene FILE", "--trials FILE", "--transitions FILE",
+                            "--contact-time S", "--initial I", "--version"};
+    for (size_t i = 0; i < sizeof listed / sizeof listed[0]; i++) {
+        const char *at = strstr(out, listed[i]);
+        CHECK(at != NULL && strstr(at + 1, listed[i]) == NULL);
+    }
     free(out);
     free(err);
     CHECK_INT(run("--version", &out, &err), 0);
@@ -171,6 +180,34 @@ static void test_usage(void)
     expect_failure("--com 1,2,inf parts/cap.off", 2, "--com");
     expect_failure("--topple sideways parts/cap.off", 2, "--topple");
     expect_failure("parts/cap.off --epsilon", 2, "needs a value");
+
+    /* One reading of numbers for every option (base/number.c): 1e-400 is
+     * refused alike, with the range stated; so is every out-of-range value. */
+    const char *tiny[] = {"-h 1e-400", "--mu 1e-400", "--vibration 1e-400", "--epsilon 1e-400",
+                          "--ci 1e-400", "--dt 1e-400", "--com 1e-400,0,0", "-v 1e-400"};
+    for (size_t i = 0; i < sizeof tiny / sizeof tiny[0]; i++) {
+        char args[128];
+        snprintf(args, sizeof args, "%s parts/cap.off", tiny[i]);
+        expect_failure(args, 2, "below the smallest normal double, 2.2e-308");
+    }
+    expect_failure("-v 1e308 parts/cap.off", 2, "from -1000 to 1000, got '1e308'");
+    expect_failure("--seed 9223372036854775808 parts/cap.off", 2,
+                   "from 0 to 9223372036854775807, got '9223372036854775808'");
+    expect_failure("--epsilon 91 parts/cap.off", 2, "from 0 to 90, got '91'");
+    expect_failure("--ci 0.5 -n 10 parts/cap.off", 2, "above 0 and below 0.5");
+    expect_failure("-n 1e3 parts/cap.off", 2, "-n: expected a number of drops from 1 to 1000000000");
+    /* A blank at either end is accepted alike (the same table either way). */
+    char *o1, *e1, *o2, *e2;
+    CHECK_INT(run("--epsilon ' 5' parts/cap.off", &o1, &e1), 0);
+    CHECK_INT(run("--epsilon '5 ' parts/cap.off", &o2, &e2), 0);
+    CHECK(strcmp(o1, o2) == 0 && strlen(o1) > 0);
+    free(o1);
+    free(e1);
+    free(o2);
+    free(e2);
+    /* The unknown option is named, not the program. */
+    expect_failure("-Xn 5 parts/cap.off", 2, "unknown option '-X'");
+    expect_failure("--group=1 parts/cap.off", 2, "option '--group' takes no value");
 }
 
 static void test_bad_input(void)
