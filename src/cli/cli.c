@@ -13,6 +13,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include "base/number.h" /* one reading of numbers, shared with scene files */
 #include "posedrop/posedrop.h"
 
@@ -111,22 +113,116 @@ static const char *end_name(pd_drop_end e)
     }
 }
 
-/* The side files (--trials, --transitions): opened with a message on
- * failure, closed with every write error caught. */
-static FILE *open_output(const char *path)
+/* A side file (--trials, --transitions). It is made ready before any work,
+ * so that a path that cannot be written fails at once (exit 2, nothing on
+ * stdout). A regular file, or one that does not exist yet, is written to a
+ * temporary file in its directory and renamed onto its path only once every
+ * byte is written: a failed or interrupted run never leaves a truncated file
+ * that looks like a result, nor destroys the one it would replace. Anything
+ * else (a device such as /dev/stdout, a pipe) is opened and written as it
+ * is; a write error there (/dev/full) is caught when it is closed. */
+typedef struct {
+    const char *path;
+    char *target; /* where the temporary is renamed to (a symbolic link resolved) */
+    char *tmp;    /* NULL when path is written directly */
+    FILE *f;
+} out_file;
+
+static int out_fail(const char *path, const char *why)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
-        fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, strerror(errno));
-    return f;
+    fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, why);
+    return 0;
 }
 
-static int close_output(FILE *f, const char *path)
+static int out_open(out_file *o, const char *path)
 {
-    int ok = fflush(f) == 0 && !ferror(f);
-    ok &= fclose(f) == 0;
+    memset(o, 0, sizeof *o);
+    o->path = path;
+    struct stat sb;
+    int exists = stat(path, &sb) == 0;
+    if (exists && S_ISDIR(sb.st_mode))
+        return out_fail(path, "is a directory");
+    if (exists && !S_ISREG(sb.st_mode)) {
+        if (!(o->f = fopen(path, "w")))
+            return out_fail(path, strerror(errno));
+        return 1;
+    }
+    if (exists && access(path, W_OK) != 0)
+        return out_fail(path, strerror(errno));
+    /* A link to a file is followed, as opening it would be. */
+    o->target = exists ? realpath(path, NULL) : strdup(path);
+    if (!o->target)
+        return out_fail(path, strerror(errno));
+    const char *slash = strrchr(o->target, '/');
+    int dirlen = slash ? (int)(slash - o->target) + 1 : 0;
+    size_t size = strlen(o->target) + 32;
+    o->tmp = malloc(size);
+    if (!o->tmp)
+        return out_fail(path, "out of memory");
+    snprintf(o->tmp, size, "%.*s.%s.posedrop-XXXXXX", dirlen, o->target,
+             slash ? slash + 1 : o->target);
+    int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        int err = errno;
+        free(o->tmp);
+        o->tmp = NULL;
+        /* Name the directory: the file itself was never the problem. */
+        char why[512];
+        struct stat db;
+        int isdir = snprintf(why, sizeof why, "%.*s", dirlen ? dirlen : 1, dirlen ? o->target : ".") > 0 &&
+                    stat(why, &db) == 0 && S_ISDIR(db.st_mode);
+        if (isdir)
+            snprintf(why, sizeof why, "cannot create a file in %.*s: %s", dirlen ? dirlen : 1,
+                     dirlen ? o->target : ".", strerror(err));
+        else
+            snprintf(why, sizeof why, "no such directory %.*s", dirlen ? dirlen : 1,
+                     dirlen ? o->target : ".");
+        return out_fail(path, why);
+    }
+    /* mkstemp makes the file private; give it the mode a new file gets. */
+    mode_t mask = umask(0);
+    umask(mask);
+    if (fchmod(fd, exists ? sb.st_mode & 07777 : 0666 & ~mask) != 0 || !(o->f = fdopen(fd, "w"))) {
+        int err = errno;
+        close(fd);
+        unlink(o->tmp);
+        free(o->tmp);
+        o->tmp = NULL;
+        return out_fail(path, strerror(err));
+    }
+    return 1;
+}
+
+/* Drops what was written (on any failure of the run). */
+static void out_abort(out_file *o)
+{
+    if (o->f)
+        fclose(o->f);
+    if (o->tmp)
+        unlink(o->tmp);
+    free(o->tmp);
+    free(o->target);
+    memset(o, 0, sizeof *o);
+}
+
+/* Closes with every write error caught, then puts the file in place. */
+static int out_commit(out_file *o)
+{
+    int ok = fflush(o->f) == 0 && !ferror(o->f);
+    int err = errno;
+    ok &= fclose(o->f) == 0;
+    o->f = NULL;
+    if (ok && o->tmp && rename(o->tmp, o->target) != 0) {
+        err = errno;
+        ok = 0;
+    }
     if (!ok)
-        fprintf(stderr, "%s: %s: write error\n", prog, path);
+        fprintf(stderr, "%s: %s: write error: %s\n", prog, o->path, strerror(err ? err : EIO));
+    if (ok) {
+        free(o->tmp);
+        o->tmp = NULL;
+    }
+    out_abort(o);
     return ok;
 }
 
@@ -134,11 +230,8 @@ static int close_output(FILE *f, const char *path)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static int write_trials(const char *path, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
 {
-    FILE *f = open_output(path);
-    if (!f)
-        return 0;
     fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
@@ -149,17 +242,13 @@ static int write_trials(const char *path, const pd_sim_result *sim, const int *c
             fprintf(f, ",%d", t->pose + 1);
         fputc('\n', f);
     }
-    return close_output(f, path);
 }
 
 /* The stationary estimator's chain in long format: row 0 is the uniform
  * drops (mu0), rows 1..k the poses (P); every pair is written, zeros
  * included, so the file is the whole matrix. */
-static int write_transitions(const char *path, const pd_sim_result *sim)
+static void write_transitions(FILE *f, const pd_sim_result *sim)
 {
-    FILE *f = open_output(path);
-    if (!f)
-        return 0;
     int k = sim->nposes;
     fprintf(f, "from_pose,to_pose,count,p\n");
     for (int i = 0; i <= k; i++) {
@@ -171,7 +260,6 @@ static int write_transitions(const char *path, const pd_sim_result *sim)
             fprintf(f, "%d,%d,%ld,%.10g\n", i, j + 1, row[j],
                     total ? (double)row[j] / (double)total : 0.0);
     }
-    return close_output(f, path);
 }
 
 typedef struct {
@@ -732,6 +820,14 @@ int main(int argc, char **argv)
     if (code >= 0)
         return code;
 
+    /* Output paths first: a run never does its work only to fail writing. */
+    out_file trials_out = {0}, transitions_out = {0};
+    if ((a.trials && !out_open(&trials_out, a.trials)) ||
+        (a.transitions && !out_open(&transitions_out, a.transitions))) {
+        out_abort(&trials_out);
+        return EXIT_USAGE;
+    }
+
     pd_diag diag;
     pd_diag_init(&diag);
     diag.warn = print_warning;
@@ -767,6 +863,17 @@ int main(int argc, char **argv)
         code = fail_status(st, &diag, a.path);
         goto done;
     }
+    /* The side files before stdout: if one cannot be written in full (a
+     * full disk, /dev/full), the run fails with nothing on stdout. */
+    if (trials_out.f)
+        write_trials(trials_out.f, sim, class_of);
+    if (transitions_out.f)
+        write_transitions(transitions_out.f, gsim ? gsim : sim);
+    if ((trials_out.f && !out_commit(&trials_out)) ||
+        (transitions_out.f && !out_commit(&transitions_out))) {
+        code = EXIT_INTERNAL;
+        goto done;
+    }
     if (a.verbose)
         print_summary(&a, part, res);
     if (sim)
@@ -780,13 +887,11 @@ int main(int argc, char **argv)
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
     if (code)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
-    if (sim && a.trials && !write_trials(a.trials, sim, class_of))
-        code = EXIT_INTERNAL;
-    if (sim && a.transitions && !write_transitions(a.transitions, gsim ? gsim : sim))
-        code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
         code = EXIT_INTERRUPTED;
 done:
+    out_abort(&trials_out);
+    out_abort(&transitions_out);
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include "check.h"
@@ -385,6 +386,57 @@ static void test_dynamic(void)
     expect_failure(args, 2, where);
 }
 
+/* Output paths are checked before any work: a bad one fails with exit 2
+ * and nothing on stdout even when the part itself would fail later (so the
+ * part is never read), a write error at the end (/dev/full) fails with
+ * nothing on stdout, and a failed run leaves an existing file as it was. */
+static void test_output_paths(void)
+{
+    char args[512], path[160], dir[160];
+    snprintf(dir, sizeof dir, "%s/adir", tmpdir);
+    CHECK(mkdir(dir, 0755) == 0);
+    const char *bad[][2] = {{"/proc/x", "cannot create a file in /proc"},
+                            {"/nonexistent/dir/t.csv", "no such directory /nonexistent/dir"},
+                            {dir, "is a directory"}};
+    for (int i = 0; i < 3; i++) {
+        snprintf(args, sizeof args, "-n 20 --trials %s /nonexistent/part.off", bad[i][0]);
+        expect_failure(args, 2, bad[i][1]);
+        snprintf(args, sizeof args, "-n 400 --initial stationary --transitions %s "
+                 "/nonexistent/part.off", bad[i][0]);
+        expect_failure(args, 2, bad[i][1]);
+    }
+    expect_failure("-n 20 --trials /dev/full parts/cap.off", 1, "/dev/full: write error");
+    expect_failure("-n 140 --initial stationary --transitions /dev/full parts/canonical/cube.off",
+                   1, "/dev/full: write error");
+
+    /* An existing file survives a failed run whole, and a good run replaces
+     * it keeping its permissions, with no temporary left beside it. */
+    snprintf(path, sizeof path, "%s/keep.csv", tmpdir);
+    write_file(path, "earlier results\n");
+    CHECK(chmod(path, 0640) == 0);
+    snprintf(args, sizeof args, "-n 5 --trials %s /nonexistent/part.off", path);
+    expect_failure(args, 2, "/nonexistent/part.off");
+    char *t = slurp(path);
+    CHECK(t && strcmp(t, "earlier results\n") == 0);
+    free(t);
+    char *out, *err;
+    snprintf(args, sizeof args, "-n 5 --trials %s parts/cap.off", path);
+    CHECK_INT(run(args, &out, &err), 0);
+    free(out);
+    free(err);
+    t = slurp(path);
+    CHECK(t && strncmp(t, "drop,qw,", 8) == 0);
+    free(t);
+    struct stat sb;
+    CHECK(stat(path, &sb) == 0 && (sb.st_mode & 0777) == 0640);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "ls -A %s | grep -c posedrop-", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 1); /* grep -c: no line matched */
+    CHECK(strncmp(out, "0", 1) == 0);
+    free(out);
+    free(err);
+}
+
 /* eq16.awk, fed the paper's own columns, must reproduce the errors the paper
  * publishes (Table 1, the cap: QS 10.1, PQS 1.2, dynamic 4.0; Table 4, the
  * square button: 17.2, 10.7, 4.8), to the tables' 0.05 rounding. */
@@ -751,6 +803,7 @@ void suite_cli(void)
     test_bad_input();
     test_results();
     test_dynamic();
+    test_output_paths();
     test_eq16();
     test_scripts();
     test_group();
