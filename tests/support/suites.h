@@ -14,6 +14,7 @@
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
     PD_SUITE(number) \
+    PD_SUITE(input)  \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \
