@@ -19,6 +19,50 @@ static void expect(pd_status got, pd_status want, const pd_diag *d, const char *
     CHECK(strstr(d->message, mention) != NULL);
 }
 
+/* ASCII STL told from binary by structure, not by its first bytes: a
+ * comment line before "solid" or a NUL byte further on used to send it to the
+ * binary reader ("declares 544761204 triangles"). */
+static void test_stl_kind(void)
+{
+    static const char tetra[] =
+        "solid t\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\n"
+        "endsolid t\n";
+    char text[1024];
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    /* A comment line first: read as ASCII, by content and by format. */
+    snprintf(text, sizeof text, "# exported by a tool\n%s", tetra);
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    for (int forced = 0; forced < 2; forced++) {
+        ro.format = forced ? PD_FORMAT_STL : PD_FORMAT_AUTO;
+        CHECK_STATUS(pd_mesh_parse(text, strlen(text), "c.stl", &ro, &m, &d), PD_OK);
+        CHECK(m && m->ntris == 4 && m->nverts == 4);
+        pd_mesh_free(m);
+        m = NULL;
+    }
+    /* A NUL byte on line 5: named, as ASCII STL. */
+    size_t n = strlen(tetra);
+    memcpy(text, tetra, n);
+    char *v = strstr(text, "vertex 0 1 0");
+    v[8] = '\0';
+    expect(pd_mesh_parse(text, n, "n.stl", NULL, &m, &d), PD_ERR_PARSE, &d,
+           "n.stl:5: a NUL byte in ASCII STL");
+    /* A binary STL whose header says "solid" is still binary; cut short, it
+     * is a truncated binary STL, not bad text. */
+    unsigned char bin[84 + 50] = "solid binary header";
+    bin[80] = 2;
+    ro.format = PD_FORMAT_STL;
+    expect(pd_mesh_parse(bin, sizeof bin, "b.stl", &ro, &m, &d), PD_ERR_PARSE, &d,
+           "truncated binary STL");
+    CHECK(m == NULL);
+}
+
 void suite_input(void)
 {
     pd_mesh *m = NULL;
@@ -79,4 +123,5 @@ void suite_input(void)
     expect(pd_mesh_parse(stl, sizeof stl, "big.stl", &ro, &m, &d), PD_ERR_RANGE, &d,
            "the limit is 67108864");
     CHECK(m == NULL);
+    test_stl_kind();
 }
