@@ -371,7 +371,8 @@ static const cli_option options[] = {
      "0..180 (1.5)"},
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
-     "0..1 (a material property; 0: rigid, the paper's model)"},
+     "0..1 (a material property; 5e-4, a plastic part on a rubber\n"
+     "belt; 0: rigid, the paper's model)"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -784,8 +785,9 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit) and "
                         "are in no count\n", prog, a->path, sim->unsettled, sim->n);
     if (sim->energy_gain)
-        fprintf(stderr, "%s: %s: %ld collisions would have added kinetic energy under Poisson's "
-                        "law and were resolved by the energetic law\n", prog, a->path,
+        fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
+                        "friction, resolved by the energetic law; or a compliant impact's step, "
+                        "scaled back)\n", prog, a->path,
                 sim->energy_gain);
     if (sim->fallbacks)
         fprintf(stderr, "%s: %s: %ld of %ld collisions could not be integrated to the end and "
