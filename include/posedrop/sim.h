@@ -130,9 +130,12 @@ typedef struct pd_sim_result {
                                last rounds' initial and final distributions */
     pd_trial *trials;       /* n records when options->keep_trials, else NULL */
     /* PD_INITIAL_STATIONARY only (otherwise 0 and NULL): */
-    long first_drops;       /* drops 0 .. first_drops-1 start from uniform orientations */
-    long pose_drops;        /* then this many start resting on each pose, interleaved:
-                               drop first_drops + t rests on pose t mod nposes */
+    long first_drops;       /* drops that start from uniform orientations */
+    long pose_drops;        /* drops that start resting on each pose. Interleaved
+                               from the start: drop i < (nposes + 1) pose_drops
+                               is uniform when i mod (nposes + 1) is 0 and rests
+                               on pose i mod (nposes + 1) - 1 otherwise; the
+                               drops after those are uniform */
     long *first_count;      /* nposes: uniform drops that settled in each pose (mu0's counts) */
     long *transitions;      /* nposes * nposes, row-major: [i * nposes + j] = drops started
                                resting on pose i that settled in pose j */

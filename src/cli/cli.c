@@ -383,7 +383,9 @@ static const cli_option options[] = {
      "many) start uniform and give the first drop's outcome mu0;\n"
      "p = lim (1/T) sum_{t<T} mu0 P^t, solved exactly, with 95%\n"
      "intervals from 1000 multinomial redraws of mu0 and P.\n"
-     "Needs N >= 10 (k+1); does not go with --ci"},
+     "Needs N >= 10 (k+1); does not go with --ci. The uniform\n"
+     "and resting drops are interleaved from the first drop, so\n"
+     "an interrupted run has both in proportion"},
     {OPT_SCENE, "scene", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
