@@ -829,6 +829,7 @@ int main(int argc, char **argv)
     if ((a.trials && !out_open(&trials_out, a.trials)) ||
         (a.transitions && !out_open(&transitions_out, a.transitions))) {
         out_abort(&trials_out);
+        out_abort(&transitions_out);
         return EXIT_USAGE;
     }
 
