@@ -9,6 +9,7 @@
 #include "base/fail.h"
 #include "base/number.h"
 #include "posedrop/sim.h"
+#include "sim/scene.h"
 
 void pd_scene_default(pd_scene *s)
 {
@@ -157,15 +158,12 @@ static pd_status read_whole(const char *path, char **out, size_t *size, pd_diag 
     return PD_OK;
 }
 
-pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
+/* Parses the lines of buf (size bytes, NUL-terminated at size, edited in
+ * place) into scene; name is for messages. */
+static pd_status parse_lines(char *buf, size_t size, const char *path, pd_scene *scene,
+                             pd_diag *diag)
 {
-    if (!path || !scene)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_scene_read: NULL %s", path ? "scene" : "path");
-    char *buf = NULL;
-    size_t size = 0;
-    pd_status st = read_whole(path, &buf, &size, diag);
-    if (st != PD_OK)
-        return st;
+    pd_status st = PD_OK;
     pd_scene s = *scene; /* a failure leaves the caller's scene untouched */
     int set_on[NKEYS] = {0}; /* line of each key's setting, to refuse a second one */
     char *p = buf, *end = buf + size;
@@ -211,8 +209,39 @@ pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
         else
             set_on[k] = lineno;
     }
-    free(buf);
     if (st == PD_OK)
         *scene = s;
+    return st;
+}
+
+pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
+{
+    if (!path || !scene)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_scene_read: NULL %s", path ? "scene" : "path");
+    char *buf = NULL;
+    size_t size = 0;
+    pd_status st = read_whole(path, &buf, &size, diag);
+    if (st == PD_OK)
+        st = parse_lines(buf, size, path, scene, diag);
+    free(buf);
+    return st;
+}
+
+pd_status pd_scene_parse(const void *data, size_t size, const char *name, pd_scene *scene,
+                         pd_diag *diag)
+{
+    if ((!data && size) || !scene)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_scene_parse: NULL %s", scene ? "data" : "scene");
+    if (size > SCENE_MAX_BYTES)
+        return pd_fail(diag, PD_ERR_RANGE, "%s: longer than %d bytes: not a scene file",
+                       name ? name : "<memory>", SCENE_MAX_BYTES);
+    char *buf = malloc(size + 1);
+    if (!buf)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+    if (size)
+        memcpy(buf, data, size);
+    buf[size] = '\0';
+    pd_status st = parse_lines(buf, size, name ? name : "<memory>", scene, diag);
+    free(buf);
     return st;
 }

@@ -15,6 +15,7 @@
     PD_SUITE(stats)  \
     PD_SUITE(number) \
     PD_SUITE(input)  \
+    PD_SUITE(fuzz_replay) \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \
