@@ -138,6 +138,8 @@ static int out_open(out_file *o, const char *path)
 {
     memset(o, 0, sizeof *o);
     o->path = path;
+    if (!*path)
+        return out_fail("''", "an empty file name");
     struct stat sb;
     int exists = stat(path, &sb) == 0;
     if (exists && S_ISDIR(sb.st_mode))

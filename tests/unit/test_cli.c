@@ -405,6 +405,7 @@ static void test_output_paths(void)
                  "/nonexistent/part.off", bad[i][0]);
         expect_failure(args, 2, bad[i][1]);
     }
+    expect_failure("-n 20 --trials '' /nonexistent/part.off", 2, "an empty file name");
     expect_failure("-n 20 --trials /dev/full parts/cap.off", 1, "/dev/full: write error");
     expect_failure("-n 140 --initial stationary --transitions /dev/full parts/canonical/cube.off",
                    1, "/dev/full: write error");
