@@ -655,6 +655,20 @@ static int take(cli_args *a, const cli_option *o, const char *arg)
     return apply(a, o, arg, x, n, k);
 }
 
+/* "--re": a prefix of more than one long name, which getopt refuses without
+ * saying why. */
+static int ambiguous(const char *arg)
+{
+    if (strncmp(arg, "--", 2) != 0)
+        return 0;
+    size_t n = strcspn(arg + 2, "=");
+    int matches = 0;
+    for (int i = 0; i < NOPTIONS; i++)
+        matches += options[i].kind != ARG_HEADING && options[i].name &&
+                   strncmp(options[i].name, arg + 2, n) == 0;
+    return matches > 1;
+}
+
 /* Returns -1 to go on, or an exit code. */
 static int parse_args(int argc, char **argv, cli_args *a)
 {
@@ -695,7 +709,10 @@ static int parse_args(int argc, char **argv, cli_args *a)
             return fail_usage("unknown option '%s'", name);
         }
         if (c == '?' || !o)
-            return fail_usage("unknown option '%s'", argv[optind - 1]);
+            return fail_usage(ambiguous(argv[optind - 1])
+                                  ? "option '%s' is the start of more than one option's name"
+                                  : "unknown option '%s'",
+                              argv[optind - 1]);
         code = take(a, o, optarg);
     }
     if (code >= 0)

@@ -209,6 +209,7 @@ static void test_usage(void)
     /* The unknown option is named, not the program. */
     expect_failure("-Xn 5 parts/cap.off", 2, "unknown option '-X'");
     expect_failure("--group=1 parts/cap.off", 2, "option '--group' takes no value");
+    expect_failure("--re 1 parts/cap.off", 2, "'--re' is the start of more than one option's name");
 }
 
 static void test_bad_input(void)
