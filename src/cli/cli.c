@@ -10,6 +10,7 @@
 #include <limits.h>
 #include <math.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -619,7 +620,7 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         usage(stdout);
         return 0;
     case OPT_VERSION:
-        printf("posedrop %s\n", PD_VERSION_STRING);
+        printf("posedrop %s\n", pd_version());
         return 0;
     default: break;
     }
@@ -828,12 +829,12 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
-static volatile sig_atomic_t interrupted;
+static atomic_int interrupted;
 
 static void on_sigint(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
 }
 
 int main(int argc, char **argv)
@@ -842,6 +843,16 @@ int main(int argc, char **argv)
     int code = parse_args(argc, argv, &a);
     if (code >= 0)
         return code;
+
+    pd_diag diag;
+    pd_diag_init(&diag);
+    diag.warn = print_warning;
+    /* The command offers every engine: it links libposedrop-bullet. */
+    pd_status st = pd_bullet_register();
+    if (st != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine: %s\n", prog, pd_status_str(st));
+        return EXIT_INTERNAL;
+    }
 
     /* Output paths first: a run never does its work only to fail writing. */
     out_file trials_out = {0}, transitions_out = {0};
@@ -852,16 +863,12 @@ int main(int argc, char **argv)
         return EXIT_USAGE;
     }
 
-    pd_diag diag;
-    pd_diag_init(&diag);
-    diag.warn = print_warning;
-
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
     int *class_of = NULL, nclasses = 0;
-    pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
+    st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;

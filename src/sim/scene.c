@@ -2,6 +2,7 @@
  * and their text form, shared by scene files and the command line. */
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,10 +27,27 @@ void pd_scene_default(pd_scene *s)
 
 typedef struct {
     const char *key;
-    double *field;
-    double scale; /* text value times scale is stored (degrees -> rad) */
+    size_t field;  /* offsetof the double in pd_scene */
+    double scale;  /* text value times scale is stored (degrees -> rad) */
     pd_num_rule rule;
 } numeric_key;
+
+/* Ranges: a drop needs a non-negative height and positive gravity; friction
+ * beyond 10 is no longer a material (the tests go to 10); restitution above 1
+ * would create energy; vibration is a tilt. The same table checks the text
+ * (pd_scene_set) and a scene filled in by a program (pd_scene_check). */
+#define REAL(what, lo, hi) {what, 0, lo, hi, 0, 0, 0, 0}
+static const numeric_key keys[] = {
+    {"height", offsetof(pd_scene, height), 1.0, REAL("a drop height in m", 0.0, 1e3)},
+    {"belt_speed", offsetof(pd_scene, belt_speed), 1.0, REAL("a belt speed in m/s", -1e3, 1e3)},
+    {"mu", offsetof(pd_scene, mu), 1.0, REAL("a friction coefficient", 0.0, 10.0)},
+    {"restitution", offsetof(pd_scene, restitution), 1.0, REAL("a restitution", 0.0, 1.0)},
+    {"vibration", offsetof(pd_scene, vibration), M_PI / 180.0,
+     REAL("an angle in degrees", 0.0, 180.0)},
+    {"gravity", offsetof(pd_scene, gravity), 1.0, REAL("an acceleration in m/s^2", 1e-3, 1e3)},
+    {"contact_time", offsetof(pd_scene, contact_time), 1.0, REAL("a duration in s", 0.0, 1.0)},
+};
+enum { NNUMERIC = sizeof keys / sizeof keys[0] };
 
 /* Every key a scene accepts, for messages and duplicate checks. */
 static const char *const scene_keys[] = {"height", "belt_speed", "mu", "restitution",
@@ -45,23 +63,46 @@ static int key_index(const char *key)
     return -1;
 }
 
+static double *field(pd_scene *s, const numeric_key *k)
+{
+    return (double *)(void *)((char *)s + k->field);
+}
+
+pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag)
+{
+    if (!scene)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_scene_check: NULL scene");
+    for (int i = 0; i < NNUMERIC; i++) {
+        const numeric_key *k = &keys[i];
+        double v = *field((pd_scene *)scene, k);
+        /* The stored value is the text's times scale, rounded; rounding is
+         * monotonic, so lo * scale and hi * scale bound exactly what
+         * pd_scene_set accepts. The message is the text's, in its unit. */
+        int bad = !isfinite(v) ? PD_NUM_NONFINITE
+                  : v < k->rule.lo * k->scale || v > k->rule.hi * k->scale ? PD_NUM_RANGE
+                                                                           : PD_NUM_OK;
+        if (bad != PD_NUM_OK) {
+            char text[32], msg[PD_DIAG_MESSAGE_LEN];
+            snprintf(text, sizeof text, "%.17g", v / k->scale);
+            pd_num_message(msg, sizeof msg, &k->rule, text, bad);
+            return pd_fail(diag, bad == PD_NUM_RANGE ? PD_ERR_RANGE : PD_ERR_NONFINITE,
+                           "scene %s: %s", k->key, msg);
+        }
+    }
+    if ((unsigned)scene->law > (unsigned)PD_RESTITUTION_ENERGETIC)
+        return pd_fail(diag, PD_ERR_RANGE, "scene restitution_law is %d: expected "
+                       "PD_RESTITUTION_POISSON or PD_RESTITUTION_ENERGETIC", (int)scene->law);
+    if ((unsigned)scene->initial > (unsigned)PD_INITIAL_STATIONARY)
+        return pd_fail(diag, PD_ERR_RANGE, "scene initial is %d: expected PD_INITIAL_UNIFORM, "
+                       "PD_INITIAL_BOOTSTRAP or PD_INITIAL_STATIONARY", (int)scene->initial);
+    return PD_OK;
+}
+
 pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag *diag)
 {
     if (!s || !key || !value)
         return pd_fail(diag, PD_ERR_USAGE, "pd_scene_set: NULL %s", !s ? "scene" : !key ? "key" : "value");
-    /* Ranges: a drop needs a non-negative height and positive gravity;
-     * friction beyond 10 is no longer a material (the tests go to 10);
-     * restitution above 1 would create energy; vibration is a tilt. */
-    const numeric_key keys[] = {
-        {"height", &s->height, 1.0, {"a drop height in m", 0, 0.0, 1e3, 0, 0, 0, 0}},
-        {"belt_speed", &s->belt_speed, 1.0, {"a belt speed in m/s", 0, -1e3, 1e3, 0, 0, 0, 0}},
-        {"mu", &s->mu, 1.0, {"a friction coefficient", 0, 0.0, 10.0, 0, 0, 0, 0}},
-        {"restitution", &s->restitution, 1.0, {"a restitution", 0, 0.0, 1.0, 0, 0, 0, 0}},
-        {"vibration", &s->vibration, M_PI / 180.0, {"an angle in degrees", 0, 0.0, 180.0, 0, 0, 0, 0}},
-        {"gravity", &s->gravity, 1.0, {"an acceleration in m/s^2", 0, 1e-3, 1e3, 0, 0, 0, 0}},
-        {"contact_time", &s->contact_time, 1.0, {"a duration in s", 0, 0.0, 1.0, 0, 0, 0, 0}},
-    };
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+    for (int i = 0; i < NNUMERIC; i++) {
         if (strcmp(key, keys[i].key) != 0)
             continue;
         double v;
@@ -73,7 +114,7 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
                                                                              : PD_ERR_RANGE,
                            "%s: %s", key, msg);
         }
-        *keys[i].field = v * keys[i].scale;
+        *field(s, &keys[i]) = v * keys[i].scale;
         return PD_OK;
     }
     if (strcmp(key, "restitution_law") == 0) {

@@ -2,7 +2,7 @@
  * closed forms, its resampling intervals, and --initial stationary end to end
  * on the cube. */
 #include <pthread.h>
-#include <signal.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
@@ -265,14 +265,14 @@ static pd_sim_result *run_stationary(const pd_part *part, const pd_static_result
     return r;
 }
 
-static volatile sig_atomic_t stop_flag;
+static atomic_int stop_flag;
 
 static void *stop_soon(void *arg)
 {
     (void)arg;
     struct timespec ts = {0, 300000000};
     nanosleep(&ts, NULL);
-    stop_flag = 1;
+    atomic_store(&stop_flag, 1);
     return NULL;
 }
 
@@ -290,7 +290,7 @@ static void test_interrupted(const pd_part *part, const pd_static_result *poses)
     pd_sim_options_default(&o);
     o.ndrops = 7000000;
     o.threads = 2;
-    stop_flag = 0;
+    atomic_store(&stop_flag, 0);
     o.cancel = &stop_flag;
     pthread_t t;
     CHECK(pthread_create(&t, NULL, stop_soon, NULL) == 0);
@@ -396,7 +396,7 @@ static void test_cube(void)
     /* Cancelled before the first drop: partial, raw counts, no NaN. */
     pd_sim_options_default(&o);
     o.ndrops = 700;
-    volatile sig_atomic_t stop = 1;
+    atomic_int stop = 1;
     o.cancel = &stop;
     r = NULL;
     CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_OK);
