@@ -2,6 +2,7 @@
  * shapes, parts far from the origin, the supported range of sizes, and the
  * refusals beyond them (docs/limits.md). */
 #include <float.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -131,7 +132,115 @@ static void test_flat_pyramids(void)
     CHECK(answered >= 2 * 62 * 12);
 }
 
+/* A unit cube's corners and m points on each face (drawn from rng): on the
+ * face planes exactly, wherever the coordinates are exact. */
+static int cube_with_face_points(test_rng *rng, int m, pd_vec3 *p)
+{
+    int n = pts_box(1, 1, 1, p);
+    for (int f = 0; f < 6; f++)
+        for (int i = 0; i < m; i++) {
+            double a = rng_range(rng, -0.5, 0.5), b = rng_range(rng, -0.5, 0.5);
+            double c = (f & 1) ? 0.5 : -0.5;
+            p[n++] = f < 2 ? v3(c, a, b) : f < 4 ? v3(a, c, b) : v3(a, b, c);
+        }
+    return n;
+}
+
+/* A 1 um cube with points on its faces, turned at random and placed 1e6 m
+ * from the origin (1e12 times its size), as in issue 18: its coordinates are
+ * rounded in steps of 1.2e-10 m, 1e-4 of its size, so its faces carry bumps
+ * of that size, but its heights must not carry that much again: computed in
+ * the file's frame they did (links "rising" by one step, exit 1). In the
+ * part's frame the estimate answers, each face near 1/6 (the bumps move the
+ * centre and the faces by ~1e-4 L: 1e-3 leaves a margin of 10; a face the
+ * bumps split counts with its pieces), and warns once that the coordinates
+ * are coarse. */
+static void test_far_part(void)
+{
+    int bad = 0;
+    for (int seed = 1; seed <= 20; seed++) {
+        test_rng rng = {(uint64_t)seed};
+        pd_vec3 p[8 + 6 * 5];
+        int n = cube_with_face_points(&rng, 5, p);
+        double R[3][3];
+        rng_rotation(&rng, R);
+        points_transform(p, n, CR(R), 1e-6, v3(1e6, 0.7e6, -0.3e6));
+        pd_part *part = NULL;
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_status st = part_of_points(p, n, &part, &d);
+        pd_static_result *r = NULL;
+        if (st == PD_OK)
+            st = pd_static_estimate(part, NULL, &r, &d);
+        int ok = st == PD_OK && d.nwarnings == 1;
+        double sum = 0.0, face[6] = {0, 0, 0, 0, 0, 0};
+        for (int i = 0; ok && i < r->nposes; i++) {
+            /* A face whose bumps split it rests on either piece: its
+             * poses' normals lie within ~1e-4 rad of the face's. */
+            int k = -1;
+            for (int j = 0; j < 6; j++) {
+                pd_vec3 e = v3(j / 2 == 0, j / 2 == 1, j / 2 == 2);
+                e = rot_apply(CR(R), j & 1 ? e : v3_neg(e));
+                if (v3_dist(r->poses[i].normal, e) < 1e-3)
+                    k = j;
+            }
+            ok = k >= 0;
+            if (ok)
+                face[k] += r->poses[i].p_qs;
+            sum += r->poses[i].p_qs;
+        }
+        for (int j = 0; ok && j < 6; j++)
+            ok = fabs(face[j] - 1.0 / 6.0) <= 1e-3;
+        if (!ok || fabs(sum - 1.0) > 1e-12) {
+            printf("     far cube seed %d: %s, %d poses, sum %.17g\n", seed,
+                   st == PD_OK ? "answered" : d.message, r ? r->nposes : 0, sum);
+            bad++;
+        }
+        pd_static_result_free(r);
+        pd_part_free(part);
+    }
+    CHECK_INT(bad, 0);
+}
+
+/* Moving a part by a multiple of the power of two at or above its size moves
+ * its origin by exactly that and its points not at all in its own frame: the
+ * results are the same bits (here the coordinates are multiples of 2^-30 and
+ * the move 2^21 m, so every coordinate stays exact). */
+static void test_placement_bits(void)
+{
+    test_rng rng = {7};
+    pd_vec3 p[8 + 6 * 4], q[8 + 6 * 4];
+    int n = cube_with_face_points(&rng, 4, p);
+    for (int i = 0; i < n; i++) {
+        p[i] = v3(ldexp(round(ldexp(p[i].x, 30)), -30), ldexp(round(ldexp(p[i].y, 30)), -30),
+                  ldexp(round(ldexp(p[i].z, 30)), -30));
+        q[i] = v3_add(p[i], v3(ldexp(1, 21), -ldexp(3, 20), ldexp(1, 19)));
+    }
+    pd_part *a = NULL, *b = NULL;
+    pd_static_result *ra = NULL, *rb = NULL;
+    CHECK_STATUS(part_of_points(p, n, &a, NULL), PD_OK);
+    CHECK_STATUS(part_of_points(q, n, &b, NULL), PD_OK);
+    if (a && b) {
+        CHECK(v3_dist(b->origin, v3_add(a->origin, v3(ldexp(1, 21), -ldexp(3, 20), ldexp(1, 19)))) == 0);
+        CHECK_STATUS(pd_static_estimate(a, NULL, &ra, NULL), PD_OK);
+        CHECK_STATUS(pd_static_estimate(b, NULL, &rb, NULL), PD_OK);
+    }
+    if (ra && rb) {
+        CHECK_INT(ra->nfacets, rb->nfacets);
+        int same = ra->nfacets == rb->nfacets;
+        for (int f = 0; same && f < ra->nfacets; f++)
+            same = memcmp(&ra->facets[f], &rb->facets[f], sizeof ra->facets[f]) == 0;
+        CHECK(same);
+    }
+    pd_static_result_free(ra);
+    pd_static_result_free(rb);
+    pd_part_free(a);
+    pd_part_free(b);
+}
+
 void suite_limits(void)
 {
     test_flat_pyramids();
+    test_far_part();
+    test_placement_bits();
 }
