@@ -50,7 +50,9 @@ typedef struct pd_part {
  * mass properties; convex hull; centre of mass strictly inside the hull.
  * A mesh that is not closed is accepted only with options->com_given.
  * options may be NULL. Returns the statuses of pd_mesh_orient, pd_mass_compute
- * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM. */
+ * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM; PD_ERR_RANGE for a
+ * size outside 1e-30 to 1e30 m, where products of the part's lengths would
+ * leave the normal doubles (docs/limits.md). */
 pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
                         pd_part **part, pd_diag *diag);
 

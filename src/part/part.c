@@ -9,6 +9,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include "base/fail.h"
+#include "base/size_range.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
 #include "base/vec3.h"
@@ -74,19 +75,23 @@ static pd_vec3 part_origin(pd_vec3 lo, pd_vec3 hi, double L)
 
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
-    /* Every size-relative tolerance below needs a finite size. */
+    /* Every size-relative tolerance below needs a finite size, within the
+     * range where products of the part's lengths stay normal doubles. */
     pd_mesh *m = p->mesh;
     for (int i = 0; i < m->nverts; i++)
         if (!v3_isfinite(m->verts[i]))
             return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
+    pd_vec3 lo = v3(0.0, 0.0, 0.0), hi = lo;
+    for (int i = 0; i < m->nverts; i++) {
+        pd_vec3 v = m->verts[i];
+        lo = i == 0 ? v : v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
+        hi = i == 0 ? v : v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
+    }
+    pd_status st = pd_size_check(lo, hi, "", diag);
+    if (st != PD_OK)
+        return st;
     p->size = pd_mesh_size(m);
-    if (m->nverts > 0 && p->size > 0.0) {
-        pd_vec3 lo = m->verts[0], hi = lo;
-        for (int i = 1; i < m->nverts; i++) {
-            pd_vec3 v = m->verts[i];
-            lo = v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
-            hi = v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
-        }
+    if (p->size > 0.0) {
         p->origin = part_origin(lo, hi, p->size);
         /* The move keeps the digits the file has; it cannot restore those a
          * far-off placement already rounded away. */
@@ -105,7 +110,7 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
         return PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
-    pd_status st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
+    st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
     if (st != PD_OK)
         return st;
 

@@ -238,9 +238,129 @@ static void test_placement_bits(void)
     pd_part_free(b);
 }
 
+/* The 1 x 0.7 x 0.4 box, turned by R and moved off the origin by 0.3 of its
+ * length, at scale s; PD_OK or the refusal, its message in d. */
+static pd_status box_at(double s, const double R[3][3], pd_part **part, pd_diag *d)
+{
+    pd_mesh *m = mesh_box(1.0, 0.7, 0.4);
+    mesh_transform(m, R, s, v3(0.3 * s, -0.2 * s, 0.1 * s));
+    *part = NULL;
+    pd_diag_init(d);
+    pd_status st = pd_part_build(m, NULL, part, d);
+    pd_mesh_free(m);
+    return st;
+}
+
+/* The supported sizes, 1e-30 to 1e30 m (src/base/size_range.h), at both
+ * ends: a turned box just inside each answers as at 1 m, and just outside is
+ * refused with PD_ERR_RANGE (a user error, exit 2) naming the range. Inside,
+ * the computation is the one at 1 m with every product of lengths scaled by
+ * a power of s and rounded once more, none of them subnormal or overflowing:
+ * so unit normals to a few ulps, and areas, heights, volume and
+ * probabilities to round-off relative to their closed forms (1e-12, the
+ * suite's round-off bound, is over 1e3 times what they carry at 1 m). */
+static void test_size_range(void)
+{
+    test_rng rng = {18};
+    double R[3][3];
+    rng_rotation(&rng, R);
+    const double dims[3] = {1.0, 0.7, 0.4};
+    /* The size: the diagonal of the turned box's bounding box, at scale 1. */
+    pd_vec3 c[8], lo, hi;
+    pts_box(dims[0], dims[1], dims[2], c);
+    points_transform(c, 8, CR(R), 1.0, v3(0, 0, 0));
+    lo = hi = c[0];
+    for (int i = 1; i < 8; i++) {
+        lo = v3(fmin(lo.x, c[i].x), fmin(lo.y, c[i].y), fmin(lo.z, c[i].z));
+        hi = v3(fmax(hi.x, c[i].x), fmax(hi.y, c[i].y), fmax(hi.z, c[i].z));
+    }
+    const double diag = v3_dist(lo, hi);
+    const double inside[2] = {1.01e-30 / diag, 0.99e30 / diag};
+    for (int end = 0; end < 2; end++) {
+        double s = inside[end];
+        pd_part *part = NULL;
+        pd_diag d;
+        CHECK_STATUS(box_at(s, CR(R), &part, &d), PD_OK);
+        pd_static_result *r = NULL;
+        if (part) {
+            CHECK_REL(part->mass.volume, 0.28 * s * s * s, 1e-12, "closed form, round-off");
+            CHECK_STATUS(pd_static_estimate(part, NULL, &r, &d), PD_OK);
+        }
+        if (r) {
+            CHECK_INT(r->nposes, 6);
+            double sum = 0.0;
+            for (int i = 0; i < r->nposes; i++) {
+                const pd_pose *p = &r->poses[i];
+                CHECK_NEAR(v3_norm(p->normal), 1.0, 4 * DBL_EPSILON, "unit normal, round-off");
+                /* The face whose normal this is: along R's axis k. */
+                int k = 0;
+                double best = 0.0;
+                for (int j = 0; j < 3; j++) {
+                    pd_vec3 e = rot_apply(CR(R), v3(j == 0, j == 1, j == 2));
+                    if (fabs(v3_dot(e, p->normal)) > best) {
+                        best = fabs(v3_dot(e, p->normal));
+                        k = j;
+                    }
+                }
+                CHECK_NEAR(best, 1.0, 1e-15, "normal along the box's axis, round-off");
+                CHECK_REL(p->height, 0.5 * dims[k] * s, 1e-12, "closed form, round-off");
+                CHECK_REL(p->area, dims[(k + 1) % 3] * dims[(k + 2) % 3] * s * s, 1e-12,
+                          "closed form, round-off");
+                sum += p->p_qs;
+            }
+            CHECK_NEAR(sum, 1.0, 1e-12, "probabilities sum to 1, round-off");
+        }
+        pd_static_result_free(r);
+        pd_part_free(part);
+
+        /* 2% outside the end: refused, saying the range. */
+        double out = end == 0 ? 0.98e-30 / diag : 1.02e30 / diag;
+        CHECK_STATUS(box_at(out, CR(R), &part, &d), PD_ERR_RANGE);
+        CHECK(strstr(d.message, "supported sizes, 1e-30 to 1e+30 m") != NULL);
+        CHECK(pd_status_is_input_error(PD_ERR_RANGE));
+        pd_part_free(part);
+    }
+    /* Sizes that went wrong before: 1e-81 m answered with normals 1.0025
+     * long, 1e-82 to 1e-89 m called flat, 1e77 m and up "within 0 of a
+     * plane": each is now refused for its size, by the part and the hull. */
+    const double wrong[] = {1e-89, 1e-81, 1e-61, 1e61, 1e77, 1e155};
+    for (int i = 0; i < (int)(sizeof wrong / sizeof wrong[0]); i++) {
+        pd_part *part = NULL;
+        pd_diag d;
+        CHECK_STATUS(box_at(wrong[i], CR(R), &part, &d), PD_ERR_RANGE);
+        pd_part_free(part);
+        pd_vec3 p[8];
+        int n = pts_box(wrong[i], wrong[i], wrong[i], p);
+        pd_hull *h = NULL;
+        CHECK_STATUS(pd_hull_build(p, n, &h, &d), PD_ERR_RANGE);
+        CHECK(strstr(d.message, "convex hull: the part's size") != NULL);
+        pd_hull_free(h);
+    }
+}
+
+/* A coordinate of 1e308 (issue 15): the size is finite but beyond the range,
+ * and its products overflow; coordinates of -1e308 and 1e308 make the size
+ * itself overflow. Both say so, not "within 0 of a line". */
+static void test_size_overflow(void)
+{
+    pd_vec3 p[4] = {v3(0, 0, 0), v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1e308)};
+    pd_hull *h = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    CHECK_STATUS(pd_hull_build(p, 4, &h, &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "1e+308 m is above the supported sizes") != NULL);
+    CHECK(strstr(d.message, "overflow") != NULL);
+    p[0] = v3(0, 0, -1e308);
+    CHECK_STATUS(pd_hull_build(p, 4, &h, &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "the part's size overflows a double") != NULL);
+    pd_hull_free(h);
+}
+
 void suite_limits(void)
 {
     test_flat_pyramids();
     test_far_part();
     test_placement_bits();
+    test_size_range();
+    test_size_overflow();
 }
