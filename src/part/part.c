@@ -7,6 +7,7 @@
  * hull. */
 #include <float.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include "base/fail.h"
 #include "base/size_range.h"
@@ -73,6 +74,23 @@ static pd_vec3 part_origin(pd_vec3 lo, pd_vec3 hi, double L)
     return v3(c[0], c[1], c[2]);
 }
 
+/* A part thinner than the weld tolerance loses its distinct vertices to
+ * welding, and the hull's refusal (too few points, or flat) would describe
+ * what was left rather than what was given: say what welding did. */
+static pd_status weld_explains(pd_status st, int nbefore, int nafter, double size, pd_diag *diag)
+{
+    if (nafter == nbefore || !diag ||
+        (st != PD_ERR_TOO_FEW_POINTS && st != PD_ERR_COLOCATED && st != PD_ERR_COLLINEAR &&
+         st != PD_ERR_COPLANAR))
+        return st;
+    char hull[PD_DIAG_MESSAGE_LEN];
+    snprintf(hull, sizeof hull, "%s", diag->message);
+    return pd_fail(diag, st,
+                   "welding vertices closer than %.3g m (%g of the part's size %.3g m) left "
+                   "%d of its %d vertices on faces with area: the part is thinner than that (%s)",
+                   PD_TOL_WELD_REL * size, PD_TOL_WELD_REL, size, nafter, nbefore, hull);
+}
+
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
     /* Every size-relative tolerance below needs a finite size, within the
@@ -107,12 +125,14 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
             m->verts[i] = v3_sub(m->verts[i], p->origin);
     }
     pd_vec3 com_given = v3_sub(opt->com, p->origin);
+    int nbefore = m->nverts;
+    double size0 = p->size;
     if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
         return PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
     st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
     if (st != PD_OK)
-        return st;
+        return weld_explains(st, nbefore, p->mesh->nverts, size0, diag);
 
     int flipped = 0;
     st = pd_mesh_orient(p->mesh, &flipped, diag);

@@ -356,6 +356,42 @@ static void test_size_overflow(void)
     pd_hull_free(h);
 }
 
+/* A 1 x 1e-9 x 1e-9 needle (issue 18): welding at 1e-6 of its size merges
+ * the ends of its every short edge and leaves no triangle with area; the
+ * refusal says so and at what distance, not only "0 points". A plate 1e-9
+ * thick likewise; a flat mesh that welding did not touch keeps the hull's
+ * own words. */
+static void test_weld_collapse(void)
+{
+    pd_part *part = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_mesh *m = mesh_box(1.0, 1e-9, 1e-9);
+    CHECK_STATUS(pd_part_build(m, NULL, &part, &d), PD_ERR_TOO_FEW_POINTS);
+    CHECK(strstr(d.message, "welding vertices closer than 1e-06 m") != NULL);
+    CHECK(strstr(d.message, "left 0 of its 8 vertices") != NULL);
+    pd_mesh_free(m);
+    m = mesh_box(1.0, 1.0, 1.0);
+    for (int i = 0; m && i < m->nverts; i++)
+        m->verts[i].z *= 1e-9;
+    CHECK_STATUS(pd_part_build(m, NULL, &part, &d), PD_ERR_COPLANAR);
+    CHECK(strstr(d.message, "left 4 of its 8 vertices") != NULL);
+    pd_mesh_free(m);
+    pd_vec3 sq[4] = {v3(0, 0, 0), v3(1, 0, 0), v3(1, 1, 0), v3(0, 1, 0)};
+    m = calloc(1, sizeof *m); /* two triangles: the oracle refuses flat input */
+    m->nverts = 4;
+    m->verts = malloc(sizeof sq);
+    memcpy(m->verts, sq, sizeof sq);
+    m->ntris = 2;
+    m->tris = malloc(sizeof *m->tris * 2);
+    const int t[2][3] = {{0, 1, 2}, {0, 2, 3}};
+    memcpy(m->tris, t, sizeof t);
+    CHECK_STATUS(pd_part_build(m, NULL, &part, &d), PD_ERR_COPLANAR);
+    CHECK(strstr(d.message, "welding") == NULL);
+    pd_mesh_free(m);
+    CHECK(part == NULL);
+}
+
 void suite_limits(void)
 {
     test_flat_pyramids();
@@ -363,4 +399,5 @@ void suite_limits(void)
     test_placement_bits();
     test_size_range();
     test_size_overflow();
+    test_weld_collapse();
 }
