@@ -50,9 +50,10 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
     pd_vec3 n = h->normal[worst], c = v3_add(p->com, p->origin);
     if (worst_gap >= -tol)
         return pd_fail(diag, PD_ERR_COM_OUTSIDE,
-                       "centre of mass (%.9g, %.9g, %.9g) m lies on the convex hull (on the "
-                       "facet with normal %.6g, %.6g, %.6g): no pose can rest on it",
-                       c.x, c.y, c.z, n.x, n.y, n.z);
+                       "centre of mass (%.9g, %.9g, %.9g) m lies on the convex hull (%.3g m "
+                       "from the plane of the facet with normal %.6g, %.6g, %.6g, within the "
+                       "tolerance %.3g m, %g of the part's size): no pose can rest on it",
+                       c.x, c.y, c.z, fabs(worst_gap), n.x, n.y, n.z, tol, PD_TOL_COM_INSIDE_REL);
     return pd_fail(diag, PD_ERR_COM_OUTSIDE,
                    "centre of mass (%.9g, %.9g, %.9g) m lies outside the convex hull, %.3g m "
                    "beyond the facet with normal %.6g, %.6g, %.6g",
