@@ -133,6 +133,54 @@ static void test_flat_pyramids(void)
     CHECK(answered >= 2 * 62 * 12);
 }
 
+/* The same family turned at random, scaled by 1e-3 to 1e3 and moved up to
+ * 100 sizes off the origin: the same two outcomes, and answers whose
+ * probabilities sum to 1 (the bound above) down a descending graph. */
+static void test_flat_pyramids_placed(void)
+{
+    test_rng rng = {1815};
+    int answered = 0, bad = 0;
+    for (int n = 3; n <= 64; n++)
+        for (int e = 0; e <= 16; e++) {
+            double h = pow(10.0, -7.0 + 0.25 * e), R[3][3];
+            pd_vec3 p[65];
+            int np = pts_flat_pyramid(n, h, p);
+            rng_rotation(&rng, R);
+            double s = pow(10.0, rng_range(&rng, -3.0, 3.0));
+            points_transform(p, np, CR(R), s,
+                             v3(rng_range(&rng, -100, 100) * s, 3 * s, -7 * s));
+            pd_part *part = NULL;
+            pd_diag d;
+            pd_diag_init(&d);
+            pd_status st = part_of_points(p, np, &part, &d);
+            if (st != PD_OK) {
+                bad += st != PD_ERR_COPLANAR && st != PD_ERR_COM_OUTSIDE;
+                continue;
+            }
+            for (int rule = 0; rule < 2; rule++) {
+                pd_static_options o;
+                pd_static_options_default(&o);
+                o.topple = rule ? PD_TOPPLE_EDGE : PD_TOPPLE_DESCENT;
+                pd_static_result *r = NULL;
+                if (pd_static_estimate(part, &o, &r, &d) != PD_OK) {
+                    printf("     placed pyramid n %d h %.3g rule %d: %s\n", n, h, rule, d.message);
+                    bad++;
+                    continue;
+                }
+                double qs = 0.0;
+                for (int i = 0; i < r->nposes; i++)
+                    qs += r->poses[i].p_qs;
+                double L = part->size;
+                bad += !graph_descends(r, L) || fabs(qs - 1) > 1e-12 + DBL_EPSILON * L / (h * s);
+                answered++;
+                pd_static_result_free(r);
+            }
+            pd_part_free(part);
+        }
+    CHECK_INT(bad, 0);
+    CHECK(answered >= 2 * 62 * 12);
+}
+
 /* A unit cube's corners and m points on each face (drawn from rng): on the
  * face planes exactly, wherever the coordinates are exact. */
 static int cube_with_face_points(test_rng *rng, int m, pd_vec3 *p)
@@ -433,6 +481,7 @@ static void test_knife_warned_once(void)
 void suite_limits(void)
 {
     test_flat_pyramids();
+    test_flat_pyramids_placed();
     test_far_part();
     test_placement_bits();
     test_size_range();
