@@ -61,12 +61,14 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
 }
 
 /* The part's origin: the centre of the bounding box [lo, hi] rounded to a
- * multiple of u, the power of two at or above the size L. Positions relative
- * to it are within 1.5 L per axis, so everything computed from them carries
- * round-off relative to L. Rounding to u, rather than taking the centre
- * itself, keeps a part that lies within about its size of the origin where
- * it is (origin 0: the same bits as without the move), and makes the move
- * exact whenever a coordinate's rounding step is at most u. */
+ * multiple of u, the least power of two above the size L (L < u <= 2 L).
+ * Positions relative to it are within 1.5 L per axis, so everything computed
+ * from them carries round-off relative to L; the move itself rounds by at
+ * most half an ulp of 1.5 L, and not at all on an axis where the origin is 3 L
+ * or more from the file's (Sterbenz: v and o within a factor 2). Rounding to
+ * u, rather than taking the centre itself, keeps a part that lies within
+ * about its size of the file's origin where it is (origin 0: the same bits
+ * as without the move). */
 static pd_vec3 part_origin(pd_vec3 lo, pd_vec3 hi, double L)
 {
     double u = ldexp(1.0, ilogb(L) + 1), c[3] = {lo.x, lo.y, lo.z}, d[3] = {hi.x, hi.y, hi.z};

@@ -251,7 +251,7 @@ static void test_far_part(void)
     CHECK_INT(bad, 0);
 }
 
-/* Moving a part by a multiple of the power of two at or above its size moves
+/* Moving a part by a multiple of the least power of two above its size moves
  * its origin by exactly that and its points not at all in its own frame: the
  * results are the same bits (here the coordinates are multiples of 2^-30 and
  * the move 2^21 m, so every coordinate stays exact). */
