@@ -7,6 +7,7 @@
 #define POSEDROP_PART_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/hull.h"
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"
@@ -22,13 +23,13 @@ typedef struct pd_part_options {
     pd_vec3 com;    /* metres, in the mesh's frame; read only when com_given */
 } pd_part_options;
 
-void pd_part_options_default(pd_part_options *options);
+PD_API void pd_part_options_default(pd_part_options *options);
 
 /* The part's frame is the mesh's frame moved to origin, a point near the
  * part: every position below (mesh vertices, hull, centre of mass, mass
  * properties) is relative to it, so that its round-off is relative to the
  * part's size, not to its distance from the mesh's origin (a 1 um part at
- * 1 km would otherwise carry rounding steps of 1e-4 of its size into every
+ * 1000 km would otherwise carry rounding steps of 1e-4 of its size into every
  * height). Add origin to a position to get it in the mesh's frame.
  * Directions, areas and heights are the same in both. */
 typedef struct pd_part {
@@ -53,10 +54,10 @@ typedef struct pd_part {
  * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM; PD_ERR_RANGE for a
  * size outside 1e-30 to 1e30 m, where products of the part's lengths would
  * leave the normal doubles (docs/limits.md). */
-pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
-                        pd_part **part, pd_diag *diag);
+PD_API pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
+                               pd_part **part, pd_diag *diag);
 
-void pd_part_free(pd_part *part);
+PD_API void pd_part_free(pd_part *part);
 
 #ifdef __cplusplus
 }
