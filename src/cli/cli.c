@@ -759,8 +759,9 @@ static void print_summary(const cli_args *a, const pd_part *part, const pd_stati
             part->mesh->ntris, part->closed ? "" : " (not closed)", part->size);
     if (part->mass_known)
         fprintf(stderr, "%s: volume %.6g m^3\n", a->path, part->mass.volume);
-    fprintf(stderr, "%s: centre of mass (%.9g, %.9g, %.9g) m%s\n", a->path, part->com.x, part->com.y,
-            part->com.z, a->part.com_given ? " (given)" : "");
+    const pd_vec3 *c = &part->com, *o = &part->origin; /* in the file's frame */
+    fprintf(stderr, "%s: centre of mass (%.9g, %.9g, %.9g) m%s\n", a->path, c->x + o->x,
+            c->y + o->y, c->z + o->z, a->part.com_given ? " (given)" : "");
     fprintf(stderr, "%s: hull %d vertices, %d facets; %d stable poses, %d knife edges\n", a->path,
             h->nverts, h->nfacets, res->nposes, res->nknife);
 }
