@@ -101,7 +101,8 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint mpi
+.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+        mpi
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
@@ -154,7 +155,9 @@ $(SO_BULLET): $(BULLET_OBJS) $(SO)
 # The command, the tests and the benchmark link the static archives (the tests
 # call internal functions the shared library does not export), and with
 # $(CXX), since they offer the Bullet engine.
-$(CLI): $(CLI_OBJS) $(LIB_BULLET) $(LIB)
+# The command reads numbers with the library's own reader (base/number.c, C
+# library only), linked in directly so that it needs nothing the API hides.
+$(CLI): $(CLI_OBJS) $(BUILD)/src/base/number.o $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 # posedrop-mpi (MPI=1): OpenMPI's wrappers give its include and library flags
@@ -164,7 +167,7 @@ $(BUILD)/mpi/%.o: src/cli/%.c Makefile
 	@mkdir -p $(dir $@)
 	OMPI_CC=$(CC) $(MPICC) $(CFLAGS_ALL) -MMD -MP -c $< -o $@
 
-$(CLI_MPI): $(CLI_MPI_OBJS) $(LIB_BULLET) $(LIB)
+$(CLI_MPI): $(CLI_MPI_OBJS) $(BUILD)/src/base/number.o $(LIB_BULLET) $(LIB)
 	OMPI_CC=$(CXX) $(MPICC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET) -lstdc++
 
 $(TEST_BIN): $(TEST_OBJS) $(LIB_BULLET) $(LIB)
@@ -215,6 +218,38 @@ bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
 	$(BENCH_BIN) $(BENCH)
 
+# make fuzz: libFuzzer targets built with clang (installed on first use) for
+# the OFF, STL and OBJ readers, scene files and the part build (mesh in, part
+# model and static estimate out), each run for FUZZ_SECONDS from the seeds in
+# parts/ and tests/fuzz/ (scripts/fuzz.sh). Only the layers these reach are
+# built, with address and undefined-behaviour sanitizers.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := off stl obj scene part
+FUZZ_BUILD   := build/fuzz
+FUZZ_CC      ?= clang
+FUZZ_CFLAGS  := -std=c11 -g -O1 -fsanitize=fuzzer-no-link,address,undefined \
+                -fno-sanitize-recover=undefined -fno-omit-frame-pointer -ffp-contract=off \
+                -D_DEFAULT_SOURCE -Iinclude -Isrc -Itests/support \
+                $(shell $(PKG_CONFIG) --cflags gsl 2>/dev/null)
+FUZZ_SRCS    := $(wildcard src/base/*.c src/mesh/*.c src/hull/*.c src/part/*.c src/static/*.c) \
+                src/sim/scene.c tests/support/fuzz_targets.c
+FUZZ_OBJS    := $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/%.o)
+
+fuzz:
+	@scripts/install-deps.sh clang libclang-rt-dev
+	@$(MAKE) --no-print-directory fuzz-build
+	scripts/fuzz.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+fuzz-build: $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
+
+$(FUZZ_BUILD)/%.o: %.c Makefile
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -MMD -MP -c $< -o $@
+
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_main.c $(FUZZ_OBJS) Makefile
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer -DPD_FUZZ_TARGET=pd_fuzz_$* -o $@ \
+	    tests/fuzz/fuzz_main.c $(FUZZ_OBJS) $(shell $(PKG_CONFIG) --libs gsl 2>/dev/null) -lm
+
 # Both libraries, shared (with their soname and development links) and
 # static, the headers, the command and a pkg-config file for each library
 # (docs/library.md), and the licence with that page in share/doc/posedrop.
@@ -260,9 +295,10 @@ help:
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make MPI=1      also build posedrop-mpi with OpenMPI (scripts/install-deps.sh mpi)"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
+	@echo "make fuzz       fuzz the readers and the part build, FUZZ_SECONDS=$(FUZZ_SECONDS) each"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(CLI_OBJS:.o=.d) \
-         $(CLI_MPI_OBJS:.o=.d)
+-include $(FUZZ_OBJS:.o=.d) $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) \
+         $(CLI_OBJS:.o=.d) $(CLI_MPI_OBJS:.o=.d)

@@ -21,6 +21,11 @@ static void string(FILE *out, const char *s)
     fputc('"', out);
 }
 
+static pd_vec3 add3(pd_vec3 a, pd_vec3 b)
+{
+    return (pd_vec3){a.x + b.x, a.y + b.y, a.z + b.z};
+}
+
 static void vec(FILE *out, pd_vec3 v)
 {
     fprintf(out, "[%.17g, %.17g, %.17g]", v.x, v.y, v.z);
@@ -43,13 +48,15 @@ static void part_json(FILE *out, const cli_args *a, const pd_part *part)
             "    \"closed\": %s,\n    \"size_m\": %.17g,\n    \"centre_of_mass_m\": ",
             name_of(a->read.units, units), part->mesh->nverts, part->mesh->ntris,
             part->closed ? "true" : "false", part->size);
-    vec(out, part->com);
+    /* In the file's frame, as --com takes it: the part's own frame is moved
+     * to part->origin. */
+    vec(out, add3(part->com, part->origin));
     fprintf(out, ",\n    \"centre_of_mass_given\": %s,\n    \"mass\": ",
             a->part.com_given ? "true" : "false");
     if (part->mass_known) {
         const double (*I)[3] = part->mass.inertia;
         fprintf(out, "{\"volume_m3\": %.17g, \"centre_of_mass_m\": ", part->mass.volume);
-        vec(out, part->mass.com);
+        vec(out, add3(part->mass.com, part->origin));
         fprintf(out, ", \"inertia_per_density_m5\": [[%.17g, %.17g, %.17g], [%.17g, %.17g, %.17g], "
                 "[%.17g, %.17g, %.17g]]}", I[0][0], I[0][1], I[0][2], I[1][0], I[1][1], I[1][2],
                 I[2][0], I[2][1], I[2][2]);
