@@ -374,8 +374,9 @@ static const cli_option options[] = {
      "0..180 (1.5)"},
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
-     "0..1 (a material property; 5e-4, a plastic part on a rubber\n"
-     "belt; 0: rigid, the paper's model)"},
+     "0..1, or auto (default): a plastic part on a rubber belt,\n"
+     "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
+     "0: rigid, the paper's model"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
