@@ -162,6 +162,40 @@ static void small_parts_ode(void)
     }
 }
 
+/* A part whose two stable facets meet at a shallow ridge, 0.9 degrees (a 2
+ * x 1 x 1 cm box with a roof for a bottom, mesh_roof_box): the energy
+ * barrier between the two poses is c (1 - cos 0.45 deg) = 3.1e-5 c for the
+ * centre of mass at height c, below the depth a resting contact may sink
+ * (PD_TOL_REST_FALL_REL = 1e-4 of the size), so a soft engine's part lying
+ * on either facet never has its energy below the barrier. Every drop must
+ * still end on a pose (none at the time limit), and the two roof facets,
+ * mirror images, share their drops within the 99.9% binomial bound. */
+static void ridge_settles(pd_engine_kind engine)
+{
+    pd_part *part;
+    pd_static_result *poses;
+    int ok = mesh_part(mesh_roof_box(0.02, 0.01, 0.01, 0.9 * M_PI / 180.0), &part, &poses);
+    int roof[2] = {-1, -1}, nroof = 0;
+    for (int k = 0; ok && k < poses->nposes; k++)
+        if (poses->poses[k].normal.z < -0.99 && nroof < 2)
+            roof[nroof++] = k;
+    CHECK_INT(nroof, 2);
+    pd_sim_options o = drop_options(engine, 300);
+    o.threads = 2;
+    pd_sim_result *r = run_drops(ok && nroof == 2, part, poses, &o);
+    if (r) {
+        if (r->unsettled)
+            printf("     engine %d: %ld of %ld ridge drops unsettled\n", (int)engine, r->unsettled,
+                   r->n);
+        CHECK_INT(r->unsettled, 0);
+        long a = r->count[roof[0]], b = r->count[roof[1]];
+        /* |a - b| against 3.29 sigma of a fair split of a + b. */
+        CHECK(fabs((double)(a - b)) <= 3.29 * sqrt((double)(a + b)) + 1.0);
+        CHECK(a + b > 0);
+    }
+    release(r, poses, part);
+}
+
 void suite_drop_step(void)
 {
     const pd_engine_kind engines[] = {PD_ENGINE_ODE, PD_ENGINE_BULLET};
@@ -169,6 +203,7 @@ void suite_drop_step(void)
         run_solid(engines[e], pts_cube, 300);
         run_solid(engines[e], pts_octahedron, 300);
         cube_uniform(engines[e]);
+        ridge_settles(engines[e]);
     }
     small_parts_ode();
 }
