@@ -25,6 +25,7 @@
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
+    PD_SUITE(engine_extreme) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(golden)
