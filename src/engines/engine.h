@@ -36,6 +36,26 @@ typedef struct pd_engine {
     pd_status (*step)(pd_engine_world *w, pd_state *s);
 } pd_engine;
 
+/* Restitution below this is taken as this by the contact law below, as by
+ * the impulse simulator's compliant law (PD_COMPLIANT_E_MIN, in a layer this
+ * one may not include): e = 0 needs an infinite damping ratio. */
+#define PD_ENGINE_E_MIN 0.01
+
+/* The spring-dashpot standing for one contact of the scene (contact_time
+ * T > 0, restitution e), as natural frequency *omega (rad/s) and damping
+ * ratio *zeta, for a contact of effective mass m: stiffness k = m omega^2,
+ * damping c = 2 zeta m omega. The contact pushes only (the engines' contact
+ * impulses are never negative), so it ends when the force k x + c x' falls
+ * to zero, before the penetration does; for that law
+ *     T = g(zeta) / omega,   e = exp(-zeta g(zeta)),
+ *     g(zeta) = (pi - 2 asin zeta) / sqrt(1 - zeta^2)     (zeta < 1),
+ *             = 2 acosh(zeta) / sqrt(zeta^2 - 1)          (zeta > 1), 2 at 1,
+ * whatever the approach speed. zeta is found from e by bisection (e falls
+ * from 1 at zeta = 0 toward 0), then omega from T. e is taken within
+ * [PD_ENGINE_E_MIN, 1]. engine_contact.c; docs/engines-crosscheck.md derives
+ * it. */
+void pd_engine_contact_law(double T, double e, double *omega, double *zeta);
+
 extern const pd_engine pd_engine_ode;    /* engine_ode.c */
 extern const pd_engine pd_engine_bullet; /* engine_bullet.cpp */
 

@@ -46,13 +46,39 @@ extern "C" {
  * some faces more than on others (a cube: faces +-z 0.19, +-x 0.14 of 3000
  * drops). The vertices' heights depend only on where they are, so this
  * contact set is the same whichever way the part's frame is turned. */
+/* The scene's contact law (contact_time > 0; engine.h): every contact a
+ * spring-dashpot for its own effective mass. */
+struct contact_law {
+    bool on;
+    double omega, zeta;
+};
+
 class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
     btPersistentManifold *manifold;
+    const contact_law *law;
+
+    /* Bullet's own spring form, the same as ODE's: with the flag set, its
+     * solver takes erp = h k / (h k + c) and cfm = 1 / (h k + c) from the
+     * point's stiffness k and damping c. The effective mass along the
+     * normal is Bullet's impulse denominator's inverse. */
+    void set_springs(const btRigidBody *body, const btVector3 &n)
+    {
+        for (int j = 0; j < manifold->getNumContacts(); j++) {
+            btManifoldPoint &p = manifold->getContactPoint(j);
+            btVector3 pa = manifold->getBody0() == body ? p.getPositionWorldOnA()
+                                                        : p.getPositionWorldOnB();
+            double m = 1.0 / double(body->computeImpulseDenominator(pa, n));
+            p.m_combinedContactStiffness1 = btScalar(m * law->omega * law->omega);
+            p.m_combinedContactDamping1 = btScalar(2.0 * law->zeta * m * law->omega);
+            p.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+        }
+    }
 
 public:
     hull_floor_algorithm(const btCollisionAlgorithmConstructionInfo &ci,
-                         const btCollisionObjectWrapper *a, const btCollisionObjectWrapper *b)
-        : btActivatingCollisionAlgorithm(ci, a, b), manifold(nullptr)
+                         const btCollisionObjectWrapper *a, const btCollisionObjectWrapper *b,
+                         const contact_law *contact)
+        : btActivatingCollisionAlgorithm(ci, a, b), manifold(nullptr), law(contact)
     {
     }
 
@@ -67,11 +93,13 @@ public:
     {
         bool swapped = a->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
         const btCollisionObjectWrapper *hw = swapped ? b : a, *pw = swapped ? a : b;
-        const btConvexHullShape *hull = static_cast<const btConvexHullShape *>(hw->getCollisionShape());
+        const btConvexHullShape *hull =
+            static_cast<const btConvexHullShape *>(hw->getCollisionShape());
         const btStaticPlaneShape *plane =
             static_cast<const btStaticPlaneShape *>(pw->getCollisionShape());
         if (!manifold)
-            manifold = m_dispatcher->getNewManifold(hw->getCollisionObject(), pw->getCollisionObject());
+            manifold =
+                m_dispatcher->getNewManifold(hw->getCollisionObject(), pw->getCollisionObject());
         out->setPersistentManifold(manifold);
 
         const btTransform &th = hw->getWorldTransform(), &tp = pw->getWorldTransform();
@@ -89,10 +117,13 @@ public:
                 out->addContactPoint(n, p - d * n, d);
         }
         out->refreshContactPoints();
+        const btRigidBody *body = btRigidBody::upcast(hw->getCollisionObject());
+        if (law->on && body)
+            set_springs(body, n);
     }
 
-    btScalar calculateTimeOfImpact(btCollisionObject *, btCollisionObject *, const btDispatcherInfo &,
-                                   btManifoldResult *) override
+    btScalar calculateTimeOfImpact(btCollisionObject *, btCollisionObject *,
+                                   const btDispatcherInfo &, btManifoldResult *) override
     {
         return btScalar(1);
     }
@@ -105,12 +136,14 @@ public:
 };
 
 struct hull_floor_create : btCollisionAlgorithmCreateFunc {
+    contact_law law;
+
     btCollisionAlgorithm *CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo &ci,
                                                    const btCollisionObjectWrapper *a,
                                                    const btCollisionObjectWrapper *b) override
     {
         void *mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(hull_floor_algorithm));
-        return mem ? new (mem) hull_floor_algorithm(ci, a, b) : nullptr;
+        return mem ? new (mem) hull_floor_algorithm(ci, a, b, &law) : nullptr;
     }
 };
 
@@ -188,6 +221,11 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * intersection and be exact only away from its corners. */
     w->hull.setMargin(btScalar(PD_BULLET_MARGIN_REL * b->size));
 
+    contact_law &law = w->hull_floor.law;
+    law.on = scene->contact_time > 0.0;
+    law.omega = law.zeta = 0.0;
+    if (law.on)
+        pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
     w->dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, STATIC_PLANE_PROXYTYPE,
                                               &w->hull_floor);
     w->dispatcher.registerCollisionCreateFunc(STATIC_PLANE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE,
@@ -200,6 +238,11 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * part to Baumgarte velocity instead, which feeds energy in. */
     info.m_splitImpulse = 1;
     info.m_splitImpulsePenetrationThreshold = 0;
+    /* With the scene's spring-dashpot (law.on) the penetration term is the
+     * spring's force: it must act on the velocities, not only on the
+     * positions, and the rebound is the dashpot's alone (no restitution). */
+    if (law.on)
+        info.m_splitImpulse = 0;
     /* Bullet's default friction acts along the sliding direction only; a
      * part resting on a face then creeps sideways at ~1e-4 m/s (measured on
      * a 1 x 2 x 3 cm box), a second, orthogonal direction holds it (2e-6 m
@@ -211,7 +254,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     w->floor_body.setFriction(1);
     w->floor_body.setRestitution(1);
     w->body.setFriction(btScalar(scene->mu));
-    w->body.setRestitution(btScalar(scene->restitution));
+    w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
     w->body.setActivationState(DISABLE_DEACTIVATION);
     w->body.setSleepingThresholds(0, 0);
     w->body.setDamping(0, 0);

@@ -86,6 +86,10 @@ struct pd_engine_world {
     double dt; /* in time units */
     double mu, restitution, bounce_vel;
     double erp, cfm;
+    /* contact_time > 0: each contact is the scene's spring-dashpot
+     * (pd_engine_contact_law) for its effective mass, in ODE's units. */
+    int compliant;
+    double omega, zeta;
     int lost; /* its ODE objects failed and could not be quarantined */
 };
 
@@ -391,6 +395,11 @@ static pd_engine_world *world_alloc(const pd_body *body, const pd_hull *hull,
     double gs = g / acc, size = body->size / w->len;
     w->bounce_vel = PD_ODE_BOUNCE_VEL_REL * sqrt(gs * size);
     contact_softness(w, gs, size);
+    if (scene->contact_time > 0.0) {
+        w->compliant = 1;
+        pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->omega,
+                              &w->zeta);
+    }
     if (!build_points(w, body) || ode_guard(w, ODE_BUILD, NULL) != PD_OK) {
         world_free(w);
         return NULL;
@@ -509,6 +518,28 @@ static int floor_contacts(const pd_engine_world *w, dContactGeom *c)
     return n;
 }
 
+/* The scene's spring-dashpot at a contact at p (world, ODE's units) as ODE's
+ * erp and cfm: stiffness k = m_eff omega^2 and damping c = 2 zeta m_eff omega
+ * for the contact's effective mass along the floor's normal z,
+ * 1 / m_eff = 1/m + (r x z) . I^-1 (r x z), r from the centre of mass; ODE's
+ * spring form for a step h: erp = h k / (h k + c), cfm = 1 / (h k + c). No
+ * bounce on top: the dashpot's loss is the restitution. */
+static void compliant_softness(const pd_engine_world *w, const dReal *p, dReal *erp, dReal *cfm)
+{
+    const dReal *x = dBodyGetPosition(w->body);
+    const dReal *R = dBodyGetRotation(w->body); /* 3 x 4, row-major: body -> world */
+    double ux = p[1] - x[1], uy = -(p[0] - x[0]); /* r x z, world; its z is 0 */
+    double inv = 1.0 / w->mass;
+    for (int i = 0; i < 3; i++) {
+        double ub = R[4 * 0 + i] * ux + R[4 * 1 + i] * uy; /* (R^T u)_i */
+        inv += ub * ub / w->moment[i];
+    }
+    double m = 1.0 / inv, h = w->dt;
+    double k = m * w->omega * w->omega, c = 2.0 * w->zeta * m * w->omega;
+    *erp = h * k / (h * k + c);
+    *cfm = 1.0 / (h * k + c);
+}
+
 static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
 {
     dContactGeom *cg = w->cand;
@@ -517,12 +548,17 @@ static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
         dContact c;
         memset(&c, 0, sizeof c);
         c.geom = cg[i];
-        c.surface.mode = dContactApprox1 | dContactBounce | dContactSoftERP | dContactSoftCFM;
+        c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
         c.surface.mu = w->mu;
-        c.surface.bounce = w->restitution;
-        c.surface.bounce_vel = w->bounce_vel;
-        c.surface.soft_erp = w->erp;
-        c.surface.soft_cfm = w->cfm;
+        if (w->compliant) {
+            compliant_softness(w, cg[i].pos, &c.surface.soft_erp, &c.surface.soft_cfm);
+        } else {
+            c.surface.mode |= dContactBounce;
+            c.surface.bounce = w->restitution;
+            c.surface.bounce_vel = w->bounce_vel;
+            c.surface.soft_erp = w->erp;
+            c.surface.soft_cfm = w->cfm;
+        }
         /* Friction pyramid's first axis along the slip (see the top). The
          * contact normal points from the floor into the part, +z. */
         dVector3 pv;
