@@ -46,8 +46,8 @@ extern "C" {
  * some faces more than on others (a cube: faces +-z 0.19, +-x 0.14 of 3000
  * drops). The vertices' heights depend only on where they are, so this
  * contact set is the same whichever way the part's frame is turned. */
-/* The scene's contact law (contact_time > 0; engine.h): every contact a
- * spring-dashpot for its own effective mass. */
+/* The scene's contact law (contact_time > 0, resolved by the step;
+ * engine.h): every contact a spring-dashpot for its own effective mass. */
 struct contact_law {
     bool on;
     double omega, zeta;
@@ -222,7 +222,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     w->hull.setMargin(btScalar(PD_BULLET_MARGIN_REL * b->size));
 
     contact_law &law = w->hull_floor.law;
-    law.on = scene->contact_time > 0.0;
+    law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
     law.omega = law.zeta = 0.0;
     if (law.on)
         pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);

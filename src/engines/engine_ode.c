@@ -86,8 +86,9 @@ struct pd_engine_world {
     double dt; /* in time units */
     double mu, restitution, bounce_vel;
     double erp, cfm;
-    /* contact_time > 0: each contact is the scene's spring-dashpot
-     * (pd_engine_contact_law) for its effective mass, in ODE's units. */
+    /* contact_time > 0 and resolved by the step: each contact is the
+     * scene's spring-dashpot (pd_engine_contact_law) for its effective mass,
+     * in ODE's units. */
     int compliant;
     double omega, zeta;
     int lost; /* its ODE objects failed and could not be quarantined */
@@ -395,7 +396,7 @@ static pd_engine_world *world_alloc(const pd_body *body, const pd_hull *hull,
     double gs = g / acc, size = body->size / w->len;
     w->bounce_vel = PD_ODE_BOUNCE_VEL_REL * sqrt(gs * size);
     contact_softness(w, gs, size);
-    if (scene->contact_time > 0.0) {
+    if (scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time) {
         w->compliant = 1;
         pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->omega,
                               &w->zeta);
