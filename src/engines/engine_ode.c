@@ -63,9 +63,10 @@
 #endif
 
 /* libode-dev is built in double precision (dGetConfiguration reports
- * ODE_double_precision); the states cross over without conversion and the
- * tests' round-off bounds assume it. A single-precision ODE would need its
- * own tolerances, so it is refused at compile time. */
+ * ODE_double_precision); the states cross over as doubles (scaled by powers
+ * of two, exactly) and the tests' round-off bounds assume it. A
+ * single-precision ODE would need its own tolerances, so it is refused at
+ * compile time. */
 _Static_assert(sizeof(dReal) == sizeof(double), "ODE must be built with dDOUBLE");
 
 struct pd_engine_world {
@@ -179,7 +180,7 @@ static void contact_softness(pd_engine_world *w, double g, double size)
     w->cfm = 1.0 / (h * kp + kd);
 }
 
-/* The world's ODE objects, from the hull arrays and the numbers in w; 0 on
+/* The world's ODE objects, from the numbers in w; 0 on
  * failure (what was made is left for ode_objects_free). Runs guarded. */
 static int ode_objects_build(pd_engine_world *w)
 {
@@ -293,7 +294,7 @@ typedef enum { ODE_BUILD, ODE_RESET, ODE_STEP, ODE_FREE } ode_op;
 static int ode_reset_body(pd_engine_world *w, const pd_state *s);
 static pd_status ode_step_body(pd_engine_world *w, pd_state *s);
 
-/* Destroys the world's ODE objects (not the hull arrays); each pointer is
+/* Destroys the world's ODE objects (not the vertex arrays); each pointer is
  * cleared as its object goes, so that after an error part way only what is
  * left is quarantined. */
 static void ode_objects_free(pd_engine_world *w)
