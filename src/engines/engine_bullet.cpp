@@ -51,6 +51,7 @@ extern "C" {
 struct contact_law {
     bool on;
     double omega, zeta;
+    double reach; /* the manifold's contact breaking threshold, m */
 };
 
 class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
@@ -97,9 +98,11 @@ public:
             static_cast<const btConvexHullShape *>(hw->getCollisionShape());
         const btStaticPlaneShape *plane =
             static_cast<const btStaticPlaneShape *>(pw->getCollisionShape());
-        if (!manifold)
+        if (!manifold) {
             manifold =
                 m_dispatcher->getNewManifold(hw->getCollisionObject(), pw->getCollisionObject());
+            manifold->setContactBreakingThreshold(btScalar(law->reach));
+        }
         out->setPersistentManifold(manifold);
 
         const btTransform &th = hw->getWorldTransform(), &tp = pw->getWorldTransform();
@@ -197,6 +200,22 @@ static bool finite_state(const pd_state *s)
     return true;
 }
 
+/* The manifold's contact breaking threshold. Bullet's own is 0.02 of the
+ * shape's bounding radius, and the manifold takes a new point within that
+ * distance of a kept one for the same point: on a 1 m x 1 cm x 1 cm rod
+ * (threshold 1 cm) the corners of an end face merged, the rod could not lie
+ * on a face, rolled onto an edge and sank into the floor. A quarter of the
+ * shortest distance between two hull vertices keeps every corner apart;
+ * Bullet's value is kept when smaller. */
+static double contact_reach(const btConvexHullShape &hull)
+{
+    double d2 = INFINITY;
+    for (int i = 0; i < hull.getNumPoints(); i++)
+        for (int j = i + 1; j < hull.getNumPoints(); j++)
+            d2 = fmin(d2, double(hull.getScaledPoint(i).distance2(hull.getScaledPoint(j))));
+    return fmin(0.25 * sqrt(d2), double(hull.getContactBreakingThreshold(gContactBreakingThreshold)));
+}
+
 static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull,
                                            const pd_scene *scene, double dt)
 {
@@ -223,6 +242,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
 
     contact_law &law = w->hull_floor.law;
     law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
+    law.reach = contact_reach(w->hull);
     law.omega = law.zeta = 0.0;
     if (law.on)
         pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
