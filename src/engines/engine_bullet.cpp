@@ -20,7 +20,8 @@
  *   not Bullet's support vertex and its probes;
  * - one fixed step per call, without interpolation;
  * - no deactivation: the drop loop decides rest by energy, never Bullet;
- * - explicit gyroscopic torque and two friction directions (bullet_world_alloc);
+ * - the gyroscopic term by the adapter (gyroscopic_step) and two friction
+ *   directions (bullet_world_alloc);
  * - restitution threshold PD_BULLET_BOUNCE_STEPS * g dt instead of an
  *   absolute 0.2 m/s; penetration recovered by split impulse only, so
  *   pushing a sunk part out adds no kinetic energy that the rest test would
