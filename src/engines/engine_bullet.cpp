@@ -33,7 +33,10 @@
 
 extern "C" {
 #include "engines/engine.h"
+#include "engines/engine_contact.h"
+#include "posedrop/bullet.h"
 #include "posedrop/tolerances.h"
+#include "posedrop/version.h"
 }
 
 /* The hull against the floor: every hull vertex within the manifold's
@@ -422,3 +425,8 @@ extern "C" const pd_engine pd_engine_bullet = {
     bullet_reset,
     bullet_step,
 };
+
+extern "C" pd_status pd_bullet_register(void)
+{
+    return pd_engine_register(PD_ENGINE_BULLET, &pd_engine_bullet, PD_VERSION_STRING);
+}

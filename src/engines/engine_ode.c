@@ -47,6 +47,7 @@
 #include <string.h>
 #include <ode/ode.h>
 #include "engines/engine.h"
+#include "engines/engine_contact.h"
 #include "posedrop/tolerances.h"
 #include "base/vec3.h"
 

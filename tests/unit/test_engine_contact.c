@@ -8,6 +8,7 @@
 #include "check.h"
 #include "dynamics/body.h"
 #include "engines/engine.h"
+#include "engines/engine_contact.h"
 #include "posedrop/posedrop.h"
 #include "base/quat.h"
 #include "base/vec3.h"
