@@ -386,8 +386,9 @@ static const cli_option options[] = {
      "0..180 (1.5)"},
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
-     "0..1 (a material property; 5e-4, a plastic part on a rubber\n"
-     "belt; 0: rigid, the paper's model)"},
+     "0..1, or auto (default): a plastic part on a rubber belt,\n"
+     "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
+     "0: rigid, the paper's model"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -838,8 +839,9 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
 {
     if (sim->unsettled)
-        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit) and "
-                        "are in no count\n", prog, a->path, sim->unsettled, sim->n);
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
+                        "the engine failed) and are in no count\n", prog, a->path, sim->unsettled,
+                sim->n);
     if (sim->energy_gain)
         fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
                         "friction, resolved by the energetic law; or a compliant impact's step, "
