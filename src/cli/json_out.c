@@ -67,12 +67,16 @@ static void part_json(FILE *out, const cli_args *a, const pd_part *part)
             part->hull->nverts, part->hull->nfacets);
 }
 
-static void run_json(FILE *out, const cli_args *a, const pd_sim_result *sim, double wall_s)
+static void run_json(FILE *out, const cli_args *a, const pd_part *part, const pd_sim_result *sim,
+                     double wall_s)
 {
     static const char *const engines[] = {"impulse", "ode", "bullet"};
     static const char *const laws[] = {"poisson", "energetic"};
     static const char *const initials[] = {"uniform", "bootstrap", "stationary"};
     const pd_scene *s = &a->scene;
+    /* The duration the drops used: the automatic one is the part's. */
+    int auto_time = s->contact_time == PD_CONTACT_TIME_AUTO;
+    double contact_time = auto_time ? pd_contact_time_auto(part->size) : s->contact_time;
     fprintf(out, "  \"posedrop\": {\"version\": \"%s\", \"command_line\": [", pd_version());
     for (int i = 0; i < a->argc; i++) {
         fprintf(out, i ? ", " : "");
@@ -82,9 +86,10 @@ static void run_json(FILE *out, const cli_args *a, const pd_sim_result *sim, dou
             a->merge ? "true" : "false", wall_s, cli_cpu_seconds());
     fprintf(out, "  \"scene\": {\"height_m\": %.17g, \"belt_speed_m_s\": %.17g, \"mu\": %.17g, "
             "\"restitution\": %.17g, \"restitution_law\": \"%s\", \"vibration_rad\": %.17g, "
-            "\"initial\": \"%s\", \"gravity_m_s2\": %.17g, \"contact_time_s\": %.17g},\n",
+            "\"initial\": \"%s\", \"gravity_m_s2\": %.17g, \"contact_time_s\": %.17g, "
+            "\"contact_time_auto\": %s},\n",
             s->height, s->belt_speed, s->mu, s->restitution, name_of(s->law, laws), s->vibration,
-            name_of(s->initial, initials), s->gravity, s->contact_time);
+            name_of(s->initial, initials), s->gravity, contact_time, auto_time ? "true" : "false");
     static const char *const topples[] = {"descent", "edge"};
     static const char *const compares[] = {"raw", "qs"};
     static const char *const bands[] = {"rect", "exact"};
@@ -144,7 +149,7 @@ void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_stat
                 const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s)
 {
     fprintf(out, "{\n");
-    run_json(out, a, sim, wall_s);
+    run_json(out, a, part, sim, wall_s);
     part_json(out, a, part);
     rows_json(out, res, sim, class_of, nclasses);
     fprintf(out, "}\n");

@@ -229,6 +229,7 @@ static void test_json(void)
                  "assert doc[\"posedrop\"][\"command_line\"][-1] == \"parts/block.stl\"\n"
                  "assert doc[\"posedrop\"][\"wall_s\"] >= 0 and doc[\"posedrop\"][\"cpu_s\"] > 0\n"
                  "assert merged[\"posedrop\"][\"merged_shards\"] is True\n"
+                 "assert doc[\"scene\"][\"contact_time_auto\"] is True and doc[\"scene\"][\"contact_time_s\"] > 0\n"
                  "' %s %s %s", csv, json, merged);
     } else {
         snprintf(cmd, sizeof cmd, "jq -e --arg h \"$(sha256sum parts/block.stl | cut -c1-64)\" "
