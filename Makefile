@@ -57,10 +57,13 @@ CFLAGS_TEST := -Itests/support $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/de
 # One folder per layer under src/ (docs/development.md); the Makefile follows
 # the tree by wildcard, so adding a file needs no edit here.
 LIB_SRCS   := $(wildcard src/*/*.c)
-LIB_SRCS   := $(filter-out src/cli/%,$(LIB_SRCS))
+LIB_SRCS   := $(filter-out src/cli/% src/viz/%,$(LIB_SRCS))
 LIB_CXX_SRCS := $(wildcard src/*/*.cpp)
 LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXX_SRCS:%.cpp=$(BUILD)/%.o)
 LIB        := $(BUILD)/libposedrop.a
+# The pictures (src/viz/) are the program's, not the library's: a client of
+# the public API that the command and the tests link.
+VIZ_OBJS   := $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/viz/*.c))
 CLI        := $(BUILD)/posedrop
 TEST_SRCS  := $(wildcard tests/unit/*.c tests/support/*.c)
 TEST_OBJS  := $(TEST_SRCS:%.c=$(BUILD)/%.o)
@@ -99,10 +102,10 @@ $(LIB): $(LIB_OBJS)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-$(CLI): $(BUILD)/src/cli/cli.o $(LIB)
+$(CLI): $(BUILD)/src/cli/cli.o $(VIZ_OBJS) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
 
-$(TEST_BIN): $(TEST_OBJS) $(LIB)
+$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
 
 $(BENCH_BIN): $(BENCH_OBJS) $(LIB)
@@ -173,4 +176,4 @@ help:
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d
+-include $(LIB_OBJS:.o=.d) $(VIZ_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d

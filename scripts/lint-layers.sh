@@ -20,7 +20,8 @@ lower() {
     contact)   echo "base hull part dynamics settle" ;;
     engines)   echo "base hull part dynamics" ;;
     sim)       echo "base mesh hull part static symmetry dynamics impact settle contact engines" ;;
-    cli)       echo "" ;; # the public API only
+    viz)       echo "base" ;; # the pictures: the public API, base's helpers
+    cli)       echo "viz" ;; # the public API and the pictures
     *)         echo "?" ;;
     esac
 }

@@ -11,7 +11,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "posedrop/posedrop.h"
+#include "viz/viz.h"
 
 enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
 
@@ -104,6 +106,14 @@ static void usage(FILE *out)
         "                     summed, the class's own interval, and a last column\n"
         "                     members: the member poses' numbers, space-separated\n"
         "  --verbose          a summary of the part (and of the drops) on stderr\n"
+        "pictures (docs/figures.md):\n"
+        "  --svg FILE         gallery of the stable poses (classes with --group), SVG\n"
+        "  --chart FILE       the estimates as grouped bars with 95%% intervals, SVG\n"
+        "  --sphere FILE      gravity directions coloured by the pose QS ends in, SVG\n"
+        "  --report FILE      one HTML file: part, gallery, chart, sphere, run\n"
+        "  --measured FILE    a measured distribution shown beside the estimates: CSV\n"
+        "                     with columns pose,count or pose,p[,n], numbered as the\n"
+        "                     output (classes with --group)\n"
         "  --help             this help\n"
         "  --version          version\n"
         "\n"
@@ -328,12 +338,15 @@ typedef struct {
     pd_scene scene;
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
+    viz_files pictures;
+    const char *measured;
 } cli_args;
 
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED };
 
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
@@ -390,6 +403,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
         {"facets", no_argument, 0, OPT_FACETS},
         {"group", no_argument, 0, OPT_GROUP},
         {"verbose", no_argument, 0, OPT_VERBOSE},
+        {"svg", required_argument, 0, OPT_SVG},
+        {"chart", required_argument, 0, OPT_CHART},
+        {"sphere", required_argument, 0, OPT_SPHERE},
+        {"report", required_argument, 0, OPT_REPORT},
+        {"measured", required_argument, 0, OPT_MEASURED},
         {"help", no_argument, 0, OPT_HELP},
         {"version", no_argument, 0, OPT_VERSION},
         {0, 0, 0, 0},
@@ -514,6 +532,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
         case OPT_VERBOSE:
             a->verbose = 1;
             break;
+        case OPT_SVG: a->pictures.svg = optarg; break;
+        case OPT_CHART: a->pictures.chart = optarg; break;
+        case OPT_SPHERE: a->pictures.sphere = optarg; break;
+        case OPT_REPORT: a->pictures.report = optarg; break;
+        case OPT_MEASURED: a->measured = optarg; break;
         case OPT_HELP:
             usage(stdout);
             return 0;
@@ -542,6 +565,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
         return fail_usage("%s", "--facets lists hull facets; it does not go with --group");
+    const viz_files *pf = &a->pictures;
+    if (a->facets && (pf->svg || pf->chart || pf->sphere || pf->report))
+        return fail_usage("%s", "--facets lists hull facets; the pictures show poses");
+    if (a->measured && !pf->svg && !pf->chart && !pf->report)
+        return fail_usage("%s", "--measured is shown by --svg, --chart or --report: give one");
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);
@@ -638,6 +666,14 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
+/* Seconds on a monotonic clock, for the report's timings. */
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static volatile sig_atomic_t interrupted;
 
 static void on_sigint(int sig)
@@ -662,7 +698,14 @@ int main(int argc, char **argv)
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
     int *class_of = NULL, nclasses = 0;
-    pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
+    viz_measured *measured = NULL;
+    double t0 = now(), t_static = 0.0, t_sim = 0.0;
+    pd_status st = a.measured ? viz_measured_read(a.measured, &measured, &diag) : PD_OK;
+    if (st != PD_OK) {
+        code = fail_status(st, &diag, NULL);
+        goto done;
+    }
+    st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -670,6 +713,7 @@ int main(int argc, char **argv)
     st = pd_part_build(mesh, &a.part, &part, &diag);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a.estimate, &res, &diag);
+    t_static = now() - t0;
     if (st == PD_OK && a.dynamic) {
         struct sigaction sa;
         memset(&sa, 0, sizeof sa);
@@ -677,6 +721,7 @@ int main(int argc, char **argv)
         sigaction(SIGINT, &sa, NULL);
         a.sim.cancel = &interrupted;
         st = pd_sim_run(part, res, &a.scene, &a.sim, &sim, &diag);
+        t_sim = now() - t0 - t_static;
     }
     if (st == PD_OK && a.group) {
         class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
@@ -686,6 +731,15 @@ int main(int argc, char **argv)
     }
     if (st != PD_OK) {
         code = fail_status(st, &diag, a.path);
+        goto done;
+    }
+    static const char *const engine_names[] = {"impulse", "ODE", "Bullet"};
+    viz_input in = {a.path, part, res, gsim ? gsim : sim, class_of, nclasses,
+                    engine_names[a.sim.engine], measured};
+    viz_run run = {a.path, a.read.units, &a.estimate, sim ? &a.scene : NULL, &a.sim, t_static,
+                   t_sim, now() - t0, argc, argv};
+    if ((st = viz_write(&a.pictures, &in, &run, &diag)) != PD_OK) {
+        code = fail_status(st, &diag, NULL);
         goto done;
     }
     if (a.verbose)
@@ -708,6 +762,7 @@ int main(int argc, char **argv)
     if (code == 0 && sim && sim->partial)
         code = EXIT_INTERRUPTED;
 done:
+    viz_measured_free(measured);
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);
