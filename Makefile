@@ -73,7 +73,8 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo paper install uninstall clean help deps golden lint
+.PHONY: all check test bench demo paper install uninstall clean help deps golden lint \
+        check-browser figures
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(CLI)
@@ -132,6 +133,12 @@ demo: deps
 	@$(MAKE) --no-print-directory all
 	$(CLI) -n 2000 -h 0.12 $(DEMO_PART)
 
+# The report and the SVGs in a real browser and renderer (headless Chromium,
+# rsvg-convert; installed when missing): tests/browser/check.sh.
+check-browser: deps
+	@$(MAKE) --no-print-directory $(CLI)
+	POSEDROP=$(CLI) tests/browser/check.sh
+
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
 	@$(MAKE) --no-print-directory all
@@ -171,6 +178,7 @@ help:
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make lint       check that no layer of src/ includes one above it"
+	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"

@@ -67,7 +67,7 @@ static void shell_word(vbuf *b, const char *s)
 static void part_section(vbuf *b, const viz_input *in, const viz_run *run)
 {
     const pd_part *part = in->part;
-    char v[256], w[64];
+    char v[256];
     static const char *const units[] = {"m", "cm", "mm", "in"};
     vbuf_put(b, "<section id=\"part\"><h2>Part</h2>\n<table>\n");
     row(b, "file", run->path);
@@ -84,9 +84,13 @@ static void part_section(vbuf *b, const viz_input *in, const viz_run *run)
     } else {
         row(b, "volume", "unknown (mesh not closed; centre of mass given)");
     }
-    length(w, sizeof w, 1.0);
-    snprintf(v, sizeof v, "(%.6g, %.6g, %.6g) mm in the file's frame%s", 1000.0 * part->com.x,
-             1000.0 * part->com.y, 1000.0 * part->com.z, part->mass_known ? "" : ", given");
+    /* Round-off of a centred part (1e-18 m) shown as 0: a millionth of the
+     * size is below every digit printed. */
+    double c[3] = {part->com.x, part->com.y, part->com.z};
+    for (int k = 0; k < 3; k++)
+        c[k] = fabs(c[k]) < 1e-6 * part->size ? 0.0 : c[k];
+    snprintf(v, sizeof v, "(%.6g, %.6g, %.6g) mm in the file's frame%s", 1000.0 * c[0],
+             1000.0 * c[1], 1000.0 * c[2], part->mass_known ? "" : ", given");
     row(b, "centre of mass", v);
     snprintf(v, sizeof v, "%d facets, %d vertices; %d stable poses", part->hull->nfacets,
              part->hull->nverts, in->res->nposes);
@@ -233,7 +237,6 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                 "perturbed quasi-static (PQS) estimators%s.</p>\n", PD_VERSION_STRING,
                 in->sim ? " and simulated drops" : "");
     part_section(b, in, run);
-    table_section(b, in, e, n);
     st = figure(b, "gallery", "Stable poses", NULL, viz_gallery, in, diag);
     if (st == PD_OK)
         st = figure(b, "chart", "Estimates side by side",
@@ -244,6 +247,7 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                     "that quasi-static motion from it ends in: each colour's share of the sphere "
                     "is that pose's QS probability.", viz_sphere, in, diag);
     if (st == PD_OK) {
+        table_section(b, in, e, n);
         run_section(b, run, in->sim);
         vbuf_put(b, "</body></html>\n");
     }
