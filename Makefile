@@ -139,6 +139,14 @@ check-browser: deps
 	@$(MAKE) --no-print-directory $(CLI)
 	POSEDROP=$(CLI) tests/browser/check.sh
 
+# The insulator cap's gallery, chart against the paper's physical tests and
+# gauss-sphere map, and the cost-accuracy chart, into docs/figures/
+# (docs/figures.md). CHART_ONLY=1 redraws the cost-accuracy chart from its
+# kept CSV instead of rerunning its several minutes of drops.
+figures: deps
+	@$(MAKE) --no-print-directory all
+	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
+
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
 	@$(MAKE) --no-print-directory all
@@ -179,6 +187,7 @@ help:
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
+	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"

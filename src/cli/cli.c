@@ -106,7 +106,8 @@ static void usage(FILE *out)
         "                     geometry of its first member, p_qs, p_pqs, count and p\n"
         "                     summed, the class's own interval, and a last column\n"
         "                     members: the member poses' numbers, space-separated\n"
-        "  --verbose          a summary of the part (and of the drops) on stderr\n"
+        "  --verbose          a summary of the part (and of the drops) on stderr\n");
+    fprintf(out,
         "pictures (docs/figures.md):\n"
         "  --svg FILE         gallery of the stable poses (classes with --group), SVG\n"
         "  --chart FILE       the estimates as grouped bars with 95%% intervals, SVG\n"
@@ -737,9 +738,9 @@ int main(int argc, char **argv)
     }
     static const char *const engine_names[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a.path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_names[a.sim.engine], measured};
-    viz_run run = {a.path, a.read.units, &a.estimate, sim ? &a.scene : NULL, &a.sim, t_static,
-                   t_sim, now() - t0, argc, argv};
+                    engine_names[a.sim.engine], sim ? &a.scene : NULL, measured};
+    viz_run run = {a.path, a.read.units, &a.estimate, &a.sim, t_static, t_sim, now() - t0, argc,
+                   argv};
     if ((st = viz_write(&a.pictures, &in, &run, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;

@@ -60,8 +60,9 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     char dyn_name[96];
     int has_dyn = e[0].has_dyn, has_meas = e[0].has_meas;
     if (has_dyn) {
-        snprintf(dyn_name, sizeof dyn_name, "%s, %ld drops", in->engine ? in->engine : "drops",
-                 in->sim->n);
+        snprintf(dyn_name, sizeof dyn_name, "%s, %ld drops%s%s", in->engine ? in->engine : "drops",
+                 in->sim->n, in->scene ? ", initial " : "",
+                 in->scene ? viz_initial_name(in->scene->initial) : "");
         s[2].name = dyn_name;
     }
     int nser = 2 + has_dyn + has_meas;

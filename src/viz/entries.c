@@ -86,3 +86,9 @@ const char *viz_base_name(const char *path)
     const char *slash = strrchr(path, '/');
     return slash && slash[1] ? slash + 1 : path;
 }
+
+const char *viz_initial_name(pd_initial initial)
+{
+    static const char *const names[] = {"uniform", "bootstrap", "stationary"};
+    return initial >= PD_INITIAL_UNIFORM && initial <= PD_INITIAL_STATIONARY ? names[initial] : "?";
+}

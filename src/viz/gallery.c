@@ -83,7 +83,8 @@ pd_status viz_gallery(const viz_input *in, int standalone, vbuf *b, pd_diag *dia
     int cols = n < 5 ? n : n <= 9 ? 3 + (n > 6) : 5;
     int rows = (n + cols - 1) / cols;
     double panel_h = draw_h + label_h;
-    double w = cols * PANEL_W + 2 * GAP, h = TITLE_H + rows * panel_h + GAP;
+    /* At least two panels wide, so that the title and scale bar fit. */
+    double w = (cols < 2 ? 2 : cols) * PANEL_W + 2 * GAP, h = TITLE_H + rows * panel_h + GAP;
     char title[512];
     snprintf(title, sizeof title, "Stable poses of %s%s", viz_base_name(in->name),
              in->class_of ? ", one panel per class" : "");

@@ -161,7 +161,8 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
     vbuf_put(b, "</section>\n");
 }
 
-static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim)
+static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
+                        const pd_scene *scene)
 {
     char v[256];
     vbuf_put(b, "<section id=\"run\"><h2>Scene, engine and timings</h2>\n<table>\n");
@@ -170,14 +171,13 @@ static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim)
              o->topple == PD_TOPPLE_DESCENT ? "descent" : "edge", o->epsilon * (180.0 / M_PI),
              o->compare == PD_PQS_COMPARE_RAW ? "raw" : "qs", o->band == PD_PQS_BAND_RECT ? "rect" : "exact");
     row(b, "static estimators", v);
-    if (run->scene && sim) {
-        const pd_scene *s = run->scene;
-        static const char *const initial[] = {"uniform", "bootstrap", "stationary"};
+    if (scene && sim) {
+        const pd_scene *s = scene;
         snprintf(v, sizeof v, "drop height %.4g m, belt %.4g m/s, mu %.4g, restitution %.4g (%s), "
                  "vibration %.4g deg, gravity %.4g m/s\xc2\xb2, contact time %.4g s, initial %s",
                  s->height, s->belt_speed, s->mu, s->restitution,
                  s->law == PD_RESTITUTION_POISSON ? "Poisson" : "energetic",
-                 s->vibration * (180.0 / M_PI), s->gravity, s->contact_time, initial[s->initial]);
+                 s->vibration * (180.0 / M_PI), s->gravity, s->contact_time, viz_initial_name(s->initial));
         row(b, "scene", v);
         static const char *const engines[] = {"impulse (posedrop's own)", "ODE", "Bullet"};
         const pd_sim_options *so = run->sim;
@@ -248,7 +248,7 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                     "is that pose's QS probability.", viz_sphere, in, diag);
     if (st == PD_OK) {
         table_section(b, in, e, n);
-        run_section(b, run, in->sim);
+        run_section(b, run, in->sim, in->scene);
         vbuf_put(b, "</body></html>\n");
     }
     free(e);

@@ -33,6 +33,7 @@ typedef struct viz_input {
     const int *class_of;          /* res->nposes classes, or NULL */
     int nclasses;
     const char *engine;           /* the dynamic estimator's name for labels */
+    const pd_scene *scene;        /* the drops' scene (NULL without drops) */
     const viz_measured *measured; /* or NULL */
 } viz_input;
 
@@ -41,7 +42,6 @@ typedef struct viz_run {
     const char *path;              /* the part's file */
     pd_units units;
     const pd_static_options *estimate;
-    const pd_scene *scene;         /* NULL when no drops were run */
     const pd_sim_options *sim;
     double seconds_static, seconds_sim, seconds_total;
     int argc;

@@ -28,6 +28,9 @@ pd_status viz_entries(const viz_input *in, viz_entry **out, int *n, pd_diag *dia
  * 0 QS, 1 PQS, 2 dynamic. */
 void viz_eq16(const viz_entry *e, int n, int which, double *e16, double *tv);
 
+/* "uniform", "bootstrap" or "stationary". */
+const char *viz_initial_name(pd_initial initial);
+
 /* The file name without its folders, for titles ("the part" for NULL). */
 const char *viz_base_name(const char *path);
 
