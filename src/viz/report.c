@@ -193,8 +193,8 @@ static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
     } else {
         row(b, "drops", "none (QS and PQS only; -n N adds simulated drops)");
     }
-    snprintf(v, sizeof v, "read and static estimates %.3f s; drops %.3f s; all but this report "
-             "%.3f s", run->seconds_static, run->seconds_sim, run->seconds_total);
+    snprintf(v, sizeof v, "reading and static estimates %.3f s; drops %.3f s; in all, before "
+             "drawing, %.3f s", run->seconds_static, run->seconds_sim, run->seconds_total);
     row(b, "timings (wall clock)", v);
     vbuf_put(b, "</table>\n<p>The command that made this report (same input and seed: the same "
                 "numbers and pictures, whatever the thread count; only the timings differ):</p>\n<pre>");

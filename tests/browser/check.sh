@@ -13,7 +13,7 @@
 # a blank image. Last line "N passed, N failed"; exit status 1 on a failure.
 set -u
 cd "$(dirname "$0")/../.."
-scripts/install-deps.sh chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3 || exit 1
+scripts/install-deps.sh browser || exit 1
 bin=${POSEDROP:-build/opt/posedrop}
 [ -x "$bin" ] || { echo "check-browser: $bin not built" >&2; exit 1; }
 tmp=$(mktemp -d)
