@@ -16,6 +16,7 @@ static const char *const style =
     "padding-bottom:2px;margin-top:1.4em}\n"
     "table{border-collapse:collapse;margin:0.4em 0}td,th{border:1px solid #ccc;padding:2px 8px;"
     "text-align:right;font-variant-numeric:tabular-nums}th{background:#f2f2f2}\n"
+    "td{white-space:nowrap}td.l{white-space:normal}\n"
     "td.l,th.l{text-align:left}.note{color:#555;font-size:0.9em}\n"
     "figure{margin:0.6em 0}svg{max-width:100%;height:auto}\n"
     "pre{background:#f6f6f6;padding:8px;white-space:pre-wrap;word-break:break-all}\n"
