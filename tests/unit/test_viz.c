@@ -360,6 +360,52 @@ static void test_sphere_map(void)
     unload(mesh, part, res);
 }
 
+/* Text equal but for numbers within tol of each other. */
+static int same_but_rounding(const char *a, const char *b, double tol)
+{
+    while (*a && *b) {
+        char *ea, *eb;
+        double x = strtod(a, &ea), y = strtod(b, &eb);
+        if (*a != ' ' && *a != '+' && ea > a && eb > b) {
+            if (fabs(x - y) > tol)
+                return 0;
+            a = ea;
+            b = eb;
+        } else if (*a++ != *b++) {
+            return 0;
+        }
+    }
+    return *a == *b;
+}
+
+/* Moving the part moves nothing in its pictures: each pose is drawn in its
+ * own floor frame. Coordinates are written to 0.01 px, so a translation's
+ * round-off may move one by that much. */
+static void test_placement(void)
+{
+    static const double I[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+    pd_mesh *moved = mesh_box(1, 2, 3);
+    mesh_transform(moved, I, 1.0, v3(7.25, -3.5, 120.125));
+    pd_part *parts[2] = {part_of(mesh_box(1, 2, 3), NULL, NULL), part_of(moved, NULL, NULL)};
+    vbuf b[2];
+    for (int k = 0; k < 2; k++) {
+        vbuf_init(&b[k]);
+        pd_static_result *res = NULL;
+        CHECK(parts[k] != NULL);
+        if (!parts[k])
+            continue;
+        CHECK_STATUS(pd_static_estimate(parts[k], NULL, &res, NULL), PD_OK);
+        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL};
+        CHECK_STATUS(viz_gallery(&in, 1, &b[k], NULL), PD_OK);
+        CHECK_STATUS(viz_sphere(&in, 1, &b[k], NULL), PD_OK);
+        pd_static_result_free(res);
+        pd_part_free(parts[k]);
+    }
+    CHECK(b[0].data && b[1].data && same_but_rounding(b[0].data, b[1].data, 0.0100001));
+    vbuf_free(&b[0]);
+    vbuf_free(&b[1]);
+}
+
 static void test_vbuf(void)
 {
     vbuf b;
@@ -509,6 +555,11 @@ static void test_command(void)
         CHECK(g && strstr(g, label));
     }
     CHECK(r && strstr(r, "eq. (16) error") && !strstr(r, "<script"));
+    /* The report's part and run sections. */
+    const char *said[] = {"units of the file", "centre of mass", "98 facets", "32 proper rotations",
+                          "initial uniform", "200 drops", "timings", "posedrop --group -n 200"};
+    for (int i = 0; i < 8; i++)
+        CHECK(r && strstr(r, said[i]));
     /* Same pictures with one thread. */
     snprintf(cmd, sizeof cmd, PD_CLI_PATH " --group -n 200 -j 1 --svg build/viz-test-g1.svg "
              "--measured %s parts/insulator_cap.off > /dev/null 2>&1", meas);
@@ -540,6 +591,7 @@ void suite_viz(void)
     test_painter_two_cubes();
     test_painter_depth_buffer();
     test_sphere_map();
+    test_placement();
     test_vbuf();
     test_xml_checker();
     test_measured();
