@@ -8,6 +8,7 @@
 #include <getopt.h>
 #include <math.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -543,7 +544,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
             usage(stdout);
             return 0;
         case OPT_VERSION:
-            printf("posedrop %s\n", PD_VERSION_STRING);
+            printf("posedrop %s\n", pd_version());
             return 0;
         case ':':
             return fail_usage("option '%s' needs a value", argv[optind - 1]);
@@ -570,6 +571,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
     const viz_files *pf = &a->pictures;
     if (a->facets && (pf->svg || pf->chart || pf->sphere || pf->report))
         return fail_usage("%s", "--facets lists hull facets; the pictures show poses");
+    const char *const picture_opts[] = {"--svg", "--chart", "--sphere", "--report", "--measured"};
+    const char *const picture_paths[] = {pf->svg, pf->chart, pf->sphere, pf->report, a->measured};
+    for (int i = 0; i < 5; i++)
+        if (picture_paths[i] && !*picture_paths[i])
+            return fail_usage("%s: expected a file name, got an empty one", picture_opts[i]);
     if (a->measured && !pf->svg && !pf->chart && !pf->report)
         return fail_usage("%s", "--measured is shown by --svg, --chart or --report: give one");
     a->path = argv[optind];
@@ -677,12 +683,12 @@ static double now(void)
     return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-static volatile sig_atomic_t interrupted;
+static atomic_int interrupted;
 
 static void on_sigint(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
 }
 
 int main(int argc, char **argv)
@@ -695,6 +701,12 @@ int main(int argc, char **argv)
     pd_diag diag;
     pd_diag_init(&diag);
     diag.warn = print_warning;
+    /* The command offers every engine: it links libposedrop-bullet. */
+    pd_status st = pd_bullet_register();
+    if (st != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine: %s\n", prog, pd_status_str(st));
+        return EXIT_INTERNAL;
+    }
 
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
@@ -703,7 +715,7 @@ int main(int argc, char **argv)
     int *class_of = NULL, nclasses = 0;
     viz_measured *measured = NULL;
     double t0 = now(), t_static = 0.0, t_sim = 0.0;
-    pd_status st = a.measured ? viz_measured_read(a.measured, &measured, &diag) : PD_OK;
+    st = a.measured ? viz_measured_read(a.measured, &measured, &diag) : PD_OK;
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;

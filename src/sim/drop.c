@@ -2,32 +2,36 @@
  * its outcome can no longer change.
  *
  * Flight is closed form (flight.c) and the next impact is found by
- * conservative advancement (flight_impact.c), so there is no time step. Each
- * impact is resolved by the frictional impulse law (impact.c). When several
- * vertices touch at once (a face or an edge landing), the approaching ones are
- * resolved as one collision at their centroid weighted by approach speed, and
- * the set is checked again until no contact approaches: a face landing flat
- * without spin gets the single impulse through its centre that Poisson's law
- * gives a flat landing (rebound e times the approach speed, no spurious
- * rotation), and uneven landings put the impulse nearer the faster contact,
- * as a sequence of Mirtich's microcollisions would, in one step. The scene's
- * contact_time widens "at once" to the contacts that would arrive within it
- * (flight_impact.c): a stand-in for the compliance that makes a nearly flat
- * landing strike its face as a whole.
+ * conservative advancement (flight_impact.c), so there is no time step
+ * between contacts. What happens at a contact depends on how many vertices
+ * share it. A lone vertex striking the floor is resolved by the frictional
+ * impulse law (impact.c), exact. When more than one vertex touches, or
+ * reaches the floor within the scene's contact_time of the first, the
+ * impact is compliant (contact/compliant.c): each vertex below the floor
+ * pushes by a Hunt-Crossley law fixed by the restitution and the contact
+ * duration, with Coulomb friction, and vertices that arrive meanwhile join;
+ * a face landing nearly flat lands as a whole, as a real part's does
+ * (docs/contact.md). The compliant run goes on through lasting face contact
+ * until the part separates, rests on a vertex or an edge, or is decided.
+ * With contact_time 0 (the paper's rigid model) touching vertices are
+ * resolved as one collision at their centroid weighted by approach speed,
+ * the set checked again until none approaches: a face landing flat without
+ * spin then gets the single impulse through its centre that Poisson's law
+ * gives a flat landing.
  *
- * Contact that lasts is simulated two ways. One vertex or one edge on the
- * floor, sliding or sticking, is a contact phase (contact_phase.c): the
- * exact continuous motion under its contact forces, until a contact lifts,
- * slips, sticks or another vertex lands. Everything else (faces, contacts
- * that chatter too much to enter a phase losslessly, hand-overs) is
- * microcollisions: the contact falls a rest fall and is stopped, which sinks
- * and damps the part slightly per step (README: "Known limit").
+ * Contact that lasts on one vertex or one edge, sliding or sticking, is a
+ * contact phase (contact_phase.c): the exact continuous motion under its
+ * contact forces, until a contact lifts, slips, sticks or another vertex
+ * lands. What is left (contacts that chatter too much to enter a phase
+ * losslessly, hand-overs; faces without compliance) is microcollisions: the
+ * contact falls a rest fall, is stopped and put back onto the floor.
  *
  * A drop ends when its energy per unit weight (a height) falls below the
  * barrier of the basin it is in (basin.c): then no future can leave the
  * basin, so its stable pose is the outcome. That needs collisions that never
  * add energy: a Poisson collision that would (possible with friction in 3-D)
- * is redone by the energetic law, which cannot, and counted. It also ends
+ * is redone by the energetic law, which cannot, and counted; a compliant
+ * impact whose step would is scaled back, and counted. It also ends
  * when the part lies on a stable facet that sliding and spinning cannot tip
  * it from (flat_rest.c): then only the rocking energy must be below a
  * barrier, not the energy of the slide. */
@@ -145,6 +149,14 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 
 /* --- the drop ----------------------------------------------------------------- */
 
+/* How far a rest step may let a vertex sink below the floor, times L. Why
+ * 2e-4: resting contact falls PD_TOL_REST_FALL_REL (1e-4) per step by
+ * design; a part that also turns must not carry another vertex much deeper
+ * meanwhile, so that lasting contact stays within 1e-3 L of the floor
+ * (docs/method.md); at twice the rest fall the bound costs extra steps only
+ * where the part turns or falls faster than 2 rest falls per rest step. */
+#define PD_REST_SINK_REL 2e-4
+
 /* Moves the contacts[0..nc) of s that touch the floor (within the impact
  * search's contact tolerance) to the front, keeping their order, and returns
  * how many; *approach is the fastest speed at which one of them approaches
@@ -191,6 +203,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     }
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
+    w->rest_depth = 0.0;
     double t = 0.0, g = sc->gravity;
     /* Resting contact advances by the time to fall rest_fall, so that a
      * vertex pressed on the floor by gravity meets it again with the speed
@@ -239,6 +252,18 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 out->end = PD_END_TIME_LIMIT;
                 break;
             }
+            if (imp.kind == PD_IMPACT_NOW && imp.height < 0.0) {
+                /* Resting contact found below the floor after a rest step:
+                 * back onto it, so that microcollisions do not sink the
+                 * part step by step. The height regained is what the step's
+                 * fall turned into the speed the collision then stops, so
+                 * the energy does not rise. */
+                w->rest_depth = fmax(w->rest_depth, -imp.height);
+                s.x.z -= imp.height;
+                if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
+                    break;
+                f_at = 0.0;
+            }
             if (imp.kind == PD_IMPACT_AT) {
                 if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
                     break;
@@ -262,6 +287,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                         break;
                     out->collisions++;
                     *energy_gain += cr.energy_gain;
+                    w->rest_depth = fmax(w->rest_depth, cr.rest_depth);
                     t += cr.time;
                     f_at = -1.0;
                     phase_ok = 1;
@@ -320,6 +346,12 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
         if (rise > m->settle.v_rest)
             dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
+        /* Nor long enough for any vertex to sink further than
+         * PD_REST_SINK_REL below the floor at the part's speed bound: the
+         * step is blind to vertices other than the touching ones. */
+        double speed = fabs(s.v.z) + v3_norm(s.w) * m->body->rmax;
+        if (speed * dt > PD_REST_SINK_REL * m->body->size)
+            dt = PD_REST_SINK_REL * m->body->size / speed;
         f_at += dt;
         if (pd_flight_eval(&f, f_at, &s) != PD_OK)
             break;
