@@ -197,8 +197,9 @@ static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
     snprintf(v, sizeof v, "reading and static estimates %.3f s; drops %.3f s; in all, before "
              "drawing, %.3f s", run->seconds_static, run->seconds_sim, run->seconds_total);
     row(b, "timings (wall clock)", v);
-    vbuf_put(b, "</table>\n<p>The command that made this report (same input and seed: the same "
-                "numbers and pictures, whatever the thread count; only the timings differ):</p>\n<pre>");
+    vbuf_put(b, "</table>\n<p>The command that made this report (rerun with the same input, "
+                "options and seed, it gives the same numbers and pictures at any thread count; "
+                "only the timings, and -j in this line, may differ):</p>\n<pre>");
     for (int i = 0; i < run->argc; i++) {
         if (i)
             vbuf_put(b, " ");

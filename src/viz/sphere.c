@@ -114,6 +114,53 @@ int viz_sphere_region(const pd_part *part, int f, int side, viz_pt **pts)
     return n;
 }
 
+/* The arcs where one pose's region meets another's, cut to the hemisphere,
+ * as path segments: the basins' borders, drawn over the facets' outlines. */
+static void basin_borders(vbuf *b, const pd_part *part, const int *entry_of_facet, int side,
+                          double cx, double cy)
+{
+    const pd_hull *h = part->hull;
+    int started = 0;
+    for (int f = 0; f < h->nfacets; f++) {
+        int k0 = h->facet_start[f], k1 = h->facet_start[f + 1];
+        for (int k = k0; k < k1; k++) {
+            int g = h->facet_adj[k];
+            if (g < f || entry_of_facet[g] == entry_of_facet[f])
+                continue;
+            poly pl = {0};
+            pd_vec3 a = v3_unit(v3_sub(h->verts[h->facet_vert[k]], part->com));
+            pd_vec3 e = v3_unit(v3_sub(h->verts[h->facet_vert[k + 1 < k1 ? k + 1 : k0]], part->com));
+            arc(&pl, a, e);
+            push(&pl, e, 0);
+            for (int i = 0; i + 1 < pl.n && !pl.failed; i++) {
+                pd_vec3 p = pl.p[i], q = pl.p[i + 1];
+                double zp = side * p.z, zq = side * q.z;
+                if (zp < 0 && zq < 0)
+                    continue;
+                if (zp < 0 || zq < 0) {
+                    pd_vec3 c = v3_lerp(p, q, zp / (zp - zq));
+                    c.z = 0.0;
+                    c = v3_unit(c);
+                    if (zp < 0)
+                        p = c;
+                    else
+                        q = c;
+                }
+                viz_xy(b, started ? " M" : "<path d=\"M", cx + RADIUS * (side > 0 ? p.x : -p.x),
+                       cy - RADIUS * p.y);
+                viz_xy(b, " L", cx + RADIUS * (side > 0 ? q.x : -q.x), cy - RADIUS * q.y);
+                started = 1;
+            }
+            if (pl.failed)
+                b->failed = 1;
+            free(pl.p);
+            free(pl.exit);
+        }
+    }
+    if (started)
+        vbuf_put(b, "\" fill=\"none\" stroke=\"#1a1a1a\" stroke-width=\"1.1\"/>\n");
+}
+
 static void disc_pt(vbuf *b, const char *lead, double cx, double cy, viz_pt p)
 {
     viz_xy(b, lead, cx + RADIUS * p.x, cy - RADIUS * p.y);
@@ -155,8 +202,8 @@ pd_status viz_sphere(const viz_input *in, int standalone, vbuf *b, pd_diag *diag
     vbuf_put(b, "<g class=\"sphere\">\n");
     viz_text(b, 10, 22, 16, "start", 1, "#111111", title);
     viz_text(b, 10, 38, 11, "start", 0, "#555555",
-             "Directions of gravity in the part's frame; colour: the pose reached; thin lines: "
-             "hull facets; dots: the poses' own directions.");
+             "Gravity's directions in the part's frame, coloured by the pose reached; dark lines: "
+             "basin borders; thin: hull facets; dots: the poses.");
     for (int hemi = 0; hemi < 2 && !b->failed; hemi++) {
         int side = hemi == 0 ? 1 : -1;
         double cx = MARGIN + RADIUS + hemi * (2 * RADIUS + 2 * MARGIN), cy = TOP + MARGIN + RADIUS;
@@ -182,6 +229,7 @@ pd_status viz_sphere(const viz_input *in, int standalone, vbuf *b, pd_diag *diag
             vbuf_printf(b, "\" fill=\"%s\" stroke=\"#ffffff\" stroke-width=\"0.5\"/>\n", colour);
             free(pts);
         }
+        basin_borders(b, part, entry_of_facet, side, cx, cy);
         viz_circle(b, cx, cy, RADIUS, "fill=\"none\" stroke=\"#111111\" stroke-width=\"1.2\"");
         /* The poses' own directions: each stable facet's normal. */
         for (int i = 0; i < res->nposes; i++) {
