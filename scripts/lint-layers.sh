@@ -21,7 +21,7 @@ lower() {
     engines)   echo "base hull part dynamics" ;;
     sim)       echo "base mesh hull part static symmetry dynamics impact settle contact engines" ;;
     viz)       echo "base" ;; # the pictures: the public API, base's helpers
-    cli)       echo "viz" ;; # the public API and the pictures
+    cli)       echo "base viz" ;; # the public API, base/number.h (linked in directly), the pictures
     *)         echo "?" ;;
     esac
 }

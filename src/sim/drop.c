@@ -245,7 +245,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
             if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                      sc->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+                                      m->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
             if (imp.kind == PD_IMPACT_NONE) {
                 t = o->time_limit;
@@ -296,7 +296,9 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                         out->end = PD_END_SETTLED;
                         break;
                     }
-                    if (cr.end == PD_COMPLIANT_TIME) {
+                    /* The run's last step may pass the limit (by less than
+                     * a step) whatever way it ended: the time is spent. */
+                    if (cr.end == PD_COMPLIANT_TIME || t >= o->time_limit) {
                         out->end = PD_END_TIME_LIMIT;
                         break;
                     }
@@ -311,7 +313,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
-                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->contact_time == 0.0;
+                resolved = out->collisions - before < PD_MAX_ROUNDS && m->contact_time == 0.0;
                 f_at = -1.0;
                 continue;
             }

@@ -6,6 +6,7 @@
 #ifndef PD_VIZ_H
 #define PD_VIZ_H
 
+#include <stdio.h>
 #include "posedrop/posedrop.h"
 
 /* A measured pose distribution (--measured FILE.csv), read before the run. */
@@ -48,13 +49,17 @@ typedef struct viz_run {
     char **argv;                   /* the command line, shown so that it can be rerun */
 } viz_run;
 
-typedef struct viz_files {
-    const char *svg, *chart, *sphere, *report; /* paths; NULL: not wanted */
-} viz_files;
+/* The pictures: --svg, --chart, --sphere, --report. */
+typedef enum { VIZ_GALLERY = 0, VIZ_CHART, VIZ_SPHERE, VIZ_REPORT, VIZ_KINDS } viz_kind;
 
-/* Writes each wanted file. PD_ERR_USAGE when the measured file names a pose
- * the table does not have, PD_ERR_IO (message names the file), PD_ERR_NOMEM. */
-pd_status viz_write(const viz_files *files, const viz_input *in, const viz_run *run,
-                    pd_diag *diag);
+/* Whether in can be drawn: PD_ERR_USAGE when the measured file names a
+ * pose the table does not have, so that a run fails before writing. */
+pd_status viz_check(const viz_input *in, pd_diag *diag);
+
+/* Writes one picture to f (the caller opens it and catches write errors when
+ * it closes it; run is read by the report only). PD_ERR_USAGE when the
+ * measured file names a pose the table does not have, PD_ERR_NOMEM. */
+pd_status viz_write_file(viz_kind kind, FILE *f, const viz_input *in, const viz_run *run,
+                         pd_diag *diag);
 
 #endif

@@ -10,10 +10,14 @@
     PD_SUITE(mass)   \
     PD_SUITE(part)   \
     PD_SUITE(static) \
+    PD_SUITE(limits) \
     PD_SUITE(basin)  \
     PD_SUITE(descent_map) \
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
+    PD_SUITE(number) \
+    PD_SUITE(input)  \
+    PD_SUITE(fuzz_replay) \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \
@@ -27,6 +31,8 @@
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
+    PD_SUITE(engine_extreme) \
+    PD_SUITE(engine_contact) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(viz)    \

@@ -580,7 +580,7 @@ static void test_command(void)
     CHECK_INT(sh(PD_CLI_PATH " --measured build/viz-test-seven.csv parts/cap.off > /dev/null 2>&1"), 2);
     CHECK_INT(sh(PD_CLI_PATH " --report '' parts/cap.off > build/viz-test.out 2>&1"), 2);
     out = slurp("build/viz-test.out");
-    CHECK(out && strstr(out, "--report: expected a file name, got an empty one"));
+    CHECK(out && strstr(out, "an empty file name"));
     free(out);
     CHECK_INT(sh(PD_CLI_PATH " --svg /nonexistent-dir/g.svg parts/cap.off > build/viz-test.out 2>&1"), 2);
     out = slurp("build/viz-test.out");
