@@ -20,11 +20,15 @@ check_pc qhull_r libqhull-dev
 command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
 # A JSON parser for the test of --format json: Python's json module, or jq.
 command -v python3 >/dev/null 2>&1 || command -v jq >/dev/null 2>&1 || missing="$missing jq"
-# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart);
-# 'mpi' stands for OpenMPI's compiler wrappers and launcher (make MPI=1).
+# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart),
+# or a group by its name: browser, what make check-browser renders with; mpi,
+# OpenMPI's compiler wrappers and launcher (make MPI=1).
 for arg in "$@"; do
-    pkgs=$arg
-    [ "$arg" = mpi ] && pkgs="libopenmpi-dev openmpi-bin"
+    case "$arg" in
+    browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
+    mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
+    *) pkgs=$arg ;;
+    esac
     for pkg in $pkgs; do
         dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
     done

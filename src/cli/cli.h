@@ -6,6 +6,7 @@
 #define PD_CLI_CLI_H
 
 #include <stdio.h>
+#include "viz/viz.h"
 #include "posedrop/posedrop.h"
 
 enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
@@ -20,6 +21,8 @@ typedef struct {
     pd_scene scene;
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
+    const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
+    const char *measured;
     int json;                      /* --format json */
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;

@@ -3,6 +3,8 @@
 #ifndef PD_TEST_CLI_RUN_H
 #define PD_TEST_CLI_RUN_H
 
+#include "files.h" /* slurp */
+
 #ifndef PD_CLI_PATH
 #define PD_CLI_PATH "build/opt/posedrop"
 #endif
@@ -11,8 +13,6 @@
  * captures. */
 extern char tmpdir[64];
 
-/* The whole file, NUL-ended (caller frees); NULL if unreadable. */
-char *slurp(const char *path);
 int write_file(const char *path, const char *text);
 
 /* Runs "posedrop ARGS" (or any shell command when raw), returns the exit code

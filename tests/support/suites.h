@@ -36,6 +36,7 @@
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(batch)  \
+    PD_SUITE(viz)    \
     PD_SUITE(golden)
 
 #define PD_SUITE(name) void suite_##name(void);

@@ -10,6 +10,7 @@
 #include <unistd.h>
 #include "check.h"
 #include "cli_run.h"
+#include "files.h"
 #include "suites.h"
 
 typedef struct {
