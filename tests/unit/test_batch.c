@@ -146,6 +146,7 @@ static void test_merge_refusals(void)
     expect_failure("--shard 1/0 -n 10 parts/cap.off", 2, "--shard");
     expect_failure("--shard 1 -n 10 parts/cap.off", 2, "--shard");
     expect_failure("--shard 1/2 --format json -n 10 parts/cap.off", 2, "--format json");
+    expect_failure("--shard 1/2 --svg /tmp/posedrop-never.svg -n 10 parts/cap.off", 2, "pictures");
     expect_failure("merge", 2, "expected the shard files");
     expect_failure("merge --format xml x", 2, "--format");
 }
