@@ -48,7 +48,13 @@ enum { X = 0, V = 3, Q = 6, W = 10, NY = 13 };
  * phase, rk8pd -> rkck: cube 108k -> 76k, box 112k -> 79k, coin 107k -> 62k. */
 pd_ode *pd_contact_phase_ode_alloc(void)
 {
-    return pd_ode_alloc_method(PD_ODE_RKCK, NY, PD_TOL_PHASE_ODE_REL, PD_TOL_PHASE_ODE_REL);
+    return pd_contact_phase_ode_alloc_tol(1.0);
+}
+
+pd_ode *pd_contact_phase_ode_alloc_tol(double tol_scale)
+{
+    double tol = tol_scale * PD_TOL_PHASE_ODE_REL;
+    return pd_ode_alloc_method(PD_ODE_RKCK, NY, tol, tol);
 }
 
 /* The same pair and tolerance for a pivot's angle (rad) and rate (per
@@ -56,7 +62,13 @@ pd_ode *pd_contact_phase_ode_alloc(void)
  * as an error of e in the full motion's position (per L) does. */
 pd_ode *pd_contact_pivot_ode_alloc(void)
 {
-    return pd_ode_alloc_method(PD_ODE_RKCK, 2, PD_TOL_PHASE_ODE_REL, PD_TOL_PHASE_ODE_REL);
+    return pd_contact_pivot_ode_alloc_tol(1.0);
+}
+
+pd_ode *pd_contact_pivot_ode_alloc_tol(double tol_scale)
+{
+    double tol = tol_scale * PD_TOL_PHASE_ODE_REL;
+    return pd_ode_alloc_method(PD_ODE_RKCK, 2, tol, tol);
 }
 
 /* What a phase integrates: the full motion, y = (x, v, q, w) in the part's

@@ -14,6 +14,10 @@
  * edge, contact_pivot.h). NULL if out of memory. */
 pd_ode *pd_contact_phase_ode_alloc(void);
 pd_ode *pd_contact_pivot_ode_alloc(void);
+/* The same with their tolerance times tol_scale (in (0, 1]), for tests of
+ * convergence. */
+pd_ode *pd_contact_phase_ode_alloc_tol(double tol_scale);
+pd_ode *pd_contact_pivot_ode_alloc_tol(double tol_scale);
 
 /* 1 if state s, touching the floor at body vertices contacts[0..nc), is a
  * contact the phase can take: one or two contacts moving normally no faster

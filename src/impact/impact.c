@@ -25,11 +25,17 @@ struct pd_impact_work {
 
 pd_impact_work *pd_impact_work_alloc(void)
 {
+    return pd_impact_work_alloc_tol(1.0);
+}
+
+pd_impact_work *pd_impact_work_alloc_tol(double tol_scale)
+{
     pd_impact_work *w = calloc(1, sizeof *w);
     if (!w)
         return NULL;
-    w->poisson = pd_ode_alloc(NSTATE_P, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
-    w->energetic = pd_ode_alloc(NSTATE, PD_TOL_IMPACT_ODE_REL, PD_TOL_IMPACT_ODE_REL);
+    double tol = tol_scale * PD_TOL_IMPACT_ODE_REL;
+    w->poisson = pd_ode_alloc(NSTATE_P, tol, tol);
+    w->energetic = pd_ode_alloc(NSTATE, tol, tol);
     if (!w->poisson || !w->energetic) {
         pd_impact_work_free(w);
         return NULL;

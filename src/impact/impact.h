@@ -48,6 +48,9 @@ typedef struct pd_impact_work pd_impact_work;
 
 /* NULL if memory runs out. */
 pd_impact_work *pd_impact_work_alloc(void);
+/* The same with the integrator's tolerance times tol_scale (in (0, 1]), for
+ * tests of convergence. */
+pd_impact_work *pd_impact_work_alloc_tol(double tol_scale);
 /* Accepts NULL. */
 void pd_impact_work_free(pd_impact_work *w);
 

@@ -111,6 +111,18 @@ int pd_settle_decided(const pd_settle *st, const pd_state *s, double g, int *hin
     return pd_settle_decided_at(st, s, g, hint, pose, &f);
 }
 
+int pd_settle_outcome(const pd_settle *st, const pd_state *s, double g, double mu, int *hint,
+                      int *pose)
+{
+    int facet, d = pd_settle_decided_at(st, s, g, hint, pose, &facet);
+    if (d == 0 && facet >= 0 && st->pose_of[facet] >= 0 &&
+        pd_flat_settled(st->flat, st->body, s, facet, g, mu, st->rest_fall)) {
+        *pose = st->pose_of[facet];
+        return 1;
+    }
+    return d;
+}
+
 double pd_settle_tilt(const pd_settle *st, const pd_state *s, int pose)
 {
     return v3_angle(gravity_in_part(st, s), st->poses->poses[pose].normal);

@@ -51,6 +51,13 @@ int pd_settle_decided(const pd_settle *settle, const pd_state *s, double gravity
 int pd_settle_decided_at(const pd_settle *settle, const pd_state *s, double gravity, int *hint,
                          int *pose, int *facet);
 
+/* The outcome test of a drop in state s: pd_settle_decided_at, or lying
+ * flat on a stable facet that sliding and spinning (friction mu) cannot tip
+ * it from (pd_flat_settled). 1 and *pose when decided, 0 if not yet, -1 on
+ * failure. */
+int pd_settle_outcome(const pd_settle *settle, const pd_state *s, double gravity, double mu,
+                      int *hint, int *pose);
+
 /* The part's tilt in state s from the facet of pose: the angle between
  * gravity and that facet's normal, rad. */
 double pd_settle_tilt(const pd_settle *settle, const pd_state *s, int pose);

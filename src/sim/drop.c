@@ -37,7 +37,6 @@
 #include "dynamics/body.h"
 #include "contact/contact_phase.h"
 #include "base/fail.h"
-#include "settle/flat_rest.h"
 #include "settle/settle.h"
 #include "sim/drop.h"
 #include "sim/drop_step.h"
@@ -146,6 +145,42 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 
 /* --- the drop ----------------------------------------------------------------- */
 
+/* Moves the contacts[0..nc) of s that touch the floor (within the impact
+ * search's contact tolerance) to the front, keeping their order, and returns
+ * how many; *approach is the fastest speed at which one of them approaches
+ * (0 if none does). The rest would only arrive within the search's window. */
+static int keep_touching(const pd_body *b, const pd_state *s, int *contacts, int nc,
+                         double *approach)
+{
+    pd_vec3 ww = quat_rotate(s->q, s->w);
+    double tol = PD_TOL_CONTACT_REL * b->size;
+    int n = 0;
+    *approach = 0.0;
+    for (int i = 0; i < nc; i++) {
+        pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
+        if (s->x.z + r.z > tol)
+            continue;
+        *approach = fmax(*approach, -(s->v.z + v3_cross(ww, r).z));
+        int c = contacts[i];
+        memmove(contacts + n + 1, contacts + n, (size_t)(i - n) * sizeof *contacts);
+        contacts[n++] = c;
+    }
+    return n;
+}
+
+/* The slowest rate at which the contacts[0..nc) of s rise from the floor,
+ * m/s (negative when one approaches; HUGE_VAL for none). */
+static double touching_rise(const pd_body *b, const pd_state *s, const int *contacts, int nc)
+{
+    pd_vec3 ww = quat_rotate(s->q, s->w);
+    double rise = HUGE_VAL;
+    for (int i = 0; i < nc; i++) {
+        pd_vec3 r = quat_rotate(s->q, b->verts[contacts[i]]);
+        rise = fmin(rise, s->v.z + v3_cross(ww, r).z);
+    }
+    return rise;
+}
+
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
@@ -172,12 +207,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * resolve, so both are skipped. */
     int resolved = 0;
     for (;;) {
-        int pose, facet, d = pd_settle_decided_at(&m->settle, &s, g, &hint, &pose, &facet);
-        if (d == 0 && facet >= 0 && m->settle.pose_of[facet] >= 0 &&
-            pd_flat_settled(m->settle.flat, m->body, &s, facet, g, sc->mu, m->settle.rest_fall)) {
-            d = 1; /* flat on a facet it cannot leave (flat_rest.h) */
-            pose = m->settle.pose_of[facet];
-        }
+        int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
         if (d < 0)
             break;
         if (d > 0) {
@@ -216,6 +246,38 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 f_at = imp.t;
             }
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
+            if (m->compliant_on) {
+                /* More than one vertex touching or arriving within a contact
+                 * duration, one of them striking: a compliant impact, which
+                 * the arriving ones join. Else the exact rigid law at the
+                 * touching vertices alone (a single vertex's impact is its
+                 * limit as the duration shrinks). */
+                double approach;
+                int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
+                if (nc >= 2 && approach > m->settle.v_rest) {
+                    pd_compliant_result cr;
+                    pd_status cs = pd_compliant_run(&m->compliant, w->compliant, &m->settle, sc,
+                                                    &s, o->time_limit - t, &cr);
+                    if (cs != PD_OK)
+                        break;
+                    out->collisions++;
+                    *energy_gain += cr.energy_gain;
+                    t += cr.time;
+                    f_at = -1.0;
+                    phase_ok = 1;
+                    if (cr.end == PD_COMPLIANT_DECIDED) {
+                        out->pose = cr.pose;
+                        out->end = PD_END_SETTLED;
+                        break;
+                    }
+                    if (cr.end == PD_COMPLIANT_TIME) {
+                        out->end = PD_END_TIME_LIMIT;
+                        break;
+                    }
+                    continue;
+                }
+                nc = ntouch;
+            }
             int before = out->collisions;
             if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
                                 fallbacks) != PD_OK)
@@ -248,12 +310,20 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             continue;
         }
         /* Touching but not approaching: separating, or resting. Nothing
-         * changed the motion, so s goes on along f. */
+         * changed the motion, so s goes on along f. When every touching
+         * contact leaves the floor faster than resting contact falls onto
+         * it, the step is only as long as lifting them clear of the contact
+         * tolerance takes: a full rest step would pass over whatever else
+         * lands meanwhile (a face's other corners after its first one
+         * rebounds), which then starts below the floor. */
         phase_ok = 1;
-        f_at += dt_rest;
+        double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
+        if (rise > m->settle.v_rest)
+            dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
+        f_at += dt;
         if (pd_flight_eval(&f, f_at, &s) != PD_OK)
             break;
-        t += dt_rest;
+        t += dt;
         if (t >= o->time_limit) {
             out->end = PD_END_TIME_LIMIT;
             break;

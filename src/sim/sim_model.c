@@ -24,9 +24,19 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
                              const pd_scene *scene, const pd_sim_options *options,
                              pd_sim_model **model, pd_diag *diag)
 {
+    return pd_sim_model_build_tol(part, poses, scene, options, 1.0, model, diag);
+}
+
+pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *poses,
+                                 const pd_scene *scene, const pd_sim_options *options,
+                                 double tol_scale, pd_sim_model **model, pd_diag *diag)
+{
+    if (!(tol_scale > 0.0 && tol_scale <= 1.0))
+        return pd_fail(diag, PD_ERR_RANGE, "tolerance scale %g outside (0, 1]", tol_scale);
     pd_sim_model *m = calloc(1, sizeof *m);
     if (!m)
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
+    m->tol_scale = tol_scale;
     /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
      * frame cut into 16 substeps. */
     if (options->engine == PD_ENGINE_ODE) {
@@ -42,6 +52,14 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
     pd_status st = pd_body_build(part, &m->body, diag);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
+    if (st == PD_OK && !m->engine && scene->contact_time > 0.0) {
+        m->compliant_on = 1;
+        st = pd_compliant_init(scene->restitution, scene->contact_time, m->body, tol_scale,
+                               &m->compliant);
+        if (st != PD_OK)
+            st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
+                         "time %g s could not be set up", scene->restitution, scene->contact_time);
+    }
     if (st != PD_OK) {
         pd_sim_model_free(m);
         return st;
@@ -62,14 +80,18 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     if (model->engine)
         w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
     else {
-        w->impact = pd_impact_work_alloc();
-        w->phase = pd_contact_phase_ode_alloc();
-        w->pivot = pd_contact_pivot_ode_alloc();
+        w->impact = pd_impact_work_alloc_tol(model->tol_scale);
+        w->phase = pd_contact_phase_ode_alloc_tol(model->tol_scale);
+        w->pivot = pd_contact_pivot_ode_alloc_tol(model->tol_scale);
+        if (model->compliant_on)
+            w->compliant = pd_compliant_work_alloc(model->body);
     }
-    if ((!w->impact || !w->phase || !w->pivot) && !w->world) {
+    if ((!w->impact || !w->phase || !w->pivot || (model->compliant_on && !w->compliant)) &&
+        !w->world) {
         pd_impact_work_free(w->impact);
         pd_ode_free(w->phase);
         pd_ode_free(w->pivot);
+        pd_compliant_work_free(w->compliant);
         free(w);
         return NULL;
     }
@@ -84,6 +106,7 @@ void pd_drop_work_free(pd_drop_work *w)
     pd_impact_work_free(w->impact);
     pd_ode_free(w->phase);
     pd_ode_free(w->pivot);
+    pd_compliant_work_free(w->compliant);
     if (w->world)
         w->engine->world_free(w->world);
     free(w);

@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include "base/gsl_adapter.h"
 #include "base/rng.h"
+#include "contact/compliant.h"
 #include "dynamics/body.h"
 #include "engines/engine.h"
 #include "impact/impact.h"
@@ -29,6 +30,9 @@ typedef struct pd_sim_model {
     const pd_engine *engine;    /* NULL: the impulse simulator */
     double dt;                  /* the stepping engine's fixed step */
     double v_eps;               /* approach speeds below this are contact, not impact */
+    int compliant_on;           /* the impulse engine with contact_time > 0 */
+    pd_compliant compliant;     /* its impacts with more than one contact */
+    double tol_scale;           /* every integration tolerance times this (1) */
 } pd_sim_model;
 
 typedef struct pd_drop_work {
@@ -36,6 +40,7 @@ typedef struct pd_drop_work {
     pd_ode *phase;              /* the sliding phases' integrator */
     pd_ode *pivot;              /* and the pivots' (contact_pivot.h) */
     pd_engine_world *world;     /* the stepping engine's, or NULL */
+    pd_compliant_work *compliant; /* with model->compliant_on, else NULL */
     const pd_engine *engine;
     int contacts[PD_MAX_CONTACTS];
 } pd_drop_work;
@@ -44,6 +49,13 @@ pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
                              const pd_scene *scene, const pd_sim_options *options,
                              pd_sim_model **model, pd_diag *diag);
 void pd_sim_model_free(pd_sim_model *model);
+
+/* pd_sim_model_build with every integration tolerance of the impulse
+ * engine's impacts and contacts times tol_scale in (0, 1]: for tests that
+ * the model converges as they tighten. */
+pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *poses,
+                                 const pd_scene *scene, const pd_sim_options *options,
+                                 double tol_scale, pd_sim_model **model, pd_diag *diag);
 
 pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scene);
 void pd_drop_work_free(pd_drop_work *work);

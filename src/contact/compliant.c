@@ -1,0 +1,342 @@
+/* compliant.c: a compliant impact with as many contacts as touch, and the
+ * lasting face contact it may turn into (see compliant.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/quat.h"
+#include "base/vec3.h"
+#include "contact/compliant.h"
+
+/* The step, as a fraction of the fastest time scale of one contact: its
+ * oscillation 1 / omega, shortened by the damping rate the law reaches at
+ * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
+ * floor, since n springs of one contact's stiffness on a rigid body vibrate
+ * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
+ * 13 steps per contact duration at e = 0.3 with one contact; a flat landing's
+ * rebound then comes out within 2e-4 of e, and halving it moves no pose
+ * probability beyond sampling noise (tests/unit/test_compliant.c). Larger:
+ * the explicit step loses accuracy, and stability beyond 2. */
+#define PD_COMPLIANT_STEP 0.25
+
+/* Vertices within this times L above the floor are watched for contact, and
+ * the list is rebuilt once the part may have moved half of it. Why 0.02: a
+ * hull's vertices near the floor are few at that height, and rebuilds come
+ * every 0.01 L of motion, a few hundred steps of a rocking part. Any value
+ * gives the same motion (a vertex can only touch from within the band);
+ * only the cost moves. */
+#define PD_COMPLIANT_BAND_REL 0.02
+
+/* Gauss-Seidel sweeps over the contacts' friction impulses per step, at
+ * most, and the stop: no impulse moved by more than this times its cone's
+ * radius in a sweep. Why 1e-6: the friction impulses are then converged far
+ * below the step's own error (PD_COMPLIANT_STEP); sticking faces converge in
+ * a few sweeps. 32 only stops a pathological coupling. */
+#define PD_COMPLIANT_SWEEPS 32
+#define PD_COMPLIANT_SWEEP_TOL 1e-6
+
+/* Steps between two tests of the outcome: the test costs a descent lookup,
+ * tens of steps' work; deciding a few steps late changes nothing, since a
+ * decided drop stays in its basin. */
+#define PD_COMPLIANT_TEST_EVERY 8
+
+struct pd_compliant_work {
+    int nverts;
+    int ncand;
+    int *cand;              /* vertices within the band */
+    unsigned char *active;  /* per vertex: below the floor, its law fixed */
+    double *k, *lam;        /* per vertex: stiffness, damping (chi / v0) */
+    /* per contact pushing in this step */
+    int *push;
+    double *pn;             /* normal impulse */
+    double *ptx, *pty;      /* tangential impulses, accumulated over sweeps */
+    double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
+    int hint;
+};
+
+pd_status pd_compliant_init(double e, double T, const pd_body *b, double tol_scale, pd_compliant *c)
+{
+    if (!(tol_scale > 0.0 && tol_scale <= 1.0))
+        return PD_ERR_RANGE;
+    pd_status st = pd_compliant_law_init(e, T, &c->law);
+    if (st != PD_OK)
+        return st;
+    c->h1 = tol_scale * PD_COMPLIANT_STEP / (c->law.omega * (1.0 + c->law.chi * c->law.s_peak));
+    c->band = PD_COMPLIANT_BAND_REL * b->size;
+    c->sweep_tol = tol_scale * PD_COMPLIANT_SWEEP_TOL;
+    return PD_OK;
+}
+
+pd_compliant_work *pd_compliant_work_alloc(const pd_body *b)
+{
+    pd_compliant_work *w = calloc(1, sizeof *w);
+    if (!w)
+        return NULL;
+    size_t n = (size_t)b->nverts;
+    w->nverts = b->nverts;
+    w->cand = malloc(n * sizeof *w->cand);
+    w->active = calloc(n, 1);
+    w->k = malloc(n * sizeof *w->k);
+    w->lam = malloc(n * sizeof *w->lam);
+    w->push = malloc(n * sizeof *w->push);
+    w->pn = malloc(n * sizeof *w->pn);
+    w->ptx = malloc(n * sizeof *w->ptx);
+    w->pty = malloc(n * sizeof *w->pty);
+    w->kt = malloc(n * sizeof *w->kt);
+    if (!w->cand || !w->active || !w->k || !w->lam || !w->push || !w->pn || !w->ptx ||
+        !w->pty || !w->kt) {
+        pd_compliant_work_free(w);
+        return NULL;
+    }
+    return w;
+}
+
+void pd_compliant_work_free(pd_compliant_work *w)
+{
+    if (!w)
+        return;
+    free(w->cand);
+    free(w->active);
+    free(w->k);
+    free(w->lam);
+    free(w->push);
+    free(w->pn);
+    free(w->ptx);
+    free(w->pty);
+    free(w->kt);
+    free(w);
+}
+
+/* Body-frame inverse inertia applied to a. */
+static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 a)
+{
+    return v3(a.x * b->inv_moment[0], a.y * b->inv_moment[1], a.z * b->inv_moment[2]);
+}
+
+/* The inverse mass of the body at r along unit directions a and c, all in
+ * the body frame: a.c / m + (r x a) I^-1 (r x c). */
+static double inv_mass(const pd_body *b, pd_vec3 r, pd_vec3 a, pd_vec3 c)
+{
+    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r, a), inv_inertia(b, v3_cross(r, c)));
+}
+
+static void rebuild_candidates(const pd_compliant *c, pd_compliant_work *w, const pd_body *b,
+                               const pd_state *s, pd_vec3 up)
+{
+    w->ncand = 0;
+    for (int i = 0; i < b->nverts; i++) {
+        if (s->x.z + v3_dot(b->verts[i], up) < c->band)
+            w->cand[w->ncand++] = i;
+        else
+            w->active[i] = 0;
+    }
+}
+
+/* Kinetic plus potential energy, J. */
+static double energy(const pd_body *b, const pd_state *s, double g)
+{
+    return pd_body_kinetic(b, s) + b->mass * g * s->x.z;
+}
+
+/* The energy the contacts below the floor hold in their springs, J. */
+static double elastic_energy(const pd_compliant_work *w, const pd_body *b, const pd_state *s)
+{
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0, 0, 1));
+    double sum = 0.0;
+    for (int j = 0; j < w->ncand; j++) {
+        int i = w->cand[j];
+        double z = s->x.z + v3_dot(b->verts[i], up);
+        if (z < 0.0 && w->active[i])
+            sum += 0.5 * w->k[i] * z * z;
+    }
+    return sum;
+}
+
+pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd_settle *settle,
+                           const pd_scene *sc, pd_state *s, double t_max, pd_compliant_result *r)
+{
+    const pd_body *b = settle->body;
+    const double g = sc->gravity, mu = sc->mu, m = b->mass;
+    const double omega2 = c->law.omega * c->law.omega, chi = c->law.chi;
+    const double v_rest = settle->v_rest;
+    memset(r, 0, sizeof *r);
+    r->pose = -1;
+
+    /* Enter with no vertex below the floor (the impact search leaves the
+     * lowest within its tolerance, either side). */
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0, 0, 1));
+    int low = pd_body_support(b, up, w->hint >= 0 && w->hint < b->nverts ? w->hint : 0);
+    double zlow = s->x.z + v3_dot(b->verts[low], up);
+    if (zlow < 0.0)
+        s->x.z -= zlow;
+    const double e_start = energy(b, s, g);
+    memset(w->active, 0, (size_t)b->nverts);
+    rebuild_candidates(c, w, b, s, up);
+
+    double t = 0.0, last_touch = 0.0, moved = 0.0, h = c->h1;
+    for (long step = 0;; step++) {
+        up = quat_rotate_inv(s->q, v3(0, 0, 1));
+        pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
+        int npush = 0, nbelow = 0, arriving = 0;
+        double deepest = 0.0, approach = 0.0, elastic = 0.0;
+        for (int j = 0; j < w->ncand; j++) {
+            int i = w->cand[j];
+            pd_vec3 r_i = b->verts[i];
+            double z = s->x.z + v3_dot(r_i, up);
+            double uz = s->v.z + v3_dot(v3_cross(s->w, r_i), up);
+            if (z >= 0.0) {
+                w->active[i] = 0;
+                if (uz < 0.0 && z < -2.0 * uz * h)
+                    arriving = 1;
+                continue;
+            }
+            if (!w->active[i]) {
+                /* Touching now: its law, from its effective mass and its
+                 * approach speed (resting contact's at least, so that a
+                 * contact creeping in is not damped without bound). */
+                w->active[i] = 1;
+                w->k[i] = omega2 / inv_mass(b, r_i, up, up);
+                w->lam[i] = chi / fmax(-uz, v_rest);
+                last_touch = t;
+            }
+            double d = -z;
+            nbelow++;
+            deepest = fmax(deepest, d);
+            approach = fmax(approach, -uz);
+            elastic += 0.5 * w->k[i] * d * d;
+            double f = w->k[i] * d * (1.0 + w->lam[i] * (-uz));
+            if (f > 0.0) {
+                w->push[npush] = i;
+                w->pn[npush] = f;
+                npush++;
+            }
+        }
+        r->depth = fmax(r->depth, deepest);
+        if (step > 0) {
+            if (nbelow == 0 && !arriving) {
+                r->end = PD_COMPLIANT_SEPARATED;
+                break;
+            }
+            if (nbelow <= 2 && t - last_touch >= c->law.T && approach <= v_rest) {
+                r->end = PD_COMPLIANT_QUIET;
+                break;
+            }
+            if (step % PD_COMPLIANT_TEST_EVERY == 0) {
+                /* The outcome of the state with its compression undone and
+                 * its elastic energy counted as height: never lower than the
+                 * energy the part has. */
+                pd_state lifted = *s;
+                lifted.x.z += deepest + elastic / (m * g);
+                int pose;
+                int d = pd_settle_outcome(settle, &lifted, g, mu, &w->hint, &pose);
+                if (d < 0)
+                    return PD_ERR_INTERNAL;
+                if (d > 0) {
+                    r->end = PD_COMPLIANT_DECIDED;
+                    r->pose = pose;
+                    break;
+                }
+            }
+        }
+        if (t >= t_max) {
+            r->end = PD_COMPLIANT_TIME;
+            break;
+        }
+
+        h = c->h1 / sqrt(nbelow > 1 ? (double)nbelow : 1.0);
+        /* Gravity and the normal impulses. */
+        pd_vec3 dv = v3(0, 0, -g * h), dw = v3(0, 0, 0);
+        double pn_max = 0.0;
+        for (int j = 0; j < npush; j++) {
+            int i = w->push[j];
+            double p = w->pn[j] * h;
+            w->pn[j] = p;
+            pn_max = fmax(pn_max, p);
+            dv.z += p / m;
+            dw = v3_add(dw, v3_cross(b->verts[i], v3_scale(up, p)));
+        }
+        s->v = v3_add(s->v, dv);
+        /* Torque-free precession (Euler's equations, explicit) and the
+         * contacts' torque. */
+        pd_vec3 wo = s->w;
+        s->w = v3_add(s->w, v3(h * b->euler[0] * wo.y * wo.z, h * b->euler[1] * wo.z * wo.x,
+                               h * b->euler[2] * wo.x * wo.y));
+        s->w = v3_add(s->w, inv_inertia(b, dw));
+
+        /* Coulomb friction: the tangential impulse at each pushing contact
+         * that stops its sliding, within its cone, the contacts coupled
+         * through the body. */
+        if (mu > 0.0 && npush > 0) {
+            for (int j = 0; j < npush; j++) {
+                pd_vec3 r_i = b->verts[w->push[j]];
+                w->ptx[j] = w->pty[j] = 0.0;
+                w->kt[j][0] = inv_mass(b, r_i, ex, ex);
+                w->kt[j][1] = inv_mass(b, r_i, ex, ey);
+                w->kt[j][2] = inv_mass(b, r_i, ey, ey);
+            }
+            double stop = c->sweep_tol * mu * pn_max;
+            for (int sweep = 0; sweep < PD_COMPLIANT_SWEEPS; sweep++) {
+                double change = 0.0;
+                for (int j = 0; j < npush; j++) {
+                    pd_vec3 r_i = b->verts[w->push[j]];
+                    pd_vec3 wr = v3_cross(s->w, r_i);
+                    double ux = s->v.x + v3_dot(wr, ex), uy = s->v.y + v3_dot(wr, ey);
+                    double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
+                    double det = kxx * kyy - kxy * kxy;
+                    double px = w->ptx[j] - (kyy * ux - kxy * uy) / det;
+                    double py = w->pty[j] - (kxx * uy - kxy * ux) / det;
+                    double cap = mu * w->pn[j], p2 = px * px + py * py;
+                    if (p2 > cap * cap) {
+                        double f = cap / sqrt(p2);
+                        px *= f;
+                        py *= f;
+                    }
+                    double ddx = px - w->ptx[j], ddy = py - w->pty[j];
+                    w->ptx[j] = px;
+                    w->pty[j] = py;
+                    s->v.x += ddx / m;
+                    s->v.y += ddy / m;
+                    pd_vec3 pb = v3_add(v3_scale(ex, ddx), v3_scale(ey, ddy));
+                    s->w = v3_add(s->w, inv_inertia(b, v3_cross(r_i, pb)));
+                    change = fmax(change, fmax(fabs(ddx), fabs(ddy)));
+                }
+                if (change <= stop)
+                    break;
+            }
+        }
+
+        /* Positions from the new velocities (the symplectic half). */
+        s->x = v3_add(s->x, v3_scale(s->v, h));
+        s->q = quat_normalize(quat_mul(s->q, quat_exp(v3_scale(s->w, h))));
+        t += h;
+        r->steps++;
+        if (!v3_isfinite(s->x) || !v3_isfinite(s->v) || !v3_isfinite(s->w))
+            return PD_ERR_NONFINITE;
+        moved += (v3_norm(s->v) + v3_norm(s->w) * b->rmax) * h;
+        if (moved > 0.5 * c->band) {
+            rebuild_candidates(c, w, b, s, quat_rotate_inv(s->q, v3(0, 0, 1)));
+            moved = 0.0;
+        }
+    }
+    r->time = t;
+    /* The law and friction only take energy; the explicit step may add some
+     * of its own error (most with e near 1, where nothing damps it). Never
+     * let the run end with more than it began with, elastic energy counted:
+     * the outcome test relies on it. */
+    double e_end = energy(b, s, g) + elastic_energy(w, b, s);
+    if (r->end != PD_COMPLIANT_DECIDED && e_end > e_start) {
+        double kin = pd_body_kinetic(b, s), excess = e_end - e_start;
+        double f = kin > excess ? sqrt((kin - excess) / kin) : 0.0;
+        s->v = v3_scale(s->v, f);
+        s->w = v3_scale(s->w, f);
+        r->energy_gain = 1;
+    }
+    if (r->end == PD_COMPLIANT_QUIET) {
+        /* Onto the floor for the contact phases: raises the part by its
+         * static compression, about g / omega^2, 2e-5 of a 1 cm part at the
+         * default contact time, less the elastic energy it held. */
+        up = quat_rotate_inv(s->q, v3(0, 0, 1));
+        int lowest = pd_body_support(b, up, w->ncand > 0 ? w->cand[0] : 0);
+        s->x.z -= fmin(0.0, s->x.z + v3_dot(b->verts[lowest], up));
+    }
+    return PD_OK;
+}

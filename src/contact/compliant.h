@@ -1,0 +1,80 @@
+/* compliant.h (private): a compliant impact of a part on the floor, with as
+ * many contacts as touch while it lasts, and the lasting face contact it may
+ * turn into.
+ *
+ * Every hull vertex below the floor pushes by the normal law of
+ * compliant_law.h, with a stiffness set when it touches from its own
+ * effective mass (k = m_c omega^2, m_c the inverse of the normal entry of the
+ * contact's inverse mass: alone, it would bounce with the scene's e and last
+ * T) and a damping from its own approach speed. Each contact that pushes
+ * also resists sliding by Coulomb friction, sticking or sliding, found as
+ * the tangential impulse of each step that stops the contact's sliding
+ * within the cone mu times its normal impulse (the contacts coupled through
+ * the body, solved by Gauss-Seidel sweeps). Vertices that reach the floor
+ * while the impact lasts join it.
+ *
+ * The motion is stepped by semi-implicit (symplectic) Euler in the body
+ * frame, the step a fixed fraction of the fastest contact oscillation.
+ * The run ends when
+ *   - no vertex is below the floor and none will reach it within two steps
+ *     (SEPARATED: flight again);
+ *   - at most two contacts push, none has touched for a contact duration and
+ *     none approaches faster than resting contact (QUIET: one vertex or an
+ *     edge resting, which the exact contact phases take over; the part is
+ *     lifted onto the floor, by its static compression, about g / omega^2);
+ *   - the outcome is decided (pd_settle_outcome on the state with its
+ *     elastic energy counted as height) (DECIDED);
+ *   - the time runs out (TIME). */
+#ifndef PD_COMPLIANT_H
+#define PD_COMPLIANT_H
+
+#include "contact/compliant_law.h"
+#include "dynamics/body.h"
+#include "posedrop/sim.h"
+#include "settle/settle.h"
+
+typedef struct pd_compliant {
+    pd_compliant_law law;
+    double h1;          /* s: the step with one contact (h1 / sqrt(n) with n) */
+    double band;        /* m: vertices this close to the floor are watched */
+    double sweep_tol;   /* friction sweeps stop when no impulse moves more
+                           than this times mu times its normal impulse */
+} pd_compliant;
+
+typedef enum pd_compliant_end {
+    PD_COMPLIANT_SEPARATED,
+    PD_COMPLIANT_QUIET,
+    PD_COMPLIANT_DECIDED,
+    PD_COMPLIANT_TIME
+} pd_compliant_end;
+
+typedef struct pd_compliant_result {
+    pd_compliant_end end;
+    int pose;           /* DECIDED: the pose index */
+    double time;        /* s the run lasted */
+    double depth;       /* m: the deepest any vertex went below the floor */
+    long steps;
+    int energy_gain;    /* 1: the energy rose across the run and was scaled back */
+} pd_compliant_result;
+
+typedef struct pd_compliant_work pd_compliant_work;
+
+/* The model for restitution e, contact duration T > 0 (s) and the body b.
+ * tol_scale (1 for the model as defined, below 1 to tighten) scales every
+ * numerical tolerance of the run: the step and the friction sweeps' stop.
+ * PD_ERR_RANGE, PD_ERR_NO_CONVERGENCE, PD_ERR_NOMEM. */
+pd_status pd_compliant_init(double e, double T, const pd_body *b, double tol_scale,
+                            pd_compliant *c);
+
+pd_compliant_work *pd_compliant_work_alloc(const pd_body *b);
+void pd_compliant_work_free(pd_compliant_work *w);
+
+/* Runs the impact of the part in state s (a vertex on the floor, within the
+ * contact tolerance, at least one approaching) for at most t_max seconds;
+ * s is left at the run's end. PD_ERR_NONFINITE if the motion stops being
+ * finite. */
+pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd_settle *settle,
+                           const pd_scene *scene, pd_state *s, double t_max,
+                           pd_compliant_result *r);
+
+#endif

@@ -1,0 +1,124 @@
+/* compliant_law.c: the normal law of one compliant contact (see
+ * compliant_law.h). */
+#include <math.h>
+#include "base/gsl_adapter.h"
+#include "contact/compliant_law.h"
+
+/* Relative accuracy of chi and tau: far below anything a drop resolves, and
+ * cheap, since a run computes them once. */
+#define PD_COMPLIANT_LAW_TOL 1e-13
+
+/* rk8pd steps one contact may take: the scaled contact lasts a few units of
+ * time and the steps at PD_COMPLIANT_LAW_TOL are ~0.05 long, so 1e5 only
+ * stops a failure. */
+#define PD_COMPLIANT_LAW_MAX_STEPS 100000
+
+/* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
+#define PD_COMPLIANT_LAW_MAX_HALVINGS 200
+
+static int scaled_law(double t, const double y[], double dydt[], void *user)
+{
+    (void)t;
+    double chi = *(const double *)user;
+    dydt[0] = y[1];
+    dydt[1] = -fmax(0.0, y[0] * (1.0 + chi * y[1]));
+    return 0;
+}
+
+/* The law with s as the variable, (dt/ds, dv/ds) = (1/v, s''/v): v is far
+ * from 0 at the contact's end (it is -e there), so this carries the state
+ * from just past s = 0 back onto it exactly. Classical RK4 over n substeps. */
+static void henon_to_zero(double chi, double *t, double *s, double *v, int n)
+{
+    double ds = -*s / n;
+    for (int i = 0; i < n; i++) {
+        double k1t, k1v, k2t, k2v, k3t, k3v, k4t, k4v, ss = *s, vv;
+#define HENON_RHS(S, V, KT, KV)                                                   \
+    do {                                                                          \
+        KT = 1.0 / (V);                                                           \
+        KV = -fmax(0.0, (S) * (1.0 + chi * (V))) / (V);                           \
+    } while (0)
+        HENON_RHS(ss, *v, k1t, k1v);
+        vv = *v + 0.5 * ds * k1v;
+        HENON_RHS(ss + 0.5 * ds, vv, k2t, k2v);
+        vv = *v + 0.5 * ds * k2v;
+        HENON_RHS(ss + 0.5 * ds, vv, k3t, k3v);
+        vv = *v + ds * k3v;
+        HENON_RHS(ss + ds, vv, k4t, k4v);
+#undef HENON_RHS
+        *t += ds * (k1t + 2.0 * k2t + 2.0 * k3t + k4t) / 6.0;
+        *v += ds * (k1v + 2.0 * k2v + 2.0 * k3v + k4v) / 6.0;
+        *s = ss + ds;
+    }
+    *s = 0.0;
+}
+
+pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *tau,
+                                   double *s_peak)
+{
+    pd_ode *ode = pd_ode_alloc(2, tol, tol);
+    if (!ode)
+        return PD_ERR_NOMEM;
+    double t = 0.0, h = 1e-3, y[2] = {0.0, 1.0}, dy[2];
+    pd_status st = PD_ERR_NO_CONVERGENCE;
+    *s_peak = 0.0;
+    for (int k = 0; k < PD_COMPLIANT_LAW_MAX_STEPS; k++) {
+        double t0 = t, y0[2] = {y[0], y[1]};
+        scaled_law(t, y, dy, &chi);
+        st = pd_ode_step_from(ode, scaled_law, &chi, &t, t + 1e3, &h, y, dy);
+        if (st != PD_OK)
+            break;
+        *s_peak = fmax(*s_peak, y[0]);
+        if (y[0] <= 0.0 && y[1] < 0.0) {
+            /* Past the end: from the step's start, which is inside, along s
+             * to s = 0 (many substeps: the step may be long). */
+            t = t0;
+            y[0] = y0[0];
+            y[1] = y0[1];
+            henon_to_zero(chi, &t, &y[0], &y[1], 64);
+            *e = -y[1];
+            *tau = t;
+            break;
+        }
+        st = PD_ERR_NO_CONVERGENCE;
+    }
+    pd_ode_free(ode);
+    return st;
+}
+
+pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law)
+{
+    if (!(e >= 0.0 && e <= 1.0) || !(T > 0.0 && isfinite(T)))
+        return PD_ERR_RANGE;
+    e = fmax(e, PD_COMPLIANT_E_MIN);
+    double lo = 0.0, hi = 1.0, eh, tau;
+    pd_status st;
+    /* e(chi) falls from 1 at chi = 0 towards 0: bracket, then halve. */
+    for (;;) {
+        if ((st = pd_compliant_law_contact(hi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
+            return st;
+        if (eh <= e)
+            break;
+        lo = hi;
+        hi *= 2.0;
+        if (hi > 1e6)
+            return PD_ERR_NO_CONVERGENCE;
+    }
+    for (int k = 0; k < PD_COMPLIANT_LAW_MAX_HALVINGS && hi - lo > PD_COMPLIANT_LAW_TOL * hi; k++) {
+        double mid = 0.5 * (lo + hi);
+        if ((st = pd_compliant_law_contact(mid, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
+            return st;
+        if (eh > e)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    law->e = e;
+    law->T = T;
+    law->chi = 0.5 * (lo + hi);
+    if ((st = pd_compliant_law_contact(law->chi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
+        return st;
+    law->tau = tau;
+    law->omega = tau / T;
+    return PD_OK;
+}

@@ -1,0 +1,52 @@
+/* compliant_law.h (private): the normal law of one compliant contact.
+ *
+ * A contact of penetration d >= 0 pushes with the linear Hunt-Crossley force
+ *     F = max(0, k d (1 + chi d' / v0)),
+ * k the contact's stiffness, v0 its approach speed when it touched and chi a
+ * damping ratio. Why this law and not a linear spring-dashpot: its force
+ * starts and ends at zero (a dashpot's jumps to c v0 at touch and pulls the
+ * part down at the end), and scaled by its own units (d by v0 / omega, time
+ * by 1 / omega, omega^2 = k / m) it becomes
+ *     s'' = -max(0, s (1 + chi s')),   s(0) = 0, s'(0) = 1,
+ * with no parameter but chi: the restitution e (rebound speed over approach
+ * speed) depends on chi alone, so one chi gives the scene's e at every
+ * approach speed, and the contact lasts tau(chi) / omega whatever v0 is.
+ * The law is the pair (e, T) a user states: chi from e, then omega from the
+ * duration T of one contact, omega = tau / T, and k = m omega^2 for each
+ * contact's effective mass m. */
+#ifndef PD_COMPLIANT_LAW_H
+#define PD_COMPLIANT_LAW_H
+
+#include "posedrop/status.h"
+
+typedef struct pd_compliant_law {
+    double e;       /* restitution the law gives (the scene's, at least PD_COMPLIANT_E_MIN) */
+    double T;       /* s: duration of one contact */
+    double chi;     /* damping ratio of the scaled law */
+    double tau;     /* duration of one contact in scaled time */
+    double s_peak;  /* the deepest scaled penetration (at step ends: an estimate) */
+    double omega;   /* rad/s: tau / T; k = m omega^2 */
+} pd_compliant_law;
+
+/* Restitution below this is taken as this: at e = 0 the law's chi is
+ * infinite (the contact never restores) and its duration with it. Why 0.01:
+ * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
+ * below what any pose statistic resolves, while chi stays near 100 and the
+ * contact's step (compliant.c) near 1/400 of its duration. */
+#define PD_COMPLIANT_E_MIN 0.01
+
+/* The law for restitution e in [0, 1] and contact duration T > 0 (s):
+ * chi by bisection on e(chi), tau by integrating the scaled law to
+ * PD_COMPLIANT_LAW_TOL. PD_ERR_RANGE for e or T outside their ranges,
+ * PD_ERR_NO_CONVERGENCE, PD_ERR_NOMEM. */
+pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law);
+
+/* One contact of the scaled law with damping ratio chi >= 0: its
+ * restitution *e, duration *tau (scaled time) and deepest penetration
+ * *s_peak (at the integrator's step ends). Integrated by GSL's rk8pd
+ * to relative error tol, the end located on s = 0 exactly by a step in s
+ * (Henon's trick). PD_ERR_NO_CONVERGENCE, PD_ERR_NOMEM. */
+pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *tau,
+                                   double *s_peak);
+
+#endif
