@@ -10,8 +10,8 @@
 # mu = restitution = 0.3, vibration 1.5 degrees, the belt's initial poses:
 # INITIAL is stationary by default, the long run of the estimated pose-to-pose
 # chain, or bootstrap, the paper's own running estimate, for comparison;
-# CONTACT_TIME, s, is the impulse engine's simultaneity window, 0 by default,
-# the rigid model: --contact-time),
+# CONTACT_TIME, s, the duration of one contact (posedrop's default when not
+# given; 0: the rigid model): --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
 # (default results/) and prints each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
@@ -24,7 +24,7 @@
 set -u
 n=2000
 initial=stationary
-contact_time=0
+contact_time=
 outdir=results
 tables=""
 while [ $# -gt 0 ]; do
@@ -55,7 +55,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
         start=$(date +%s.%N)
-        "$bin" --group -n "$n" --initial "$initial" --contact-time "$contact_time" \
+        "$bin" --group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
             --engine "$engine" "$file" \
             > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
         end=$(date +%s.%N)

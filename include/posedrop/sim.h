@@ -44,11 +44,13 @@ typedef struct pd_scene {
     pd_initial initial;     /* PD_INITIAL_UNIFORM */
     double gravity;         /* m/s^2; 9.81 */
     double contact_time;    /* s: how long one contact takes to compress and
-                               restore, a property of the materials; 0: rigid,
-                               only contacts within PD_TOL_CONTACT_REL of the size
-                               at once (the paper's model). For now the impulse
-                               simulator strikes the contacts that would reach the
-                               floor within this time of the first as one impact */
+                               restore, a property of the materials; 5e-4 (a
+                               plastic part on a rubber belt). With more than one
+                               vertex on the floor at once or within this time,
+                               the impulse simulator's impact is compliant (a
+                               Hunt-Crossley law at each, with friction); one
+                               vertex alone keeps the rigid law, its limit.
+                               0: rigid throughout (the paper's model) */
 } pd_scene;
 
 void pd_scene_default(pd_scene *scene);
@@ -114,9 +116,10 @@ typedef struct pd_sim_result {
     long *count;            /* per pose: drops that settled there */
     double *p, *ci_lo, *ci_hi; /* count / n and its 95% Wilson interval */
     long unsettled;         /* drops that hit a limit or failed (not in any count) */
-    long energy_gain;       /* collisions that would have added kinetic energy
-                               (Poisson with friction) and were resolved with the
-                               energetic law instead */
+    long energy_gain;       /* collisions that would have added energy: under
+                               Poisson's law with friction (resolved with the
+                               energetic law instead), or by a compliant impact's
+                               step error (its velocities scaled back) */
     long fallbacks;         /* collisions whose sliding integration could not
                                finish (a stiff approach to sticking), resolved
                                by stopping the contact within the friction cone */

@@ -70,7 +70,8 @@ static void usage(FILE *out)
         "  --restitution-law L  poisson (default) or energetic\n"
         "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
         "  --contact-time S   how long one contact takes to compress and restore, s\n"
-        "                     (a material property; 0: rigid, the paper's model)\n"
+        "                     (a material property; 5e-4, a plastic part on a rubber\n"
+        "                     belt; 0: rigid, the paper's model)\n"
         "  --initial I        uniform (default): orientations uniform at random;\n"
         "                     bootstrap: the paper's belt, drops resting on poses drawn\n"
         "                     from the running estimate, rounds of 100 after 20 uniform;\n"
@@ -617,8 +618,9 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit) and "
                         "are in no count\n", prog, a->path, sim->unsettled, sim->n);
     if (sim->energy_gain)
-        fprintf(stderr, "%s: %s: %ld collisions would have added kinetic energy under Poisson's "
-                        "law and were resolved by the energetic law\n", prog, a->path,
+        fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
+                        "friction, resolved by the energetic law; or a compliant impact's step, "
+                        "scaled back)\n", prog, a->path,
                 sim->energy_gain);
     if (sim->fallbacks)
         fprintf(stderr, "%s: %s: %ld of %ld collisions could not be integrated to the end and "
