@@ -10,11 +10,19 @@ PREFIX  ?= /usr/local
 PKG_CONFIG ?= pkg-config
 
 # Libraries the project links through pkg-config: GSL (quadrature, ODE
-# stepping, special functions), ODE with libccd and Bullet for the stepping
-# backends (src/engines/). qhull_r is for the
-# tests' and the benchmark's reference hull only, never for libposedrop.
-LIB_PKGS  := gsl ode ccd bullet
-TEST_PKGS := qhull_r
+# stepping, special functions), ODE with libccd for libposedrop; Bullet, C++,
+# for libposedrop-bullet only (src/engines/engine_bullet.cpp), so that a C
+# program that does not ask for it needs neither Bullet nor the C++ runtime.
+# qhull_r is for the tests' and the benchmark's reference hull only.
+LIB_PKGS    := gsl ode ccd
+BULLET_PKGS := bullet
+TEST_PKGS   := qhull_r
+
+# The version has one home, include/posedrop/version.h; the shared libraries
+# are named after it and carry the soname lib*.so.MAJOR.
+version_of = $(shell sed -n 's/^.define PD_VERSION_$(1) \([0-9]*\)$$/\1/p' include/posedrop/version.h)
+MAJOR   := $(call version_of,MAJOR)
+VERSION := $(MAJOR).$(call version_of,MINOR).$(call version_of,PATCH)
 
 CONFIG := opt
 # -O3 changes no result (no reassociation without -ffast-math): measured with
@@ -42,15 +50,22 @@ WARN := -Wall -Wextra -Wpedantic -Wshadow -Wmissing-prototypes -Wstrict-prototyp
         -Wvla -Wdouble-promotion
 # -ffp-contract=off: no fused multiply-add, so results are bit-identical across
 # machines and compilers; never -ffast-math.
+# -fvisibility=hidden: only what the public headers mark PD_API leaves the
+# shared libraries (posedrop/export.h); -fPIC since the same objects go into
+# the static and the shared library (hidden symbols are called directly, so
+# position independence costs no indirection inside the library).
 CFLAGS_ALL := -std=c11 -g -pthread $(CFLAGS_OPT) $(WARN) $(CFLAGS_WERROR) -ffp-contract=off \
+              -fPIC -fvisibility=hidden \
               -D_DEFAULT_SOURCE -Iinclude -Isrc $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null) \
               $(CFLAGS)
 # The one C++ file (the Bullet adapter). Bullet's headers come in as system
 # headers (-isystem) so their own warnings do not trip WERROR=1.
 CXXFLAGS_ALL := -std=c++17 -g -pthread $(CFLAGS_OPT) -Wall -Wextra $(CFLAGS_WERROR) -ffp-contract=off \
-                -Iinclude -Isrc $(patsubst -I%,-isystem %,$(shell $(PKG_CONFIG) --cflags bullet 2>/dev/null)) \
+                -fPIC -fvisibility=hidden -fvisibility-inlines-hidden \
+                -Iinclude -Isrc $(patsubst -I%,-isystem %,$(shell $(PKG_CONFIG) --cflags $(BULLET_PKGS) 2>/dev/null)) \
                 $(CXXFLAGS)
 LDLIBS_LIB := $(shell $(PKG_CONFIG) --libs $(LIB_PKGS) 2>/dev/null) -lm -pthread
+LDLIBS_BULLET := $(shell $(PKG_CONFIG) --libs $(BULLET_PKGS) 2>/dev/null)
 LDLIBS_TEST := $(shell $(PKG_CONFIG) --libs $(TEST_PKGS) 2>/dev/null)
 CFLAGS_TEST := -Itests/support $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/dev/null)
 
@@ -58,9 +73,12 @@ CFLAGS_TEST := -Itests/support $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/de
 # the tree by wildcard, so adding a file needs no edit here.
 LIB_SRCS   := $(wildcard src/*/*.c)
 LIB_SRCS   := $(filter-out src/cli/%,$(LIB_SRCS))
-LIB_CXX_SRCS := $(wildcard src/*/*.cpp)
-LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o) $(LIB_CXX_SRCS:%.cpp=$(BUILD)/%.o)
+LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o)
+BULLET_OBJS := $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard src/*/*.cpp))
 LIB        := $(BUILD)/libposedrop.a
+LIB_BULLET := $(BUILD)/libposedrop-bullet.a
+SO         := $(BUILD)/libposedrop.so.$(VERSION)
+SO_BULLET  := $(BUILD)/libposedrop-bullet.so.$(VERSION)
 CLI        := $(BUILD)/posedrop
 TEST_SRCS  := $(wildcard tests/unit/*.c tests/support/*.c)
 TEST_OBJS  := $(TEST_SRCS:%.c=$(BUILD)/%.o)
@@ -70,10 +88,10 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check test bench demo paper install uninstall clean help deps golden lint
+.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint
 .DEFAULT_GOAL := all
 
-all: $(LIB) $(CLI)
+all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI)
 
 # Objects depend on this Makefile too: a change of flags (the optimisation
 # level, warnings) rebuilds them rather than linking old objects with new.
@@ -93,20 +111,40 @@ $(BUILD)/bench-%.o: %.c Makefile
 	@mkdir -p $(dir $@)
 	$(CC) $(CFLAGS_ALL) $(CFLAGS_TEST) -MMD -MP -c $< -o $@
 
-# Binaries link with $(CXX): the archive holds the Bullet adapter, which needs
-# the C++ runtime.
 $(LIB): $(LIB_OBJS)
 	@rm -f $@
 	$(AR) rcs $@ $^
 
-$(CLI): $(BUILD)/src/cli/cli.o $(LIB)
-	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB)
+$(LIB_BULLET): $(BULLET_OBJS)
+	@rm -f $@
+	$(AR) rcs $@ $^
 
-$(TEST_BIN): $(TEST_OBJS) $(LIB)
-	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+# The shared libraries, with the links a linker (lib*.so) and the loader
+# (lib*.so.MAJOR, the soname) look for. --no-undefined: each names every
+# library it needs, so a program links it without knowing its insides.
+$(SO): $(LIB_OBJS)
+	$(CC) -shared -Wl,-soname,libposedrop.so.$(MAJOR) -Wl,--no-undefined $(LDFLAGS_SAN) $(LDFLAGS) \
+	      -o $@ $^ $(LDLIBS_LIB)
+	ln -sf $(notdir $@) $(BUILD)/libposedrop.so.$(MAJOR)
+	ln -sf libposedrop.so.$(MAJOR) $(BUILD)/libposedrop.so
 
-$(BENCH_BIN): $(BENCH_OBJS) $(LIB)
-	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB)
+$(SO_BULLET): $(BULLET_OBJS) $(SO)
+	$(CXX) -shared -Wl,-soname,libposedrop-bullet.so.$(MAJOR) -Wl,--no-undefined $(LDFLAGS_SAN) \
+	       $(LDFLAGS) -o $@ $(BULLET_OBJS) $(SO) $(LDLIBS_BULLET)
+	ln -sf $(notdir $@) $(BUILD)/libposedrop-bullet.so.$(MAJOR)
+	ln -sf libposedrop-bullet.so.$(MAJOR) $(BUILD)/libposedrop-bullet.so
+
+# The command, the tests and the benchmark link the static archives (the tests
+# call internal functions the shared library does not export), and with
+# $(CXX), since they offer the Bullet engine.
+$(CLI): $(BUILD)/src/cli/cli.o $(LIB_BULLET) $(LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET)
+
+$(TEST_BIN): $(TEST_OBJS) $(LIB_BULLET) $(LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB) $(LDLIBS_BULLET)
+
+$(BENCH_BIN): $(BENCH_OBJS) $(LIB_BULLET) $(LIB)
+	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 # Installs the Debian packages when pkg-config cannot find them (quick no-op
 # otherwise). The targets a new user runs first go through it; their real work
@@ -122,7 +160,14 @@ test: $(TEST_BIN) $(CLI)
 lint:
 	@scripts/lint-layers.sh
 
+# The library as a user gets it: installed into a temporary prefix, the
+# documented example built with plain pkg-config and run
+# (tests/install/check-install.sh, which says what it checks).
+check-install: all
+	+@MAKE="$(MAKE)" CC="$(CC)" CXX="$(CXX)" EXAMPLE_FLAGS="$(LDFLAGS_SAN)" tests/install/check-install.sh
+
 check: deps lint
+	@$(MAKE) --no-print-directory check-install
 	@$(MAKE) --no-print-directory test
 
 demo: deps
@@ -143,34 +188,52 @@ bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
 	$(BENCH_BIN)
 
+# Both libraries, shared (with their soname and development links) and
+# static, the headers, the command and a pkg-config file for each library
+# (docs/library.md), and the licence with that page in share/doc/posedrop.
+# Under /usr/local, run ldconfig afterwards.
+LIBDIR := $(DESTDIR)$(PREFIX)/lib
 install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig \
-	           $(DESTDIR)$(PREFIX)/include/posedrop
+	install -d $(DESTDIR)$(PREFIX)/bin $(LIBDIR)/pkgconfig $(DESTDIR)$(PREFIX)/include/posedrop
 	install -m 755 $(CLI) $(DESTDIR)$(PREFIX)/bin/posedrop
-	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/libposedrop.a
+	install -m 644 $(LIB) $(LIB_BULLET) $(LIBDIR)/
+	install -m 755 $(SO) $(SO_BULLET) $(LIBDIR)/
+	for l in libposedrop libposedrop-bullet; do \
+	    ln -sf $$l.so.$(VERSION) $(LIBDIR)/$$l.so.$(MAJOR) && ln -sf $$l.so.$(MAJOR) $(LIBDIR)/$$l.so; \
+	done
 	install -m 644 include/posedrop/*.h $(DESTDIR)$(PREFIX)/include/posedrop/
-	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(shell sed -n 's/.*PD_VERSION_STRING "\(.*\)"/\1/p' include/posedrop/posedrop.h)|' \
-	    -e 's|@REQUIRES@|$(LIB_PKGS)|' scripts/posedrop.pc.in > $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
+	install -d $(DESTDIR)$(PREFIX)/share/doc/posedrop
+	install -m 644 LICENSE NOTICE docs/library.md $(DESTDIR)$(PREFIX)/share/doc/posedrop/
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(LIB_PKGS)|' \
+	    scripts/posedrop.pc.in > $(LIBDIR)/pkgconfig/posedrop.pc
+	sed -e 's|@PREFIX@|$(PREFIX)|' -e 's|@VERSION@|$(VERSION)|' -e 's|@REQUIRES@|$(BULLET_PKGS)|' \
+	    scripts/posedrop-bullet.pc.in > $(LIBDIR)/pkgconfig/posedrop-bullet.pc
 
 uninstall:
-	rm -f $(DESTDIR)$(PREFIX)/bin/posedrop $(DESTDIR)$(PREFIX)/lib/libposedrop.a \
-	      $(DESTDIR)$(PREFIX)/lib/pkgconfig/posedrop.pc
-	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop
+	rm -f $(DESTDIR)$(PREFIX)/bin/posedrop $(LIBDIR)/pkgconfig/posedrop.pc \
+	      $(LIBDIR)/pkgconfig/posedrop-bullet.pc
+	for l in libposedrop libposedrop-bullet; do \
+	    rm -f $(LIBDIR)/$$l.a $(LIBDIR)/$$l.so $(LIBDIR)/$$l.so.$(MAJOR) $(LIBDIR)/$$l.so.$(VERSION); \
+	done
+	rm -rf $(DESTDIR)$(PREFIX)/include/posedrop $(DESTDIR)$(PREFIX)/share/doc/posedrop
 
 clean:
 	rm -rf build
 
 help:
-	@echo "make            build libposedrop.a and the posedrop command ($(BUILD)/)"
+	@echo "make            build libposedrop (.so, .a), libposedrop-bullet and the"
+	@echo "                posedrop command ($(BUILD)/)"
 	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make lint       check that no layer of src/ includes one above it"
+	@echo "make check-install  install to a temporary prefix, build the library example"
+	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(LIB_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d
+-include $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d

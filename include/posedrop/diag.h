@@ -8,6 +8,8 @@
 #ifndef POSEDROP_DIAG_H
 #define POSEDROP_DIAG_H
 
+#include "posedrop/export.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -24,7 +26,7 @@ typedef struct pd_diag {
 } pd_diag;
 
 /* Empty message, no callback, zero warnings. */
-void pd_diag_init(pd_diag *diag);
+PD_API void pd_diag_init(pd_diag *diag);
 
 #ifdef __cplusplus
 }

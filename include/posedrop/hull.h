@@ -8,6 +8,7 @@
 #define POSEDROP_HULL_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/status.h"
 #include "posedrop/types.h"
 
@@ -35,15 +36,15 @@ typedef struct pd_hull {
  * PD_ERR_TOO_FEW_POINTS (< 4), PD_ERR_NONFINITE, PD_ERR_COLOCATED,
  * PD_ERR_COLLINEAR, PD_ERR_COPLANAR; also PD_ERR_NOMEM, PD_ERR_INTERNAL.
  * On success *hull is owned by the caller (pd_hull_free). */
-pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *diag);
+PD_API pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *diag);
 
 /* Validates a hull: unit normals, loops of >= 3 corners, each corner on its
  * facet plane, convexity at every edge, symmetric adjacency, Euler's formula,
  * and (when pts != NULL) every input point inside or on the hull, all within
  * PD_TOL_PLANE_REL. PD_OK or PD_ERR_INTERNAL with the failed check in diag. */
-pd_status pd_hull_check(const pd_hull *hull, const pd_vec3 *pts, int npts, pd_diag *diag);
+PD_API pd_status pd_hull_check(const pd_hull *hull, const pd_vec3 *pts, int npts, pd_diag *diag);
 
-void pd_hull_free(pd_hull *hull);
+PD_API void pd_hull_free(pd_hull *hull);
 
 #ifdef __cplusplus
 }

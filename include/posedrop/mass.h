@@ -8,6 +8,7 @@
 #define POSEDROP_MASS_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/mesh.h"
 #include "posedrop/status.h"
 #include "posedrop/types.h"
@@ -24,7 +25,7 @@ typedef struct pd_mass {
 
 /* Mass properties of a closed, consistently oriented mesh (see pd_mesh_orient).
  * PD_ERR_COPLANAR if the volume is not positive beyond round-off. */
-pd_status pd_mass_compute(const pd_mesh *mesh, pd_mass *mass, pd_diag *diag);
+PD_API pd_status pd_mass_compute(const pd_mesh *mesh, pd_mass *mass, pd_diag *diag);
 
 #ifdef __cplusplus
 }

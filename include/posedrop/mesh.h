@@ -8,6 +8,7 @@
 
 #include <stddef.h>
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/status.h"
 #include "posedrop/types.h"
 
@@ -25,9 +26,9 @@ typedef enum pd_mesh_format {
 typedef enum pd_units { PD_UNITS_M = 0, PD_UNITS_CM, PD_UNITS_MM, PD_UNITS_IN } pd_units;
 
 /* Metres per unit: 1, 0.01, 0.001, 0.0254. */
-double pd_units_scale(pd_units units);
+PD_API double pd_units_scale(pd_units units);
 /* "m", "cm", "mm", "in" -> units. PD_ERR_USAGE for anything else. */
-pd_status pd_units_parse(const char *text, pd_units *units);
+PD_API pd_status pd_units_parse(const char *text, pd_units *units);
 
 typedef struct pd_mesh {
     int nverts;
@@ -42,31 +43,31 @@ typedef struct pd_mesh_read_options {
     pd_units units;        /* unit of the file's coordinates; default metres */
 } pd_mesh_read_options;
 
-void pd_mesh_read_options_default(pd_mesh_read_options *options);
+PD_API void pd_mesh_read_options_default(pd_mesh_read_options *options);
 
 /* Reads a mesh file. options may be NULL (defaults). On success *mesh is a new
  * mesh owned by the caller (pd_mesh_free). Returns PD_ERR_IO, PD_ERR_FORMAT,
  * PD_ERR_PARSE (malformed or truncated content, wrong counts), PD_ERR_NONFINITE,
  * PD_ERR_RANGE (index out of range, count too large), PD_ERR_NOMEM; the diag
  * message names the file and, for text formats, the line. */
-pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options,
-                       pd_mesh **mesh, pd_diag *diag);
+PD_API pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options,
+                              pd_mesh **mesh, pd_diag *diag);
 
 /* As pd_mesh_read, from memory. name is used in messages and, with
  * PD_FORMAT_AUTO, its extension breaks ties between formats. */
-pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
-                        const pd_mesh_read_options *options, pd_mesh **mesh,
-                        pd_diag *diag);
+PD_API pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
+                               const pd_mesh_read_options *options, pd_mesh **mesh,
+                               pd_diag *diag);
 
 /* A deep copy; NULL if out of memory. */
-pd_mesh *pd_mesh_clone(const pd_mesh *mesh);
+PD_API pd_mesh *pd_mesh_clone(const pd_mesh *mesh);
 
 /* Welds vertices closer than tol (metres): bit-identical vertices always, near
  * duplicates by distance. Triangles are re-indexed; triangles that collapse
  * (two corners welded) are removed; unused vertices are dropped. Deterministic:
  * the survivor of a cluster is its first vertex in input order. *nmerged (may be
  * NULL) receives the number of vertices removed. Returns PD_OK, PD_ERR_NOMEM. */
-pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged);
+PD_API pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged);
 
 /* Makes the faces of a welded mesh consistently oriented with outward normals.
  * Works shell by shell (connected components): flips the faces that disagree
@@ -76,12 +77,12 @@ pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged);
  * number of faces flipped. PD_ERR_NOT_CLOSED if an edge is not shared by exactly
  * two faces (boundary or non-manifold), PD_ERR_ORIENTATION if no consistent
  * orientation exists. The mesh is unchanged on failure. */
-pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag);
+PD_API pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag);
 
 /* Diagonal of the bounding box of the vertices: the part's length scale. */
-double pd_mesh_size(const pd_mesh *mesh);
+PD_API double pd_mesh_size(const pd_mesh *mesh);
 
-void pd_mesh_free(pd_mesh *mesh);
+PD_API void pd_mesh_free(pd_mesh *mesh);
 
 #ifdef __cplusplus
 }

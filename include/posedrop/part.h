@@ -7,6 +7,7 @@
 #define POSEDROP_PART_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/hull.h"
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"
@@ -22,7 +23,7 @@ typedef struct pd_part_options {
     pd_vec3 com;    /* metres, in the mesh's frame; read only when com_given */
 } pd_part_options;
 
-void pd_part_options_default(pd_part_options *options);
+PD_API void pd_part_options_default(pd_part_options *options);
 
 typedef struct pd_part {
     pd_mesh *mesh;     /* welded and, when closed, consistently oriented */
@@ -40,10 +41,10 @@ typedef struct pd_part {
  * A mesh that is not closed is accepted only with options->com_given.
  * options may be NULL. Returns the statuses of pd_mesh_orient, pd_mass_compute
  * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM. */
-pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
-                        pd_part **part, pd_diag *diag);
+PD_API pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
+                               pd_part **part, pd_diag *diag);
 
-void pd_part_free(pd_part *part);
+PD_API void pd_part_free(pd_part *part);
 
 #ifdef __cplusplus
 }

@@ -1,4 +1,5 @@
-/* posedrop/posedrop.h: the whole public API of libposedrop.
+/* posedrop/posedrop.h: the whole public API of libposedrop (and of
+ * libposedrop-bullet, posedrop/bullet.h).
  *
  * Typical use:
  *   pd_mesh *mesh; pd_part *part; pd_static_result *res; pd_diag diag;
@@ -13,11 +14,7 @@
 #ifndef POSEDROP_POSEDROP_H
 #define POSEDROP_POSEDROP_H
 
-#define PD_VERSION_MAJOR 0
-#define PD_VERSION_MINOR 1
-#define PD_VERSION_PATCH 0
-#define PD_VERSION_STRING "0.1.0"
-
+#include "posedrop/bullet.h"
 #include "posedrop/diag.h"
 #include "posedrop/hull.h"
 #include "posedrop/mass.h"
@@ -29,5 +26,6 @@
 #include "posedrop/symmetry.h"
 #include "posedrop/tolerances.h"
 #include "posedrop/types.h"
+#include "posedrop/version.h"
 
 #endif

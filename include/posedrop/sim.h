@@ -10,12 +10,26 @@
 #ifndef POSEDROP_SIM_H
 #define POSEDROP_SIM_H
 
-#include <signal.h>
 #include <stdint.h>
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/part.h"
 #include "posedrop/static.h"
 #include "posedrop/status.h"
+
+/* The cancel flag of pd_sim_options: a C11 atomic_int, which C++23 spells
+ * std::atomic<int> (the same object, so a C++ caller can share it). The
+ * extern "C++" keeps <atomic> working when a caller wraps this header in
+ * extern "C". */
+#ifdef __cplusplus
+extern "C++" {
+#include <atomic>
+}
+typedef std::atomic<int> pd_cancel_flag;
+#else
+#include <stdatomic.h>
+typedef atomic_int pd_cancel_flag;
+#endif
 
 #ifdef __cplusplus
 extern "C" {
@@ -53,7 +67,7 @@ typedef struct pd_scene {
                                0: rigid throughout (the paper's model) */
 } pd_scene;
 
-void pd_scene_default(pd_scene *scene);
+PD_API void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed (or v), mu, restitution, restitution_law
@@ -61,11 +75,19 @@ void pd_scene_default(pd_scene *scene);
  * (uniform|bootstrap|stationary), gravity, contact_time (s). PD_ERR_USAGE for
  * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
  * of range; the scene is unchanged on failure. */
-pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
+PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
 
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
  * what it holds. Errors name the file and line. */
-pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag);
+PD_API pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag);
+
+/* Whether every field of a scene is one pd_scene_set would accept: height 0
+ * to 1000 m, belt_speed -1000 to 1000 m/s, mu 0 to 10, restitution 0 to 1,
+ * vibration 0 to pi rad (180 degrees), gravity 0.001 to 1000 m/s^2,
+ * contact_time 0 to 1 s, and law and initial one of their enum values.
+ * PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_RANGE for a value out of
+ * range; the message names the field. pd_sim_run calls it first. */
+PD_API pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag);
 
 /* How a drop ended. */
 typedef enum pd_drop_end {
@@ -81,25 +103,48 @@ typedef enum pd_engine_kind {
     PD_ENGINE_BULLET       /* Bullet Physics, fixed step */
 } pd_engine_kind;
 
+/* Defaults after the field's meaning; pd_sim_run refuses values outside the
+ * stated ranges. */
 typedef struct pd_sim_options {
     pd_engine_kind engine;  /* PD_ENGINE_IMPULSE */
-    double dt;              /* s, fixed step of ODE and Bullet; 0 picks each engine's
-                               default (ODE 1 ms, Bullet 1/960 s) */
-    long ndrops;            /* drops to run (with ci_halfwidth: at least these); 2000 */
+    double dt;              /* s, fixed step of ODE and Bullet, at most 0.01; 0 picks
+                               each engine's default (ODE 1 ms, Bullet 1/960 s) */
+    long ndrops;            /* drops to run (with ci_halfwidth: at least these), >= 0; 2000 */
     uint64_t seed;          /* 1 */
-    int threads;            /* 0: all cores */
-    double ci_halfwidth;    /* > 0: keep dropping until every pose's 95% interval
-                               is at most this wide on each side; 0 */
-    long max_drops;         /* cap for ci_halfwidth runs; 10^7 */
-    double time_limit;      /* s of simulated time per drop; 20 */
-    int max_collisions;     /* per drop; 100000 */
-    int keep_trials;        /* 1: fill result->trials (one record per drop) */
-    volatile sig_atomic_t *cancel; /* may be NULL; set non-zero (e.g. from a SIGINT
-                               handler) to stop early: the result is then marked
-                               partial and holds the first n drops */
+    int threads;            /* 0: all cores; at most 256 are used */
+    double ci_halfwidth;    /* in (0, 0.5): keep dropping until every pose's 95%
+                               interval is at most this wide on each side; 0 */
+    long max_drops;         /* cap for ci_halfwidth runs, >= 0; 10^7 */
+    double time_limit;      /* s of simulated time per drop, > 0; 20 */
+    int max_collisions;     /* per drop, >= 1; 100000 */
+    int keep_trials;        /* 1: fill result->trials (one record per drop); 0 */
+    pd_cancel_flag *cancel; /* may be NULL; see below */
 } pd_sim_options;
 
-void pd_sim_options_default(pd_sim_options *options);
+/* Cancelling a run: point options->cancel at an atomic_int holding 0 and
+ * store non-zero into it (atomic_store) from any thread, or from a signal
+ * handler (atomic_int is lock-free wherever posedrop builds, which C11 asks
+ * of an object a handler touches). The drops under way finish, no new one
+ * starts, and pd_sim_run returns PD_OK with result->partial set and the
+ * first result->n drops of the run counted (each the drop it would be in a
+ * full run, whatever the thread count). The flag is only read, never reset:
+ * clear it before the next run. */
+
+PD_API void pd_sim_options_default(pd_sim_options *options);
+
+/* 1 if pd_sim_run can run that engine in this program: the impulse engine and
+ * ODE always, Bullet once pd_bullet_register (posedrop/bullet.h) was called. */
+PD_API int pd_engine_available(pd_engine_kind engine);
+
+/* The table behind a stepping engine; private to posedrop's libraries. */
+typedef struct pd_engine pd_engine;
+
+/* For posedrop's own engine libraries, not for programs: pd_bullet_register
+ * calls it to hand over Bullet's table. version is the PD_VERSION_STRING the
+ * engine library was built with; the table's layout is private, so another
+ * version than this library's gets PD_ERR_UNAVAILABLE. */
+PD_API pd_status pd_engine_register(pd_engine_kind kind, const pd_engine *engine,
+                                    const char *version);
 
 /* One drop, for --trials. */
 typedef struct pd_trial {
@@ -165,13 +210,18 @@ typedef struct pd_sim_result {
  * advance): PD_ERR_USAGE otherwise. A cancelled run gives pi of the drops run
  * when they define the chain, else count / n (closed_classes = 0).
  *
- * Returns PD_ERR_USAGE (bad options), PD_ERR_NOMEM; a cancelled run returns
- * PD_OK with result->partial set. On success *result is owned by the caller. */
-pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_result,
-                     const pd_scene *scene, const pd_sim_options *options,
-                     pd_sim_result **result, pd_diag *diag);
+ * Every field of scene and options is checked before any drop runs (scene:
+ * pd_scene_check; options: the ranges given with each field). Returns
+ * PD_ERR_NONFINITE (a NaN or infinity in scene or options), PD_ERR_RANGE (a
+ * scene value out of range), PD_ERR_USAGE (NULL argument, an option out of
+ * range), PD_ERR_UNAVAILABLE (PD_ENGINE_BULLET without pd_bullet_register),
+ * PD_ERR_NOMEM; diag's message names the field. A cancelled run returns PD_OK
+ * with result->partial set. On success *result is owned by the caller. */
+PD_API pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_result,
+                            const pd_scene *scene, const pd_sim_options *options,
+                            pd_sim_result **result, pd_diag *diag);
 
-void pd_sim_result_free(pd_sim_result *result);
+PD_API void pd_sim_result_free(pd_sim_result *result);
 
 #ifdef __cplusplus
 }

@@ -12,6 +12,7 @@
 #define POSEDROP_STATIC_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/part.h"
 #include "posedrop/status.h"
 #include "posedrop/types.h"
@@ -49,7 +50,7 @@ typedef struct pd_static_options {
     pd_pqs_band band;       /* default PD_PQS_BAND_RECT */
 } pd_static_options;
 
-void pd_static_options_default(pd_static_options *options);
+PD_API void pd_static_options_default(pd_static_options *options);
 
 /* Per hull facet (same index as in part->hull). */
 typedef struct pd_facet_result {
@@ -86,16 +87,16 @@ typedef struct pd_static_result {
  * *result is owned by the caller (pd_static_result_free). Returns
  * PD_ERR_USAGE (epsilon not in [0, 90 deg]), PD_ERR_NOMEM, PD_ERR_INTERNAL
  * (a QSG link that would raise the centre of mass: a bug). */
-pd_status pd_static_estimate(const pd_part *part, const pd_static_options *options,
-                             pd_static_result **result, pd_diag *diag);
+PD_API pd_status pd_static_estimate(const pd_part *part, const pd_static_options *options,
+                                    pd_static_result **result, pd_diag *diag);
 
-void pd_static_result_free(pd_static_result *result);
+PD_API void pd_static_result_free(pd_static_result *result);
 
 /* Solid angle (sr) of triangle abc seen from the origin, by the atan2 form of
  * Van Oosterom and Strackee (1983): full relative precision for tiny and thin
  * triangles. Positive when dot(a, cross(b - a, c - a)) > 0, as for a hull
  * facet's loop seen from a point inside the hull; negative otherwise. */
-double pd_solid_angle_triangle(pd_vec3 a, pd_vec3 b, pd_vec3 c);
+PD_API double pd_solid_angle_triangle(pd_vec3 a, pd_vec3 b, pd_vec3 c);
 
 #ifdef __cplusplus
 }

@@ -7,6 +7,8 @@
 #ifndef POSEDROP_STATUS_H
 #define POSEDROP_STATUS_H
 
+#include "posedrop/export.h"
+
 #ifdef __cplusplus
 extern "C" {
 #endif
@@ -29,15 +31,17 @@ typedef enum pd_status {
     PD_ERR_NO_CONVERGENCE, /* an iteration did not finish within its bound */
     PD_ERR_NOMEM,          /* memory allocation failed */
     PD_ERR_INTERNAL,       /* an internal consistency check failed: a bug */
+    PD_ERR_UNAVAILABLE,    /* asked for something this program was not linked with
+                              (the Bullet engine without libposedrop-bullet) */
     PD_STATUS_COUNT
 } pd_status;
 
 /* Short fixed English name of a status, e.g. "parse error". Never NULL. */
-const char *pd_status_str(pd_status status);
+PD_API const char *pd_status_str(pd_status status);
 
 /* 1 if the status blames the input (file or arguments), 0 if it is internal.
  * The CLI maps the first kind to exit code 2 and the second to exit code 1. */
-int pd_status_is_input_error(pd_status status);
+PD_API int pd_status_is_input_error(pd_status status);
 
 #ifdef __cplusplus
 }

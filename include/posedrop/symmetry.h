@@ -9,6 +9,7 @@
 #define POSEDROP_SYMMETRY_H
 
 #include "posedrop/diag.h"
+#include "posedrop/export.h"
 #include "posedrop/part.h"
 #include "posedrop/sim.h"
 #include "posedrop/static.h"
@@ -39,9 +40,9 @@ typedef struct pd_symmetry {
  * n^2 cheap distance tests for the candidate pairs (a few ns each; 0.05 s
  * at 4000 vertices) instead of n^2 vertex lookups. On success *symmetry is
  * owned by the caller (pd_symmetry_free). PD_ERR_NOMEM. */
-pd_status pd_symmetry_find(const pd_part *part, pd_symmetry **symmetry, pd_diag *diag);
+PD_API pd_status pd_symmetry_find(const pd_part *part, pd_symmetry **symmetry, pd_diag *diag);
 
-void pd_symmetry_free(pd_symmetry *symmetry);
+PD_API void pd_symmetry_free(pd_symmetry *symmetry);
 
 /* Groups the stable poses of res (computed for this part) into classes:
  * poses i and j are one class when a rotation of pd_symmetry_find maps pose
@@ -51,8 +52,8 @@ void pd_symmetry_free(pd_symmetry *symmetry);
  * 0.. in order of first appearance in the pose table, so class 0 holds pose
  * 0. *nclasses receives their number. Returns PD_ERR_USAGE (a pose whose
  * facet is not a facet of part's hull), PD_ERR_NOMEM. */
-pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int *class_of,
-                          int *nclasses, pd_diag *diag);
+PD_API pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int *class_of,
+                                 int *nclasses, pd_diag *diag);
 
 /* Drop counts summed over classes: a new result with nposes = nclasses,
  * count[c] the sum over the class's poses, p = count / n and the 95% Wilson
@@ -65,8 +66,8 @@ pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int 
  * stationary_shift is then measured between the classes. class_of has
  * sim->nposes entries in [0, nclasses).
  * Free with pd_sim_result_free. PD_ERR_USAGE, PD_ERR_NOMEM. */
-pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
-                                pd_sim_result **grouped, pd_diag *diag);
+PD_API pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
+                                       pd_sim_result **grouped, pd_diag *diag);
 
 #ifdef __cplusplus
 }

@@ -55,6 +55,7 @@ const char *pd_status_str(pd_status status)
         [PD_ERR_NO_CONVERGENCE] = "no convergence",
         [PD_ERR_NOMEM] = "out of memory",
         [PD_ERR_INTERNAL] = "internal error",
+        [PD_ERR_UNAVAILABLE] = "not available in this program",
     };
     if ((unsigned)status >= PD_STATUS_COUNT)
         return "unknown status";

@@ -8,6 +8,7 @@
 #include <getopt.h>
 #include <math.h>
 #include <signal.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -519,7 +520,7 @@ static int parse_args(int argc, char **argv, cli_args *a)
             usage(stdout);
             return 0;
         case OPT_VERSION:
-            printf("posedrop %s\n", PD_VERSION_STRING);
+            printf("posedrop %s\n", pd_version());
             return 0;
         case ':':
             return fail_usage("option '%s' needs a value", argv[optind - 1]);
@@ -640,12 +641,12 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
-static volatile sig_atomic_t interrupted;
+static atomic_int interrupted;
 
 static void on_sigint(int sig)
 {
     (void)sig;
-    interrupted = 1;
+    atomic_store(&interrupted, 1);
 }
 
 int main(int argc, char **argv)
@@ -658,13 +659,19 @@ int main(int argc, char **argv)
     pd_diag diag;
     pd_diag_init(&diag);
     diag.warn = print_warning;
+    /* The command offers every engine: it links libposedrop-bullet. */
+    pd_status st = pd_bullet_register();
+    if (st != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine: %s\n", prog, pd_status_str(st));
+        return EXIT_INTERNAL;
+    }
 
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
     int *class_of = NULL, nclasses = 0;
-    pd_status st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
+    st = pd_mesh_read(a.path, &a.read, &mesh, &diag);
     if (st != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;

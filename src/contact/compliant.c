@@ -34,6 +34,16 @@
 #define PD_COMPLIANT_SWEEPS 32
 #define PD_COMPLIANT_SWEEP_TOL 1e-6
 
+/* A contact below the floor is resting, not in the middle of a bounce,
+ * when it moves either way no faster than resting contact arrives and its
+ * spring holds at most this many times the part's weight. Why 4: a part
+ * resting or rocking slowly on one vertex or an edge loads it with its
+ * weight and the centripetal part of its rocking, well under 4 m g, while
+ * a bounce at the resting speed v_rest already compresses its contact to
+ * about that much, and every faster bounce to more; the test exists so that
+ * a bounce's turning point (speed 0, deepest) is never taken for rest. */
+#define PD_COMPLIANT_REST_LOAD 4.0
+
 /* Steps between two tests of the outcome: the test costs a descent lookup,
  * tens of steps' work; deciding a few steps late changes nothing, since a
  * decided drop stays in its basin. */
@@ -177,7 +187,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
         up = quat_rotate_inv(s->q, v3(0, 0, 1));
         pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
         int npush = 0, nbelow = 0, arriving = 0;
-        double deepest = 0.0, approach = 0.0, elastic = 0.0;
+        double deepest = 0.0, speed = 0.0, load = 0.0, elastic = 0.0;
         for (int j = 0; j < w->ncand; j++) {
             int i = w->cand[j];
             pd_vec3 r_i = b->verts[i];
@@ -201,7 +211,8 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             double d = -z;
             nbelow++;
             deepest = fmax(deepest, d);
-            approach = fmax(approach, -uz);
+            speed = fmax(speed, fabs(uz));
+            load = fmax(load, w->k[i] * d);
             elastic += 0.5 * w->k[i] * d * d;
             double f = w->k[i] * d * (1.0 + w->lam[i] * (-uz));
             if (f > 0.0) {
@@ -211,12 +222,15 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             }
         }
         r->depth = fmax(r->depth, deepest);
+        if (nbelow > 0 && speed <= v_rest && load <= PD_COMPLIANT_REST_LOAD * m * g)
+            r->rest_depth = fmax(r->rest_depth, deepest);
         if (step > 0) {
             if (nbelow == 0 && !arriving) {
                 r->end = PD_COMPLIANT_SEPARATED;
                 break;
             }
-            if (nbelow <= 2 && t - last_touch >= c->law.T && approach <= v_rest) {
+            if (nbelow <= 2 && t - last_touch >= c->law.T && speed <= v_rest &&
+                load <= PD_COMPLIANT_REST_LOAD * m * g) {
                 r->end = PD_COMPLIANT_QUIET;
                 break;
             }

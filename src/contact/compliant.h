@@ -18,10 +18,12 @@
  * The run ends when
  *   - no vertex is below the floor and none will reach it within two steps
  *     (SEPARATED: flight again);
- *   - at most two contacts push, none has touched for a contact duration and
- *     none approaches faster than resting contact (QUIET: one vertex or an
- *     edge resting, which the exact contact phases take over; the part is
- *     lifted onto the floor, by its static compression, about g / omega^2);
+ *   - at most two contacts are below the floor, none has touched for a
+ *     contact duration and both rest: they move either way no faster than
+ *     resting contact arrives and carry a few times the part's weight at
+ *     most, so no bounce is under way (QUIET: one vertex or an edge resting,
+ *     which the exact contact phases take over; the part is lifted onto the
+ *     floor, by its static compression, about g / omega^2);
  *   - the outcome is decided (pd_settle_outcome on the state with its
  *     elastic energy counted as height) (DECIDED);
  *   - the time runs out (TIME). */
@@ -53,6 +55,9 @@ typedef struct pd_compliant_result {
     int pose;           /* DECIDED: the pose index */
     double time;        /* s the run lasted */
     double depth;       /* m: the deepest any vertex went below the floor */
+    double rest_depth;  /* m: the same while every contact below the floor
+                           rests (as QUIET has it: slow, lightly loaded), not
+                           the elastic compression of a bounce */
     long steps;
     int energy_gain;    /* 1: the energy rose across the run and was scaled back */
 } pd_compliant_result;

@@ -37,6 +37,12 @@ typedef struct pd_engine {
 } pd_engine;
 
 extern const pd_engine pd_engine_ode;    /* engine_ode.c */
-extern const pd_engine pd_engine_bullet; /* engine_bullet.cpp */
+/* engine_bullet.cpp, in libposedrop-bullet: libposedrop itself never refers
+ * to it, it only holds what pd_bullet_register hands to pd_engine_register. */
+extern const pd_engine pd_engine_bullet;
+
+/* The stepping engine of that kind in this program: ODE always, Bullet once
+ * registered; NULL for the impulse simulator and for an unregistered one. */
+const pd_engine *pd_engine_get(pd_engine_kind kind);
 
 #endif

@@ -30,7 +30,9 @@
 
 extern "C" {
 #include "engines/engine.h"
+#include "posedrop/bullet.h"
 #include "posedrop/tolerances.h"
+#include "posedrop/version.h"
 }
 
 /* The convex-plane algorithm finds one contact (the support vertex) per step
@@ -222,3 +224,8 @@ extern "C" const pd_engine pd_engine_bullet = {
     bullet_reset,
     bullet_step,
 };
+
+extern "C" pd_status pd_bullet_register(void)
+{
+    return pd_engine_register(PD_ENGINE_BULLET, &pd_engine_bullet, PD_VERSION_STRING);
+}

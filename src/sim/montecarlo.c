@@ -27,6 +27,10 @@ enum { BOOTSTRAP_FIRST = 20, BOOTSTRAP_ROUND = 100 };
 /* --ci: drops between checks of the stopping rule. Plain runs go in batches
  * of at most BATCH_MAX, so the outcome buffer stays small for any -n. */
 enum { CI_BATCH = 1000, BATCH_MAX = 65536 };
+/* The coarsest fixed step a stepping engine is given, the CLI's --dt limit:
+ * a part of 1 cm dropped 0.12 m meets the floor at 1.5 m/s and crosses its
+ * own size in under 7 ms, so a longer step would pass through contacts. */
+static const double PD_SIM_DT_MAX = 0.01;
 /* Two-sided 95% normal quantile for the Wilson intervals. */
 static const double Z95 = PD_Z95;
 
@@ -78,7 +82,16 @@ typedef struct batch {
     atomic_int failed;      /* a thread could not get its work area */
 } batch;
 
-static int cancelled(const pd_sim_options *o) { return o->cancel && *o->cancel; }
+/* C11 lets a signal handler touch an atomic object only if it is lock-free,
+ * and the CLI sets the flag from its SIGINT handler. */
+_Static_assert(ATOMIC_INT_LOCK_FREE == 2, "the cancel flag must be a lock-free atomic_int");
+
+/* Relaxed: the flag only asks the workers to stop; no data is published
+ * through it (the records are joined with the threads). */
+static int cancelled(const pd_sim_options *o)
+{
+    return o->cancel && atomic_load_explicit(o->cancel, memory_order_relaxed) != 0;
+}
 
 static void *worker(void *arg)
 {
@@ -364,6 +377,54 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
     return PD_OK;
 }
 
+/* Every field of the options, so that a program's mistake is a clear status
+ * rather than a run that ends every drop unsettled (or never ends). The
+ * limits are the CLI's where it has the option. */
+static pd_status check_options(const pd_sim_options *o, pd_diag *diag)
+{
+    const struct {
+        const char *name;
+        double value;
+    } reals[] = {{"dt", o->dt}, {"ci_halfwidth", o->ci_halfwidth}, {"time_limit", o->time_limit}};
+    for (size_t i = 0; i < sizeof reals / sizeof reals[0]; i++)
+        if (!isfinite(reals[i].value))
+            return pd_fail(diag, PD_ERR_NONFINITE, "pd_sim_run: option %s is %g", reals[i].name,
+                           reals[i].value);
+    if ((unsigned)o->engine > (unsigned)PD_ENGINE_BULLET)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option engine is %d: expected "
+                       "PD_ENGINE_IMPULSE, PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
+    if (!pd_engine_available(o->engine))
+        return pd_fail(diag, PD_ERR_UNAVAILABLE, "pd_sim_run: the Bullet engine is not in this "
+                       "program: link libposedrop-bullet (pkg-config posedrop-bullet) and call "
+                       "pd_bullet_register() first");
+    if (o->dt < 0 || o->dt > PD_SIM_DT_MAX)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option dt is %g s: expected 0 (the "
+                       "engine's default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
+    if (o->ndrops < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ndrops is %ld: expected 0 or more",
+                       o->ndrops);
+    if (o->threads < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option threads is %d: expected 0 (all "
+                       "cores) or more", o->threads);
+    if (o->ci_halfwidth < 0 || o->ci_halfwidth >= 0.5)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ci_halfwidth is %g: expected 0 "
+                       "(a fixed number of drops) or a half-width above 0 and below 0.5",
+                       o->ci_halfwidth);
+    if (o->max_drops < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_drops is %ld: expected 0 or "
+                       "more", o->max_drops);
+    if (!(o->time_limit > 0))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option time_limit is %g s: expected a "
+                       "positive time", o->time_limit);
+    if (o->max_collisions < 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_collisions is %d: expected 1 "
+                       "or more", o->max_collisions);
+    if (o->keep_trials != 0 && o->keep_trials != 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option keep_trials is %d: expected 0 or 1",
+                       o->keep_trials);
+    return PD_OK;
+}
+
 pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const pd_scene *scene,
                      const pd_sim_options *options, pd_sim_result **result, pd_diag *diag)
 {
@@ -379,17 +440,18 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         pd_sim_options_default(&o);
     if (!part || !poses || !result)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL argument");
-    if (o.ndrops < 0 || o.max_drops < 0 || !(o.ci_halfwidth >= 0) || !(o.time_limit > 0) ||
-        o.max_collisions < 1 || !(o.dt >= 0 && o.dt < 1) ||
-        (unsigned)o.engine > (unsigned)PD_ENGINE_BULLET)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: invalid options");
-    if (poses->nposes < 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the part has no stable pose");
+    pd_status st = pd_scene_check(&sc, diag);
+    if (st == PD_OK)
+        st = check_options(&o, diag);
+    if (st != PD_OK)
+        return st;
+    if (poses->nposes < 1 || !poses->poses)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the static result has no stable pose");
     int stationary = sc.initial == PD_INITIAL_STATIONARY;
     if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
         return PD_ERR_USAGE;
     pd_sim_model *model = NULL;
-    pd_status st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
+    st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
     if (st != PD_OK)
         return st;
     pd_sim_result *r = calloc(1, sizeof *r);

@@ -2,6 +2,7 @@
  * and their text form, shared by scene files and the command line. */
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -24,28 +25,64 @@ void pd_scene_default(pd_scene *s)
 
 typedef struct {
     const char *key;
-    double *field;
-    double lo, hi;     /* allowed range, inclusive */
+    size_t field;      /* offsetof the double in pd_scene */
+    double lo, hi;     /* allowed range of the text value, inclusive */
     double scale;      /* text value times scale is stored (degrees -> rad) */
     const char *what;
 } numeric_key;
 
+/* Ranges: a drop needs a non-negative height and positive gravity; friction
+ * beyond 10 is no longer a material (the tests go to 10); restitution above 1
+ * would create energy; vibration is a tilt. The same table checks the text
+ * (pd_scene_set) and a scene filled in by a program (pd_scene_check). */
+static const numeric_key keys[] = {
+    {"height", offsetof(pd_scene, height), 0.0, 1e3, 1.0, "a drop height in m, 0 to 1000"},
+    {"belt_speed", offsetof(pd_scene, belt_speed), -1e3, 1e3, 1.0, "a speed in m/s, -1000 to 1000"},
+    {"v", offsetof(pd_scene, belt_speed), -1e3, 1e3, 1.0, "a speed in m/s, -1000 to 1000"},
+    {"mu", offsetof(pd_scene, mu), 0.0, 10.0, 1.0, "a friction coefficient from 0 to 10"},
+    {"restitution", offsetof(pd_scene, restitution), 0.0, 1.0, 1.0, "a restitution from 0 to 1"},
+    {"vibration", offsetof(pd_scene, vibration), 0.0, 180.0, M_PI / 180.0,
+     "an angle in degrees, 0 to 180"},
+    {"gravity", offsetof(pd_scene, gravity), 1e-3, 1e3, 1.0,
+     "an acceleration in m/s^2, 0.001 to 1000"},
+    {"contact_time", offsetof(pd_scene, contact_time), 0.0, 1.0, 1.0, "a duration in s, 0 to 1"},
+};
+enum { NKEYS = sizeof keys / sizeof keys[0] };
+
+static double *field(pd_scene *s, const numeric_key *k)
+{
+    return (double *)(void *)((char *)s + k->field);
+}
+
+pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag)
+{
+    if (!scene)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_scene_check: NULL scene");
+    for (int i = 0; i < NKEYS; i++) {
+        const numeric_key *k = &keys[i];
+        double v = *field((pd_scene *)scene, k);
+        /* The stored value is the text's times scale, rounded; rounding is
+         * monotonic, so lo * scale and hi * scale bound exactly what
+         * pd_scene_set accepts. */
+        if (!isfinite(v))
+            return pd_fail(diag, PD_ERR_NONFINITE, "scene %s is %g: expected %s", k->key,
+                           v / k->scale, k->what);
+        if (v < k->lo * k->scale || v > k->hi * k->scale)
+            return pd_fail(diag, PD_ERR_RANGE, "scene %s is %.17g: expected %s", k->key,
+                           v / k->scale, k->what);
+    }
+    if ((unsigned)scene->law > (unsigned)PD_RESTITUTION_ENERGETIC)
+        return pd_fail(diag, PD_ERR_RANGE, "scene restitution_law is %d: expected "
+                       "PD_RESTITUTION_POISSON or PD_RESTITUTION_ENERGETIC", (int)scene->law);
+    if ((unsigned)scene->initial > (unsigned)PD_INITIAL_STATIONARY)
+        return pd_fail(diag, PD_ERR_RANGE, "scene initial is %d: expected PD_INITIAL_UNIFORM, "
+                       "PD_INITIAL_BOOTSTRAP or PD_INITIAL_STATIONARY", (int)scene->initial);
+    return PD_OK;
+}
+
 pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag *diag)
 {
-    /* Ranges: a drop needs a non-negative height and positive gravity;
-     * friction beyond 10 is no longer a material (the tests go to 10);
-     * restitution above 1 would create energy; vibration is a tilt. */
-    const numeric_key keys[] = {
-        {"height", &s->height, 0.0, 1e3, 1.0, "a drop height in m, 0 to 1000"},
-        {"belt_speed", &s->belt_speed, -1e3, 1e3, 1.0, "a speed in m/s"},
-        {"v", &s->belt_speed, -1e3, 1e3, 1.0, "a speed in m/s"},
-        {"mu", &s->mu, 0.0, 10.0, 1.0, "a friction coefficient from 0 to 10"},
-        {"restitution", &s->restitution, 0.0, 1.0, 1.0, "a restitution from 0 to 1"},
-        {"vibration", &s->vibration, 0.0, 180.0, M_PI / 180.0, "an angle in degrees, 0 to 180"},
-        {"gravity", &s->gravity, 1e-3, 1e3, 1.0, "an acceleration in m/s^2, 0.001 to 1000"},
-        {"contact_time", &s->contact_time, 0.0, 1.0, 1.0, "a duration in s, 0 to 1"},
-    };
-    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++) {
+    for (int i = 0; i < NKEYS; i++) {
         if (strcmp(key, keys[i].key) != 0)
             continue;
         double v;
@@ -53,7 +90,7 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
             return pd_fail(diag, PD_ERR_PARSE, "%s: expected %s, got '%s'", key, keys[i].what, value);
         if (v < keys[i].lo || v > keys[i].hi)
             return pd_fail(diag, PD_ERR_RANGE, "%s: expected %s, got %s", key, keys[i].what, value);
-        *keys[i].field = v * keys[i].scale;
+        *field(s, &keys[i]) = v * keys[i].scale;
         return PD_OK;
     }
     if (strcmp(key, "restitution_law") == 0) {

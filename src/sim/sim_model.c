@@ -39,13 +39,16 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     m->tol_scale = tol_scale;
     /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
      * frame cut into 16 substeps. */
-    if (options->engine == PD_ENGINE_ODE) {
-        m->engine = &pd_engine_ode;
-        m->dt = options->dt > 0 ? options->dt : 1e-3;
-    } else if (options->engine == PD_ENGINE_BULLET) {
-        m->engine = &pd_engine_bullet;
-        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    m->engine = pd_engine_get(options->engine);
+    if (options->engine != PD_ENGINE_IMPULSE && !m->engine) {
+        free(m);
+        return pd_fail(diag, PD_ERR_UNAVAILABLE, "the %s engine is not in this program",
+                       options->engine == PD_ENGINE_BULLET ? "Bullet" : "requested");
     }
+    if (options->engine == PD_ENGINE_ODE)
+        m->dt = options->dt > 0 ? options->dt : 1e-3;
+    else if (options->engine == PD_ENGINE_BULLET)
+        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
     m->hull = part->hull;
     m->com = part->com;
     m->poses = poses;

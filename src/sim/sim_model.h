@@ -43,6 +43,9 @@ typedef struct pd_drop_work {
     pd_compliant_work *compliant; /* with model->compliant_on, else NULL */
     const pd_engine *engine;
     int contacts[PD_MAX_CONTACTS];
+    double rest_depth;          /* m: the last drop's deepest lasting contact:
+                                   a resting contact found below the floor, or
+                                   a compliant contact older than its duration */
 } pd_drop_work;
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,

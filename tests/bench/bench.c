@@ -654,7 +654,11 @@ static int wanted(int argc, char **argv, const char *name)
 
 int main(int argc, char **argv)
 {
-    printf("posedrop %s benchmark (best of %d runs each)\n", PD_VERSION_STRING, BEST_OF);
+    printf("posedrop %s benchmark (best of %d runs each)\n", pd_version(), BEST_OF);
+    if (pd_bullet_register() != PD_OK) {
+        fprintf(stderr, "bench: the Bullet engine would not register\n");
+        return 1;
+    }
     if (wanted(argc, argv, "static")) {
         bench_static();
         bench_symmetry();

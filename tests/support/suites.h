@@ -4,6 +4,7 @@
 
 #define PD_SUITES   \
     PD_SUITE(status) \
+    PD_SUITE(api)    \
     PD_SUITE(mesh)   \
     PD_SUITE(hull)   \
     PD_SUITE(mass)   \
@@ -20,6 +21,7 @@
     PD_SUITE(flat_rest) \
     PD_SUITE(contact_phase) \
     PD_SUITE(contact_pivot) \
+    PD_SUITE(compliant) \
     PD_SUITE(sim)    \
     PD_SUITE(markov) \
     PD_SUITE(drop_step) \

@@ -66,6 +66,9 @@ static void run_solid(pd_engine_kind engine, int (*solid)(pd_vec3 *), long drops
 void suite_drop_step(void)
 {
     const pd_engine_kind engines[] = {PD_ENGINE_ODE, PD_ENGINE_BULLET};
+    /* As a program linked with libposedrop-bullet does (test_api checks the
+     * status without it). */
+    CHECK_STATUS(pd_bullet_register(), PD_OK);
     for (int e = 0; e < 2; e++) {
         run_solid(engines[e], pts_cube, 300);
         run_solid(engines[e], pts_octahedron, 300);

@@ -1,6 +1,7 @@
 /* test_markov.c: the long-run distribution of a pose-to-pose chain against
  * closed forms, its resampling intervals, and --initial stationary end to end
  * on the cube. */
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -340,7 +341,7 @@ static void test_cube(void)
     /* Cancelled before the first drop: partial, raw counts, no NaN. */
     pd_sim_options_default(&o);
     o.ndrops = 700;
-    volatile sig_atomic_t stop = 1;
+    atomic_int stop = 1;
     o.cancel = &stop;
     r = NULL;
     CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_OK);

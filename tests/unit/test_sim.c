@@ -1,6 +1,7 @@
 /* test_sim.c: the Monte Carlo dynamic estimator: statistics of symmetric
  * parts, determinism whatever the thread count, scale, the run's contracts
  * (cancellation, bootstrap, --ci, trial records). */
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -146,7 +147,7 @@ static void test_contracts(void)
 
     /* Cancelled before it starts: nothing run, marked partial, still valid. */
     pd_sim_options_default(&o);
-    volatile sig_atomic_t stop = 1;
+    atomic_int stop = 1;
     o.cancel = &stop;
     pd_sim_result *r = run(&f, NULL, &o);
     CHECK(r != NULL && r->partial == 1 && r->n == 0);

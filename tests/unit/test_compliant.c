@@ -1,0 +1,564 @@
+/* test_compliant.c: the compliant impact (src/contact/compliant*.c) against
+ * closed forms and limits: the normal law's restitution and duration, the
+ * rigid law as the duration shrinks, flat landings, Housner's rocking block,
+ * the near-flat cube, convergence of the pose distribution as every
+ * integration tolerance tightens, and lasting contact that does not sink. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "base/gsl_adapter.h"
+#include "base/quat.h"
+#include "base/vec3.h"
+#include "check.h"
+#include "contact/compliant.h"
+#include "drop_fixture.h"
+#include "posedrop/posedrop.h"
+#include "shapes.h"
+#include "suites.h"
+
+/* The sanitizer build runs every check, on fewer drops where a statistic
+ * allows it (the statistical tests keep their level at any count). */
+#if defined(__SANITIZE_ADDRESS__)
+#define DROPS_SCALE 4
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define DROPS_SCALE 4
+#endif
+#endif
+#ifndef DROPS_SCALE
+#define DROPS_SCALE 1
+#endif
+
+/* --- a model of any part, at any tolerance scale ---------------------------- */
+
+typedef struct {
+    pd_part *part;
+    pd_static_result *poses;
+    pd_sim_model *model;
+    pd_drop_work *work;
+} model_fixture;
+
+static int model_setup(model_fixture *fx, pd_part *part, const pd_scene *sc, double tol_scale)
+{
+    memset(fx, 0, sizeof *fx);
+    fx->part = part;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    int ok = part && pd_static_estimate(part, NULL, &fx->poses, NULL) == PD_OK &&
+             pd_sim_model_build_tol(part, fx->poses, sc, &o, tol_scale, &fx->model, NULL) == PD_OK &&
+             (fx->work = pd_drop_work_alloc(fx->model, sc)) != NULL;
+    CHECK(ok);
+    return ok;
+}
+
+static void model_teardown(model_fixture *fx)
+{
+    pd_drop_work_free(fx->work);
+    pd_sim_model_free(fx->model);
+    pd_static_result_free(fx->poses);
+    pd_part_free(fx->part);
+}
+
+static pd_part *part_file(const char *path)
+{
+    pd_mesh *m = NULL;
+    pd_part *p = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    if (pd_mesh_read(path, NULL, &m, &d) != PD_OK || pd_part_build(m, NULL, &p, &d) != PD_OK)
+        printf("     %s: %s\n", path, d.message);
+    pd_mesh_free(m);
+    return p;
+}
+
+/* --- the normal law ---------------------------------------------------------- */
+
+/* One contact of mass mass, approach speed v0, under the law's force in its
+ * own dimensional variables, by classical RK4 at a fixed step dt, written
+ * here independently of the library's scaled integration; the end where the
+ * penetration returns to 0, located on the cubic Hermite interpolant of the
+ * last step. Gives the rebound speed and the duration. */
+static void law_dimensional(const pd_compliant_law *law, double mass, double v0, double dt,
+                            double *rebound, double *duration)
+{
+    double k = mass * law->omega * law->omega, c = law->chi / v0;
+#define FORCE(D, V) fmax(0.0, k * (D) * (1.0 + c * (V)))
+    double t = 0.0, d = 0.0, v = v0; /* v = dd/dt, into the floor */
+    for (;;) {
+        double k1d = v, k1v = -FORCE(d, v) / mass;
+        double k2d = v + 0.5 * dt * k1v, k2v = -FORCE(d + 0.5 * dt * k1d, v + 0.5 * dt * k1v) / mass;
+        double k3d = v + 0.5 * dt * k2v, k3v = -FORCE(d + 0.5 * dt * k2d, v + 0.5 * dt * k2v) / mass;
+        double k4d = v + dt * k3v, k4v = -FORCE(d + dt * k3d, v + dt * k3v) / mass;
+        double d1 = d + dt * (k1d + 2 * k2d + 2 * k3d + k4d) / 6.0;
+        double v1 = v + dt * (k1v + 2 * k2v + 2 * k3v + k4v) / 6.0;
+        if (d1 < 0.0 && t > 0.0) {
+            /* Hermite on [t, t + dt]: root of d by bisection, its slope there. */
+            double lo = 0.0, hi = 1.0;
+            for (int i = 0; i < 200; i++) {
+                double u = 0.5 * (lo + hi), h00 = 2 * u * u * u - 3 * u * u + 1,
+                       h10 = u * u * u - 2 * u * u + u, h01 = -2 * u * u * u + 3 * u * u,
+                       h11 = u * u * u - u * u;
+                double du = h00 * d + h10 * dt * v + h01 * d1 + h11 * dt * v1;
+                if (du > 0.0)
+                    lo = u;
+                else
+                    hi = u;
+            }
+            double u = 0.5 * (lo + hi);
+            double g00 = 6 * u * u - 6 * u, g10 = 3 * u * u - 4 * u + 1, g01 = -6 * u * u + 6 * u,
+                   g11 = 3 * u * u - 2 * u;
+            *rebound = -(g00 * d + g10 * dt * v + g01 * d1 + g11 * dt * v1) / dt;
+            *duration = t + u * dt;
+            break;
+        }
+        d = d1;
+        v = v1;
+        t += dt;
+    }
+#undef FORCE
+}
+
+/* The law's rebound is e times the approach speed and its contact lasts T,
+ * whatever the approach speed and mass: closed form of the scaled law,
+ * checked by integrating the dimensional one independently, to 1e-6 (the
+ * issue's bound; the RK4 at 20000 steps per contact is good to ~1e-10 away
+ * from the force's clamp, whose kink costs one step's second-order error,
+ * ~1e-9). */
+static void test_law_closed_form(void)
+{
+    const double es[] = {0.0, 0.05, 0.3, 0.7, 0.95, 1.0};
+    const double Ts[] = {1e-7, 5e-4, 2e-2};
+    double worst_e = 0.0, worst_t = 0.0;
+    for (size_t i = 0; i < sizeof es / sizeof *es; i++)
+        for (size_t j = 0; j < sizeof Ts / sizeof *Ts; j++) {
+            pd_compliant_law law;
+            CHECK_STATUS(pd_compliant_law_init(es[i], Ts[j], &law), PD_OK);
+            double e = fmax(es[i], PD_COMPLIANT_E_MIN);
+            CHECK_REL(law.e, e, 0.0, "e = 0 is taken as PD_COMPLIANT_E_MIN");
+            double v0 = 0.3 + 1.7 * (double)j, mass = 0.02 + 0.5 * (double)i;
+            double rebound, duration;
+            law_dimensional(&law, mass, v0, law.T * 5e-5 * (law.tau / M_PI), &rebound, &duration);
+            CHECK_REL(rebound / v0, e, 1e-6, "closed form: the law's rebound is e v0 (issue: 1e-6)");
+            CHECK_REL(duration, Ts[j], 1e-6, "closed form: the law lasts T (issue: 1e-6)");
+            worst_e = fmax(worst_e, fabs(rebound / v0 - e) / e);
+            worst_t = fmax(worst_t, fabs(duration - Ts[j]) / Ts[j]);
+        }
+    CHECK_STATUS(pd_compliant_law_init(-0.1, 1e-3, &(pd_compliant_law){0}), PD_ERR_RANGE);
+    CHECK_STATUS(pd_compliant_law_init(0.3, 0.0, &(pd_compliant_law){0}), PD_ERR_RANGE);
+    CHECK_STATUS(pd_compliant_law_init(0.3, NAN, &(pd_compliant_law){0}), PD_ERR_RANGE);
+    if (getenv("PD_TEST_VERBOSE"))
+        printf("compliant: law vs independent integration: e %.2g, T %.2g relative at worst\n",
+               worst_e, worst_t);
+}
+
+/* --- single impacts of random bodies ---------------------------------------- */
+
+/* A random state of body b touching the floor at one vertex (the lowest of
+ * a random orientation) with approach speed in [3, 6] m/s per unit size (so
+ * that the impact leaves the part far above every basin's barrier and the
+ * run cannot end decided),
+ * sliding speed up to `slide` times it and spin up to that over the size. */
+static pd_state random_touch(const pd_body *b, test_rng *rng, double slide, int *vertex)
+{
+    pd_state s;
+    double r[3][3];
+    rng_rotation(rng, r);
+    s.q = quat_from_matrix((const double(*)[3])r);
+    pd_vec3 up = quat_rotate_inv(s.q, v3(0, 0, 1));
+    *vertex = pd_body_support_scan(b, up);
+    s.x = v3(0, 0, -v3_dot(b->verts[*vertex], up));
+    double vn = b->size * rng_range(rng, 3.0, 6.0);
+    s.w = v3_scale(rng_unit_vector(rng), rng_range(rng, 0.0, 1.0) * vn / b->size);
+    pd_vec3 tang = v3_scale(v3_unit(v3(rng_range(rng, -1, 1), rng_range(rng, -1, 1), 0)),
+                            slide * vn * rng_range(rng, 0.2, 1.0));
+    /* The vertex's own velocity: approaching at vn, sliding at tang. */
+    pd_vec3 wr = v3_cross(quat_rotate(s.q, s.w), quat_rotate(s.q, b->verts[*vertex]));
+    s.v = v3_sub(v3_add(tang, v3(0, 0, -vn)), wr);
+    return s;
+}
+
+static double total(const pd_body *b, double g, const pd_state *s)
+{
+    return total_energy(b, g, s);
+}
+
+/* Energy never rises across a compliant impact: 1e5 random single-vertex
+ * impacts of random bodies, random restitution in [0, 0.95], friction in
+ * [0, 1.5], duration over four decades. The law and Coulomb friction only
+ * take energy; the explicit step's own error could add some, which the run
+ * would scale back and flag (energy_gain): the check is that it never had
+ * to. e near 1 is left out: the law then takes almost nothing and the
+ * step's error, either sign, is all there is (the run guards it, counted). */
+static void test_energy_random_impacts(void)
+{
+    test_rng rng = {20261126};
+    long n = 100000 / DROPS_SCALE, gains = 0, ended = 0;
+    double worst = -HUGE_VAL;
+    for (int body = 0; body < 20; body++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        model_fixture fx;
+        if (!model_setup(&fx, part_random_ellipsoid(&rng, 24, 0.7, 0.5, 0.2, 0.1), &sc, 1.0))
+            return;
+        const pd_body *b = fx.model->body;
+        pd_compliant_work *w = pd_compliant_work_alloc(b);
+        CHECK(w != NULL);
+        for (long k = 0; w && k < n / 20; k++) {
+            sc.restitution = rng_range(&rng, 0.0, 0.95);
+            sc.mu = rng_range(&rng, 0.0, 1.5);
+            double T = pow(10.0, rng_range(&rng, -7.0, -3.0));
+            pd_compliant c;
+            if (pd_compliant_init(sc.restitution, T, b, 1.0, &c) != PD_OK) {
+                CHECK(0);
+                break;
+            }
+            int v;
+            pd_state s = random_touch(b, &rng, 2.0 * rng_uniform(&rng), &v);
+            double e0 = total(b, sc.gravity, &s);
+            pd_compliant_result r;
+            CHECK_STATUS(pd_compliant_run(&c, w, &fx.model->settle, &sc, &s, 10.0 * T, &r), PD_OK);
+            gains += r.energy_gain;
+            ended += r.end == PD_COMPLIANT_SEPARATED || r.end == PD_COMPLIANT_QUIET ||
+                     r.end == PD_COMPLIANT_DECIDED;
+            worst = fmax(worst, (total(b, sc.gravity, &s) - e0) / e0);
+        }
+        pd_compliant_work_free(w);
+        model_teardown(&fx);
+    }
+    CHECK_INT(gains, 0);
+    CHECK(worst <= 0.0);
+    CHECK_INT(ended, n);
+    if (getenv("PD_TEST_VERBOSE"))
+        printf("compliant: %ld random impacts, energy change at most %.3g of the start\n", n, worst);
+}
+
+/* As the contact duration shrinks the compliant impact of one vertex tends
+ * to a rigid law: the same flow of contact velocity against normal impulse
+ * as the rigid law the drop loop uses (pd_drop_collide: Poisson's law with
+ * Routh's friction), dU/dP = K (n + mu sliding direction), sticking
+ * included. The two end alike wherever the normal inverse mass along the
+ * flow stays put: always without friction, and while sliding keeps its
+ * direction; where friction turns the sliding, Poisson's impulse ratio and
+ * the compliant law's velocity ratio part by a little.
+ * Random bodies at T = 1e-7 s (gravity over T, g T / v ~ 1e-7, is nothing):
+ * frictionless, outgoing velocities within 1e-4 (the issue's bound) at an
+ * eighth of the model's step, and within 2e-3 at the model's own step (the
+ * explicit step's error, second order: measured up to 5e-3 falling to 8e-5
+ * at an eighth); sliding fast (20 to 100 mu times the approach speed),
+ * within 0.1 at any step (measured up to 0.044, the same at every step: the
+ * two laws' difference, not an error). The drop loop itself resolves a
+ * lone vertex by the rigid law. */
+static void test_rigid_limit(void)
+{
+    test_rng rng = {7};
+    double worst[2] = {0, 0}, worst1 = 0.0;
+    long n[2] = {0, 0};
+    for (int body = 0; body < 10; body++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        model_fixture fx;
+        if (!model_setup(&fx, part_random_ellipsoid(&rng, 24, 0.7, 0.5, 0.2, 0.1), &sc, 1.0))
+            return;
+        const pd_body *b = fx.model->body;
+        pd_compliant_work *w = pd_compliant_work_alloc(b);
+        CHECK(w != NULL);
+        for (int k = 0; w && k < 40; k++) {
+            int sliding = k & 1;
+            sc.restitution = rng_range(&rng, 0.05, 0.9);
+            sc.mu = sliding ? rng_range(&rng, 0.05, 0.3) : 0.0;
+            pd_compliant c, cq;
+            CHECK_STATUS(pd_compliant_init(sc.restitution, 1e-7, b, 1.0, &c), PD_OK);
+            CHECK_STATUS(pd_compliant_init(sc.restitution, 1e-7, b, 0.125, &cq), PD_OK);
+            int v;
+            /* Sliding fast enough that friction cannot stop it within the
+             * impact: at 20 to 100 times mu times the approach speed. */
+            pd_state s0 = random_touch(b, &rng, sliding ? 100.0 * sc.mu : 0.0, &v);
+            pd_state sc_ = s0, sq = s0, sr = s0;
+            pd_compliant_result r;
+            CHECK_STATUS(pd_compliant_run(&c, w, &fx.model->settle, &sc, &sc_, 1e-4, &r), PD_OK);
+            CHECK_INT(r.end, PD_COMPLIANT_SEPARATED);
+            CHECK_STATUS(pd_compliant_run(&cq, w, &fx.model->settle, &sc, &sq, 1e-4, &r), PD_OK);
+            CHECK_INT(r.end, PD_COMPLIANT_SEPARATED);
+            int impacts = 0;
+            long gain = 0, fb = 0;
+            CHECK_STATUS(pd_drop_collide(fx.model, fx.work, &sc, &sr, &v, 1, &impacts, &gain, &fb),
+                         PD_OK);
+            double scale_v = v3_norm(s0.v) + v3_norm(s0.w) * b->rmax;
+            double dv = v3_norm(v3_sub(sq.v, sr.v)) / scale_v;
+            double dw = v3_norm(v3_sub(sq.w, sr.w)) * b->rmax / scale_v;
+            if (sliding)
+                CHECK_NEAR(fmax(dv, dw), 0.0, 0.1, "Poisson's and the compliant law, sliding");
+            else
+                CHECK_NEAR(fmax(dv, dw), 0.0, 1e-4, "rigid limit of one vertex (issue: 1e-4)");
+            worst[sliding] = fmax(worst[sliding], fmax(dv, dw));
+            dv = v3_norm(v3_sub(sc_.v, sr.v)) / scale_v;
+            dw = v3_norm(v3_sub(sc_.w, sr.w)) * b->rmax / scale_v;
+            CHECK_NEAR(fmax(dv, dw), 0.0, sliding ? 0.1 : 1e-2, "the model's step: second order");
+            if (!sliding)
+                worst1 = fmax(worst1, fmax(dv, dw));
+            n[sliding]++;
+        }
+        pd_compliant_work_free(w);
+        model_teardown(&fx);
+    }
+    if (getenv("PD_TEST_VERBOSE"))
+        printf("compliant: rigid limit at T = 1e-7 s, an eighth of the step: frictionless %.2g "
+               "over %ld, sliding %.2g over %ld (relative); frictionless %.2g at the model's "
+               "step\n", worst[0], n[0], worst[1], n[1], worst1);
+}
+
+/* --- landings on several contacts -------------------------------------------- */
+
+/* A part landing exactly flat on two (a box on an edge, turned 45 degrees
+ * about its long axis) or four contacts (on a face), friction on: by
+ * symmetry a pure bounce, each contact's law the same scaled equation, so it
+ * rebounds at e times the approach speed with no spin: within 2e-3 at the
+ * model's step, the explicit step's error, which must shrink at least as
+ * fast as the step (converging; it is second order here). */
+static void test_flat_landings(void)
+{
+    for (int edge = 0; edge < 2; edge++) {
+        double err[2] = {0, 0};
+        for (int half = 0; half < 2; half++) {
+            pd_scene sc;
+            pd_scene_default(&sc);
+            sc.gravity = 1e-6; /* g T / v0 ~ 3e-10: the law alone */
+            model_fixture fx;
+            if (!model_setup(&fx, part_of(mesh_box(0.05, 0.01, 0.01), NULL, NULL), &sc,
+                             half ? 0.5 : 1.0))
+                return;
+            const pd_body *b = fx.model->body;
+            /* World = part frame, turned 45 degrees about x for the edge. */
+            pd_quat turn = edge ? quat_axis_angle(v3(1, 0, 0), M_PI / 4) : quat_identity();
+            pd_state s;
+            s.q = quat_mul(turn, b->frame);
+            pd_vec3 up = quat_rotate_inv(s.q, v3(0, 0, 1));
+            int low = pd_body_support_scan(b, up);
+            s.x = v3(0, 0, -v3_dot(b->verts[low], up));
+            s.v = v3(0, 0, -1.53);
+            s.w = v3(0, 0, 0);
+            pd_compliant_result r;
+            CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant,
+                                          &fx.model->settle, &sc, &s, 1.0, &r), PD_OK);
+            CHECK_INT(r.end, PD_COMPLIANT_SEPARATED);
+            double rebound = s.v.z;
+            err[half] = fabs(rebound / 1.53 - sc.restitution);
+            CHECK_NEAR(rebound / 1.53, sc.restitution, 2e-3, "the step's error at PD_COMPLIANT_STEP");
+            CHECK_NEAR(v3_norm(s.w) * b->size, 0.0, 1e-12 * 1.53, "symmetry: no spin (round-off)");
+            CHECK_NEAR(hypot(s.v.x, s.v.y), 0.0, 1e-12 * 1.53, "symmetry: no slide (round-off)");
+            model_teardown(&fx);
+        }
+        CHECK(err[1] <= 0.55 * err[0]); /* at least first order, 10% slack */
+        if (getenv("PD_TEST_VERBOSE"))
+            printf("compliant: flat landing on %d contacts: rebound off e by %.2g, %.2g at half "
+                   "the step\n", edge ? 2 : 4, err[0], err[1]);
+    }
+}
+
+/* Housner's rocking block: a rectangular block of slenderness alpha
+ * (tan alpha = width / height) rocking about one bottom edge lands on the
+ * other; with a plastic impact that does not slip, angular momentum about
+ * the new edge is conserved and the rate falls by r = 1 - 1.5 sin^2 alpha
+ * (Housner 1963). Compliant, e = 0 (taken as PD_COMPLIANT_E_MIN, a rebound
+ * of 1% of the edge's approach), mu = 3 and a short contact (T = 1e-6 s,
+ * so gravity acts for nothing during it): within 2% for three
+ * slendernesses (the issue's bound; the 1% rebound and the old edge's
+ * release are inside it). */
+static void test_housner(void)
+{
+    const double alphas[] = {10.0, 20.0, 30.0};
+    for (int k = 0; k < 3; k++) {
+        double a = alphas[k] * M_PI / 180.0, hw = 0.005, hh = hw / tan(a); /* half width, height */
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.restitution = 0.0;
+        sc.mu = 3.0;
+        sc.contact_time = 1e-6;
+        model_fixture fx;
+        if (!model_setup(&fx, part_of(mesh_box(2 * hw, 0.02, 2 * hh), NULL, NULL), &sc, 1.0))
+            return;
+        const pd_body *b = fx.model->body;
+        /* Flat on the floor, turning about the edge x = +hw at rate w1 < 0
+         * about y, so the edge x = -hw comes down at 2 hw |w1|: fast enough
+         * that the block would go over (energy far above the barrier). */
+        double w1 = -40.0;
+        pd_state s;
+        s.q = b->frame;
+        s.x = v3(0, 0, hh);
+        pd_vec3 ww = v3(0, w1, 0);
+        s.v = v3_cross(ww, v3(-hw, 0, hh));
+        s.w = quat_rotate_inv(s.q, ww);
+        pd_compliant_result r;
+        CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant, &fx.model->settle,
+                                      &sc, &s, 1e-3, &r), PD_OK);
+        CHECK(r.end == PD_COMPLIANT_QUIET || r.end == PD_COMPLIANT_SEPARATED);
+        double w2 = quat_rotate(s.q, s.w).y, ratio = w2 / w1;
+        double housner = 1.0 - 1.5 * sin(a) * sin(a);
+        CHECK_REL(ratio, housner, 0.02, "Housner 1963: r = 1 - 1.5 sin^2 alpha (issue: 2%)");
+        if (getenv("PD_TEST_VERBOSE"))
+            printf("compliant: Housner block alpha %.0f deg: rate ratio %.4f, closed form %.4f\n",
+                   alphas[k], ratio, housner);
+        model_teardown(&fx);
+    }
+}
+
+/* --- drops ---------------------------------------------------------------------- */
+
+/* The share of n drops of fx started resting on pose 0 (turned by the
+ * scene's vibration) that end on it; *depth is their deepest lasting
+ * contact, per L. */
+static double stay_share(model_fixture *fx, const pd_scene *sc, long n, double *depth)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.seed = 2026;
+    int np = fx->poses->nposes;
+    double *cdf = malloc(sizeof *cdf * (size_t)np);
+    for (int k = 0; k < np; k++)
+        cdf[k] = 1.0; /* everything on pose 0 */
+    long stay = 0;
+    *depth = 0.0;
+    for (long i = 0; i < n; i++) {
+        pd_trial t;
+        long gain = 0, fb = 0;
+        pd_drop_run(fx->model, fx->work, sc, &o, i, cdf, &t, &gain, &fb);
+        stay += t.pose == 0;
+        *depth = fmax(*depth, fx->work->rest_depth / fx->model->body->size);
+    }
+    free(cdf);
+    return (double)stay / (double)n;
+}
+
+/* The paper's belt: a 1 cm cube resting on a face, turned 1.5 degrees by the
+ * vibration, dropped from 0.12 m. Its face lands as a whole at the default
+ * contact time and the cube stays on it (at least 70% of 200 drops, the
+ * issue's bound; MuJoCo's soft contact keeps 99-100%); as the contact time
+ * shrinks the corners are struck one by one and the share falls to the
+ * rigid model's: at 1e-6 s within 3 binomial sigmas of it (sigma of a
+ * difference of two shares of 200 near 25%: 0.043). */
+static void test_near_flat_cube(void)
+{
+    const double Ts[] = {5e-4, 1e-4, 1e-5, 1e-6, 0.0};
+    double share[5], depth;
+    long n = 200;
+    for (int k = 0; k < 5; k++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.contact_time = Ts[k];
+        model_fixture fx;
+        if (!model_setup(&fx, part_file("parts/canonical/cube.off"), &sc, 1.0))
+            return;
+        share[k] = stay_share(&fx, &sc, n, &depth);
+        model_teardown(&fx);
+    }
+    CHECK(share[0] >= 0.7);
+    CHECK(share[1] < share[0] - 3 * 0.043);
+    CHECK_NEAR(share[3], share[4], 3 * 0.043, "3 binomial sigmas: near the rigid model");
+    if (getenv("PD_TEST_VERBOSE"))
+        printf("compliant: cube resting start stays on its face: %.3f %.3f %.3f %.3f at T = 5e-4 "
+               "1e-4 1e-5 1e-6 s, %.3f rigid\n", share[0], share[1], share[2], share[3], share[4]);
+}
+
+/* Counts of poses over n uniform drops (seeded) of fx; index nposes counts
+ * unsettled drops. */
+static void pose_counts(model_fixture *fx, const pd_scene *sc, long n, long *count, double *depth)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.seed = 99;
+    int np = fx->poses->nposes;
+    memset(count, 0, sizeof *count * (size_t)(np + 1));
+    *depth = 0.0;
+    for (long i = 0; i < n; i++) {
+        pd_trial t;
+        long gain = 0, fb = 0;
+        pd_drop_run(fx->model, fx->work, sc, &o, i, NULL, &t, &gain, &fb);
+        count[t.pose >= 0 ? t.pose : np]++;
+        *depth = fmax(*depth, fx->work->rest_depth / fx->model->body->size);
+    }
+}
+
+/* Halving every integration tolerance of the impact and contact models (the
+ * compliant step and friction sweeps, the rigid impact's and the contact
+ * phases' integrators) moves no pose probability beyond sampling noise:
+ * chi-square test of homogeneity of the two runs' pose counts at 99%
+ * (poses pooled until each expected count is at least 5). The same seeds
+ * run in both, so most drops repeat and the test errs towards passing only
+ * where nothing moved; chaotic drops may flip one by one. Unsettled drops
+ * are a cell of their own (a 32-gon coin may roll on its rim, losing almost
+ * nothing at each corner, until the time limit: about 1% of its drops).
+ * Lasting contact never sinks more than 1e-3 of the part's size (the
+ * issue's bound) in any of these drops. */
+static void test_convergence(void)
+{
+    static const struct {
+        const char *path;
+        long n;
+    } parts[] = {
+        {"parts/canonical/cube.off", 4000},
+        {"parts/canonical/box_1x2x3.off", 4000},
+        {"parts/canonical/coin_h0.25.off", 4000},
+        {"parts/cap.off", 4000},
+    };
+    for (size_t k = 0; k < sizeof parts / sizeof *parts; k++) {
+        long n = parts[k].n / DROPS_SCALE;
+        long *count[2] = {NULL, NULL};
+        int np = 0;
+        double depth_max = 0.0;
+        for (int half = 0; half < 2; half++) {
+            pd_scene sc;
+            pd_scene_default(&sc);
+            model_fixture fx;
+            if (!model_setup(&fx, part_file(parts[k].path), &sc, half ? 0.5 : 1.0))
+                return;
+            np = fx.poses->nposes;
+            count[half] = calloc((size_t)np + 1, sizeof **count);
+            double depth;
+            pose_counts(&fx, &sc, n, count[half], &depth);
+            depth_max = fmax(depth_max, depth);
+            model_teardown(&fx);
+        }
+        /* Pool poses in order until both columns' expected counts reach 5. */
+        double x2 = 0.0;
+        int cells = 0;
+        long a = 0, c = 0;
+        for (int i = 0; i <= np; i++) {
+            a += count[0][i];
+            c += count[1][i];
+            if ((a + c) / 2.0 >= 5.0 || i == np) {
+                if (a + c > 0) {
+                    double e = (a + c) / 2.0;
+                    x2 += (a - e) * (a - e) / e + (c - e) * (c - e) / e;
+                    cells++;
+                }
+                a = c = 0;
+            }
+        }
+        double p = cells > 1 ? pd_gsl_chisq_q(x2, cells - 1) : 1.0;
+        CHECK(p > 0.01);
+        CHECK_NEAR(depth_max, 0.0, 1e-3, "lasting contact depth per L (issue: 1e-3)");
+        CHECK(count[0][np] <= n / 50); /* at most 2% unsettled: see above */
+        if (getenv("PD_TEST_VERBOSE"))
+            printf("compliant: %s, %ld drops at tolerance scale 1 and 0.5: chi-square %.2f on %d "
+                   "dof, p %.3f; unsettled %ld, %ld; lasting contact depth at most %.2g L\n",
+                   parts[k].path, n, x2, cells - 1, p, count[0][np], count[1][np], depth_max);
+        free(count[0]);
+        free(count[1]);
+    }
+}
+
+void suite_compliant(void)
+{
+    void (*tests[])(void) = {test_law_closed_form, test_energy_random_impacts, test_rigid_limit,
+                             test_flat_landings, test_housner, test_near_flat_cube,
+                             test_convergence};
+    for (size_t i = 0; i < sizeof tests / sizeof *tests; i++) {
+        clock_t c0 = clock();
+        tests[i]();
+        if (getenv("PD_TEST_VERBOSE"))
+            printf("compliant: test %zu took %.1f s of CPU\n", i,
+                   (double)(clock() - c0) / CLOCKS_PER_SEC);
+    }
+}
