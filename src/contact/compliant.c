@@ -12,10 +12,11 @@
  * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
  * floor, since n springs of one contact's stiffness on a rigid body vibrate
  * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
- * 13 steps per contact duration at e = 0.3 with one contact; a flat landing's
- * rebound then comes out within 2e-4 of e, and halving it moves no pose
- * probability beyond sampling noise (tests/unit/test_compliant.c). Larger:
- * the explicit step loses accuracy, and stability beyond 2. */
+ * 40 steps per contact duration at e = 0.3 with one contact (850 at the
+ * smallest e, 0.01); a flat landing's rebound then comes out within 4e-4 of
+ * e, and halving it moves no pose probability beyond sampling noise
+ * (tests/unit/test_compliant.c). Larger: the explicit step loses accuracy,
+ * and stability beyond 2. */
 #define PD_COMPLIANT_STEP 0.25
 
 /* Vertices within this times L above the floor are watched for contact, and

@@ -31,8 +31,8 @@ typedef struct pd_compliant_law {
 /* Restitution below this is taken as this: at e = 0 the law's chi is
  * infinite (the contact never restores) and its duration with it. Why 0.01:
  * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
- * below what any pose statistic resolves, while chi stays near 100 and the
- * contact's step (compliant.c) near 1/400 of its duration. */
+ * below what any pose statistic resolves, while chi stays at 100 and a
+ * contact takes about 850 of compliant.c's steps. */
 #define PD_COMPLIANT_E_MIN 0.01
 
 /* The law for restitution e in [0, 1] and contact duration T > 0 (s):

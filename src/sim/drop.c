@@ -2,32 +2,36 @@
  * its outcome can no longer change.
  *
  * Flight is closed form (flight.c) and the next impact is found by
- * conservative advancement (flight_impact.c), so there is no time step. Each
- * impact is resolved by the frictional impulse law (impact.c). When several
- * vertices touch at once (a face or an edge landing), the approaching ones are
- * resolved as one collision at their centroid weighted by approach speed, and
- * the set is checked again until no contact approaches: a face landing flat
- * without spin gets the single impulse through its centre that Poisson's law
- * gives a flat landing (rebound e times the approach speed, no spurious
- * rotation), and uneven landings put the impulse nearer the faster contact,
- * as a sequence of Mirtich's microcollisions would, in one step. The scene's
- * contact_time widens "at once" to the contacts that would arrive within it
- * (flight_impact.c): a stand-in for the compliance that makes a nearly flat
- * landing strike its face as a whole.
+ * conservative advancement (flight_impact.c), so there is no time step
+ * between contacts. What happens at a contact depends on how many vertices
+ * share it. A lone vertex striking the floor is resolved by the frictional
+ * impulse law (impact.c), exact. When more than one vertex touches, or
+ * reaches the floor within the scene's contact_time of the first, the
+ * impact is compliant (contact/compliant.c): each vertex below the floor
+ * pushes by a Hunt-Crossley law fixed by the restitution and the contact
+ * duration, with Coulomb friction, and vertices that arrive meanwhile join;
+ * a face landing nearly flat lands as a whole, as a real part's does
+ * (docs/contact.md). The compliant run goes on through lasting face contact
+ * until the part separates, rests on a vertex or an edge, or is decided.
+ * With contact_time 0 (the paper's rigid model) touching vertices are
+ * resolved as one collision at their centroid weighted by approach speed,
+ * the set checked again until none approaches: a face landing flat without
+ * spin then gets the single impulse through its centre that Poisson's law
+ * gives a flat landing.
  *
- * Contact that lasts is simulated two ways. One vertex or one edge on the
- * floor, sliding or sticking, is a contact phase (contact_phase.c): the
- * exact continuous motion under its contact forces, until a contact lifts,
- * slips, sticks or another vertex lands. Everything else (faces, contacts
- * that chatter too much to enter a phase losslessly, hand-overs) is
- * microcollisions: the contact falls a rest fall and is stopped, which sinks
- * and damps the part slightly per step (README: "Known limit").
+ * Contact that lasts on one vertex or one edge, sliding or sticking, is a
+ * contact phase (contact_phase.c): the exact continuous motion under its
+ * contact forces, until a contact lifts, slips, sticks or another vertex
+ * lands. What is left (contacts that chatter too much to enter a phase
+ * losslessly, hand-overs; faces without compliance) is microcollisions: the
+ * contact falls a rest fall, is stopped and put back onto the floor.
  *
  * A drop ends when its energy per unit weight (a height) falls below the
  * barrier of the basin it is in (basin.c): then no future can leave the
  * basin, so its stable pose is the outcome. That needs collisions that never
  * add energy: a Poisson collision that would (possible with friction in 3-D)
- * is redone by the energetic law, which cannot, and counted. It also ends
+ * is redone by the energetic law, which cannot, and counted; a compliant
+ * impact whose step would is scaled back, and counted. It also ends
  * when the part lies on a stable facet that sliding and spinning cannot tip
  * it from (flat_rest.c): then only the rocking energy must be below a
  * barrier, not the energy of the slide. */
