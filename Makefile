@@ -88,7 +88,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint
+.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint fuzz fuzz-build
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI)
@@ -137,7 +137,9 @@ $(SO_BULLET): $(BULLET_OBJS) $(SO)
 # The command, the tests and the benchmark link the static archives (the tests
 # call internal functions the shared library does not export), and with
 # $(CXX), since they offer the Bullet engine.
-$(CLI): $(BUILD)/src/cli/cli.o $(LIB_BULLET) $(LIB)
+# The command reads numbers with the library's own reader (base/number.c, C
+# library only), linked in directly so that it needs nothing the API hides.
+$(CLI): $(BUILD)/src/cli/cli.o $(BUILD)/src/base/number.o $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 $(TEST_BIN): $(TEST_OBJS) $(LIB_BULLET) $(LIB)
@@ -188,6 +190,38 @@ bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI)
 	$(BENCH_BIN)
 
+# make fuzz: libFuzzer targets built with clang (installed on first use) for
+# the OFF, STL and OBJ readers, scene files and the part build (mesh in, part
+# model and static estimate out), each run for FUZZ_SECONDS from the seeds in
+# parts/ and tests/fuzz/ (scripts/fuzz.sh). Only the layers these reach are
+# built, with address and undefined-behaviour sanitizers.
+FUZZ_SECONDS ?= 60
+FUZZ_TARGETS := off stl obj scene part
+FUZZ_BUILD   := build/fuzz
+FUZZ_CC      ?= clang
+FUZZ_CFLAGS  := -std=c11 -g -O1 -fsanitize=fuzzer-no-link,address,undefined \
+                -fno-sanitize-recover=undefined -fno-omit-frame-pointer -ffp-contract=off \
+                -D_DEFAULT_SOURCE -Iinclude -Isrc -Itests/support \
+                $(shell $(PKG_CONFIG) --cflags gsl 2>/dev/null)
+FUZZ_SRCS    := $(wildcard src/base/*.c src/mesh/*.c src/hull/*.c src/part/*.c src/static/*.c) \
+                src/sim/scene.c tests/support/fuzz_targets.c
+FUZZ_OBJS    := $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/%.o)
+
+fuzz:
+	@scripts/install-deps.sh clang libclang-rt-dev
+	@$(MAKE) --no-print-directory fuzz-build
+	scripts/fuzz.sh $(FUZZ_SECONDS) $(FUZZ_TARGETS)
+
+fuzz-build: $(FUZZ_TARGETS:%=$(FUZZ_BUILD)/fuzz_%)
+
+$(FUZZ_BUILD)/%.o: %.c Makefile
+	@mkdir -p $(dir $@)
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -MMD -MP -c $< -o $@
+
+$(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_main.c $(FUZZ_OBJS) Makefile
+	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer -DPD_FUZZ_TARGET=pd_fuzz_$* -o $@ \
+	    tests/fuzz/fuzz_main.c $(FUZZ_OBJS) $(shell $(PKG_CONFIG) --libs gsl 2>/dev/null) -lm
+
 # Both libraries, shared (with their soname and development links) and
 # static, the headers, the command and a pkg-config file for each library
 # (docs/library.md), and the licence with that page in share/doc/posedrop.
@@ -232,8 +266,9 @@ help:
 	@echo "make check-install  install to a temporary prefix, build the library example"
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
+	@echo "make fuzz       fuzz the readers and the part build, FUZZ_SECONDS=$(FUZZ_SECONDS) each"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d
+-include $(FUZZ_OBJS:.o=.d) $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d

@@ -20,7 +20,7 @@ lower() {
     contact)   echo "base hull part dynamics settle" ;;
     engines)   echo "base hull part dynamics" ;;
     sim)       echo "base mesh hull part static symmetry dynamics impact settle contact engines" ;;
-    cli)       echo "" ;; # the public API only
+    cli)       echo "base" ;; # the public API, and base/number.h (linked in directly)
     *)         echo "?" ;;
     esac
 }

@@ -70,7 +70,7 @@ typedef struct pd_scene {
 PD_API void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
- * height, belt_speed (or v), mu, restitution, restitution_law
+ * height, belt_speed, mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
  * (uniform|bootstrap|stationary), gravity, contact_time (s). PD_ERR_USAGE for
  * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
@@ -78,7 +78,7 @@ PD_API void pd_scene_default(pd_scene *scene);
 PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
 
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
- * what it holds. Errors name the file and line. */
+ * what it holds; a key set twice is refused. Errors name the file and line. */
 PD_API pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag);
 
 /* Whether every field of a scene is one pd_scene_set would accept: height 0
@@ -175,9 +175,12 @@ typedef struct pd_sim_result {
                                last rounds' initial and final distributions */
     pd_trial *trials;       /* n records when options->keep_trials, else NULL */
     /* PD_INITIAL_STATIONARY only (otherwise 0 and NULL): */
-    long first_drops;       /* drops 0 .. first_drops-1 start from uniform orientations */
-    long pose_drops;        /* then this many start resting on each pose, interleaved:
-                               drop first_drops + t rests on pose t mod nposes */
+    long first_drops;       /* drops that start from uniform orientations */
+    long pose_drops;        /* drops that start resting on each pose. Interleaved
+                               from the start: drop i < (nposes + 1) pose_drops
+                               is uniform when i mod (nposes + 1) is 0 and rests
+                               on pose i mod (nposes + 1) - 1 otherwise; the
+                               drops after those are uniform */
     long *first_count;      /* nposes: uniform drops that settled in each pose (mu0's counts) */
     long *transitions;      /* nposes * nposes, row-major: [i * nposes + j] = drops started
                                resting on pose i that settled in pose j */

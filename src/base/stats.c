@@ -13,8 +13,11 @@ void pd_wilson(long k, long n, double z, double *lo, double *hi)
     double p = (double)k / (double)n, z2n = z * z / (double)n;
     double centre = (p + 0.5 * z2n) / (1.0 + z2n);
     double half = z * sqrt(p * (1.0 - p) / (double)n + 0.25 * z2n / (double)n) / (1.0 + z2n);
-    *lo = fmax(0.0, centre - half);
-    *hi = fmin(1.0, centre + half);
+    /* At k = 0 (k = n) the lower (upper) end is 0 (1) exactly, the root of
+     * the interval's quadratic at p = 0; centre - half would leave round-off
+     * like 5.55e-17 there, outside which p = 0 would lie. */
+    *lo = k <= 0 ? 0.0 : fmax(0.0, centre - half);
+    *hi = k >= n ? 1.0 : fmin(1.0, centre + half);
 }
 
 long pd_sample_size(double delta, double alpha, int k)

@@ -1,5 +1,4 @@
 /* text.c: the bounded text cursor and number parsing (see text.h). */
-#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -158,25 +157,6 @@ pd_status pd_text_fail(const pd_text *t, pd_diag *diag, pd_status status, const 
 
 /* --- numbers ---------------------------------------------------------------- */
 
-int pd_parse_double(const char *s, size_t n, double *out)
-{
-    /* strtod needs a terminated string; no genuine number is this long. */
-    char buf[128];
-    if (n == 0 || n >= sizeof buf)
-        return PD_NUM_BAD;
-    memcpy(buf, s, n);
-    buf[n] = '\0';
-    char *stop;
-    errno = 0;
-    double v = strtod(buf, &stop);
-    if (stop != buf + n)
-        return PD_NUM_BAD;
-    if (!isfinite(v))
-        return PD_NUM_NONFINITE;
-    *out = v;
-    return PD_NUM_OK;
-}
-
 int pd_parse_int(const char *s, size_t n, long long *out)
 {
     /* Saturating keeps "99999999999999999999" an honest too-large count
@@ -214,6 +194,9 @@ pd_status pd_text_coord(pd_text *t, pd_diag *diag, const char *what, double scal
     if (rc == PD_NUM_NONFINITE || !isfinite(v))
         return pd_text_fail(t, diag, PD_ERR_NONFINITE, "non-finite %s %s", what,
                             pd_text_show(shown, sizeof shown, s, n));
+    if (rc == PD_NUM_TINY)
+        return pd_text_fail(t, diag, PD_ERR_RANGE, "%s %s is non-zero but below the smallest "
+                            "normal double, 2.2e-308", what, pd_text_show(shown, sizeof shown, s, n));
     *out = v;
     return PD_OK;
 }

@@ -9,6 +9,7 @@
 
 #include <stddef.h>
 #include "base/fail.h"
+#include "base/number.h" /* pd_parse_double and its outcomes */
 
 /* --- text cursor ---------------------------------------------------------- */
 
@@ -47,15 +48,12 @@ pd_status pd_text_fail(const pd_text *t, pd_diag *diag, pd_status status, const 
 
 /* --- numbers ---------------------------------------------------------------- */
 
-enum { PD_NUM_OK, PD_NUM_BAD, PD_NUM_NONFINITE };
-/* A whole token as a double: PD_NUM_OK, PD_NUM_BAD (not a number), or
- * PD_NUM_NONFINITE (nan, inf, or overflowing like 1e999). */
-int pd_parse_double(const char *s, size_t n, double *out);
 /* A whole token as a decimal integer, saturated at +-1e18 (callers compare it
  * with far smaller limits). 0 if the token is not an integer. */
 int pd_parse_int(const char *s, size_t n, long long *out);
 /* Reads the next token of the line as a coordinate scaled by scale, with the
- * message for a missing, malformed or non-finite one ("expected what"). */
+ * message for a missing, malformed, non-finite or underflowing one
+ * ("expected what"). */
 pd_status pd_text_coord(pd_text *t, pd_diag *diag, const char *what, double scale, double *out);
 
 #endif

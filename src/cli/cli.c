@@ -5,168 +5,23 @@
  * input (nothing is printed on stdout), 1 internal failure, 130 interrupted
  * (what was done is printed, marked partial). */
 #include <errno.h>
+#include <float.h>
 #include <getopt.h>
+#include <limits.h>
 #include <math.h>
 #include <signal.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include "base/number.h" /* one reading of numbers, shared with scene files */
 #include "posedrop/posedrop.h"
 
 enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
 
 static const char *prog = "posedrop";
-
-static void usage(FILE *out)
-{
-    fprintf(out,
-        "usage: %s [options] PART\n"
-        "\n"
-        "Predicts the probability of each stable pose of a rigid part dropped on a\n"
-        "flat surface and prints one CSV row per stable pose:\n"
-        "  pose,nx,ny,nz,area,height,p_qs,p_pqs[,n,count,p,ci_lo,ci_hi,unsettled,partial]\n"
-        "pose: 1 = most probable (QS); nx,ny,nz: outward unit normal of the resting\n"
-        "facet in the file's frame (gravity's direction in the part's frame); area:\n"
-        "facet area in m^2; height: centre of mass above the floor in m; p_qs, p_pqs:\n"
-        "quasi-static and perturbed quasi-static estimates. With -n or --ci, drops\n"
-        "are simulated too: count of n drops ended in the pose, p = count / n and\n"
-        "its 95%% Wilson interval; unsettled: drops that hit a limit (in no count);\n"
-        "partial: 1 if interrupted before all drops ran. With --initial stationary,\n"
-        "p is the long-run probability of the estimated pose-to-pose chain and\n"
-        "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
-        "\n"
-        "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
-        "\n"
-        "part:\n"
-        "  --units U          unit of the file's coordinates: m (default), cm, mm, in\n"
-        "  --format F         off, stl or obj (default: detect from content and name)\n"
-        "  --com X,Y,Z        centre of mass in the file's units (default: computed\n"
-        "                     from the mesh, uniform density); required for meshes\n"
-        "                     that are not closed\n"
-        "static estimators:\n"
-        "  --topple RULE      descent (default): exact quasi-static motion, steepest\n"
-        "                     descent of the centre of mass, which may end on a facet\n"
-        "                     sharing only a vertex; edge: the paper's graph between\n"
-        "                     edge-adjacent facets\n"
-        "  --epsilon DEG      PQS perturbation angle in degrees, 0..90 (default 20)\n"
-        "  --pqs-compare C    raw (default): transfer when the facet's solid-angle\n"
-        "                     probability is lower; qs: compare propagated QS values\n"
-        "  --pqs-band B       rect (default): the paper's |a| x epsilon band clipped\n"
-        "                     to its triangle; exact: exact spherical band area\n"
-        "dynamic estimator (simulated drops):\n", prog);
-    /* Two strings: C11 compilers need only take 4095 characters in one. */
-    fprintf(out,
-        "  -n N               drops to simulate (default: none)\n"
-        "  --engine E         impulse (default): posedrop's own simulator; ode or\n"
-        "                     bullet: the same drops on a stepping engine, to cross-check\n"
-        "  --dt S             time step of ode (default 0.001) or bullet (1/960)\n"
-        "  --ci DELTA         drop until every pose's 95%% interval is within DELTA\n"
-        "  --seed S           random seed (default 1); same seed, same bytes\n"
-        "  -j THREADS         threads (default: all cores); never changes results\n"
-        "  -h H               drop height in m: lowest point above the floor (0.12)\n"
-        "  -v V               horizontal belt velocity in m/s (0.05)\n"
-        "  --mu MU            friction coefficient (0.3)\n"
-        "  --restitution E    coefficient of restitution (0.3)\n"
-        "  --restitution-law L  poisson (default) or energetic\n"
-        "  --vibration DEG    initial poses turned by up to DEG about a random axis (1.5)\n"
-        "  --contact-time S   how long one contact takes to compress and restore, s\n"
-        "                     (a material property; 5e-4, a plastic part on a rubber\n"
-        "                     belt; 0: rigid, the paper's model)\n"
-        "  --initial I        uniform (default): orientations uniform at random;\n"
-        "                     bootstrap: the paper's belt, drops resting on poses drawn\n"
-        "                     from the running estimate, rounds of 100 after 20 uniform;\n"
-        "                     stationary: the belt's long run: of N drops, N/(k+1)\n"
-        "                     start resting on each of the k poses and estimate the\n"
-        "                     pose-to-pose transition matrix P, the rest (at least as\n"
-        "                     many) start uniform and give the first drop's outcome mu0;\n"
-        "                     p = lim (1/T) sum_{t<T} mu0 P^t, solved exactly, with 95%%\n"
-        "                     intervals from 1000 multinomial redraws of mu0 and P.\n"
-        "                     Needs N >= 10 (k+1); does not go with --ci\n"
-        "  --scene FILE       'key = value' lines: height, belt_speed, mu, restitution,\n"
-        "                     restitution_law, vibration, initial, gravity,\n"
-        "                     contact_time; options given after it override it\n"
-        "  --trials FILE      one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
-        "                     (pose 0: unsettled); with --group, pose is the class\n"
-        "                     number of the output and a last column member the pose\n"
-        "                     within it, numbered as without --group\n"
-        "  --transitions FILE with --initial stationary, the estimated chain as CSV:\n"
-        "                     from_pose,to_pose,count,p, one row per pair of poses\n"
-        "                     (numbered as in the output, classes with --group);\n"
-        "                     count: drops started resting on from_pose that settled\n"
-        "                     in to_pose, p: count over the row's settled drops (P);\n"
-        "                     from_pose 0: the uniform drops (mu0)\n"
-        "output:\n"
-        "  --facets           one row per hull facet instead of per pose, with its\n"
-        "                     stability and quasi-static successor\n"
-        "  --group            one row per class of poses that a rotation of the part\n"
-        "                     about its centre of mass maps onto each other (a prism's\n"
-        "                     sides; mirror images stay apart): pose = class number,\n"
-        "                     geometry of its first member, p_qs, p_pqs, count and p\n"
-        "                     summed, the class's own interval, and a last column\n"
-        "                     members: the member poses' numbers, space-separated\n"
-        "  --verbose          a summary of the part (and of the drops) on stderr\n"
-        "  --help             this help\n"
-        "  --version          version\n"
-        "\n"
-        "exit status: 0 success, 2 bad usage or input, 1 internal failure,\n"
-        "130 interrupted (the rows printed are marked partial)\n");
-}
-
-static int fail_usage(const char *fmt, const char *arg)
-{
-    fprintf(stderr, "%s: ", prog);
-    fprintf(stderr, fmt, arg);
-    fprintf(stderr, "\n%s: see '%s --help'\n", prog, prog);
-    return EXIT_USAGE;
-}
-
-/* Strict: the whole text must be one finite number. */
-static int parse_double(const char *text, double *out)
-{
-    char *end;
-    errno = 0;
-    double v = strtod(text, &end);
-    if (end == text || *end != '\0' || errno == ERANGE || !isfinite(v))
-        return 0;
-    *out = v;
-    return 1;
-}
-
-/* Strict: the whole text one integer in [lo, hi]. */
-static int parse_long(const char *text, long lo, long hi, long *out)
-{
-    char *end;
-    errno = 0;
-    long long v = strtoll(text, &end, 10);
-    if (end == text || *end != '\0' || errno == ERANGE || v < lo || v > hi)
-        return 0;
-    *out = (long)v;
-    return 1;
-}
-
-/* "x,y,z" with three finite numbers. */
-static int parse_vec3(const char *text, pd_vec3 *out)
-{
-    double c[3];
-    const char *p = text;
-    for (int i = 0; i < 3; i++) {
-        const char *comma = strchr(p, ',');
-        size_t len = comma ? (size_t)(comma - p) : strlen(p);
-        if ((i < 2) != (comma != NULL) || len == 0 || len >= 64)
-            return 0;
-        char buf[64];
-        memcpy(buf, p, len);
-        buf[len] = '\0';
-        if (!parse_double(buf, &c[i]))
-            return 0;
-        p = comma ? comma + 1 : p + len;
-    }
-    out->x = c[0];
-    out->y = c[1];
-    out->z = c[2];
-    return 1;
-}
 
 static void print_warning(void *user, const char *message)
 {
@@ -259,22 +114,118 @@ static const char *end_name(pd_drop_end e)
     }
 }
 
-/* The side files (--trials, --transitions): opened with a message on
- * failure, closed with every write error caught. */
-static FILE *open_output(const char *path)
+/* A side file (--trials, --transitions). It is made ready before any work,
+ * so that a path that cannot be written fails at once (exit 2, nothing on
+ * stdout). A regular file, or one that does not exist yet, is written to a
+ * temporary file in its directory and renamed onto its path only once every
+ * byte is written: a failed or interrupted run never leaves a truncated file
+ * that looks like a result, nor destroys the one it would replace. Anything
+ * else (a device such as /dev/stdout, a pipe) is opened and written as it
+ * is; a write error there (/dev/full) is caught when it is closed. */
+typedef struct {
+    const char *path;
+    char *target; /* where the temporary is renamed to (a symbolic link resolved) */
+    char *tmp;    /* NULL when path is written directly */
+    FILE *f;
+} out_file;
+
+static int out_fail(const char *path, const char *why)
 {
-    FILE *f = fopen(path, "w");
-    if (!f)
-        fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, strerror(errno));
-    return f;
+    fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, why);
+    return 0;
 }
 
-static int close_output(FILE *f, const char *path)
+static int out_open(out_file *o, const char *path)
 {
-    int ok = fflush(f) == 0 && !ferror(f);
-    ok &= fclose(f) == 0;
+    memset(o, 0, sizeof *o);
+    o->path = path;
+    if (!*path)
+        return out_fail("''", "an empty file name");
+    struct stat sb;
+    int exists = stat(path, &sb) == 0;
+    if (exists && S_ISDIR(sb.st_mode))
+        return out_fail(path, "is a directory");
+    if (exists && !S_ISREG(sb.st_mode)) {
+        if (!(o->f = fopen(path, "w")))
+            return out_fail(path, strerror(errno));
+        return 1;
+    }
+    if (exists && access(path, W_OK) != 0)
+        return out_fail(path, strerror(errno));
+    /* A link to a file is followed, as opening it would be. */
+    o->target = exists ? realpath(path, NULL) : strdup(path);
+    if (!o->target)
+        return out_fail(path, strerror(errno));
+    const char *slash = strrchr(o->target, '/');
+    int dirlen = slash ? (int)(slash - o->target) + 1 : 0;
+    size_t size = strlen(o->target) + 32;
+    o->tmp = malloc(size);
+    if (!o->tmp)
+        return out_fail(path, "out of memory");
+    snprintf(o->tmp, size, "%.*s.%s.posedrop-XXXXXX", dirlen, o->target,
+             slash ? slash + 1 : o->target);
+    int fd = mkstemp(o->tmp);
+    if (fd < 0) {
+        int err = errno;
+        free(o->tmp);
+        o->tmp = NULL;
+        /* Name the directory: the file itself was never the problem. */
+        char why[512];
+        struct stat db;
+        int isdir = snprintf(why, sizeof why, "%.*s", dirlen ? dirlen : 1, dirlen ? o->target : ".") > 0 &&
+                    stat(why, &db) == 0 && S_ISDIR(db.st_mode);
+        if (isdir)
+            snprintf(why, sizeof why, "cannot create a file in %.*s: %s", dirlen ? dirlen : 1,
+                     dirlen ? o->target : ".", strerror(err));
+        else
+            snprintf(why, sizeof why, "no such directory %.*s", dirlen ? dirlen : 1,
+                     dirlen ? o->target : ".");
+        return out_fail(path, why);
+    }
+    /* mkstemp makes the file private; give it the mode a new file gets. */
+    mode_t mask = umask(0);
+    umask(mask);
+    if (fchmod(fd, exists ? sb.st_mode & 07777 : 0666 & ~mask) != 0 || !(o->f = fdopen(fd, "w"))) {
+        int err = errno;
+        close(fd);
+        unlink(o->tmp);
+        free(o->tmp);
+        o->tmp = NULL;
+        return out_fail(path, strerror(err));
+    }
+    return 1;
+}
+
+/* Drops what was written (on any failure of the run). */
+static void out_abort(out_file *o)
+{
+    if (o->f)
+        fclose(o->f);
+    if (o->tmp)
+        unlink(o->tmp);
+    free(o->tmp);
+    free(o->target);
+    memset(o, 0, sizeof *o);
+}
+
+/* Closes with every write error caught, then puts the file in place. */
+static int out_commit(out_file *o)
+{
+    int ok = fflush(o->f) == 0 && !ferror(o->f);
+    int err = errno;
+    ok &= fclose(o->f) == 0;
+    o->f = NULL;
+    if (ok && o->tmp && rename(o->tmp, o->target) != 0) {
+        err = errno;
+        ok = 0;
+    }
     if (!ok)
-        fprintf(stderr, "%s: %s: write error\n", prog, path);
+        fprintf(stderr, "%s: %s: write error: %s\n", prog, o->path, strerror(err ? err : EIO));
+    if (ok) {
+        free(o->tmp);
+        o->tmp = NULL;
+    }
+    out_abort(o);
     return ok;
 }
 
@@ -282,11 +233,8 @@ static int close_output(FILE *f, const char *path)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static int write_trials(const char *path, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
 {
-    FILE *f = open_output(path);
-    if (!f)
-        return 0;
     fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
@@ -297,17 +245,13 @@ static int write_trials(const char *path, const pd_sim_result *sim, const int *c
             fprintf(f, ",%d", t->pose + 1);
         fputc('\n', f);
     }
-    return close_output(f, path);
 }
 
 /* The stationary estimator's chain in long format: row 0 is the uniform
  * drops (mu0), rows 1..k the poses (P); every pair is written, zeros
  * included, so the file is the whole matrix. */
-static int write_transitions(const char *path, const pd_sim_result *sim)
+static void write_transitions(FILE *f, const pd_sim_result *sim)
 {
-    FILE *f = open_output(path);
-    if (!f)
-        return 0;
     int k = sim->nposes;
     fprintf(f, "from_pose,to_pose,count,p\n");
     for (int i = 0; i <= k; i++) {
@@ -319,7 +263,6 @@ static int write_transitions(const char *path, const pd_sim_result *sim)
             fprintf(f, "%d,%d,%ld,%.10g\n", i, j + 1, row[j],
                     total ? (double)row[j] / (double)total : 0.0);
     }
-    return close_output(f, path);
 }
 
 typedef struct {
@@ -332,75 +275,420 @@ typedef struct {
     int dynamic, facets, group, verbose;
 } cli_args;
 
+/* --- the options ------------------------------------------------------------
+ * One table drives the parsing (getopt's arrays are built from it), the
+ * checking of every value (one number reader and one message form, shared
+ * with scene files through base/number.c) and the help. */
+
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME };
 
+typedef enum {
+    ARG_HEADING, /* not an option: a heading of the help */
+    ARG_FLAG,    /* no value */
+    ARG_REAL,    /* a number obeying rule */
+    ARG_WHOLE,   /* a whole number obeying rule */
+    ARG_CHOICE,  /* one of choices */
+    ARG_VEC3,    /* X,Y,Z, each a number obeying rule */
+    ARG_FILE,    /* a path */
+    ARG_SCENE    /* a scene setting: the library checks it by key, as in scene files */
+} arg_kind;
+
+typedef struct {
+    int id;                      /* getopt's value: the letter, or an OPT_ */
+    const char *name;            /* long name; NULL for a letter-only option */
+    arg_kind kind;
+    const char *arg;             /* the value's name in the help */
+    pd_num_rule rule;            /* ARG_REAL, ARG_WHOLE, ARG_VEC3 */
+    const char *const *choices;  /* ARG_CHOICE, NULL-terminated */
+    const char *key;             /* ARG_SCENE */
+    const char *help;            /* lines separated by '\n' */
+} cli_option;
+
+#define NO_RULE {0, 0, 0, 0, 0, 0, 0, 0}
+#define REAL(what, lo, hi, lo_open, hi_open) {what, 0, lo, hi, lo_open, hi_open, 0, 0}
+#define WHOLE(what, lo, hi) {what, 1, 0, 0, 0, 0, lo, hi}
+#define HEADING(text) {0, NULL, ARG_HEADING, NULL, NO_RULE, NULL, NULL, text}
+
+static const char *const units_names[] = {"m", "cm", "mm", "in", NULL};
+static const char *const format_names[] = {"off", "stl", "obj", NULL};
+static const char *const topple_names[] = {"descent", "edge", NULL};
+static const char *const compare_names[] = {"raw", "qs", NULL};
+static const char *const band_names[] = {"rect", "exact", NULL};
+static const char *const engine_names[] = {"impulse", "ode", "bullet", NULL};
+
+static const cli_option options[] = {
+    HEADING("part:"),
+    {OPT_UNITS, "units", ARG_CHOICE, "U", NO_RULE, units_names, NULL,
+     "unit of the file's coordinates: m (default), cm, mm, in"},
+    {OPT_FORMAT, "format", ARG_CHOICE, "F", NO_RULE, format_names, NULL,
+     "off, stl or obj (default: detect from content and name)"},
+    {OPT_COM, "com", ARG_VEC3, "X,Y,Z", REAL("a coordinate", -DBL_MAX, DBL_MAX, 0, 0), NULL, NULL,
+     "centre of mass in the file's units (default: computed\n"
+     "from the mesh, uniform density); required for meshes\n"
+     "that are not closed"},
+    HEADING("static estimators:"),
+    {OPT_TOPPLE, "topple", ARG_CHOICE, "RULE", NO_RULE, topple_names, NULL,
+     "descent (default): exact quasi-static motion, steepest\n"
+     "descent of the centre of mass, which may end on a facet\n"
+     "sharing only a vertex; edge: the paper's graph between\n"
+     "edge-adjacent facets"},
+    {OPT_EPSILON, "epsilon", ARG_REAL, "DEG", REAL("an angle in degrees", 0, 90, 0, 0), NULL, NULL,
+     "PQS perturbation angle in degrees, 0..90 (default 20)"},
+    {OPT_PQS_COMPARE, "pqs-compare", ARG_CHOICE, "C", NO_RULE, compare_names, NULL,
+     "raw (default): transfer when the facet's solid-angle\n"
+     "probability is lower; qs: compare propagated QS values"},
+    {OPT_PQS_BAND, "pqs-band", ARG_CHOICE, "B", NO_RULE, band_names, NULL,
+     "rect (default): the paper's |a| x epsilon band clipped\n"
+     "to its triangle; exact: exact spherical band area"},
+    HEADING("dynamic estimator (simulated drops):"),
+    {'n', NULL, ARG_WHOLE, "N", WHOLE("a number of drops", 1, 1000000000), NULL, NULL,
+     "drops to simulate, 1..10^9 (default: none)"},
+    {OPT_ENGINE, "engine", ARG_CHOICE, "E", NO_RULE, engine_names, NULL,
+     "impulse (default): posedrop's own simulator; ode or\n"
+     "bullet: the same drops on a stepping engine, to cross-check"},
+    {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
+     "time step of ode (default 0.001) or bullet (1/960),\n"
+     "above 0 and at most 0.01"},
+    {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
+     "drop until every pose's 95% interval is within DELTA\n"
+     "(above 0 and below 0.5)"},
+    {OPT_SEED, "seed", ARG_WHOLE, "S", WHOLE("a seed", 0, LLONG_MAX), NULL, NULL,
+     "random seed, 0..2^63-1 (default 1); same seed, same bytes"},
+    {'j', NULL, ARG_WHOLE, "THREADS", WHOLE("a number of threads", 1, 256), NULL, NULL,
+     "threads, 1..256 (default: all cores); never changes results"},
+    {'h', NULL, ARG_SCENE, "H", NO_RULE, NULL, "height",
+     "drop height in m: lowest point above the floor, 0..1000\n"
+     "(0.12)"},
+    {'v', NULL, ARG_SCENE, "V", NO_RULE, NULL, "belt_speed",
+     "horizontal belt velocity in m/s, -1000..1000 (0.05)"},
+    {OPT_MU, "mu", ARG_SCENE, "MU", NO_RULE, NULL, "mu", "friction coefficient, 0..10 (0.3)"},
+    {OPT_RESTITUTION, "restitution", ARG_SCENE, "E", NO_RULE, NULL, "restitution",
+     "coefficient of restitution, 0..1 (0.3)"},
+    {OPT_LAW, "restitution-law", ARG_SCENE, "L", NO_RULE, NULL, "restitution_law",
+     "poisson (default) or energetic"},
+    {OPT_VIBRATION, "vibration", ARG_SCENE, "DEG", NO_RULE, NULL, "vibration",
+     "initial poses turned by up to DEG about a random axis,\n"
+     "0..180 (1.5)"},
+    {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
+     "how long one contact takes to compress and restore, s,\n"
+     "0..1 (a material property; 5e-4, a plastic part on a rubber\n"
+     "belt; 0: rigid, the paper's model)"},
+    {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
+     "uniform (default): orientations uniform at random;\n"
+     "bootstrap: the paper's belt, drops resting on poses drawn\n"
+     "from the running estimate, rounds of 100 after 20 uniform;\n"
+     "stationary: the belt's long run: of N drops, N/(k+1)\n"
+     "start resting on each of the k poses and estimate the\n"
+     "pose-to-pose transition matrix P, the rest (at least as\n"
+     "many) start uniform and give the first drop's outcome mu0;\n"
+     "p = lim (1/T) sum_{t<T} mu0 P^t, solved exactly, with 95%\n"
+     "intervals from 1000 multinomial redraws of mu0 and P.\n"
+     "Needs N >= 10 (k+1); does not go with --ci. The uniform\n"
+     "and resting drops are interleaved from the first drop, so\n"
+     "an interrupted run has both in proportion"},
+    {OPT_SCENE, "scene", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "'key = value' lines: height, belt_speed, mu, restitution,\n"
+     "restitution_law, vibration, initial, gravity,\n"
+     "contact_time, each at most once; options given after it\n"
+     "override it"},
+    {OPT_TRIALS, "trials", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
+     "(pose 0: unsettled); with --group, pose is the class\n"
+     "number of the output and a last column member the pose\n"
+     "within it, numbered as without --group"},
+    {OPT_TRANSITIONS, "transitions", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "with --initial stationary, the estimated chain as CSV:\n"
+     "from_pose,to_pose,count,p, one row per pair of poses\n"
+     "(numbered as in the output, classes with --group);\n"
+     "count: drops started resting on from_pose that settled\n"
+     "in to_pose, p: count over the row's settled drops (P);\n"
+     "from_pose 0: the uniform drops (mu0)"},
+    HEADING("output:"),
+    {OPT_FACETS, "facets", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "one row per hull facet instead of per pose, with its\n"
+     "stability and quasi-static successor"},
+    {OPT_GROUP, "group", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "one row per class of poses that a rotation of the part\n"
+     "about its centre of mass maps onto each other (a prism's\n"
+     "sides; mirror images stay apart): pose = class number,\n"
+     "geometry of its first member, p_qs, p_pqs, count and p\n"
+     "summed, the class's own interval, and a last column\n"
+     "members: the member poses' numbers, space-separated"},
+    {OPT_VERBOSE, "verbose", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "a summary of the part (and of the drops) on stderr"},
+    {OPT_HELP, "help", ARG_FLAG, NULL, NO_RULE, NULL, NULL, "this help"},
+    {OPT_VERSION, "version", ARG_FLAG, NULL, NO_RULE, NULL, NULL, "version"},
+};
+enum { NOPTIONS = sizeof options / sizeof options[0] };
+
+/* "-n" or "--units", for messages and the help. */
+static const char *option_name(const cli_option *o, char *buf, size_t size)
+{
+    if (o->name)
+        snprintf(buf, size, "--%s", o->name);
+    else
+        snprintf(buf, size, "-%c", o->id);
+    return buf;
+}
+
+static const cli_option *find_option(int id)
+{
+    for (int i = 0; i < NOPTIONS; i++)
+        if (options[i].kind != ARG_HEADING && options[i].id == id)
+            return &options[i];
+    return NULL;
+}
+
+static void usage(FILE *out)
+{
+    fprintf(out,
+        "usage: %s [options] PART\n"
+        "\n"
+        "Predicts the probability of each stable pose of a rigid part dropped on a\n"
+        "flat surface and prints one CSV row per stable pose:\n"
+        "  pose,nx,ny,nz,area,height,p_qs,p_pqs[,n,count,p,ci_lo,ci_hi,unsettled,partial]\n"
+        "pose: 1 = most probable (QS); nx,ny,nz: outward unit normal of the resting\n"
+        "facet in the file's frame (gravity's direction in the part's frame); area:\n"
+        "facet area in m^2; height: centre of mass above the floor in m; p_qs, p_pqs:\n"
+        "quasi-static and perturbed quasi-static estimates. With -n or --ci, drops\n"
+        "are simulated too: count of n drops ended in the pose, p = count / n and\n"
+        "its 95%% Wilson interval; unsettled: drops that hit a limit (in no count);\n"
+        "partial: 1 if interrupted before all drops ran. With --initial stationary,\n"
+        "p is the long-run probability of the estimated pose-to-pose chain and\n"
+        "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
+        "\n"
+        "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
+        "\n", prog);
+    for (int i = 0; i < NOPTIONS; i++) {
+        const cli_option *o = &options[i];
+        if (o->kind == ARG_HEADING) {
+            fprintf(out, "%s\n", o->help);
+            continue;
+        }
+        char name[32], flag[48];
+        snprintf(flag, sizeof flag, "%s%s%s", option_name(o, name, sizeof name), o->arg ? " " : "",
+                 o->arg ? o->arg : "");
+        /* The help column starts at 21; a longer flag pushes its first line. */
+        const char *line = o->help;
+        for (int first = 1; *line; first = 0) {
+            const char *nl = strchr(line, '\n');
+            int len = nl ? (int)(nl - line) : (int)strlen(line);
+            if (first)
+                fprintf(out, "  %-18s %.*s\n", flag, len, line);
+            else
+                fprintf(out, "%21s%.*s\n", "", len, line);
+            line += len + (nl != NULL);
+        }
+    }
+    fprintf(out,
+        "\n"
+        "Numbers may be written in any C form (0.5, 5e-1); a non-zero number below\n"
+        "2.2e-308 in magnitude, nan and inf are refused.\n"
+        "\n"
+        "exit status: 0 success, 2 bad usage or input, 1 internal failure,\n"
+        "130 interrupted (the rows printed are marked partial)\n");
+}
+
+static int fail_usage(const char *fmt, const char *arg)
+{
+    fprintf(stderr, "%s: ", prog);
+    fprintf(stderr, fmt, arg);
+    fprintf(stderr, "\n%s: see '%s --help'\n", prog, prog);
+    return EXIT_USAGE;
+}
+
+/* A refused number: "OPTION: expected WHAT RANGE, got 'TEXT' (WHY)". */
+static int fail_number(const cli_option *o, const char *prefix, const char *text, int outcome)
+{
+    char name[32], msg[256];
+    pd_num_message(msg, sizeof msg, &o->rule, text, outcome);
+    fprintf(stderr, "%s: %s: %s%s\n%s: see '%s --help'\n", prog, option_name(o, name, sizeof name),
+            prefix, msg, prog, prog);
+    return EXIT_USAGE;
+}
+
+/* "x,y,z": three numbers obeying the option's rule; -1 or an exit code. */
+static int parse_vec3(const cli_option *o, const char *text, pd_vec3 *out)
+{
+    double c[3];
+    const char *p = text;
+    for (int i = 0; i < 3; i++) {
+        const char *comma = strchr(p, ',');
+        size_t len = comma ? (size_t)(comma - p) : strlen(p);
+        if ((i < 2) != (comma != NULL)) {
+            char name[32];
+            fprintf(stderr, "%s: %s: expected three numbers X,Y,Z, got '%s'\n%s: see '%s --help'\n",
+                    prog, option_name(o, name, sizeof name), text, prog, prog);
+            return EXIT_USAGE;
+        }
+        char buf[128];
+        snprintf(buf, sizeof buf, "%.*s", (int)(len < sizeof buf ? len : sizeof buf - 1), p);
+        int rc = len < sizeof buf ? pd_num_read(&o->rule, buf, &c[i], NULL) : PD_NUM_BAD;
+        if (rc != PD_NUM_OK) {
+            char prefix[32];
+            snprintf(prefix, sizeof prefix, "%c: ", "XYZ"[i]);
+            return fail_number(o, prefix, buf, rc);
+        }
+        p = comma ? comma + 1 : p + len;
+    }
+    *out = (pd_vec3){c[0], c[1], c[2]};
+    return -1;
+}
+
 /* A scene setting given as an option: the library checks it, by the same
  * names and rules as in scene files. */
-static int scene_option(cli_args *a, const char *option, const char *key, const char *value)
+static int scene_option(cli_args *a, const cli_option *o, const char *value)
 {
     pd_diag d;
     pd_diag_init(&d);
-    if (pd_scene_set(&a->scene, key, value, &d) != PD_OK) {
-        fprintf(stderr, "%s: %s: %s\n%s: see '%s --help'\n", prog, option, d.message, prog, prog);
+    if (pd_scene_set(&a->scene, o->key, value, &d) != PD_OK) {
+        char name[32];
+        fprintf(stderr, "%s: %s: %s\n%s: see '%s --help'\n", prog, option_name(o, name, sizeof name),
+                d.message, prog, prog);
         return EXIT_USAGE;
     }
     return -1;
 }
 
-static int choose(const char *option, const char *value, const char *const *names, int n,
-                  int *out)
+static int choose(const cli_option *o, const char *value, int *out)
 {
+    int n = 0;
+    while (o->choices[n])
+        n++;
     for (int i = 0; i < n; i++)
-        if (strcmp(value, names[i]) == 0) {
+        if (strcmp(value, o->choices[i]) == 0) {
             *out = i;
             return 1;
         }
-    fprintf(stderr, "%s: %s: expected", prog, option);
+    char name[32];
+    fprintf(stderr, "%s: %s: expected", prog, option_name(o, name, sizeof name));
     for (int i = 0; i < n; i++)
-        fprintf(stderr, "%s %s", i ? (i + 1 == n ? " or" : ",") : "", names[i]);
+        fprintf(stderr, "%s %s", i ? (i + 1 == n ? " or" : ",") : "", o->choices[i]);
     fprintf(stderr, ", got '%s'\n%s: see '%s --help'\n", value, prog, prog);
     return 0;
+}
+
+/* Stores one checked value; -1 to go on, or an exit code (--help, --version,
+ * a scene file that cannot be read). */
+static int apply(cli_args *a, const cli_option *o, const char *arg, double x, long long n, int k)
+{
+    switch (o->id) {
+    case OPT_UNITS: pd_units_parse(o->choices[k], &a->read.units); break;
+    case OPT_FORMAT: a->read.format = (pd_mesh_format)(PD_FORMAT_OFF + k); break;
+    case OPT_COM:
+        a->part.com_given = 1;
+        a->com_text = arg;
+        break;
+    case OPT_TOPPLE: a->estimate.topple = (pd_topple_rule)k; break;
+    case OPT_EPSILON: a->estimate.epsilon = x * (M_PI / 180.0); break;
+    case OPT_PQS_COMPARE: a->estimate.compare = (pd_pqs_compare)k; break;
+    case OPT_PQS_BAND: a->estimate.band = (pd_pqs_band)k; break;
+    case 'n':
+        a->sim.ndrops = (long)n;
+        a->dynamic = 1;
+        break;
+    case OPT_CI:
+        a->sim.ci_halfwidth = x;
+        a->dynamic = 1;
+        break;
+    case OPT_SEED: a->sim.seed = (uint64_t)n; break;
+    case 'j': a->sim.threads = (int)n; break;
+    case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
+    case OPT_DT: a->sim.dt = x; break;
+    case OPT_SCENE: {
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_status st = pd_scene_read(arg, &a->scene, &d);
+        if (st != PD_OK) {
+            fprintf(stderr, "%s: %s\n", prog, d.message);
+            return pd_status_is_input_error(st) ? EXIT_USAGE : EXIT_INTERNAL;
+        }
+        break;
+    }
+    case OPT_TRIALS:
+        a->trials = arg;
+        a->sim.keep_trials = 1;
+        break;
+    case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_FACETS: a->facets = 1; break;
+    case OPT_GROUP: a->group = 1; break;
+    case OPT_VERBOSE: a->verbose = 1; break;
+    case OPT_HELP:
+        usage(stdout);
+        return 0;
+    case OPT_VERSION:
+        printf("posedrop %s\n", pd_version());
+        return 0;
+    default: break;
+    }
+    return -1;
+}
+
+/* Checks one option's value by its kind, then stores it; -1 to go on. */
+static int take(cli_args *a, const cli_option *o, const char *arg)
+{
+    double x = 0.0;
+    long long n = 0;
+    int k = 0, rc;
+    switch (o->kind) {
+    case ARG_REAL:
+    case ARG_WHOLE:
+        rc = pd_num_read(&o->rule, arg, &x, &n);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        break;
+    case ARG_CHOICE:
+        if (!choose(o, arg, &k))
+            return EXIT_USAGE;
+        break;
+    case ARG_VEC3:
+        if ((rc = parse_vec3(o, arg, &a->part.com)) >= 0)
+            return rc;
+        break;
+    case ARG_SCENE:
+        return scene_option(a, o, arg);
+    default:
+        break;
+    }
+    return apply(a, o, arg, x, n, k);
+}
+
+/* "--re": a prefix of more than one long name, which getopt refuses without
+ * saying why. */
+static int ambiguous(const char *arg)
+{
+    if (strncmp(arg, "--", 2) != 0)
+        return 0;
+    size_t n = strcspn(arg + 2, "=");
+    int matches = 0;
+    for (int i = 0; i < NOPTIONS; i++)
+        matches += options[i].kind != ARG_HEADING && options[i].name &&
+                   strncmp(options[i].name, arg + 2, n) == 0;
+    return matches > 1;
 }
 
 /* Returns -1 to go on, or an exit code. */
 static int parse_args(int argc, char **argv, cli_args *a)
 {
-    static const struct option longopts[] = {
-        {"units", required_argument, 0, OPT_UNITS},
-        {"format", required_argument, 0, OPT_FORMAT},
-        {"com", required_argument, 0, OPT_COM},
-        {"topple", required_argument, 0, OPT_TOPPLE},
-        {"epsilon", required_argument, 0, OPT_EPSILON},
-        {"pqs-compare", required_argument, 0, OPT_PQS_COMPARE},
-        {"pqs-band", required_argument, 0, OPT_PQS_BAND},
-        {"ci", required_argument, 0, OPT_CI},
-        {"seed", required_argument, 0, OPT_SEED},
-        {"mu", required_argument, 0, OPT_MU},
-        {"restitution", required_argument, 0, OPT_RESTITUTION},
-        {"restitution-law", required_argument, 0, OPT_LAW},
-        {"vibration", required_argument, 0, OPT_VIBRATION},
-        {"contact-time", required_argument, 0, OPT_CONTACT_TIME},
-        {"initial", required_argument, 0, OPT_INITIAL},
-        {"scene", required_argument, 0, OPT_SCENE},
-        {"trials", required_argument, 0, OPT_TRIALS},
-        {"transitions", required_argument, 0, OPT_TRANSITIONS},
-        {"engine", required_argument, 0, OPT_ENGINE},
-        {"dt", required_argument, 0, OPT_DT},
-        {"facets", no_argument, 0, OPT_FACETS},
-        {"group", no_argument, 0, OPT_GROUP},
-        {"verbose", no_argument, 0, OPT_VERBOSE},
-        {"help", no_argument, 0, OPT_HELP},
-        {"version", no_argument, 0, OPT_VERSION},
-        {0, 0, 0, 0},
-    };
-    static const char *const formats[] = {"off", "stl", "obj"};
-    static const char *const topples[] = {"descent", "edge"};
-    static const char *const compares[] = {"raw", "qs"};
-    static const char *const bands[] = {"rect", "exact"};
-    static const char *const engines[] = {"impulse", "ode", "bullet"};
+    struct option longopts[NOPTIONS + 1];
+    char shortopts[2 * NOPTIONS + 2] = ":";
+    int nlong = 0;
+    for (int i = 0; i < NOPTIONS; i++) {
+        const cli_option *o = &options[i];
+        if (o->kind == ARG_HEADING)
+            continue;
+        if (o->name)
+            longopts[nlong++] = (struct option){o->name, o->kind == ARG_FLAG ? no_argument
+                                                                          : required_argument,
+                                                NULL, o->id};
+        else
+            strcat(shortopts, o->kind == ARG_FLAG ? (char[]){(char)o->id, 0}
+                                                  : (char[]){(char)o->id, ':', 0});
+    }
+    longopts[nlong] = (struct option){0, 0, 0, 0};
     memset(a, 0, sizeof *a);
     pd_mesh_read_options_default(&a->read);
     pd_part_options_default(&a->part);
@@ -408,125 +696,25 @@ static int parse_args(int argc, char **argv, cli_args *a)
     pd_scene_default(&a->scene);
     pd_sim_options_default(&a->sim);
     opterr = 0;
-    int c, code = -1, k;
-    double x;
-    long n;
-    while (code < 0 && (c = getopt_long(argc, argv, ":n:h:v:j:", longopts, NULL)) != -1) {
-        switch (c) {
-        case OPT_UNITS:
-            if (pd_units_parse(optarg, &a->read.units) != PD_OK)
-                return fail_usage("--units: expected m, cm, mm or in, got '%s'", optarg);
-            break;
-        case OPT_FORMAT:
-            if (!choose("--format", optarg, formats, 3, &k))
-                return EXIT_USAGE;
-            a->read.format = (pd_mesh_format)(PD_FORMAT_OFF + k);
-            break;
-        case OPT_COM:
-            if (!parse_vec3(optarg, &a->part.com))
-                return fail_usage("--com: expected three finite numbers X,Y,Z, got '%s'", optarg);
-            a->part.com_given = 1;
-            a->com_text = optarg;
-            break;
-        case OPT_TOPPLE:
-            if (!choose("--topple", optarg, topples, 2, &k))
-                return EXIT_USAGE;
-            a->estimate.topple = (pd_topple_rule)k;
-            break;
-        case OPT_EPSILON:
-            if (!parse_double(optarg, &x) || x < 0.0 || x > 90.0)
-                return fail_usage("--epsilon: expected an angle in degrees from 0 to 90, got '%s'",
-                                  optarg);
-            a->estimate.epsilon = x * (M_PI / 180.0);
-            break;
-        case OPT_PQS_COMPARE:
-            if (!choose("--pqs-compare", optarg, compares, 2, &k))
-                return EXIT_USAGE;
-            a->estimate.compare = (pd_pqs_compare)k;
-            break;
-        case OPT_PQS_BAND:
-            if (!choose("--pqs-band", optarg, bands, 2, &k))
-                return EXIT_USAGE;
-            a->estimate.band = (pd_pqs_band)k;
-            break;
-        case 'n':
-            if (!parse_long(optarg, 1, 1000000000L, &n))
-                return fail_usage("-n: expected a number of drops from 1 to 10^9, got '%s'", optarg);
-            a->sim.ndrops = n;
-            a->dynamic = 1;
-            break;
-        case OPT_CI:
-            if (!parse_double(optarg, &x) || x <= 0.0 || x >= 0.5)
-                return fail_usage("--ci: expected a half-width between 0 and 0.5, got '%s'", optarg);
-            a->sim.ci_halfwidth = x;
-            a->dynamic = 1;
-            break;
-        case OPT_SEED:
-            if (!parse_long(optarg, 0, 0x7fffffffffffffffL, &n))
-                return fail_usage("--seed: expected a non-negative integer, got '%s'", optarg);
-            a->sim.seed = (uint64_t)n;
-            break;
-        case 'j':
-            if (!parse_long(optarg, 1, 256, &n))
-                return fail_usage("-j: expected a number of threads from 1 to 256, got '%s'", optarg);
-            a->sim.threads = (int)n;
-            break;
-        case 'h': code = scene_option(a, "-h", "height", optarg); break;
-        case 'v': code = scene_option(a, "-v", "belt_speed", optarg); break;
-        case OPT_MU: code = scene_option(a, "--mu", "mu", optarg); break;
-        case OPT_RESTITUTION: code = scene_option(a, "--restitution", "restitution", optarg); break;
-        case OPT_LAW: code = scene_option(a, "--restitution-law", "restitution_law", optarg); break;
-        case OPT_VIBRATION: code = scene_option(a, "--vibration", "vibration", optarg); break;
-        case OPT_CONTACT_TIME: code = scene_option(a, "--contact-time", "contact_time", optarg); break;
-        case OPT_INITIAL: code = scene_option(a, "--initial", "initial", optarg); break;
-        case OPT_SCENE: {
-            pd_diag d;
-            pd_diag_init(&d);
-            pd_status st = pd_scene_read(optarg, &a->scene, &d);
-            if (st != PD_OK) {
-                fprintf(stderr, "%s: %s\n", prog, d.message);
-                return pd_status_is_input_error(st) ? EXIT_USAGE : EXIT_INTERNAL;
-            }
-            break;
+    int c, code = -1;
+    while (code < 0 && (c = getopt_long(argc, argv, shortopts, longopts, NULL)) != -1) {
+        const cli_option *o = find_option(c == ':' || c == '?' ? optopt : c);
+        char name[32];
+        if (c == ':')
+            return fail_usage("option '%s' needs a value", o ? option_name(o, name, sizeof name)
+                                                              : argv[optind - 1]);
+        if (c == '?' && o && o->kind == ARG_FLAG)
+            return fail_usage("option '%s' takes no value", option_name(o, name, sizeof name));
+        if (c == '?' && optopt > 0 && optopt < 256) {
+            snprintf(name, sizeof name, "-%c", optopt);
+            return fail_usage("unknown option '%s'", name);
         }
-        case OPT_ENGINE:
-            if (!choose("--engine", optarg, engines, 3, &k))
-                return EXIT_USAGE;
-            a->sim.engine = (pd_engine_kind)k;
-            break;
-        case OPT_DT:
-            if (!parse_double(optarg, &x) || x <= 0.0 || x > 0.01)
-                return fail_usage("--dt: expected a time step in s, above 0 and at most 0.01, got '%s'",
-                                  optarg);
-            a->sim.dt = x;
-            break;
-        case OPT_TRIALS:
-            a->trials = optarg;
-            a->sim.keep_trials = 1;
-            break;
-        case OPT_TRANSITIONS:
-            a->transitions = optarg;
-            break;
-        case OPT_FACETS:
-            a->facets = 1;
-            break;
-        case OPT_GROUP:
-            a->group = 1;
-            break;
-        case OPT_VERBOSE:
-            a->verbose = 1;
-            break;
-        case OPT_HELP:
-            usage(stdout);
-            return 0;
-        case OPT_VERSION:
-            printf("posedrop %s\n", pd_version());
-            return 0;
-        case ':':
-            return fail_usage("option '%s' needs a value", argv[optind - 1]);
-        default:
-            return fail_usage("unknown option '%s'", argv[optind - 1]);
-        }
+        if (c == '?' || !o)
+            return fail_usage(ambiguous(argv[optind - 1])
+                                  ? "option '%s' is the start of more than one option's name"
+                                  : "unknown option '%s'",
+                              argv[optind - 1]);
+        code = take(a, o, optarg);
     }
     if (code >= 0)
         return code;
@@ -666,6 +854,15 @@ int main(int argc, char **argv)
         return EXIT_INTERNAL;
     }
 
+    /* Output paths first: a run never does its work only to fail writing. */
+    out_file trials_out = {0}, transitions_out = {0};
+    if ((a.trials && !out_open(&trials_out, a.trials)) ||
+        (a.transitions && !out_open(&transitions_out, a.transitions))) {
+        out_abort(&trials_out);
+        out_abort(&transitions_out);
+        return EXIT_USAGE;
+    }
+
     pd_mesh *mesh = NULL;
     pd_part *part = NULL;
     pd_static_result *res = NULL;
@@ -697,6 +894,17 @@ int main(int argc, char **argv)
         code = fail_status(st, &diag, a.path);
         goto done;
     }
+    /* The side files before stdout: if one cannot be written in full (a
+     * full disk, /dev/full), the run fails with nothing on stdout. */
+    if (trials_out.f)
+        write_trials(trials_out.f, sim, class_of);
+    if (transitions_out.f)
+        write_transitions(transitions_out.f, gsim ? gsim : sim);
+    if ((trials_out.f && !out_commit(&trials_out)) ||
+        (transitions_out.f && !out_commit(&transitions_out))) {
+        code = EXIT_INTERNAL;
+        goto done;
+    }
     if (a.verbose)
         print_summary(&a, part, res);
     if (sim)
@@ -710,13 +918,11 @@ int main(int argc, char **argv)
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
     if (code)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
-    if (sim && a.trials && !write_trials(a.trials, sim, class_of))
-        code = EXIT_INTERNAL;
-    if (sim && a.transitions && !write_transitions(a.transitions, gsim ? gsim : sim))
-        code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
         code = EXIT_INTERRUPTED;
 done:
+    out_abort(&trials_out);
+    out_abort(&transitions_out);
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);

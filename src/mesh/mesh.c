@@ -6,6 +6,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include "mesh/mesh_internal.h"
 #include "mesh/mesh_reader.h"
 #include "posedrop/mesh.h"
@@ -141,23 +142,42 @@ pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
                    name);
 }
 
-/* Reads the whole file; works for pipes too, which have no size to ask for. */
-static pd_status slurp(FILE *f, const char *path, unsigned char **out, size_t *size,
+/* Reads the whole file, up to max bytes; works for pipes too, which have no
+ * size to ask for. */
+static pd_status slurp(FILE *f, const char *path, size_t max, unsigned char **out, size_t *size,
                        pd_diag *diag)
 {
+    struct stat sb;
+    int fd = fileno(f);
+    if (fstat(fd, &sb) == 0) {
+        if (S_ISDIR(sb.st_mode))
+            return pd_fail(diag, PD_ERR_IO, "%s: is a directory, not a mesh file", path);
+        /* A regular file's size is known: refuse it before reading. */
+        if (S_ISREG(sb.st_mode) && (uintmax_t)sb.st_size > max)
+            return pd_fail(diag, PD_ERR_RANGE, "%s: %jd bytes; posedrop reads mesh files of at "
+                           "most %zu bytes", path, (intmax_t)sb.st_size, max);
+    }
     size_t cap = 1 << 16, n = 0;
     unsigned char *buf = malloc(cap);
     if (!buf)
         return pd_fail(diag, PD_ERR_NOMEM, "%s: out of memory", path);
     for (;;) {
         if (n == cap) {
-            unsigned char *q = cap <= SIZE_MAX / 2 ? realloc(buf, cap * 2) : NULL;
+            if (n > max) {
+                free(buf);
+                return pd_fail(diag, PD_ERR_RANGE, "%s: more than %zu bytes and not at its end "
+                               "(an endless input?); posedrop reads mesh files of at most %zu "
+                               "bytes", path, max, max);
+            }
+            /* Up to one byte past the limit, which tells "too long" apart. */
+            size_t next = cap <= max / 2 ? cap * 2 : max + 1;
+            unsigned char *q = realloc(buf, next);
             if (!q) {
                 free(buf);
                 return pd_fail(diag, PD_ERR_NOMEM, "%s: out of memory after %zu bytes", path, n);
             }
             buf = q;
-            cap *= 2;
+            cap = next;
         }
         size_t got = fread(buf + n, 1, cap - n, f);
         n += got;
@@ -176,8 +196,8 @@ static pd_status slurp(FILE *f, const char *path, unsigned char **out, size_t *s
     return PD_OK;
 }
 
-pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options, pd_mesh **mesh,
-                       pd_diag *diag)
+pd_status pd_mesh_read_capped(const char *path, const pd_mesh_read_options *options,
+                              size_t max_bytes, pd_mesh **mesh, pd_diag *diag)
 {
     if (!path || !mesh)
         return pd_fail(diag, PD_ERR_USAGE, "pd_mesh_read: NULL %s", path ? "mesh" : "path");
@@ -189,13 +209,19 @@ pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options, pd
     unsigned char *data = NULL;
     size_t size = 0;
     errno = 0;
-    pd_status st = slurp(f, path, &data, &size, diag);
+    pd_status st = slurp(f, path, max_bytes, &data, &size, diag);
     fclose(f);
     if (st != PD_OK)
         return st;
     st = pd_mesh_parse(data, size, path, options, mesh, diag);
     free(data);
     return st;
+}
+
+pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options, pd_mesh **mesh,
+                       pd_diag *diag)
+{
+    return pd_mesh_read_capped(path, options, PD_MESH_MAX_BYTES, mesh, diag);
 }
 
 /* --- the mesh itself -------------------------------------------------------- */

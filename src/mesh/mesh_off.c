@@ -133,6 +133,10 @@ static pd_status read_vertex(pd_text *t, pd_diag *diag, double scale, pd_vec3 *v
         if (rc == PD_NUM_NONFINITE)
             return pd_text_fail(t, diag, PD_ERR_NONFINITE, "non-finite coordinate %s",
                                 pd_text_show(shown, sizeof shown, s, n));
+        if (rc == PD_NUM_TINY)
+            return pd_text_fail(t, diag, PD_ERR_RANGE, "coordinate %s is non-zero but below the "
+                                "smallest normal double, 2.2e-308",
+                                pd_text_show(shown, sizeof shown, s, n));
     }
     /* Scales are at most 1 (metres per unit), so scaling cannot overflow. */
     v->x = c[0] * scale;

@@ -9,6 +9,19 @@
 #include "base/fail.h"
 #include "base/text.h"
 
+/* --- reading a file -------------------------------------------------------- */
+
+/* The most bytes pd_mesh_read takes from a file or pipe, so that an endless
+ * input (/dev/zero, a pipe that never ends) is refused instead of read until
+ * memory runs out. 1 GiB holds a binary STL of 21 million triangles, or an
+ * ASCII one of about 4 million: above the largest CAD meshes users feed to a
+ * pose estimator, and well within a machine's memory. */
+#define PD_MESH_MAX_BYTES ((size_t)1 << 30)
+
+/* pd_mesh_read with another byte limit (the tests' small one). */
+pd_status pd_mesh_read_capped(const char *path, const pd_mesh_read_options *options,
+                              size_t max_bytes, pd_mesh **mesh, pd_diag *diag);
+
 /* --- mesh builder ----------------------------------------------------------- */
 
 /* Growable vertex and triangle arrays. Sizes never pass PD_MAX_ELEMENTS, so

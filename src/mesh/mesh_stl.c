@@ -36,13 +36,41 @@ static int starts_with_solid(const unsigned char *d, size_t size)
     return size - i >= 5 && pd_text_is((const char *)d + i, 5, "solid");
 }
 
+/* The first word of each line in the file's first bytes: a "solid" line
+ * followed by a "facet" or "endsolid" line is ASCII STL's structure, which
+ * no binary STL shows (its header may start with "solid", but what follows
+ * is floats). Looking past the first line finds it after a comment line, and
+ * a NUL byte further on does not hide it. */
+static int has_ascii_structure(const unsigned char *d, size_t size)
+{
+    /* Far more than a "solid" line with a long name and the first facet. */
+    enum { WINDOW = 1 << 14 };
+    pd_text t;
+    pd_text_init(&t, d, size < WINDOW ? size : WINDOW, "", 0, 0);
+    int solid = 0;
+    const char *s;
+    size_t n;
+    while (pd_text_next_line(&t) && pd_text_token(&t, &s, &n)) {
+        if (pd_text_is(s, n, "solid"))
+            solid = 1;
+        else if (solid && (pd_text_is(s, n, "facet") || pd_text_is(s, n, "endsolid")))
+            return 1;
+    }
+    return 0;
+}
+
 int pd_stl_is_binary(const unsigned char *data, size_t size)
 {
-    /* Text never holds a NUL byte; a binary file almost always does (the high
-     * byte of its triangle count, zeros in its floats). Exporters do write
+    /* Binary STL has no magic number; its size formula is its signature (no
+     * text matches it: bytes 80-83 of text make a count of at least
+     * 0x09090909, gigabytes beyond any file read). Exporters do write
      * "solid" at the start of binary headers, so that word alone decides
-     * nothing. */
-    int text = starts_with_solid(data, size) && memchr(data, 0, size) == NULL;
+     * nothing. Otherwise text: a file starting with "solid" without NUL
+     * bytes, or one with ASCII STL's structure. */
+    if (size >= COUNT_END && COUNT_END + (uint64_t)RECORD * le32(data + HEADER) == size)
+        return 1;
+    int text = (starts_with_solid(data, size) && memchr(data, 0, size) == NULL) ||
+               has_ascii_structure(data, size);
     return !text;
 }
 
@@ -169,8 +197,20 @@ static pd_status read_facet(pd_text *t, pd_diag *diag, double scale, pd_build *b
 static pd_status read_ascii(const unsigned char *d, size_t size, const char *name, double scale,
                             pd_build *b, pd_vmap *map, pd_diag *diag)
 {
+    /* Text has no NUL byte; one (a damaged file) is named with its line
+     * rather than left to look like a bad token. */
+    const unsigned char *nul = memchr(d, 0, size);
+    if (nul) {
+        long long line = 1;
+        for (const unsigned char *c = d; c < nul; c++)
+            line += *c == '\n';
+        return pd_fail(diag, PD_ERR_PARSE, "%s:%lld: a NUL byte in ASCII STL, which is text", name,
+                       line);
+    }
+    /* '#' comment lines are no part of STL, but some tools write one before
+     * "solid"; the format detection skips them too. */
     pd_text t;
-    pd_text_init(&t, d, size, name, 0, 0);
+    pd_text_init(&t, d, size, name, '#', 0);
     pd_status st = pd_vmap_init(map, 0);
     if (st != PD_OK)
         return pd_fail(diag, st, "%s: out of memory", name);

@@ -70,9 +70,10 @@ typedef struct batch {
     const pd_sim_options *opt;
     const double *init_cdf;
     const double *pose_cdfs; /* not NULL: drop i starts resting on pose
-                               (i - pose_first) mod nposes, whose point-mass cdf
-                               is that row of pose_cdfs (instead of init_cdf) */
-    long pose_first;
+                               stationary_pose(i, ...) when it is one, whose
+                               point-mass cdf is that row of pose_cdfs (instead
+                               of init_cdf) */
+    long pose_drops;
     int nposes;
     long first, last;       /* drop indices [first, last) */
     pd_trial *out;          /* out[i - first] */
@@ -93,6 +94,18 @@ static int cancelled(const pd_sim_options *o)
     return o->cancel && atomic_load_explicit(o->cancel, memory_order_relaxed) != 0;
 }
 
+/* --initial stationary: where drop i starts, -1 for a uniform orientation or
+ * the pose it rests on. The first (k+1) pose_drops drops go round uniform,
+ * pose 0, ..., pose k-1; the rest (fewer than k+1) are uniform. Interleaved
+ * from the first drop, so a run stopped at any point has drops of every
+ * phase in proportion. */
+static int stationary_pose(long i, long pose_drops, int k)
+{
+    if (i >= (long)(k + 1) * pose_drops)
+        return -1;
+    return (int)(i % (k + 1)) - 1;
+}
+
 static void *worker(void *arg)
 {
     batch *b = arg;
@@ -107,8 +120,9 @@ static void *worker(void *arg)
         if (i >= b->last || cancelled(b->opt))
             break;
         const double *cdf = b->init_cdf;
-        if (b->pose_cdfs)
-            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)((i - b->pose_first) % b->nposes);
+        int pose = b->pose_cdfs ? stationary_pose(i, b->pose_drops, b->nposes) : -1;
+        if (pose >= 0)
+            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)pose;
         pd_drop_run(b->model, w, b->scene, b->opt, i, cdf, &b->out[i - b->first], &gain,
                     &fallbacks);
     }
@@ -161,11 +175,11 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->count[t[i].pose]++;
         if (!r->transitions)
             continue;
-        long phase2 = r->n + i - r->first_drops;
-        if (phase2 < 0)
+        int from = stationary_pose(r->n + i, r->pose_drops, r->nposes);
+        if (from < 0)
             r->first_count[t[i].pose]++;
         else
-            r->transitions[(size_t)(phase2 % r->nposes) * (size_t)r->nposes + (size_t)t[i].pose]++;
+            r->transitions[(size_t)from * (size_t)r->nposes + (size_t)t[i].pose]++;
     }
     r->n += n;
 }
@@ -309,10 +323,10 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     return st;
 }
 
-/* --initial stationary: drops [0, first_drops) from uniform orientations,
- * then the rest resting on the poses in turn. Interleaved rather than pose
- * after pose, so that a run stopped early has drops from every pose and can
- * still give pi. */
+/* --initial stationary: first_drops drops from uniform orientations and
+ * pose_drops resting on each pose, interleaved from the first drop
+ * (stationary_pose), so that a run stopped early has drops of every phase and
+ * can still give pi. */
 static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
                                   const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)
 {
@@ -330,11 +344,9 @@ static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *sce
             point[i * K + j] = j >= i ? 1.0 : 0.0;
     int nthreads = thread_count(o);
     while (st == PD_OK && r->n < o->ndrops && !r->partial) {
-        int resting = r->n >= r->first_drops;
-        long end = resting ? o->ndrops : r->first_drops;
-        long size = end - r->n > BATCH_MAX ? BATCH_MAX : end - r->n;
-        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = resting ? point : NULL,
-                   .pose_first = r->first_drops, .nposes = k, .first = r->n,
+        long size = o->ndrops - r->n > BATCH_MAX ? BATCH_MAX : o->ndrops - r->n;
+        batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = point,
+                   .pose_drops = r->pose_drops, .nposes = k, .first = r->n,
                    .last = r->n + size, .out = buf};
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;

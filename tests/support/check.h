@@ -16,6 +16,15 @@ void pd_check_report(int ok, const char *file, int line, const char *what);
 void pd_check_report_num(int ok, const char *file, int line, const char *expr,
                          double actual, double expected, double tol, const char *source);
 
+/* A measured figure worth reading (errors reached, counts of cases): printed
+ * only with PD_TEST_VERBOSE=1 in the environment, so that a plain run shows
+ * failures and totals alone. */
+void pd_note(const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 1, 2)))
+#endif
+    ;
+
 /* A boolean property. */
 #define CHECK(cond) pd_check_report(!!(cond), __FILE__, __LINE__, #cond)
 

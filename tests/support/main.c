@@ -1,7 +1,10 @@
 /* main.c: the test runner. Runs every suite, or those named on the command
  * line, and ends with the line "N passed, N failed"; the exit code is non-zero
- * when any check failed. */
+ * when any check failed. Measured figures (pd_note) only with
+ * PD_TEST_VERBOSE=1. */
+#include <stdarg.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include "check.h"
 #include "suites.h"
@@ -28,6 +31,21 @@ void pd_check_report_num(int ok, const char *file, int line, const char *expr,
     pd_checks_failed++;
     printf("FAIL %s:%d: %s\n     actual   %.17g\n     expected %.17g\n     tolerance %.3g (%s)\n",
            file, line, expr, actual, expected, tol, source);
+}
+
+void pd_note(const char *fmt, ...)
+{
+    static int verbose = -1;
+    if (verbose < 0) {
+        const char *v = getenv("PD_TEST_VERBOSE");
+        verbose = v && strcmp(v, "1") == 0;
+    }
+    if (!verbose)
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    vprintf(fmt, ap);
+    va_end(ap);
 }
 
 static const struct {

@@ -14,6 +14,9 @@
     PD_SUITE(descent_map) \
     PD_SUITE(rng)    \
     PD_SUITE(stats)  \
+    PD_SUITE(number) \
+    PD_SUITE(input)  \
+    PD_SUITE(fuzz_replay) \
     PD_SUITE(scene)  \
     PD_SUITE(flight) \
     PD_SUITE(impact) \

@@ -5,6 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
 #include "check.h"
@@ -137,6 +138,15 @@ static void test_usage(void)
     CHECK_INT(run("--help", &out, &err), 0);
     CHECK(strstr(out, "usage: posedrop") != NULL);
     CHECK(strstr(out, "--epsilon") != NULL);
+    /* The help is generated from the option table: each option listed once
+     * (a value counted as an option when getopt takes it). */
+    const char *listed[] = {"--units U", "--com X,Y,Z", "-n N", "-j THREADS", "-h H", "-v V",
+                            "--seed S", "--scene FILE", "--trials FILE", "--transitions FILE",
+                            "--contact-time S", "--initial I", "--version"};
+    for (size_t i = 0; i < sizeof listed / sizeof listed[0]; i++) {
+        const char *at = strstr(out, listed[i]);
+        CHECK(at != NULL && strstr(at + 1, listed[i]) == NULL);
+    }
     free(out);
     free(err);
     CHECK_INT(run("--version", &out, &err), 0);
@@ -171,6 +181,35 @@ static void test_usage(void)
     expect_failure("--com 1,2,inf parts/cap.off", 2, "--com");
     expect_failure("--topple sideways parts/cap.off", 2, "--topple");
     expect_failure("parts/cap.off --epsilon", 2, "needs a value");
+
+    /* One reading of numbers for every option (base/number.c): 1e-400 is
+     * refused alike, with the range stated; so is every out-of-range value. */
+    const char *tiny[] = {"-h 1e-400", "--mu 1e-400", "--vibration 1e-400", "--epsilon 1e-400",
+                          "--ci 1e-400", "--dt 1e-400", "--com 1e-400,0,0", "-v 1e-400"};
+    for (size_t i = 0; i < sizeof tiny / sizeof tiny[0]; i++) {
+        char args[128];
+        snprintf(args, sizeof args, "%s parts/cap.off", tiny[i]);
+        expect_failure(args, 2, "below the smallest normal double, 2.2e-308");
+    }
+    expect_failure("-v 1e308 parts/cap.off", 2, "from -1000 to 1000, got '1e308'");
+    expect_failure("--seed 9223372036854775808 parts/cap.off", 2,
+                   "from 0 to 9223372036854775807, got '9223372036854775808'");
+    expect_failure("--epsilon 91 parts/cap.off", 2, "from 0 to 90, got '91'");
+    expect_failure("--ci 0.5 -n 10 parts/cap.off", 2, "above 0 and below 0.5");
+    expect_failure("-n 1e3 parts/cap.off", 2, "-n: expected a number of drops from 1 to 1000000000");
+    /* A blank at either end is accepted alike (the same table either way). */
+    char *o1, *e1, *o2, *e2;
+    CHECK_INT(run("--epsilon ' 5' parts/cap.off", &o1, &e1), 0);
+    CHECK_INT(run("--epsilon '5 ' parts/cap.off", &o2, &e2), 0);
+    CHECK(strcmp(o1, o2) == 0 && strlen(o1) > 0);
+    free(o1);
+    free(e1);
+    free(o2);
+    free(e2);
+    /* The unknown option is named, not the program. */
+    expect_failure("-Xn 5 parts/cap.off", 2, "unknown option '-X'");
+    expect_failure("--group=1 parts/cap.off", 2, "option '--group' takes no value");
+    expect_failure("--re 1 parts/cap.off", 2, "'--re' is the start of more than one option's name");
 }
 
 static void test_bad_input(void)
@@ -346,6 +385,58 @@ static void test_dynamic(void)
     char where[200];
     snprintf(where, sizeof where, "%s:2:", path);
     expect_failure(args, 2, where);
+}
+
+/* Output paths are checked before any work: a bad one fails with exit 2
+ * and nothing on stdout even when the part itself would fail later (so the
+ * part is never read), a write error at the end (/dev/full) fails with
+ * nothing on stdout, and a failed run leaves an existing file as it was. */
+static void test_output_paths(void)
+{
+    char args[512], path[160], dir[160];
+    snprintf(dir, sizeof dir, "%s/adir", tmpdir);
+    CHECK(mkdir(dir, 0755) == 0);
+    const char *bad[][2] = {{"/proc/x", "cannot create a file in /proc"},
+                            {"/nonexistent/dir/t.csv", "no such directory /nonexistent/dir"},
+                            {dir, "is a directory"}};
+    for (int i = 0; i < 3; i++) {
+        snprintf(args, sizeof args, "-n 20 --trials %s /nonexistent/part.off", bad[i][0]);
+        expect_failure(args, 2, bad[i][1]);
+        snprintf(args, sizeof args, "-n 400 --initial stationary --transitions %s "
+                 "/nonexistent/part.off", bad[i][0]);
+        expect_failure(args, 2, bad[i][1]);
+    }
+    expect_failure("-n 20 --trials '' /nonexistent/part.off", 2, "an empty file name");
+    expect_failure("-n 20 --trials /dev/full parts/cap.off", 1, "/dev/full: write error");
+    expect_failure("-n 140 --initial stationary --transitions /dev/full parts/canonical/cube.off",
+                   1, "/dev/full: write error");
+
+    /* An existing file survives a failed run whole, and a good run replaces
+     * it keeping its permissions, with no temporary left beside it. */
+    snprintf(path, sizeof path, "%s/keep.csv", tmpdir);
+    write_file(path, "earlier results\n");
+    CHECK(chmod(path, 0640) == 0);
+    snprintf(args, sizeof args, "-n 5 --trials %s /nonexistent/part.off", path);
+    expect_failure(args, 2, "/nonexistent/part.off");
+    char *t = slurp(path);
+    CHECK(t && strcmp(t, "earlier results\n") == 0);
+    free(t);
+    char *out, *err;
+    snprintf(args, sizeof args, "-n 5 --trials %s parts/cap.off", path);
+    CHECK_INT(run(args, &out, &err), 0);
+    free(out);
+    free(err);
+    t = slurp(path);
+    CHECK(t && strncmp(t, "drop,qw,", 8) == 0);
+    free(t);
+    struct stat sb;
+    CHECK(stat(path, &sb) == 0 && (sb.st_mode & 0777) == 0640);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "ls -A %s | grep -c posedrop-", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 1); /* grep -c: no line matched */
+    CHECK(strncmp(out, "0", 1) == 0);
+    free(out);
+    free(err);
 }
 
 /* eq16.awk, fed the paper's own columns, must reproduce the errors the paper
@@ -714,6 +805,7 @@ void suite_cli(void)
     test_bad_input();
     test_results();
     test_dynamic();
+    test_output_paths();
     test_eq16();
     test_scripts();
     test_group();

@@ -218,7 +218,7 @@ static void test_random_phases(void)
     CHECK(started >= 100);
     CHECK_INT(rises, 0);
     CHECK_INT(below, 0);
-    printf("contact_phase: %d of 300 random sliding or spinning contacts started a phase\n", started);
+    pd_note("contact_phase: %d of 300 random sliding or spinning contacts started a phase\n", started);
     pd_ode_free(pivot);
     pd_ode_free(ode);
     drop_teardown(&fx);
@@ -284,7 +284,7 @@ static void test_start_modes(void)
      * error: measured 1.2e-8 m g L (2e-4 when the phase took its modes
      * afresh from the projected state). */
     CHECK_NEAR(fmax(worst, 0.0), 0.0, 10.0 * PD_TOL_PHASE_ODE_REL, "ODE error over a phase");
-    printf("contact_phase: %d starts near the slip threshold, energy rising at most %.1e m g L\n",
+    pd_note("contact_phase: %d starts near the slip threshold, energy rising at most %.1e m g L\n",
            started, worst);
     pd_ode_free(pivot);
     pd_ode_free(ode);
@@ -330,7 +330,7 @@ static void test_reference_agreement(void)
     CHECK(compared >= 50);
     double tol = 10.0 * PD_TOL_PHASE_ODE_REL; /* a few steps of local error each */
     state_gap_check(&gap, tol);
-    printf("contact_phase: rkck vs rk8pd on %d phases: x %.1e v %.1e q %.1e w %.1e E %.1e\n",
+    pd_note("contact_phase: rkck vs rk8pd on %d phases: x %.1e v %.1e q %.1e w %.1e E %.1e\n",
            compared, gap.x, gap.v, gap.q, gap.w, gap.E);
     pd_ode_free(ref);
     pd_ode_free(pivot);

@@ -173,7 +173,7 @@ static void check_motion(drop_fixture *fx, pd_scene *sc, test_rng *rng)
     CHECK_NEAR(dt, 0.0, PD_TOL_PHASE_EVENT_REL + 1e-7, "end times per sqrt(L/g)");
     state_gap_check(&gap, tol);
     CHECK_NEAR(drift, 0.0, tol, "the pivot's energy over a phase");
-    printf("contact_pivot: %d events, %d compared: t %.1e x %.1e v %.1e q %.1e w %.1e E %.1e, "
+    pd_note("contact_pivot: %d events, %d compared: t %.1e x %.1e v %.1e q %.1e w %.1e E %.1e, "
            "pivot energy drift %.1e m g L\n",
            events, compared, dt, gap.x, gap.v, gap.q, gap.w, gap.E, drift);
     pd_ode_free(pivot);

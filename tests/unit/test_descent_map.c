@@ -187,7 +187,7 @@ static void test_agrees(void)
     CHECK(rt.answered > 0.99 * (double)rt.asked);
     CHECK(rt_pivot.answered > 0.3 * (double)rt_pivot.asked);
     CHECK(et.answered > 0.2 * (double)et.asked && et.answered < 0.9 * (double)et.asked);
-    printf("  descent map: looked up %ld of %ld and %ld of %ld random directions, "
+    pd_note("  descent map: looked up %ld of %ld and %ld of %ld random directions, "
            "%ld of %ld near boundaries\n",
            rt.answered, rt.asked, rt_pivot.answered, rt_pivot.asked, et.answered, et.asked);
 }

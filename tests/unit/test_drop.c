@@ -193,7 +193,7 @@ static void test_impact_window(void)
     CHECK_INT(ncs[1], 4);
     CHECK(spin[0] > 100.0);
     CHECK(spin[1] < 0.1 * spin[0]);
-    printf("drop: cube landing 1.5 deg off flat: spin %.1f rad/s rigid, %.1f rad/s with a 0.3 ms window\n",
+    pd_note("drop: cube landing 1.5 deg off flat: spin %.1f rad/s rigid, %.1f rad/s with a 0.3 ms window\n",
            spin[0], spin[1]);
     drop_teardown(&fx);
 }

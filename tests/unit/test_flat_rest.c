@@ -241,7 +241,7 @@ static void agree(const char *name, pd_mesh *mesh, long n, long min_earlier)
     }
     CHECK_INT(differ, 0);
     CHECK(earlier >= min_earlier);
-    printf("flat_rest: %s, %ld drops: %ld decided earlier by the flat test, none differ in outcome "
+    pd_note("flat_rest: %s, %ld drops: %ld decided earlier by the flat test, none differ in outcome "
            "(%ld); collisions per drop %.1f with it, %.1f without\n",
            name, n, earlier, differ, (double)coll[0] / n, (double)coll[1] / n);
     for (int f = 0; f < nf; f++)

@@ -426,7 +426,7 @@ static void test_flight_reference(void)
         vs_ode(ode, J, q, v3_scale(d, 20.0), 1.0, sym, yflags);
     }
     pd_ode_free(ode);
-    printf("flight: closed form vs rk8pd at 1e-14, 20 rad/s for 1 s: generic %.1e rad %.1e rel, "
+    pd_note("flight: closed form vs rk8pd at 1e-14, 20 rad/s for 1 s: generic %.1e rad %.1e rel, "
            "nearly symmetric %.1e rad %.1e rel, near the separatrix %.1e rad %.1e rel "
            "(%.1e times 1 - m); theta series in %d, %d, %d of %d\n",
            generic[0], generic[1], sym[0], sym[1], sep[0], sep[1], sep[2], gflags[1], yflags[1],
@@ -558,7 +558,7 @@ static void test_impact(void)
         CHECK_NEAR(scan_height(b, &f, imp.t), 0.0, tol, "impact tolerance");
     }
     CHECK(ntrials > 40);
-    printf("flight: skimming impact search: %.1f steps on average over %d spinning starts\n",
+    pd_note("flight: skimming impact search: %.1f steps on average over %d spinning starts\n",
            ntrials ? (double)steps / ntrials : 0.0, ntrials);
 
     /* The simultaneity window: the box falling nearly flat (turned 0.5 deg
@@ -587,7 +587,7 @@ static void test_impact(void)
             counts[k] = imp.ncontacts;
         }
         CHECK(counts[0] == 1 && counts[1] < 4 && counts[1] < counts[3] && counts[3] == 4);
-        printf("flight: contact set of a face landing 0.5 deg off flat, windows 0, 5e-5, 1e-4, 3e-4 s: "
+        pd_note("flight: contact set of a face landing 0.5 deg off flat, windows 0, 5e-5, 1e-4, 3e-4 s: "
                "%d, %d, %d, %d corners\n", counts[0], counts[1], counts[2], counts[3]);
     }
 
@@ -867,7 +867,7 @@ static void test_curvature_step(void)
     CHECK_NEAR(worst_below, 0.0, 1e-14, "never below the bound, the flight's round-off");
     CHECK(tightest <= 1.0 && tightest > 0.05);
     CHECK_NEAR(worst_step, 0.0, 1e-14, "smallest root over all vertices, heights' round-off");
-    printf("flight: curvature bound: the worst vertex used %.2f of its C D^3 / 6\n", tightest);
+    pd_note("flight: curvature bound: the worst vertex used %.2f of its C D^3 / 6\n", tightest);
 }
 
 /* ulps of |y|'s binade, for the sine and cosine. */

@@ -190,7 +190,7 @@ static void test_random_energy(void)
     CHECK_INT(egain, 0);
     CHECK_INT(unstuck, 0);
     CHECK(worst <= PD_TOL_IMPACT_ENERGY_REL);
-    printf("impact: %d random impacts: Poisson added energy in %d, energetic in %d "
+    pd_note("impact: %d random impacts: Poisson added energy in %d, energetic in %d "
            "(max dke/(|p||u0|) %.3g); %d stable sticks, %d resumed on the ray, max %d steps, "
            "%d no convergence\n",
            n, pgain, egain, worst, sticks, resumed, maxsteps, bad);
@@ -249,7 +249,7 @@ static void test_figure7(void)
                 worst_free = fmax(worst_free, tangential_angle(r.u1, th));
             }
         }
-        printf("impact: figure 7 K #%d: theta_e = %.3f deg, %d of 36 stuck first, %d ended on the ray, "
+        pd_note("impact: figure 7 K #%d: theta_e = %.3f deg, %d of 36 stuck first, %d ended on the ray, "
                "others within %.3g rad of it\n", found, th * 180.0 / M_PI, nstick, nray, worst_free);
     }
     CHECK(found > 0);
@@ -355,7 +355,7 @@ static void test_figure7_portrait(void)
             worst = fmax(worst, fabs(remainder(dir - th, 2.0 * M_PI)));
         }
         CHECK_NEAR(worst, 0.0, 1e-3, "a pull >= 0.3 over ln|u| >= 34 bounds it by 1.4e-4 rad; 7x room for the pull, a finite difference");
-        printf("impact: figure 7 portrait: ray at %.2f deg, pull %.2f, %d of 36 reach the origin, "
+        pd_note("impact: figure 7 portrait: ray at %.2f deg, pull %.2f, %d of 36 reach the origin, "
                "the rest end within %.2g rad of the ray\n", th * 180.0 / M_PI, kappa, nstick, worst);
     }
     CHECK_INT(unstable, 4);
@@ -474,7 +474,7 @@ static void test_hard_cases(void)
         hard_case(w, CR(Krod), random_u0(&rng), rng_range(&rng, 0, 2), rng_uniform(&rng), "hammer");
         hard_case(w, CR(Krod), v3(0.3, 0.1, -1e-12), 10.0, 0.0, "hammer grazing mu 10 e 0");
     }
-    printf("impact: hard cases: %d of 320 ended with the contact still approaching (KNOWN)\n",
+    pd_note("impact: hard cases: %d of 320 ended with the contact still approaching (KNOWN)\n",
            hard_approaching);
     pd_impact_work_free(w);
 }
@@ -666,7 +666,7 @@ static void test_laws_oracle(void)
         n++;
     }
     CHECK(n >= 8);
-    printf("impact: %d sliding collisions, both laws, e = 0.01 and 0.3: impulse within %.2g of RK4's\n", n, worst);
+    pd_note("impact: %d sliding collisions, both laws, e = 0.01 and 0.3: impulse within %.2g of RK4's\n", n, worst);
     pd_impact_work_free(w);
 }
 
@@ -769,7 +769,7 @@ static void test_ray_tail(void)
     }
     CHECK(taken >= 40);
     CHECK(wide >= 5); /* measured 12: tails where the third-order one could not go */
-    printf("impact: ray tails (series): %d of %d offered taken (%d beyond 0.1 rad at slip > 0.1), "
+    pd_note("impact: ray tails (series): %d of %d offered taken (%d beyond 0.1 rad at slip > 0.1), "
            "impulse within %.2g and work within %.2g (relative beyond 1) of RK4 to the origin; "
            "on the ray within %.2g\n",
            taken, tried, wide, worst, worst_w, worst_on);
@@ -813,7 +813,7 @@ static void test_incoming_rays(void)
     }
     CHECK_NEAR(worst, 0.0, 1e-12, "both root-finders stop at round-off of th; 1e4 x for the roots' conditioning");
     CHECK_NEAR(worst_turn, 0.0, 1e-14, "round-off: the turning rate at the root, relative to |v|");
-    printf("impact: incoming rays of 2000 random K: %d, %d more than a 4096-point scan finds; "
+    pd_note("impact: incoming rays of 2000 random K: %d, %d more than a 4096-point scan finds; "
            "directions agree to %.2g, turning rate at them %.2g of |v|\n", total, extra, worst, worst_turn);
 
     /* Degenerate flows. a = 0, B anisotropic: the eigenvectors of B, all four

@@ -1,9 +1,11 @@
 /* test_markov.c: the long-run distribution of a pose-to-pose chain against
  * closed forms, its resampling intervals, and --initial stationary end to end
  * on the cube. */
+#include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include "check.h"
 #include "base/gsl_adapter.h"
 #include "sim/markov.h"
@@ -263,6 +265,58 @@ static pd_sim_result *run_stationary(const pd_part *part, const pd_static_result
     return r;
 }
 
+static atomic_int stop_flag;
+
+static void *stop_soon(void *arg)
+{
+    (void)arg;
+    struct timespec ts = {0, 300000000};
+    nanosleep(&ts, NULL);
+    atomic_store(&stop_flag, 1);
+    return NULL;
+}
+
+/* A run interrupted long before its uniform share is done (7e6 drops, of
+ * which 1e6 uniform) still has drops of every phase, in proportion: the
+ * phases are interleaved from the first drop. Whenever the stop comes, each
+ * pose's row holds floor(n/7) or ceil(n/7) started drops, less any
+ * unsettled ones; it used to hold none until the uniform drops were done. */
+static void test_interrupted(const pd_part *part, const pd_static_result *poses)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.initial = PD_INITIAL_STATIONARY;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 7000000;
+    o.threads = 2;
+    atomic_store(&stop_flag, 0);
+    o.cancel = &stop_flag;
+    pthread_t t;
+    CHECK(pthread_create(&t, NULL, stop_soon, NULL) == 0);
+    pd_sim_result *r = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_OK);
+    pthread_join(t, NULL);
+    CHECK(r != NULL);
+    if (!r)
+        return;
+    CHECK(r->partial == 1 && r->n < o.ndrops);
+    int in_share = 1;
+    long firsts = 0;
+    for (int i = 0; i < 6; i++) {
+        long row = 0;
+        for (int j = 0; j < 6; j++)
+            row += r->transitions[i * 6 + j];
+        in_share &= row >= r->n / 7 - r->unsettled && row <= (r->n + 6) / 7;
+        firsts += r->first_count[i];
+    }
+    CHECK(in_share);
+    CHECK(firsts >= r->n / 7 - r->unsettled && firsts <= (r->n + 6) / 7);
+    pd_sim_result_free(r);
+}
+
 static void test_cube(void)
 {
     pd_diag d;
@@ -322,6 +376,7 @@ static void test_cube(void)
     }
     pd_sim_result_free(a);
     pd_sim_result_free(b);
+    test_interrupted(part, poses);
 
     /* Too few drops for the poses: refused with the minimum named. */
     pd_scene sc;

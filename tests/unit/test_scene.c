@@ -37,6 +37,21 @@ void suite_scene(void)
     CHECK_STATUS(pd_scene_set(&s, "mu", "0.3x", &d), PD_ERR_PARSE);
     CHECK_STATUS(pd_scene_set(&s, "colour", "red", &d), PD_ERR_USAGE);
     CHECK(strstr(d.message, "colour") != NULL);
+    /* The numbers of every key read as everywhere else (base/number.c):
+     * underflow refused, blanks at either end alike, the range stated. */
+    CHECK_STATUS(pd_scene_set(&s, "mu", "1e-400", &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "from 0 to 10") != NULL);
+    CHECK_STATUS(pd_scene_set(&s, "height", "1e-400", &d), PD_ERR_RANGE);
+    CHECK_STATUS(pd_scene_set(&s, "belt_speed", "1e308", &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "from -1000 to 1000") != NULL);
+    /* "v" was an undocumented second name of belt_speed: one name each. */
+    CHECK_STATUS(pd_scene_set(&s, "v", "0.1", &d), PD_ERR_USAGE);
+    CHECK(memcmp(&before, &s, sizeof s) == 0);
+    CHECK_STATUS(pd_scene_set(&s, "mu", " 0.25", &d), PD_OK);
+    CHECK(s.mu == 0.25);
+    CHECK_STATUS(pd_scene_set(&s, "mu", "0.35 ", &d), PD_OK);
+    CHECK(s.mu == 0.35);
+    s = before;
     CHECK(memcmp(&before, &s, sizeof s) == 0);
 
     /* A file: comments, blanks, spaces; an error names file and line and
@@ -59,6 +74,34 @@ void suite_scene(void)
     snprintf(where, sizeof where, "%s:2:", path);
     CHECK(strstr(d.message, where) != NULL);
     CHECK(memcmp(&before, &s, sizeof s) == 0);
+
+    /* A key set twice is refused, naming both lines. */
+    f = fopen(path, "w");
+    fputs("mu = 0.4\nheight = 0.1\nmu = 0.6\n", f);
+    fclose(f);
+    CHECK_STATUS(pd_scene_read(path, &s, &d), PD_ERR_PARSE);
+    snprintf(where, sizeof where, "%s:3: mu is set a second time (first on line 1)", path);
+    CHECK(strstr(d.message, where) != NULL);
+    CHECK(memcmp(&before, &s, sizeof s) == 0);
+
+    /* A UTF-8 byte-order mark is no part of the first key; a NUL byte is
+     * named with its line. */
+    f = fopen(path, "w");
+    fputs("\xEF\xBB\xBFmu = 0.45\n", f);
+    fclose(f);
+    CHECK_STATUS(pd_scene_read(path, &s, &d), PD_OK);
+    CHECK(s.mu == 0.45);
+    f = fopen(path, "wb");
+    fwrite("mu = 0.4\nheight\0 = 0.1\n", 1, 24, f);
+    fclose(f);
+    CHECK_STATUS(pd_scene_read(path, &s, &d), PD_ERR_PARSE);
+    snprintf(where, sizeof where, "%s:2: a NUL byte", path);
+    CHECK(strstr(d.message, where) != NULL);
     remove(path);
     CHECK_STATUS(pd_scene_read("/nonexistent/scene", &s, &d), PD_ERR_IO);
+    CHECK_STATUS(pd_scene_read("/tmp", &s, &d), PD_ERR_IO);
+    CHECK(strstr(d.message, "/tmp: is a directory") != NULL);
+    /* An endless input ends at the size limit. */
+    CHECK_STATUS(pd_scene_read("/dev/zero", &s, &d), PD_ERR_RANGE);
+    CHECK(strstr(d.message, "longer than") != NULL);
 }

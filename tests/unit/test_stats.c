@@ -25,6 +25,17 @@ void suite_stats(void)
     CHECK_NEAR(hi, 1 - lo2, 1e-15, "symmetry, round-off");
     pd_wilson(0, 0, z, &lo, &hi);
     CHECK(lo == 0.0 && hi == 1.0);
+    /* No drop in a pose: p = 0 is the interval's lower end, exactly (it used
+     * to come out as round-off like 5.55e-17, leaving p outside its own
+     * interval); every drop in it: p = 1 is the upper end. */
+    int exact_ends = 1;
+    for (long n = 1; n <= 5000; n++) {
+        pd_wilson(0, n, z, &lo, &hi);
+        exact_ends &= lo == 0.0;
+        pd_wilson(n, n, z, &lo, &hi);
+        exact_ends &= hi == 1.0;
+    }
+    CHECK(exact_ends);
 
     /* The interval's ends are the roots of its defining quadratic,
      * (k/n - p)^2 = z^2 p (1 - p) / n, for every k of n (away from the

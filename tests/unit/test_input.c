@@ -1,0 +1,127 @@
+/* test_input.c: what the mesh reader will take: bytes (an endless input ends
+ * at the limit), triangles (a header may not declare more than the limit),
+ * and what it says of inputs that are no mesh file at all. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "check.h"
+#include "mesh/mesh_reader.h"
+#include "posedrop/mesh.h"
+#include "posedrop/tolerances.h"
+#include "suites.h"
+
+static void expect(pd_status got, pd_status want, const pd_diag *d, const char *mention)
+{
+    CHECK_STATUS(got, want);
+    if (!strstr(d->message, mention))
+        printf("     wanted '%s' in: %s\n", mention, d->message);
+    CHECK(strstr(d->message, mention) != NULL);
+}
+
+/* ASCII STL told from binary by structure, not by its first bytes: a
+ * comment line before "solid" or a NUL byte further on used to send it to the
+ * binary reader ("declares 544761204 triangles"). */
+static void test_stl_kind(void)
+{
+    static const char tetra[] =
+        "solid t\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 1 0\nvertex 1 0 0\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 0 1\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 0 0 0\nvertex 0 0 1\nvertex 0 1 0\nendloop\nendfacet\n"
+        "facet normal 0 0 0\nouter loop\nvertex 1 0 0\nvertex 0 1 0\nvertex 0 0 1\nendloop\nendfacet\n"
+        "endsolid t\n";
+    char text[1024];
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    /* A comment line first: read as ASCII, by content and by format. */
+    snprintf(text, sizeof text, "# exported by a tool\n%s", tetra);
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    for (int forced = 0; forced < 2; forced++) {
+        ro.format = forced ? PD_FORMAT_STL : PD_FORMAT_AUTO;
+        CHECK_STATUS(pd_mesh_parse(text, strlen(text), "c.stl", &ro, &m, &d), PD_OK);
+        CHECK(m && m->ntris == 4 && m->nverts == 4);
+        pd_mesh_free(m);
+        m = NULL;
+    }
+    /* A NUL byte on line 5: named, as ASCII STL. */
+    size_t n = strlen(tetra);
+    memcpy(text, tetra, n);
+    char *v = strstr(text, "vertex 0 1 0");
+    v[8] = '\0';
+    expect(pd_mesh_parse(text, n, "n.stl", NULL, &m, &d), PD_ERR_PARSE, &d,
+           "n.stl:5: a NUL byte in ASCII STL");
+    /* A binary STL whose header says "solid" is still binary; cut short, it
+     * is a truncated binary STL, not bad text. */
+    unsigned char bin[84 + 50] = "solid binary header";
+    bin[80] = 2;
+    ro.format = PD_FORMAT_STL;
+    expect(pd_mesh_parse(bin, sizeof bin, "b.stl", &ro, &m, &d), PD_ERR_PARSE, &d,
+           "truncated binary STL");
+    CHECK(m == NULL);
+}
+
+void suite_input(void)
+{
+    pd_mesh *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    /* An endless device ends one byte past the limit, refused as too long. */
+    expect(pd_mesh_read_capped("/dev/zero", NULL, 1 << 20, &m, &d), PD_ERR_RANGE, &d,
+           "/dev/zero: more than 1048576 bytes");
+    CHECK(m == NULL);
+    /* A regular file over the limit is refused by its size, unread; at the
+     * limit it is read. */
+    char path[] = "/tmp/posedrop-input-XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    const char *tetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    size_t len = strlen(tetra);
+    CHECK(write(fd, tetra, len) == (ssize_t)len);
+    close(fd);
+    expect(pd_mesh_read_capped(path, NULL, len - 1, &m, &d), PD_ERR_RANGE, &d,
+           "posedrop reads mesh files of at most");
+    CHECK_STATUS(pd_mesh_read_capped(path, NULL, len, &m, &d), PD_OK);
+    CHECK(m && m->ntris == 4);
+    pd_mesh_free(m);
+    m = NULL;
+    remove(path);
+    /* A pipe that would go on for ever: the same refusal, in bounded time. */
+    FILE *p = popen("exec yes 'v 0 0 0' 2>/dev/null", "r");
+    CHECK(p != NULL);
+    if (p) {
+        char dev[64];
+        snprintf(dev, sizeof dev, "/dev/fd/%d", fileno(p));
+        pd_mesh_read_options ro;
+        pd_mesh_read_options_default(&ro);
+        ro.format = PD_FORMAT_OBJ;
+        expect(pd_mesh_read_capped(dev, &ro, 1 << 20, &m, &d), PD_ERR_RANGE, &d,
+               "more than 1048576 bytes");
+        pclose(p);
+    }
+    /* The real limit is what pd_mesh_read uses. */
+    expect(pd_mesh_read("/dev/zero", NULL, &m, &d), PD_ERR_RANGE, &d, "more than 1073741824 bytes");
+    /* A directory is named as one. */
+    expect(pd_mesh_read("/tmp", NULL, &m, &d), PD_ERR_IO, &d, "/tmp: is a directory");
+
+    /* Triangles: a header may not declare more than PD_MAX_ELEMENTS. */
+    char off[128];
+    snprintf(off, sizeof off, "OFF\n4 %d 0\n", PD_MAX_ELEMENTS + 1);
+    expect(pd_mesh_parse(off, strlen(off), "big.off", NULL, &m, &d), PD_ERR_RANGE, &d,
+           "the limit is 67108864");
+    unsigned char stl[84] = {0};
+    unsigned n = (unsigned)PD_MAX_ELEMENTS + 1;
+    stl[80] = (unsigned char)n;
+    stl[81] = (unsigned char)(n >> 8);
+    stl[82] = (unsigned char)(n >> 16);
+    stl[83] = (unsigned char)(n >> 24);
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    ro.format = PD_FORMAT_STL;
+    expect(pd_mesh_parse(stl, sizeof stl, "big.stl", &ro, &m, &d), PD_ERR_RANGE, &d,
+           "the limit is 67108864");
+    CHECK(m == NULL);
+    test_stl_kind();
+}

@@ -1,0 +1,98 @@
+/* test_number.c: one reading of numbers everywhere (base/number.c): the
+ * outcomes of odd texts, exact 64-bit whole numbers, the one message form,
+ * and the same refusal of an underflowing number in a mesh coordinate. */
+#include <float.h>
+#include <limits.h>
+#include <string.h>
+#include "base/number.h"
+#include "check.h"
+#include "posedrop/mesh.h"
+#include "suites.h"
+
+static int real(const pd_num_rule *r, const char *text, double *v)
+{
+    return pd_num_read(r, text, v, NULL);
+}
+
+void suite_number(void)
+{
+    const pd_num_rule angle = {"an angle", 0, 0.0, 90.0, 0, 0, 0, 0};
+    const pd_num_rule open = {"a half-width", 0, 0.0, 0.5, 1, 1, 0, 0};
+    const pd_num_rule seed = {"a seed", 1, 0, 0, 0, 0, 0, LLONG_MAX};
+    double v = -1.0;
+    long long n = -1;
+
+    /* Blanks at either end are ignored alike; inside they spoil the number. */
+    CHECK_INT(real(&angle, " 5", &v), PD_NUM_OK);
+    CHECK(v == 5.0);
+    CHECK_INT(real(&angle, "5 ", &v), PD_NUM_OK);
+    CHECK_INT(real(&angle, "\t5\n", &v), PD_NUM_OK);
+    CHECK_INT(real(&angle, "5 0", &v), PD_NUM_BAD);
+    CHECK_INT(real(&angle, "", &v), PD_NUM_BAD);
+    CHECK_INT(real(&angle, "  ", &v), PD_NUM_BAD);
+    /* Underflow is refused whatever the range: 1e-400 would read as 0 and a
+     * subnormal has lost digits. 0 itself and the smallest normal are fine. */
+    v = -1.0;
+    CHECK_INT(real(&angle, "1e-400", &v), PD_NUM_TINY);
+    CHECK_INT(real(&open, "1e-400", &v), PD_NUM_TINY);
+    CHECK_INT(real(&angle, "-1e-400", &v), PD_NUM_TINY);
+    CHECK_INT(real(&angle, "4e-320", &v), PD_NUM_TINY);
+    CHECK(v == -1.0); /* untouched on failure */
+    CHECK_INT(real(&angle, "0", &v), PD_NUM_OK);
+    CHECK(v == 0.0);
+    CHECK_INT(real(&angle, "2.2250738585072014e-308", &v), PD_NUM_OK);
+    CHECK(v == DBL_MIN);
+    CHECK_INT(real(&angle, "1e999", &v), PD_NUM_NONFINITE);
+    CHECK_INT(real(&angle, "nan", &v), PD_NUM_NONFINITE);
+    CHECK_INT(real(&angle, "-inf", &v), PD_NUM_NONFINITE);
+    CHECK_INT(real(&angle, "90.0000001", &v), PD_NUM_RANGE);
+    CHECK_INT(real(&angle, "90", &v), PD_NUM_OK);
+    CHECK_INT(real(&open, "0.5", &v), PD_NUM_RANGE);
+    CHECK_INT(real(&open, "0", &v), PD_NUM_RANGE);
+
+    /* Whole numbers: exact up to 2^63 - 1, beyond that out of range (not
+     * saturated or wrapped), and no fractions or exponents. */
+    CHECK_INT(pd_num_read(&seed, "9223372036854775807", NULL, &n), PD_NUM_OK);
+    CHECK(n == LLONG_MAX);
+    CHECK_INT(pd_num_read(&seed, "2000000000000000001", NULL, &n), PD_NUM_OK);
+    CHECK(n == 2000000000000000001LL);
+    CHECK_INT(pd_num_read(&seed, "9223372036854775808", NULL, &n), PD_NUM_RANGE);
+    CHECK_INT(pd_num_read(&seed, "99999999999999999999999", NULL, &n), PD_NUM_RANGE);
+    CHECK_INT(pd_num_read(&seed, "-1", NULL, &n), PD_NUM_RANGE);
+    CHECK_INT(pd_num_read(&seed, " 7 ", NULL, &n), PD_NUM_OK);
+    CHECK(n == 7);
+    CHECK_INT(pd_num_read(&seed, "1e3", NULL, &n), PD_NUM_BAD);
+    CHECK_INT(pd_num_read(&seed, "2.5", NULL, &n), PD_NUM_BAD);
+    CHECK_INT(pd_num_read(&seed, "+", NULL, &n), PD_NUM_BAD);
+
+    /* One message form, stating the range whatever went wrong. */
+    char msg[256];
+    pd_num_message(msg, sizeof msg, &angle, "1e308", PD_NUM_RANGE);
+    CHECK(strcmp(msg, "expected an angle from 0 to 90, got '1e308' (out of range)") == 0);
+    pd_num_message(msg, sizeof msg, &open, "x", PD_NUM_BAD);
+    CHECK(strcmp(msg, "expected a half-width above 0 and below 0.5, got 'x' (not a number)") == 0);
+    pd_num_message(msg, sizeof msg, &seed, "9223372036854775808", PD_NUM_RANGE);
+    CHECK(strstr(msg, "from 0 to 9223372036854775807") != NULL);
+    pd_num_message(msg, sizeof msg, &angle, "1e-400", PD_NUM_TINY);
+    CHECK(strstr(msg, "from 0 to 90") != NULL && strstr(msg, "2.2e-308") != NULL);
+
+    /* A mesh coordinate of 1e-400 is refused like any other number, with its
+     * line, in both readers that read coordinates as text. */
+    const char *off = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1e-400 0\n0 0 1\n"
+                      "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    const char *obj = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1e-400\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+    const char *texts[2] = {off, obj}, *where[2] = {"t.off:5:", "t.obj:4:"};
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    for (int i = 0; i < 2; i++) {
+        pd_mesh *m = NULL;
+        pd_diag d;
+        pd_diag_init(&d);
+        ro.format = i ? PD_FORMAT_OBJ : PD_FORMAT_OFF;
+        CHECK_STATUS(pd_mesh_parse(texts[i], strlen(texts[i]), i ? "t.obj" : "t.off", &ro, &m, &d),
+                     PD_ERR_RANGE);
+        CHECK(strstr(d.message, where[i]) != NULL && strstr(d.message, "2.2e-308") != NULL);
+        CHECK(m == NULL);
+        pd_mesh_free(m);
+    }
+}
