@@ -33,7 +33,8 @@ typedef struct pd_hull {
 } pd_hull;
 
 /* Convex hull of npts points. Classifies degenerate input first:
- * PD_ERR_TOO_FEW_POINTS (< 4), PD_ERR_NONFINITE, PD_ERR_COLOCATED,
+ * PD_ERR_TOO_FEW_POINTS (< 4), PD_ERR_NONFINITE, PD_ERR_RANGE (a size, the
+ * bounding-box diagonal, outside 1e-30 to 1e30 m: docs/limits.md), PD_ERR_COLOCATED,
  * PD_ERR_COLLINEAR, PD_ERR_COPLANAR; also PD_ERR_NOMEM, PD_ERR_INTERNAL.
  * On success *hull is owned by the caller (pd_hull_free). */
 PD_API pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *diag);

@@ -25,22 +25,35 @@ typedef struct pd_part_options {
 
 PD_API void pd_part_options_default(pd_part_options *options);
 
+/* The part's frame is the mesh's frame moved to origin, a point near the
+ * part: every position below (mesh vertices, hull, centre of mass, mass
+ * properties) is relative to it, so that its round-off is relative to the
+ * part's size, not to its distance from the mesh's origin (a 1 um part at
+ * 1000 km would otherwise carry rounding steps of 1e-4 of its size into every
+ * height). Add origin to a position to get it in the mesh's frame.
+ * Directions, areas and heights are the same in both. */
 typedef struct pd_part {
+    pd_vec3 origin;    /* m, in the mesh's frame; 0 for a part within about
+                          its own size of the mesh's origin */
     pd_mesh *mesh;     /* welded and, when closed, consistently oriented */
     double size;       /* bounding-box diagonal, m: the length scale of all tolerances */
     int closed;        /* 1 if the mesh is a closed surface */
     int mass_known;    /* 1 if mass holds the mesh's own mass properties */
     pd_mass mass;      /* volume and inertia valid only when mass_known */
-    pd_vec3 com;       /* centre of mass used: given or computed, m */
+    pd_vec3 com;       /* centre of mass used: given or computed, m,
+                          relative to origin */
     pd_hull *hull;
 } pd_part;
 
-/* Builds a part from a mesh (the mesh is copied, not kept). Steps: weld at
+/* Builds a part from a mesh (the mesh is copied, not kept). Steps: move to
+ * the part's origin (above); weld at
  * PD_TOL_WELD_REL of the size; orient (faces flipped are reported by a warning);
  * mass properties; convex hull; centre of mass strictly inside the hull.
  * A mesh that is not closed is accepted only with options->com_given.
  * options may be NULL. Returns the statuses of pd_mesh_orient, pd_mass_compute
- * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM. */
+ * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM; PD_ERR_RANGE for a
+ * size outside 1e-30 to 1e30 m, where products of the part's lengths would
+ * leave the normal doubles (docs/limits.md). */
 PD_API pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options,
                                pd_part **part, pd_diag *diag);
 

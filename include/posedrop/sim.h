@@ -58,21 +58,34 @@ typedef struct pd_scene {
     pd_initial initial;     /* PD_INITIAL_UNIFORM */
     double gravity;         /* m/s^2; 9.81 */
     double contact_time;    /* s: how long one contact takes to compress and
-                               restore, a property of the materials; 5e-4 (a
-                               plastic part on a rubber belt). With more than one
-                               vertex on the floor at once or within this time,
-                               the impulse simulator's impact is compliant (a
-                               Hunt-Crossley law at each, with friction); one
-                               vertex alone keeps the rigid law, its limit.
-                               0: rigid throughout (the paper's model) */
+                               restore, a property of the materials and of the
+                               part's size. With more than one vertex on the
+                               floor at once or within this time, the impulse
+                               simulator's impact is compliant (a Hunt-Crossley
+                               law at each, with friction); one vertex alone
+                               keeps the rigid law, its limit. 0: rigid
+                               throughout (the paper's model).
+                               PD_CONTACT_TIME_AUTO (the default): a plastic part
+                               on a rubber belt, pd_contact_time_auto() */
 } pd_scene;
+
+/* contact_time's default: the duration a Hertz contact of a plastic part on a
+ * rubber belt takes at the drop's speed, 5e-4 s for a 1 cm cube, in
+ * proportion to the part's size for geometrically similar parts (Hertz: the
+ * duration goes as (m^2 / (R E^2 v))^(1/5), with the mass m ~ L^3 and the
+ * corner radius R ~ L: as L). docs/contact.md. */
+#define PD_CONTACT_TIME_AUTO (-1.0)
+
+/* The duration PD_CONTACT_TIME_AUTO stands for, for a part of size L (the
+ * bounding-box diagonal, m): 5e-4 s times L over a 1 cm cube's diagonal. */
+PD_API double pd_contact_time_auto(double size);
 
 PD_API void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed, mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
- * (uniform|bootstrap|stationary), gravity, contact_time (s). PD_ERR_USAGE for
+ * (uniform|bootstrap|stationary), gravity, contact_time (s, or auto). PD_ERR_USAGE for
  * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
  * of range; the scene is unchanged on failure. */
 PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
@@ -84,7 +97,8 @@ PD_API pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
 /* Whether every field of a scene is one pd_scene_set would accept: height 0
  * to 1000 m, belt_speed -1000 to 1000 m/s, mu 0 to 10, restitution 0 to 1,
  * vibration 0 to pi rad (180 degrees), gravity 0.001 to 1000 m/s^2,
- * contact_time 0 to 1 s, and law and initial one of their enum values.
+ * contact_time 0 to 1 s or PD_CONTACT_TIME_AUTO, and law and initial one of
+ * their enum values.
  * PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_RANGE for a value out of
  * range; the message names the field. pd_sim_run calls it first. */
 PD_API pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag);

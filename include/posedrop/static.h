@@ -58,8 +58,10 @@ typedef struct pd_facet_result {
     double p_raw;       /* solid_angle / (4 pi) */
     double area;        /* m^2 */
     double height;      /* centre of mass above the floor when resting here, m */
-    int stable;         /* 1 iff the centre of mass projects strictly inside */
-    int knife;          /* 1 if it projects on the boundary (within tolerance) */
+    int stable;         /* 1 iff the centre of mass projects strictly inside,
+                           or on the boundary with no lower facet across it */
+    int knife;          /* 1 if it projects on the boundary (within tolerance)
+                           and a facet across it is lower: then unstable */
     int next;           /* QSG successor (unstable facets), -1 for stable ones */
     int rest;           /* the stable facet this facet ends on (itself if stable) */
     double p_qs;        /* final QS probability (0 unless stable) */

@@ -20,7 +20,8 @@ typedef enum pd_status {
     PD_ERR_FORMAT,         /* unknown or unrecognisable file format */
     PD_ERR_PARSE,          /* malformed content: bad token, wrong count, truncated file */
     PD_ERR_NONFINITE,      /* a NaN or infinite number in the input */
-    PD_ERR_RANGE,          /* an index out of range or a count too large to be real */
+    PD_ERR_RANGE,          /* an index out of range, a count too large to be real, or a
+                              part size outside the supported range (docs/limits.md) */
     PD_ERR_TOO_FEW_POINTS, /* fewer than 4 distinct points */
     PD_ERR_COLOCATED,      /* all points coincide within the weld tolerance */
     PD_ERR_COLLINEAR,      /* all points on one line */

@@ -45,15 +45,6 @@
  * stay two. */
 #define PD_TOL_PLANE_REL 1e-7
 
-/* Smallest point-set size (bounding-box diagonal, metres) the hull accepts;
- * below it the points count as colocated. Why 1e-90: the exact orientation
- * predicate multiplies three coordinate differences, and for sizes below
- * ~1e-100 those products (1e-300) reach the subnormal range of double, where
- * they are no longer exact. No physical part is within 80 orders of
- * magnitude of this; larger would refuse real parts, smaller would let the
- * predicate silently lose its exactness. */
-#define PD_HULL_MIN_SIZE 1e-90
-
 /* --- static estimators ----------------------------------------------------- */
 
 /* The centre of mass must lie at least this far inside every hull facet

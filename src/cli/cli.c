@@ -374,8 +374,9 @@ static const cli_option options[] = {
      "0..180 (1.5)"},
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
-     "0..1 (a material property; 5e-4, a plastic part on a rubber\n"
-     "belt; 0: rigid, the paper's model)"},
+     "0..1, or auto (default): a plastic part on a rubber belt,\n"
+     "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
+     "0: rigid, the paper's model"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -759,8 +760,9 @@ static void print_summary(const cli_args *a, const pd_part *part, const pd_stati
             part->mesh->ntris, part->closed ? "" : " (not closed)", part->size);
     if (part->mass_known)
         fprintf(stderr, "%s: volume %.6g m^3\n", a->path, part->mass.volume);
-    fprintf(stderr, "%s: centre of mass (%.9g, %.9g, %.9g) m%s\n", a->path, part->com.x, part->com.y,
-            part->com.z, a->part.com_given ? " (given)" : "");
+    const pd_vec3 *c = &part->com, *o = &part->origin; /* in the file's frame */
+    fprintf(stderr, "%s: centre of mass (%.9g, %.9g, %.9g) m%s\n", a->path, c->x + o->x,
+            c->y + o->y, c->z + o->z, a->part.com_given ? " (given)" : "");
     fprintf(stderr, "%s: hull %d vertices, %d facets; %d stable poses, %d knife edges\n", a->path,
             h->nverts, h->nfacets, res->nposes, res->nknife);
 }

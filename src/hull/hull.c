@@ -13,6 +13,7 @@
 #include "hull/hull_internal.h"
 #include "posedrop/tolerances.h"
 #include "base/predicates.h"
+#include "base/size_range.h"
 #include "base/vec3.h"
 
 /* Classifies pts and picks the seed tetrahedron; sets *size. */
@@ -40,12 +41,13 @@ static pd_status classify(const pd_vec3 *p, int n, int seed[4], double *size, pd
             ext[5] = i;
     }
     pd_vec3 lo = v3(p[ext[0]].x, p[ext[2]].y, p[ext[4]].z), hi = v3(p[ext[1]].x, p[ext[3]].y, p[ext[5]].z);
+    pd_status st = pd_size_check(lo, hi, "convex hull: ", diag);
+    if (st != PD_OK)
+        return st;
     double L = v3_dist(lo, hi);
     *size = L;
-    if (!(L >= PD_HULL_MIN_SIZE))
-        return pd_fail(diag, PD_ERR_COLOCATED,
-                       "convex hull: all %d points coincide (bounding-box diagonal %.3g m, minimum %.3g m)", n, L,
-                       PD_HULL_MIN_SIZE);
+    if (L == 0.0)
+        return pd_fail(diag, PD_ERR_COLOCATED, "convex hull: all %d points coincide", n);
     double tol = PD_TOL_PLANE_REL * L;
     /* The farthest pair among the six extremes spans at least L / sqrt(3). */
     int a = ext[0], b = ext[1];

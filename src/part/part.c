@@ -5,8 +5,12 @@
  * co-located, collinear, coplanar points); closedness and orientation come
  * next, then mass properties, then the centre of mass is checked against the
  * hull. */
+#include <float.h>
+#include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include "base/fail.h"
+#include "base/size_range.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
 #include "base/vec3.h"
@@ -43,31 +47,95 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
     }
     if (worst_gap > tol)
         return PD_OK;
-    pd_vec3 n = h->normal[worst];
+    pd_vec3 n = h->normal[worst], c = v3_add(p->com, p->origin);
     if (worst_gap >= -tol)
         return pd_fail(diag, PD_ERR_COM_OUTSIDE,
-                       "centre of mass (%.9g, %.9g, %.9g) m lies on the convex hull (on the "
-                       "facet with normal %.6g, %.6g, %.6g): no pose can rest on it",
-                       p->com.x, p->com.y, p->com.z, n.x, n.y, n.z);
+                       "centre of mass (%.9g, %.9g, %.9g) m lies on the convex hull (%.3g m "
+                       "from the plane of the facet with normal %.6g, %.6g, %.6g, within the "
+                       "tolerance %.3g m, %g of the part's size): no pose can rest on it",
+                       c.x, c.y, c.z, fabs(worst_gap), n.x, n.y, n.z, tol, PD_TOL_COM_INSIDE_REL);
     return pd_fail(diag, PD_ERR_COM_OUTSIDE,
                    "centre of mass (%.9g, %.9g, %.9g) m lies outside the convex hull, %.3g m "
                    "beyond the facet with normal %.6g, %.6g, %.6g",
-                   p->com.x, p->com.y, p->com.z, -worst_gap, n.x, n.y, n.z);
+                   c.x, c.y, c.z, -worst_gap, n.x, n.y, n.z);
+}
+
+/* The part's origin: the centre of the bounding box [lo, hi] rounded to a
+ * multiple of u, the least power of two above the size L (L < u <= 2 L).
+ * Positions relative to it are within 1.5 L per axis, so everything computed
+ * from them carries round-off relative to L; the move itself rounds by at
+ * most half an ulp of 1.5 L, and not at all on an axis where the origin is 3 L
+ * or more from the file's (Sterbenz: v and o within a factor 2). Rounding to
+ * u, rather than taking the centre itself, keeps a part that lies within
+ * about its size of the file's origin where it is (origin 0: the same bits
+ * as without the move). */
+static pd_vec3 part_origin(pd_vec3 lo, pd_vec3 hi, double L)
+{
+    double u = ldexp(1.0, ilogb(L) + 1), c[3] = {lo.x, lo.y, lo.z}, d[3] = {hi.x, hi.y, hi.z};
+    for (int i = 0; i < 3; i++)
+        c[i] = u * floor((c[i] + 0.5 * (d[i] - c[i])) / u + 0.5);
+    return v3(c[0], c[1], c[2]);
+}
+
+/* A part thinner than the weld tolerance loses its distinct vertices to
+ * welding, and the hull's refusal (too few points, or flat) would describe
+ * what was left rather than what was given: say what welding did. */
+static pd_status weld_explains(pd_status st, int nbefore, int nafter, double size, pd_diag *diag)
+{
+    if (nafter == nbefore || !diag ||
+        (st != PD_ERR_TOO_FEW_POINTS && st != PD_ERR_COLOCATED && st != PD_ERR_COLLINEAR &&
+         st != PD_ERR_COPLANAR))
+        return st;
+    char hull[PD_DIAG_MESSAGE_LEN];
+    snprintf(hull, sizeof hull, "%s", diag->message);
+    return pd_fail(diag, st,
+                   "welding vertices closer than %.3g m (%g of the part's size %.3g m) left "
+                   "%d of its %d vertices on faces with area: the part is thinner than that (%s)",
+                   PD_TOL_WELD_REL * size, PD_TOL_WELD_REL, size, nafter, nbefore, hull);
 }
 
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
-    /* Every size-relative tolerance below needs a finite size. */
-    for (int i = 0; i < p->mesh->nverts; i++)
-        if (!v3_isfinite(p->mesh->verts[i]))
+    /* Every size-relative tolerance below needs a finite size, within the
+     * range where products of the part's lengths stay normal doubles. */
+    pd_mesh *m = p->mesh;
+    for (int i = 0; i < m->nverts; i++)
+        if (!v3_isfinite(m->verts[i]))
             return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
-    p->size = pd_mesh_size(p->mesh);
+    pd_vec3 lo = v3(0.0, 0.0, 0.0), hi = lo;
+    for (int i = 0; i < m->nverts; i++) {
+        pd_vec3 v = m->verts[i];
+        lo = i == 0 ? v : v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
+        hi = i == 0 ? v : v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
+    }
+    pd_status st = pd_size_check(lo, hi, "", diag);
+    if (st != PD_OK)
+        return st;
+    p->size = pd_mesh_size(m);
+    if (p->size > 0.0) {
+        p->origin = part_origin(lo, hi, p->size);
+        /* The move keeps the digits the file has; it cannot restore those a
+         * far-off placement already rounded away. */
+        double far = fmax(fmax(fmax(fabs(lo.x), fabs(hi.x)), fmax(fabs(lo.y), fabs(hi.y))),
+                          fmax(fabs(lo.z), fabs(hi.z)));
+        double step = far * DBL_EPSILON;
+        if (step > PD_TOL_PLANE_REL * p->size)
+            pd_warn(diag, "coordinates reach %.3g m from the file's origin, so they are rounded "
+                          "in steps of up to %.3g m, %.2g of the part's size %.3g m (more than "
+                          "the plane tolerance %.0e): the part is taken as the rounded points",
+                    far, step, step / p->size, p->size, PD_TOL_PLANE_REL);
+        for (int i = 0; i < m->nverts; i++)
+            m->verts[i] = v3_sub(m->verts[i], p->origin);
+    }
+    pd_vec3 com_given = v3_sub(opt->com, p->origin);
+    int nbefore = m->nverts;
+    double size0 = p->size;
     if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
         return PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
-    pd_status st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
+    st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
     if (st != PD_OK)
-        return st;
+        return weld_explains(st, nbefore, p->mesh->nverts, size0, diag);
 
     int flipped = 0;
     st = pd_mesh_orient(p->mesh, &flipped, diag);
@@ -96,7 +164,7 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
         else if (diag)
             diag->message[0] = '\0';
     }
-    p->com = opt->com_given ? opt->com : p->mass.com;
+    p->com = opt->com_given ? com_given : p->mass.com;
     if (!v3_isfinite(p->com))
         return pd_fail(diag, PD_ERR_NONFINITE, "centre of mass is not finite");
     return check_com_inside(p, diag);

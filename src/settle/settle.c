@@ -32,7 +32,13 @@ pd_status pd_settle_build(const pd_part *part, const pd_body *body, const pd_sta
     pd_static_options_default(&so);
     so.topple = PD_TOPPLE_DESCENT;
     so.epsilon = 0.0;
-    pd_status s = pd_static_estimate(part, &so, &st->descent, diag);
+    /* The estimate that made poses has given the part's warnings (knife
+     * edges) already; this one, of the same part, would repeat them. */
+    pd_diag quiet;
+    pd_diag_init(&quiet);
+    pd_status s = pd_static_estimate(part, &so, &st->descent, &quiet);
+    if (s != PD_OK)
+        pd_fail(diag, s, "%s", quiet.message);
     if (s == PD_OK)
         s = pd_star_build(part->hull, &st->star);
     if (s == PD_OK)

@@ -245,7 +245,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
             if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                      sc->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+                                      m->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
             if (imp.kind == PD_IMPACT_NONE) {
                 t = o->time_limit;
@@ -311,7 +311,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
-                resolved = out->collisions - before < PD_MAX_ROUNDS && sc->contact_time == 0.0;
+                resolved = out->collisions - before < PD_MAX_ROUNDS && m->contact_time == 0.0;
                 f_at = -1.0;
                 continue;
             }

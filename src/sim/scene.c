@@ -22,7 +22,12 @@ void pd_scene_default(pd_scene *s)
     s->vibration = 1.5 * M_PI / 180.0;
     s->initial = PD_INITIAL_UNIFORM;
     s->gravity = 9.81;
-    s->contact_time = 5e-4; /* a plastic part on a rubber belt (docs/method.md) */
+    s->contact_time = PD_CONTACT_TIME_AUTO;
+}
+
+double pd_contact_time_auto(double size)
+{
+    return 5e-4 * size / (0.01 * sqrt(3.0));
 }
 
 typedef struct {
@@ -75,6 +80,8 @@ pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag)
     for (int i = 0; i < NNUMERIC; i++) {
         const numeric_key *k = &keys[i];
         double v = *field((pd_scene *)scene, k);
+        if (k->field == offsetof(pd_scene, contact_time) && v == PD_CONTACT_TIME_AUTO)
+            continue;
         /* The stored value is the text's times scale, rounded; rounding is
          * monotonic, so lo * scale and hi * scale bound exactly what
          * pd_scene_set accepts. The message is the text's, in its unit. */
@@ -105,6 +112,10 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
     for (int i = 0; i < NNUMERIC; i++) {
         if (strcmp(key, keys[i].key) != 0)
             continue;
+        if (keys[i].field == offsetof(pd_scene, contact_time) && strcmp(value, "auto") == 0) {
+            s->contact_time = PD_CONTACT_TIME_AUTO;
+            return PD_OK;
+        }
         double v;
         int rc = pd_num_read(&keys[i].rule, value, &v, NULL);
         if (rc != PD_NUM_OK) {

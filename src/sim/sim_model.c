@@ -55,13 +55,16 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     pd_status st = pd_body_build(part, &m->body, diag);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
-    if (st == PD_OK && !m->engine && scene->contact_time > 0.0) {
+    m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
+                          ? pd_contact_time_auto(part->size)
+                          : scene->contact_time;
+    if (st == PD_OK && !m->engine && m->contact_time > 0.0) {
         m->compliant_on = 1;
-        st = pd_compliant_init(scene->restitution, scene->contact_time, m->body, tol_scale,
+        st = pd_compliant_init(scene->restitution, m->contact_time, m->body, tol_scale,
                                &m->compliant);
         if (st != PD_OK)
             st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
-                         "time %g s could not be set up", scene->restitution, scene->contact_time);
+                         "time %g s could not be set up", scene->restitution, m->contact_time);
     }
     if (st != PD_OK) {
         pd_sim_model_free(m);
@@ -80,9 +83,13 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     pd_drop_work *w = calloc(1, sizeof *w);
     if (!w)
         return NULL;
-    if (model->engine)
-        w->world = model->engine->world_alloc(model->body, model->hull, scene, model->dt);
-    else {
+    if (model->engine) {
+        /* The engines see the contact time the run resolved, never the
+         * "auto" marker. */
+        pd_scene resolved = *scene;
+        resolved.contact_time = model->contact_time;
+        w->world = model->engine->world_alloc(model->body, model->hull, &resolved, model->dt);
+    } else {
         w->impact = pd_impact_work_alloc_tol(model->tol_scale);
         w->phase = pd_contact_phase_ode_alloc_tol(model->tol_scale);
         w->pivot = pd_contact_pivot_ode_alloc_tol(model->tol_scale);

@@ -30,6 +30,7 @@ typedef struct pd_sim_model {
     const pd_engine *engine;    /* NULL: the impulse simulator */
     double dt;                  /* the stepping engine's fixed step */
     double v_eps;               /* approach speeds below this are contact, not impact */
+    double contact_time;        /* s: the scene's, PD_CONTACT_TIME_AUTO resolved */
     int compliant_on;           /* the impulse engine with contact_time > 0 */
     pd_compliant compliant;     /* its impacts with more than one contact */
     double tol_scale;           /* every integration tolerance times this (1) */

@@ -6,6 +6,14 @@
 #include "static/static_internal.h"
 #include "base/vec3.h"
 
+double pd_facet_edge_inside(const pd_hull *hull, pd_vec3 com, int f, int i)
+{
+    const int *loop = hull->facet_vert + hull->facet_start[f];
+    int k = hull->facet_start[f + 1] - hull->facet_start[f];
+    pd_vec3 a = hull->verts[loop[i]], b = hull->verts[loop[(i + 1) % k]];
+    return v3_dot(v3_sub(com, a), v3_unit(v3_cross(hull->normal[f], v3_sub(b, a))));
+}
+
 void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
                        pd_facet_result *r)
 {
@@ -34,7 +42,7 @@ void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
     for (int i = 0; i < k; i++) {
         pd_vec3 a = hull->verts[loop[i]], b = hull->verts[loop[(i + 1) % k]];
         pd_vec3 e = v3_sub(b, a), ca = v3_sub(com, a);
-        double d = v3_dot(ca, v3_unit(v3_cross(n, e)));
+        double d = pd_facet_edge_inside(hull, com, f, i);
         if (d < inside) {
             inside = d;
             best_edge = i;

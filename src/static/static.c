@@ -87,11 +87,12 @@ static pd_status estimate(const pd_part *part, const pd_static_options *opt,
         pd_facet_classify(hull, part->com, f, &geom[f], &fr[f]);
         fr[f].solid_angle = pd_solid_angle_facet(hull, part->com, f, geom[f].nearest);
         fr[f].p_raw = fr[f].solid_angle / (4.0 * M_PI);
-        res->nknife += fr[f].knife;
     }
     pd_status st = pd_topple_graph(hull, part->com, geom, opt->topple, res, diag);
     if (st != PD_OK)
         return st;
+    for (int f = 0; f < hull->nfacets; f++)
+        res->nknife += fr[f].knife;
     warn_knives(hull, res, diag);
     for (int f = 0; f < hull->nfacets; f++)
         fr[fr[f].rest].p_qs += fr[f].p_raw;

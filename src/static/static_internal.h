@@ -14,6 +14,24 @@
 #include "posedrop/status.h"
 #include "posedrop/types.h"
 
+/* A knife facet (the centre of mass's foot within PD_TOL_KNIFE_REL of its
+ * boundary) counts as unstable only where toppling across an edge of that
+ * boundary lowers the centre of mass by more than this, relative to the
+ * size L. Why 1e-13: heights are offset - n . com with both terms at most
+ * ~2.6 L in the part's frame (positions within 1.5 L of its origin per axis),
+ * so their round-off is a few ulps of that, ~2e-15 L; 1e-13 is 50 times
+ * above. Below it, which neighbour is lower is decided by round-off: on a
+ * flat regular pyramid the foot lies at the apex, within the knife band of
+ * every side facet, and all of them are at one height; toppling each to a
+ * neighbour of "lower" round-off made the graph a cycle. Exactly, those
+ * facets are stable (the foot is inside each, by ~h^2 / r), and so they are
+ * counted. A genuine knife across an edge of dihedral turn phi drops by
+ * r phi^2 / 2 (r the centre's distance from the edge), above this for
+ * phi > sqrt(2e-13 L / r), 1.4e-6 rad at r = 0.1 L; flatter edges with the
+ * centre exactly over them are ambiguous at this precision either way. Larger: such knives would stay
+ * stable more often; smaller: round-off would pick the way down again. */
+#define PD_TOL_KNIFE_DROP_REL 1e-13
+
 /* Where the centre of mass projects relative to one facet's polygon. */
 typedef struct facet_geom {
     pd_vec3 foot;    /* projection of the centre of mass onto the facet plane */
@@ -28,6 +46,10 @@ typedef struct facet_geom {
     int best_edge;   /* loop position of the edge beyond whose line foot lies
                         farthest: the paper's toppling edge */
 } facet_geom;
+
+/* Signed distance of the centre of mass's foot on facet f from the line of
+ * its edge i (loop corner i to i + 1), positive inside. */
+double pd_facet_edge_inside(const pd_hull *hull, pd_vec3 com, int f, int i);
 
 /* Fills g and the area, height, stable and knife fields of r for facet f. */
 void pd_facet_classify(const pd_hull *hull, pd_vec3 com, int f, facet_geom *g,
@@ -51,7 +73,8 @@ pd_status pd_descend(const pd_hull *hull, const pd_star *star, pd_vec3 com, pd_v
                      int *facet, int *hint);
 
 /* The quasi-static successor of every unstable facet: res->facets[f].next,
- * and .rest for all facets. Checks that every link lowers the centre of mass
+ * and .rest for all facets. A knife facet with no lower facet across its
+ * boundary becomes stable (one warning counts them). Checks that every link lowers the centre of mass
  * (PD_ERR_INTERNAL otherwise) and that descent ends (PD_ERR_NO_CONVERGENCE). */
 pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
                           pd_topple_rule rule, pd_static_result *res, pd_diag *diag);

@@ -143,10 +143,61 @@ static pd_status resolve_rest(pd_static_result *res, pd_diag *diag)
     return PD_OK;
 }
 
+/* Where knife facet f topples: across its best edge (the paper's rule) when
+ * that lowers the centre of mass, else across the edge within the knife
+ * band whose neighbour is lowest; -1 when none is lower by more than
+ * PD_TOL_KNIFE_DROP_REL (then f is stable after all). */
+static int knife_exit(const pd_hull *hull, pd_vec3 com, const facet_geom *g,
+                      const pd_static_result *res, int f)
+{
+    int base = hull->facet_start[f], k = hull->facet_start[f + 1] - base;
+    double top = res->facets[f].height - PD_TOL_KNIFE_DROP_REL * hull->size;
+    int best = hull->facet_adj[base + g->best_edge];
+    if (res->facets[best].height < top)
+        return best;
+    double knife = PD_TOL_KNIFE_REL * hull->size;
+    int out = -1;
+    for (int i = 0; i < k; i++) {
+        int nb = hull->facet_adj[base + i];
+        if (pd_facet_edge_inside(hull, com, f, i) <= knife && res->facets[nb].height < top &&
+            (out < 0 || res->facets[nb].height < res->facets[out].height))
+            out = nb;
+    }
+    return out;
+}
+
+/* Knife facets with no way down are stable: the centre of mass sits in a
+ * valley that only round-off made look like a ridge. One warning names how
+ * many, and the first. */
+static void settle_flat_knives(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
+                               pd_static_result *res, int *exit_of, pd_diag *diag)
+{
+    int count = 0, first = -1;
+    for (int f = 0; f < res->nfacets; f++) {
+        pd_facet_result *r = &res->facets[f];
+        exit_of[f] = r->knife ? knife_exit(hull, com, &geom[f], res, f) : -1;
+        if (r->knife && exit_of[f] < 0) {
+            r->knife = 0;
+            r->stable = 1;
+            if (count++ == 0)
+                first = f;
+        }
+    }
+    if (count > 0)
+        pd_warn(diag,
+                "%d facet%s (the first is facet %d): the centre of mass projects within %.3g m "
+                "of the boundary, but no facet across it is lower; counted as stable",
+                count, count > 1 ? "s" : "", first + 1, PD_TOL_KNIFE_REL * hull->size);
+}
+
 pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
                           pd_topple_rule rule, pd_static_result *res, pd_diag *diag)
 {
     pd_star star = {NULL, NULL};
+    int *exit_of = malloc(sizeof *exit_of * (size_t)(hull->nfacets > 0 ? hull->nfacets : 1));
+    if (!exit_of)
+        return PD_ERR_NOMEM;
+    settle_flat_knives(hull, com, geom, res, exit_of, diag);
     pd_status st = PD_OK;
     if (rule == PD_TOPPLE_DESCENT)
         st = pd_star_build(hull, &star);
@@ -157,7 +208,9 @@ pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *ge
         r->next = -1;
         if (r->stable)
             continue;
-        if (rule == PD_TOPPLE_EDGE || r->knife)
+        if (r->knife)
+            r->next = exit_of[f];
+        else if (rule == PD_TOPPLE_EDGE)
             r->next = hull->facet_adj[base + g->best_edge];
         else if (g->near_vertex < 0)
             r->next = hull->facet_adj[base + g->near_edge];
@@ -181,6 +234,7 @@ pd_status pd_topple_graph(const pd_hull *hull, pd_vec3 com, const facet_geom *ge
                          f + 1, r->next + 1, rise);
     }
     pd_star_free(&star);
+    free(exit_of);
     if (st == PD_OK)
         st = resolve_rest(res, diag);
     return st;

@@ -66,7 +66,8 @@ int pd_fuzz_scene(const uint8_t *data, size_t size)
         return memcmp(&s, &before, sizeof s) == 0 && d.message[0] != '\0';
     return s.height >= 0 && s.height <= 1e3 && s.mu >= 0 && s.mu <= 10 && s.restitution >= 0 &&
            s.restitution <= 1 && s.gravity > 0 && isfinite(s.belt_speed) && s.vibration >= 0 &&
-           s.contact_time >= 0;
+           (s.contact_time >= 0 || s.contact_time == PD_CONTACT_TIME_AUTO) &&
+           pd_scene_check(&s, NULL) == PD_OK;
 }
 
 /* Mesh in (any format, by content), part model out, then its static

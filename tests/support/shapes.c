@@ -205,6 +205,16 @@ int pts_prism(int nsides, double radius, double height, pd_vec3 *out)
     return 2 * nsides;
 }
 
+int pts_flat_pyramid(int nsides, double height, pd_vec3 *out)
+{
+    for (int i = 0; i < nsides; i++) {
+        double t = 2.0 * M_PI * i / nsides;
+        out[i] = v3(cos(t), sin(t), 0.0);
+    }
+    out[nsides] = v3(0.0, 0.0, height);
+    return nsides + 1;
+}
+
 int pts_tetrahedron(pd_vec3 *out)
 {
     out[0] = v3(1, 1, 1);
@@ -315,6 +325,20 @@ pd_part *part_of(pd_mesh *m, const pd_vec3 *com, pd_diag *diag)
     if (st != PD_OK)
         printf("     part_of: %s (%s)\n", pd_status_str(st), diag ? diag->message : "");
     return st == PD_OK ? part : NULL;
+}
+
+pd_status part_of_points(const pd_vec3 *pts, int n, pd_part **part, pd_diag *diag)
+{
+    pd_hull *h = NULL;
+    *part = NULL;
+    pd_status st = pd_hull_build(pts, n, &h, diag);
+    if (st == PD_OK) {
+        pd_mesh *m = mesh_of_hull(h);
+        st = m ? pd_part_build(m, NULL, part, diag) : PD_ERR_NOMEM;
+        pd_mesh_free(m);
+    }
+    pd_hull_free(h);
+    return st;
 }
 
 pd_part *part_random_ellipsoid(test_rng *rng, int n, double ay, double az, double cx, double cy)

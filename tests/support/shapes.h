@@ -41,6 +41,9 @@ int convex_facet_count(const pd_vec3 *pts, int n);
 int pts_box(double ax, double ay, double az, pd_vec3 *out);   /* edge lengths */
 int pts_prism(int nsides, double radius, double height, pd_vec3 *out); /* n <= 32 */
 int pts_tetrahedron(pd_vec3 *out);
+/* A regular pyramid, flat when height << 1: nsides (<= 64) corners of
+ * circumradius 1 on z = 0 (the first on +x) and the apex at (0, 0, height). */
+int pts_flat_pyramid(int nsides, double height, pd_vec3 *out);
 int pts_cube(pd_vec3 *out);
 int pts_octahedron(pd_vec3 *out);
 int pts_dodecahedron(pd_vec3 *out);
@@ -91,6 +94,12 @@ struct pd_part *ring_part(const ring_spec *r, const double R[3][3], double scale
  * P(X > statistic) with nposes - 1 degrees of freedom. */
 struct pd_sim_result;
 double uniform_p_value(const struct pd_sim_result *r);
+
+/* The part of the hull of n points (pd_hull_build, then pd_part_build on
+ * its facets): PD_OK and *part, or the first refusal, its message in diag
+ * (may be NULL); nothing printed. */
+struct pd_part;
+pd_status part_of_points(const pd_vec3 *pts, int n, struct pd_part **part, struct pd_diag *diag);
 
 /* Convenience: convex_mesh of the points above. */
 pd_mesh *mesh_box(double ax, double ay, double az);

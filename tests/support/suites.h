@@ -10,6 +10,7 @@
     PD_SUITE(mass)   \
     PD_SUITE(part)   \
     PD_SUITE(static) \
+    PD_SUITE(limits) \
     PD_SUITE(basin)  \
     PD_SUITE(descent_map) \
     PD_SUITE(rng)    \

@@ -14,7 +14,11 @@ void suite_scene(void)
     CHECK(s.height == 0.12 && s.belt_speed == 0.05 && s.mu == 0.3 && s.restitution == 0.3);
     CHECK_NEAR(s.vibration, 1.5 * M_PI / 180, 1e-17, "1.5 degrees");
     CHECK(s.law == PD_RESTITUTION_POISSON && s.initial == PD_INITIAL_UNIFORM);
-    CHECK(s.contact_time == 5e-4); /* a plastic part on a rubber belt */
+    CHECK(s.contact_time == PD_CONTACT_TIME_AUTO); /* a plastic part on a rubber belt */
+    /* 5e-4 s for a 1 cm cube (diagonal sqrt(3) cm), in proportion to size. */
+    CHECK_REL(pd_contact_time_auto(0.01 * sqrt(3.0)), 5e-4, 1e-15, "round-off");
+    CHECK_REL(pd_contact_time_auto(1.0), 1e2 * pd_contact_time_auto(0.01), 1e-15, "linear");
+    CHECK_STATUS(pd_scene_check(&s, NULL), PD_OK);
 
     pd_diag d;
     pd_diag_init(&d);
@@ -30,6 +34,14 @@ void suite_scene(void)
     CHECK(s.initial == PD_INITIAL_STATIONARY);
     CHECK_STATUS(pd_scene_set(&s, "contact_time", "1e-4", &d), PD_OK);
     CHECK(s.contact_time == 1e-4);
+    CHECK_STATUS(pd_scene_set(&s, "contact_time", "auto", &d), PD_OK);
+    CHECK(s.contact_time == PD_CONTACT_TIME_AUTO);
+    CHECK_STATUS(pd_scene_set(&s, "contact_time", "1e-4", &d), PD_OK);
+    {
+        pd_scene bad = s;
+        bad.contact_time = -0.5; /* only the marker itself is "auto" */
+        CHECK_STATUS(pd_scene_check(&bad, NULL), PD_ERR_RANGE);
+    }
     pd_scene before = s;
     CHECK_STATUS(pd_scene_set(&s, "contact_time", "-1e-4", &d), PD_ERR_RANGE);
     CHECK_STATUS(pd_scene_set(&s, "restitution", "1.5", &d), PD_ERR_RANGE);
