@@ -806,8 +806,9 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
 {
     if (sim->unsettled)
-        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit) and "
-                        "are in no count\n", prog, a->path, sim->unsettled, sim->n);
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
+                        "the engine failed) and are in no count\n", prog, a->path, sim->unsettled,
+                sim->n);
     if (sim->energy_gain)
         fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
                         "friction, resolved by the energetic law; or a compliant impact's step, "

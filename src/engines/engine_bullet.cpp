@@ -16,9 +16,12 @@
  *   not the inflated ones, rest on z = 0;
  * - friction and restitution: Bullet multiplies the two bodies' values, so
  *   the floor's are 1 and the part's are the scene's (exact: 1 * x == x);
+ * - the floor's contacts are every hull vertex near it (hull_floor_algorithm),
+ *   not Bullet's support vertex and its probes;
  * - one fixed step per call, without interpolation;
  * - no deactivation: the drop loop decides rest by energy, never Bullet;
- * - explicit gyroscopic torque and two friction directions (bullet_world_alloc);
+ * - the gyroscopic term by the adapter (gyroscopic_step) and two friction
+ *   directions (bullet_world_alloc);
  * - restitution threshold PD_BULLET_BOUNCE_STEPS * g dt instead of an
  *   absolute 0.2 m/s; penetration recovered by split impulse only, so
  *   pushing a sunk part out adds no kinetic energy that the rest test would
@@ -30,21 +33,130 @@
 
 extern "C" {
 #include "engines/engine.h"
+#include "engines/engine_contact.h"
 #include "posedrop/bullet.h"
 #include "posedrop/tolerances.h"
 #include "posedrop/version.h"
 }
 
-/* The convex-plane algorithm finds one contact (the support vertex) per step
- * unless asked to probe more by small rotations of the part; a face landing
- * flat then starts on one corner and tips about it. Asking for more points
- * whenever the manifold holds fewer than this (of Bullet's 4) gets the whole
- * face in the step it lands. */
-static const int BULLET_PLANE_PROBES = 4;
-static const int BULLET_PLANE_MIN_POINTS = 3;
+/* The hull against the floor: every hull vertex within the manifold's
+ * contact threshold of the plane becomes a contact point, and the manifold
+ * keeps Bullet's four (the deepest, then the largest area). Bullet's own
+ * convex-plane algorithm finds one point (the support vertex) per step, and
+ * its option to probe more rotates the part about two axes it computes in the
+ * world (perpendicular to the plane's normal) but applies in the part's own
+ * frame: the probes then find a facet's corners when the part's z axis points
+ * down and miss some when its x or y axis does, so landing flat sticks on
+ * some faces more than on others (a cube: faces +-z 0.19, +-x 0.14 of 3000
+ * drops). The vertices' heights depend only on where they are, so this
+ * contact set is the same whichever way the part's frame is turned. */
+/* The scene's contact law (contact_time > 0, resolved by the step;
+ * engine.h): every contact a spring-dashpot for its own effective mass. */
+struct contact_law {
+    bool on;
+    double omega, zeta;
+    double reach; /* the manifold's contact breaking threshold, m */
+};
+
+class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
+    btPersistentManifold *manifold;
+    const contact_law *law;
+
+    /* Bullet's own spring form, the same as ODE's: with the flag set, its
+     * solver takes erp = h k / (h k + c) and cfm = 1 / (h k + c) from the
+     * point's stiffness k and damping c. The effective mass along the
+     * normal is Bullet's impulse denominator's inverse. */
+    void set_springs(const btRigidBody *body, const btVector3 &n)
+    {
+        for (int j = 0; j < manifold->getNumContacts(); j++) {
+            btManifoldPoint &p = manifold->getContactPoint(j);
+            btVector3 pa = manifold->getBody0() == body ? p.getPositionWorldOnA()
+                                                        : p.getPositionWorldOnB();
+            double m = 1.0 / double(body->computeImpulseDenominator(pa, n));
+            p.m_combinedContactStiffness1 = btScalar(m * law->omega * law->omega);
+            p.m_combinedContactDamping1 = btScalar(2.0 * law->zeta * m * law->omega);
+            p.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
+        }
+    }
+
+public:
+    hull_floor_algorithm(const btCollisionAlgorithmConstructionInfo &ci,
+                         const btCollisionObjectWrapper *a, const btCollisionObjectWrapper *b,
+                         const contact_law *contact)
+        : btActivatingCollisionAlgorithm(ci, a, b), manifold(nullptr), law(contact)
+    {
+    }
+
+    ~hull_floor_algorithm() override
+    {
+        if (manifold)
+            m_dispatcher->releaseManifold(manifold);
+    }
+
+    void processCollision(const btCollisionObjectWrapper *a, const btCollisionObjectWrapper *b,
+                          const btDispatcherInfo &, btManifoldResult *out) override
+    {
+        bool swapped = a->getCollisionShape()->getShapeType() == STATIC_PLANE_PROXYTYPE;
+        const btCollisionObjectWrapper *hw = swapped ? b : a, *pw = swapped ? a : b;
+        const btConvexHullShape *hull =
+            static_cast<const btConvexHullShape *>(hw->getCollisionShape());
+        const btStaticPlaneShape *plane =
+            static_cast<const btStaticPlaneShape *>(pw->getCollisionShape());
+        if (!manifold) {
+            manifold =
+                m_dispatcher->getNewManifold(hw->getCollisionObject(), pw->getCollisionObject());
+            manifold->setContactBreakingThreshold(btScalar(law->reach));
+        }
+        out->setPersistentManifold(manifold);
+
+        const btTransform &th = hw->getWorldTransform(), &tp = pw->getWorldTransform();
+        btVector3 n = tp.getBasis() * plane->getPlaneNormal();
+        btScalar c = plane->getPlaneConstant() + n.dot(tp.getOrigin());
+        /* The shape is the hull inflated by its margin, the plane lowered by
+         * as much (see bullet_world_alloc): a vertex's distance is that of
+         * its inflated sphere's lowest point. */
+        btScalar margin = hull->getMargin();
+        btScalar reach = manifold->getContactBreakingThreshold();
+        for (int i = 0; i < hull->getNumPoints(); i++) {
+            btVector3 p = th(hull->getScaledPoint(i)) - margin * n;
+            btScalar d = n.dot(p) - c;
+            if (d < reach)
+                out->addContactPoint(n, p - d * n, d);
+        }
+        out->refreshContactPoints();
+        const btRigidBody *body = btRigidBody::upcast(hw->getCollisionObject());
+        if (law->on && body)
+            set_springs(body, n);
+    }
+
+    btScalar calculateTimeOfImpact(btCollisionObject *, btCollisionObject *,
+                                   const btDispatcherInfo &, btManifoldResult *) override
+    {
+        return btScalar(1);
+    }
+
+    void getAllContactManifolds(btManifoldArray &array) override
+    {
+        if (manifold)
+            array.push_back(manifold);
+    }
+};
+
+struct hull_floor_create : btCollisionAlgorithmCreateFunc {
+    contact_law law;
+
+    btCollisionAlgorithm *CreateCollisionAlgorithm(btCollisionAlgorithmConstructionInfo &ci,
+                                                   const btCollisionObjectWrapper *a,
+                                                   const btCollisionObjectWrapper *b) override
+    {
+        void *mem = ci.m_dispatcher1->allocateCollisionAlgorithm(sizeof(hull_floor_algorithm));
+        return mem ? new (mem) hull_floor_algorithm(ci, a, b, &law) : nullptr;
+    }
+};
 
 struct pd_engine_world {
     btDefaultCollisionConfiguration config;
+    hull_floor_create hull_floor;
     btCollisionDispatcher dispatcher;
     btDbvtBroadphase broadphase;
     btSequentialImpulseConstraintSolver solver;
@@ -92,6 +204,23 @@ static bool finite_state(const pd_state *s)
     return true;
 }
 
+/* The manifold's contact breaking threshold. Bullet's own is 0.02 of the
+ * shape's bounding radius, and the manifold takes a new point within that
+ * distance of a kept one for the same point: on a 1 m x 1 cm x 1 cm rod
+ * (threshold 1 cm) the corners of an end face merged, the rod could not lie
+ * on a face, rolled onto an edge and sank into the floor. A quarter of the
+ * shortest distance between two hull vertices keeps every corner apart;
+ * Bullet's value is kept when smaller. */
+static double contact_reach(const btConvexHullShape &hull)
+{
+    double d2 = INFINITY;
+    for (int i = 0; i < hull.getNumPoints(); i++)
+        for (int j = i + 1; j < hull.getNumPoints(); j++)
+            d2 = fmin(d2, double(hull.getScaledPoint(i).distance2(hull.getScaledPoint(j))));
+    double bullet = double(hull.getContactBreakingThreshold(gContactBreakingThreshold));
+    return fmin(0.25 * sqrt(d2), bullet);
+}
+
 static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull,
                                            const pd_scene *scene, double dt)
 {
@@ -116,7 +245,16 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * intersection and be exact only away from its corners. */
     w->hull.setMargin(btScalar(PD_BULLET_MARGIN_REL * b->size));
 
-    w->config.setPlaneConvexMultipointIterations(BULLET_PLANE_PROBES, BULLET_PLANE_MIN_POINTS);
+    contact_law &law = w->hull_floor.law;
+    law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
+    law.reach = contact_reach(w->hull);
+    law.omega = law.zeta = 0.0;
+    if (law.on)
+        pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
+    w->dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, STATIC_PLANE_PROXYTYPE,
+                                              &w->hull_floor);
+    w->dispatcher.registerCollisionCreateFunc(STATIC_PLANE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE,
+                                              &w->hull_floor);
 
     btContactSolverInfo &info = w->world.getSolverInfo();
     info.m_restitutionVelocityThreshold = btScalar(PD_BULLET_BOUNCE_STEPS * scene->gravity * dt);
@@ -125,6 +263,11 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * part to Baumgarte velocity instead, which feeds energy in. */
     info.m_splitImpulse = 1;
     info.m_splitImpulsePenetrationThreshold = 0;
+    /* With the scene's spring-dashpot (law.on) the penetration term is the
+     * spring's force: it must act on the velocities, not only on the
+     * positions, and the rebound is the dashpot's alone (no restitution). */
+    if (law.on)
+        info.m_splitImpulse = 0;
     /* Bullet's default friction acts along the sliding direction only; a
      * part resting on a face then creeps sideways at ~1e-4 m/s (measured on
      * a 1 x 2 x 3 cm box), a second, orthogonal direction holds it (2e-6 m
@@ -136,16 +279,20 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     w->floor_body.setFriction(1);
     w->floor_body.setRestitution(1);
     w->body.setFriction(btScalar(scene->mu));
-    w->body.setRestitution(btScalar(scene->restitution));
+    w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
     w->body.setActivationState(DISABLE_DEACTIVATION);
     w->body.setSleepingThresholds(0, 0);
     w->body.setDamping(0, 0);
-    /* Bullet's default gyroscopic term (implicit, body frame) is applied by
-     * the contact solver only, which skips a body without contacts: in
-     * flight the world angular velocity then stays constant and a tumbling
-     * part's angular momentum drifts by 17% in 0.1 s. The explicit term is
-     * applied in flight too (first order: 0.5% there). */
-    w->body.setFlags(BT_ENABLE_GYROSCOPIC_FORCE_EXPLICIT);
+    /* The gyroscopic term is applied by bullet_step (gyroscopic_step), not
+     * by Bullet (flags 0): Bullet's implicit one is applied by the contact
+     * solver only, which skips a body without contacts (in flight the world
+     * angular velocity then stays constant and a tumbling part's angular
+     * momentum drifts by 17% in 0.1 s), and is zero for a small part anyway
+     * (its 3 x 3 solve refuses a determinant below 1.2e-7, and a 1 cm part's
+     * is ~1e-27); its explicit one is forward Euler, unstable once |w| dt is
+     * of order 1 (a 0.01 mm flake spun to 3750 rad/s by a bounce, 3.9 rad
+     * per step, gained 1e29 times its energy). */
+    w->body.setFlags(0);
 
     w->world.addRigidBody(&w->floor_body);
     w->world.addRigidBody(&w->body);
@@ -191,10 +338,64 @@ static pd_status bullet_reset(pd_engine_world *w, const pd_state *s)
     return PD_OK;
 }
 
+/* Euler's equations for the torque-free part over one step, I w' = -w x I w
+ * in the body frame, by one Newton step of backward Euler (Bullet's own
+ * scheme, computed here in double precision and without its absolute
+ * determinant test): solve I (x - w) + dt x x I x = 0 from x = w. Stable at
+ * any |w| dt, first order; applied before the step, as Bullet's solver
+ * applies external impulses before the contacts. */
+static void gyroscopic_step(pd_engine_world *w)
+{
+    btRigidBody &b = w->body;
+    const btMatrix3x3 &R = b.getCenterOfMassTransform().getBasis();
+    btVector3 ww = b.getAngularVelocity();
+    double I[3], om[3], Io[3], f[3], J[3][3];
+    btVector3 inertia = b.getLocalInertia();
+    for (int i = 0; i < 3; i++) {
+        I[i] = double(inertia[i]);
+        om[i] = double(R[0][i]) * double(ww.x()) + double(R[1][i]) * double(ww.y()) +
+                double(R[2][i]) * double(ww.z()); /* R^T w */
+        Io[i] = I[i] * om[i];
+    }
+    double h = double(w->dt);
+    for (int i = 0; i < 3; i++) {
+        int j = (i + 1) % 3, k = (i + 2) % 3;
+        f[i] = h * (om[j] * Io[k] - om[k] * Io[j]);
+        /* d/dx of h x x I x: row i, columns j and k (the diagonal is 0). */
+        J[i][i] = I[i];
+        J[i][j] = h * (-om[k] * I[j] + Io[k]);
+        J[i][k] = h * (om[j] * I[k] - Io[j]);
+    }
+    double det = J[0][0] * (J[1][1] * J[2][2] - J[1][2] * J[2][1]) -
+                 J[0][1] * (J[1][0] * J[2][2] - J[1][2] * J[2][0]) +
+                 J[0][2] * (J[1][0] * J[2][1] - J[1][1] * J[2][0]);
+    if (!(fabs(det) > 0.0) || !std::isfinite(det))
+        return;
+    double d[3];
+    for (int c = 0; c < 3; c++) { /* Cramer: column c replaced by f */
+        double M[3][3];
+        for (int r = 0; r < 3; r++)
+            for (int q = 0; q < 3; q++)
+                M[r][q] = q == c ? f[r] : J[r][q];
+        d[c] = (M[0][0] * (M[1][1] * M[2][2] - M[1][2] * M[2][1]) -
+                M[0][1] * (M[1][0] * M[2][2] - M[1][2] * M[2][0]) +
+                M[0][2] * (M[1][0] * M[2][1] - M[1][1] * M[2][0])) /
+               det;
+    }
+    for (int i = 0; i < 3; i++)
+        om[i] -= d[i];
+    btVector3 nw;
+    for (int i = 0; i < 3; i++)
+        nw[i] = btScalar(double(R[i][0]) * om[0] + double(R[i][1]) * om[1] +
+                         double(R[i][2]) * om[2]);
+    b.setAngularVelocity(nw);
+}
+
 static pd_status bullet_step(pd_engine_world *w, pd_state *s)
 {
     if (!w || !s)
         return PD_ERR_USAGE;
+    gyroscopic_step(w);
     /* maxSubSteps = 0: exactly one step of dt, and the transform read below
      * is the simulated one, not an interpolation. */
     w->world.stepSimulation(w->dt, 0, w->dt);

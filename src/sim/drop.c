@@ -296,7 +296,9 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                         out->end = PD_END_SETTLED;
                         break;
                     }
-                    if (cr.end == PD_COMPLIANT_TIME) {
+                    /* The run's last step may pass the limit (by less than
+                     * a step) whatever way it ended: the time is spent. */
+                    if (cr.end == PD_COMPLIANT_TIME || t >= o->time_limit) {
                         out->end = PD_END_TIME_LIMIT;
                         break;
                     }

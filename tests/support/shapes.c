@@ -277,6 +277,21 @@ pd_mesh *mesh_prism(int nsides, double radius, double height)
     return convex_mesh(p, pts_prism(nsides, radius, height, p));
 }
 
+pd_mesh *mesh_roof_box(double w, double d, double h, double ridge)
+{
+    double rise = 0.5 * w * tan(0.5 * ridge);
+    pd_vec3 p[10];
+    int n = 0;
+    for (int sy = -1; sy <= 1; sy += 2) {
+        p[n++] = v3(0.0, 0.5 * sy * d, 0.0);
+        for (int sx = -1; sx <= 1; sx += 2) {
+            p[n++] = v3(0.5 * sx * w, 0.5 * sy * d, rise);
+            p[n++] = v3(0.5 * sx * w, 0.5 * sy * d, h);
+        }
+    }
+    return convex_mesh(p, n);
+}
+
 pd_mesh *mesh_of_hull(const pd_hull *h)
 {
     pd_mesh *m = calloc(1, sizeof *m);

@@ -105,4 +105,12 @@ pd_status part_of_points(const pd_vec3 *pts, int n, struct pd_part **part, struc
 pd_mesh *mesh_box(double ax, double ay, double az);
 pd_mesh *mesh_prism(int nsides, double radius, double height);
 
+/* A w x d x h box (x, y, z) whose bottom is a shallow roof: two facets
+ * meeting along the y axis at z = 0, each tilted ridge / 2 (rad) up toward
+ * x = +-w/2. With the centre of mass above the ridge, both roof facets are
+ * stable, and the energy barrier between them is the rise of the centre of
+ * mass from lying on one to balancing on the ridge, about c (1 - cos(ridge/2))
+ * for c its height: tiny for a ridge of a degree. */
+pd_mesh *mesh_roof_box(double w, double d, double h, double ridge);
+
 #endif

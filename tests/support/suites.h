@@ -31,6 +31,8 @@
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
+    PD_SUITE(engine_extreme) \
+    PD_SUITE(engine_contact) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(golden)

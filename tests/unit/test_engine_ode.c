@@ -381,22 +381,33 @@ static void test_scale_and_many_corners(void)
     }
 }
 
-/* One world per thread: drops stepped in two threads at once give the bytes
- * the same drop gives alone in this thread. */
+/* One drop in its own world, after `failures` steps that fail inside ODE
+ * (test_internal_error); run alone or in a thread. */
 typedef struct {
     const fixture *fx;
-    pd_state s;
-    pd_status st;
+    int failures;    /* failing steps to provoke first */
+    pd_state s;      /* in: the drop's start; out: its end */
+    pd_status first; /* what the first provoked failure returned */
+    pd_status st;    /* the drop's */
 } thread_job;
 
 static void *thread_drop(void *arg)
 {
     thread_job *job = arg;
-    job->st = PD_ERR_NOMEM;
+    job->st = job->first = PD_ERR_NOMEM;
     pd_engine_world *w = pd_engine_ode.world_alloc(job->fx->body, job->fx->part->hull,
                                                    &job->fx->scene, DT);
     if (!w)
         return NULL;
+    for (int i = 0; i < job->failures; i++) {
+        /* 1e200 rad/s: ODE's quaternion normalisation fails (an assertion). */
+        pd_state bad = {v3(0, 0, 0.05), quat_identity(), v3(0, 0, 0), v3(1e200, 3e199, 0)};
+        pd_status st = pd_engine_ode.reset(w, &bad);
+        if (st == PD_OK)
+            st = pd_engine_ode.step(w, &bad);
+        if (i == 0)
+            job->first = st;
+    }
     job->st = pd_engine_ode.reset(w, &job->s);
     if (job->st == PD_OK)
         job->st = run(w, &job->s, 1000);
@@ -404,16 +415,10 @@ static void *thread_drop(void *arg)
     return NULL;
 }
 
-static void test_threads(void)
+/* Runs the two jobs at once in two threads; each must end as ref did, to the
+ * byte. */
+static void two_threads(thread_job jobs[2], const thread_job *ref)
 {
-    fixture fx;
-    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
-        return;
-    pd_state s0 = {v3(0, 0, 0.08), quat_normalize(quat(0.6, -0.2, 0.5, 0.3)), v3(0.05, 0.01, 0),
-                   v3(-4.0, 12.0, 2.0)};
-    thread_job ref = {&fx, s0, PD_OK}, jobs[2] = {{&fx, s0, PD_OK}, {&fx, s0, PD_OK}};
-    thread_drop(&ref);
-    CHECK_STATUS(ref.st, PD_OK);
     pthread_t t[2];
     int started[2];
     for (int i = 0; i < 2; i++)
@@ -424,7 +429,54 @@ static void test_threads(void)
             continue;
         pthread_join(t[i], NULL);
         CHECK_STATUS(jobs[i].st, PD_OK);
-        CHECK(memcmp(&jobs[i].s, &ref.s, sizeof ref.s) == 0);
+        CHECK(memcmp(&jobs[i].s, &ref->s, sizeof ref->s) == 0);
+    }
+}
+
+/* One world per thread: drops stepped in two threads at once give the bytes
+ * the same drop gives alone in this thread.
+ *
+ * And ODE's internal errors end the call, not the process: a step from an
+ * angular velocity of 1e200 rad/s fails ODE's quaternion normalisation (an
+ * assertion, which aborted the process before), and a body with a negative
+ * moment fails ODE's mass check (another assertion). The step reports
+ * PD_ERR_NO_CONVERGENCE, and the world, rebuilt, then steps a drop to the
+ * bytes a fresh world gives; meanwhile another thread's world, failing
+ * nothing, is not disturbed (the jump back is per thread). */
+static void test_threads_and_errors(void)
+{
+    fixture fx;
+    if (!setup(&fx, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    pd_state s0 = {v3(0, 0, 0.08), quat_normalize(quat(0.6, -0.2, 0.5, 0.3)), v3(0.05, 0.01, 0),
+                   v3(-4.0, 12.0, 2.0)};
+    thread_job ref = {&fx, 0, s0, PD_OK, PD_OK};
+    thread_drop(&ref);
+    CHECK_STATUS(ref.st, PD_OK);
+    thread_job jobs[2] = {{&fx, 0, s0, PD_OK, PD_OK}, {&fx, 0, s0, PD_OK, PD_OK}};
+    two_threads(jobs, &ref);
+
+    thread_job once = {&fx, 1, s0, PD_OK, PD_OK};
+    thread_drop(&once);
+    CHECK_STATUS(once.first, PD_ERR_NO_CONVERGENCE);
+    CHECK_STATUS(once.st, PD_OK);
+    CHECK(memcmp(&once.s, &ref.s, sizeof ref.s) == 0);
+    /* Two threads: one fails 20 times, then drops; the other only drops. */
+    thread_job mixed[2] = {{&fx, 20, s0, PD_OK, PD_OK}, {&fx, 0, s0, PD_OK, PD_OK}};
+    two_threads(mixed, &ref);
+    CHECK_STATUS(mixed[0].first, PD_ERR_NO_CONVERGENCE);
+
+    double keep = fx.body->moment[0];
+    fx.body->moment[0] = -keep;
+    CHECK(pd_engine_ode.world_alloc(fx.body, fx.part->hull, &fx.scene, DT) == NULL);
+    fx.body->moment[0] = keep;
+    /* A zero quaternion has no orientation: refused before ODE sees it. */
+    pd_engine_world *w = world(&fx);
+    if (w) {
+        pd_state z = s0;
+        z.q = quat(0, 0, 0, 0);
+        CHECK_STATUS(pd_engine_ode.reset(w, &z), PD_ERR_USAGE);
+        pd_engine_ode.world_free(w);
     }
     teardown(&fx);
 }
@@ -437,5 +489,5 @@ void suite_engine_ode(void)
     test_topple();
     test_reset_and_determinism();
     test_scale_and_many_corners();
-    test_threads();
+    test_threads_and_errors();
 }

@@ -1,0 +1,77 @@
+/* engine_contact.h (private): the spring-dashpot that stands for the
+ * scene's contact in the stepping engines. Inline in a header because the
+ * engines live in two libraries (ODE in libposedrop, Bullet in
+ * libposedrop-bullet), and this is no part of libposedrop's interface. */
+#ifndef PD_ENGINE_CONTACT_H
+#define PD_ENGINE_CONTACT_H
+
+#include <math.h>
+
+/* Restitution below this is taken as this by the contact law below, as by
+ * the impulse simulator's compliant law (PD_COMPLIANT_E_MIN, in a layer this
+ * one may not include): e = 0 needs an infinite damping ratio. */
+#define PD_ENGINE_E_MIN 0.01
+
+/* Steps a contact must span for an engine to stand for it by that law: with
+ * a step h > T / PD_ENGINE_CONTACT_STEPS the engine keeps its own contact
+ * (its bounce with restitution e), the law's own limit as T -> 0. Why 10:
+ * both engines step the spring-dashpot implicitly, which loses about
+ * e g^2 / 2 h / T of the rebound (g = omega T <= pi): at 10 steps a
+ * corner's rebound of 0.3 comes out 0.25 (ODE) and 0.23 (Bullet), at 2
+ * steps 0.18 and 0.10, at Bullet's default 1/960 s for T = 5e-4 s 0.02. A
+ * contact that short is rigid as far as such a step can tell. */
+#define PD_ENGINE_CONTACT_STEPS 10.0
+
+/* Bisection halvings of zeta's bracket: 200 reach round-off of any bracket. */
+enum { PD_ENGINE_CONTACT_HALVINGS = 200 };
+
+/* The bracket's top: e(zeta) ~ 1 / (2 zeta)^2 for large zeta, 2.5e-7 at
+ * 1000, far below PD_ENGINE_E_MIN. */
+#define PD_ENGINE_CONTACT_ZETA_MAX 1000.0
+
+/* Duration of a push-only contact times omega (pd_engine_contact_law). */
+static inline double pd_engine_contact_duration(double zeta)
+{
+    const double pi = 3.14159265358979323846;
+    if (zeta < 1.0)
+        return (pi - 2.0 * asin(zeta)) / sqrt(1.0 - zeta * zeta);
+    if (zeta > 1.0)
+        return 2.0 * acosh(zeta) / sqrt(zeta * zeta - 1.0);
+    return 2.0;
+}
+
+static inline double pd_engine_contact_restitution(double zeta)
+{
+    return exp(-zeta * pd_engine_contact_duration(zeta));
+}
+
+/* The spring-dashpot standing for one contact of the scene (contact_time
+ * T > 0, restitution e), as natural frequency *omega (rad/s) and damping
+ * ratio *zeta, for a contact of effective mass m: stiffness k = m omega^2,
+ * damping c = 2 zeta m omega. The contact pushes only (the engines' contact
+ * impulses are never negative), so it ends when the force k x + c x' falls
+ * to zero, before the penetration does; for that law
+ *     T = g(zeta) / omega,   e = exp(-zeta g(zeta)),
+ *     g(zeta) = (pi - 2 asin zeta) / sqrt(1 - zeta^2)     (zeta < 1),
+ *             = 2 acosh(zeta) / sqrt(zeta^2 - 1)          (zeta > 1), 2 at 1,
+ * whatever the approach speed. zeta is found from e by bisection (e falls
+ * from 1 at zeta = 0 toward 0), then omega from T. e is taken within
+ * [PD_ENGINE_E_MIN, 1]. docs/engines-crosscheck.md derives it. */
+static inline void pd_engine_contact_law(double T, double e, double *omega, double *zeta)
+{
+    double target = fmin(1.0, fmax(e, PD_ENGINE_E_MIN));
+    double lo = 0.0, hi = PD_ENGINE_CONTACT_ZETA_MAX;
+    for (int i = 0; i < PD_ENGINE_CONTACT_HALVINGS && lo < hi; i++) {
+        double mid = 0.5 * (lo + hi);
+        if (mid <= lo || mid >= hi)
+            break;
+        if (pd_engine_contact_restitution(mid) > target)
+            lo = mid;
+        else
+            hi = mid;
+    }
+    *zeta = target >= 1.0 ? 0.0 : 0.5 * (lo + hi);
+    *omega = pd_engine_contact_duration(*zeta) / T;
+}
+
+#endif
