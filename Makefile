@@ -72,13 +72,16 @@ CFLAGS_TEST := -Itests/support $(shell $(PKG_CONFIG) --cflags $(TEST_PKGS) 2>/de
 # One folder per layer under src/ (docs/development.md); the Makefile follows
 # the tree by wildcard, so adding a file needs no edit here.
 LIB_SRCS   := $(wildcard src/*/*.c)
-LIB_SRCS   := $(filter-out src/cli/%,$(LIB_SRCS))
+LIB_SRCS   := $(filter-out src/cli/% src/viz/%,$(LIB_SRCS))
 LIB_OBJS   := $(LIB_SRCS:%.c=$(BUILD)/%.o)
 BULLET_OBJS := $(patsubst %.cpp,$(BUILD)/%.o,$(wildcard src/*/*.cpp))
 LIB        := $(BUILD)/libposedrop.a
 LIB_BULLET := $(BUILD)/libposedrop-bullet.a
 SO         := $(BUILD)/libposedrop.so.$(VERSION)
 SO_BULLET  := $(BUILD)/libposedrop-bullet.so.$(VERSION)
+# The pictures (src/viz/) are the program's, not the library's: a client of
+# the public API that the command and the tests link.
+VIZ_OBJS   := $(patsubst %.c,$(BUILD)/%.o,$(wildcard src/viz/*.c))
 CLI        := $(BUILD)/posedrop
 TEST_SRCS  := $(wildcard tests/unit/*.c tests/support/*.c)
 TEST_OBJS  := $(TEST_SRCS:%.c=$(BUILD)/%.o)
@@ -88,7 +91,8 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint fuzz fuzz-build
+.PHONY: all check check-install test bench demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+        check-browser figures
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI)
@@ -139,10 +143,10 @@ $(SO_BULLET): $(BULLET_OBJS) $(SO)
 # $(CXX), since they offer the Bullet engine.
 # The command reads numbers with the library's own reader (base/number.c, C
 # library only), linked in directly so that it needs nothing the API hides.
-$(CLI): $(BUILD)/src/cli/cli.o $(BUILD)/src/base/number.o $(LIB_BULLET) $(LIB)
+$(CLI): $(BUILD)/src/cli/cli.o $(BUILD)/src/base/number.o $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
-$(TEST_BIN): $(TEST_OBJS) $(LIB_BULLET) $(LIB)
+$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 $(BENCH_BIN): $(BENCH_OBJS) $(LIB_BULLET) $(LIB)
@@ -175,6 +179,20 @@ check: deps lint
 demo: deps
 	@$(MAKE) --no-print-directory all
 	$(CLI) -n 2000 -h 0.12 $(DEMO_PART)
+
+# The report and the SVGs in a real browser and renderer (headless Chromium,
+# rsvg-convert; installed when missing): tests/browser/check.sh.
+check-browser: deps
+	@$(MAKE) --no-print-directory $(CLI)
+	POSEDROP=$(CLI) tests/browser/check.sh
+
+# The insulator cap's gallery, chart against the paper's physical tests and
+# gauss-sphere map, and the cost-accuracy chart, into docs/figures/
+# (docs/figures.md). CHART_ONLY=1 redraws the cost-accuracy chart from its
+# kept CSV instead of rerunning its several minutes of drops.
+figures: deps
+	@$(MAKE) --no-print-directory all
+	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
 
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
@@ -263,6 +281,8 @@ help:
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make lint       check that no layer of src/ includes one above it"
+	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
+	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"
 	@echo "make check-install  install to a temporary prefix, build the library example"
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
@@ -271,4 +291,4 @@ help:
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"
 
--include $(FUZZ_OBJS:.o=.d) $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d
+-include $(FUZZ_OBJS:.o=.d) $(LIB_OBJS:.o=.d) $(BULLET_OBJS:.o=.d) $(VIZ_OBJS:.o=.d) $(TEST_OBJS:.o=.d) $(BENCH_OBJS:.o=.d) $(BUILD)/src/cli/cli.d

@@ -32,7 +32,9 @@ while [ $# -gt 0 ]; do
     esac
 done
 here=$(cd "$(dirname "$0")/.." && pwd)
-bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
+# POSEDROP names the binary (make figures passes the optimised build's);
+# otherwise the newest one built.
+bin=${POSEDROP:-$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)}
 [ -n "$bin" ] || { echo "cost-accuracy.sh: posedrop not built (run make)" >&2; exit 2; }
 if [ -z "$tables" ]; then
     for t in "$here/../shared/data/paper-tables.csv" "$here/parts/paper-tables.csv"; do

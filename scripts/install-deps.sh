@@ -18,9 +18,16 @@ check_pc ccd libccd-dev
 check_pc bullet libbullet-dev
 check_pc qhull_r libqhull-dev
 command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
-# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart).
-for pkg in "$@"; do
-    dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
+# Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart),
+# or a group by its name: browser, what make check-browser renders with.
+for arg in "$@"; do
+    case "$arg" in
+    browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
+    *) pkgs=$arg ;;
+    esac
+    for pkg in $pkgs; do
+        dpkg -s "$pkg" >/dev/null 2>&1 || missing="$missing $pkg"
+    done
 done
 
 [ -z "$missing" ] && exit 0

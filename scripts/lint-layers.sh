@@ -20,7 +20,8 @@ lower() {
     contact)   echo "base hull part dynamics settle" ;;
     engines)   echo "base hull part dynamics" ;;
     sim)       echo "base mesh hull part static symmetry dynamics impact settle contact engines" ;;
-    cli)       echo "base" ;; # the public API, and base/number.h (linked in directly)
+    viz)       echo "base" ;; # the pictures: the public API, base's helpers
+    cli)       echo "base viz" ;; # the public API, base/number.h (linked in directly), the pictures
     *)         echo "?" ;;
     esac
 }

@@ -14,9 +14,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include "base/number.h" /* one reading of numbers, shared with scene files */
+#include "viz/viz.h"
 #include "posedrop/posedrop.h"
 
 enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1, EXIT_INTERRUPTED = 130 };
@@ -273,6 +275,8 @@ typedef struct {
     pd_scene scene;
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
+    const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
+    const char *measured;
 } cli_args;
 
 /* --- the options ------------------------------------------------------------
@@ -283,7 +287,8 @@ typedef struct {
 enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_COMPARE,
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
-       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME };
+       OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -420,6 +425,19 @@ static const cli_option options[] = {
      "members: the member poses' numbers, space-separated"},
     {OPT_VERBOSE, "verbose", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
      "a summary of the part (and of the drops) on stderr"},
+    HEADING("pictures (docs/figures.md):"),
+    {OPT_SVG, "svg", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "gallery of the stable poses (classes with --group), SVG"},
+    {OPT_CHART, "chart", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "the estimates as grouped bars with 95% intervals, SVG"},
+    {OPT_SPHERE, "sphere", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "gravity directions coloured by the pose QS ends in, SVG"},
+    {OPT_REPORT, "report", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "one HTML file: part, gallery, chart, sphere, run"},
+    {OPT_MEASURED, "measured", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+     "a measured distribution shown beside the estimates: CSV\n"
+     "with columns pose,count or pose,p[,n], numbered as the\n"
+     "output (classes with --group)"},
     {OPT_HELP, "help", ARG_FLAG, NULL, NO_RULE, NULL, NULL, "this help"},
     {OPT_VERSION, "version", ARG_FLAG, NULL, NO_RULE, NULL, NULL, "version"},
 };
@@ -617,6 +635,11 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
+    case OPT_SVG: a->pictures[VIZ_GALLERY] = arg; break;
+    case OPT_CHART: a->pictures[VIZ_CHART] = arg; break;
+    case OPT_SPHERE: a->pictures[VIZ_SPHERE] = arg; break;
+    case OPT_REPORT: a->pictures[VIZ_REPORT] = arg; break;
+    case OPT_MEASURED: a->measured = arg; break;
     case OPT_HELP:
         usage(stdout);
         return 0;
@@ -733,6 +756,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
         return fail_usage("%s", "--facets lists hull facets; it does not go with --group");
+    const char *const *pic = a->pictures;
+    if (a->facets && (pic[VIZ_GALLERY] || pic[VIZ_CHART] || pic[VIZ_SPHERE] || pic[VIZ_REPORT]))
+        return fail_usage("%s", "--facets lists hull facets; the pictures show poses");
+    if (a->measured && !pic[VIZ_GALLERY] && !pic[VIZ_CHART] && !pic[VIZ_REPORT])
+        return fail_usage("%s", "--measured is shown by --svg, --chart or --report: give one");
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);
@@ -832,6 +860,14 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
+/* Seconds on a monotonic clock, for the report's timings. */
+static double now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
 static atomic_int interrupted;
 
 static void on_sigint(int sig)
@@ -858,11 +894,23 @@ int main(int argc, char **argv)
     }
 
     /* Output paths first: a run never does its work only to fail writing. */
-    out_file trials_out = {0}, transitions_out = {0};
-    if ((a.trials && !out_open(&trials_out, a.trials)) ||
-        (a.transitions && !out_open(&transitions_out, a.transitions))) {
+    out_file trials_out = {0}, transitions_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    int opened = (!a.trials || out_open(&trials_out, a.trials)) &&
+                 (!a.transitions || out_open(&transitions_out, a.transitions));
+    for (int k = 0; k < VIZ_KINDS && opened; k++)
+        opened = !a.pictures[k] || out_open(&pic_out[k], a.pictures[k]);
+    /* A measured distribution is read before the work too. */
+    viz_measured *measured = NULL;
+    double t0 = now(), t_static = 0.0, t_sim = 0.0;
+    if (opened && a.measured && (st = viz_measured_read(a.measured, &measured, &diag)) != PD_OK) {
+        fail_status(st, &diag, NULL);
+        opened = 0;
+    }
+    if (!opened) {
         out_abort(&trials_out);
         out_abort(&transitions_out);
+        for (int k = 0; k < VIZ_KINDS; k++)
+            out_abort(&pic_out[k]);
         return EXIT_USAGE;
     }
 
@@ -879,6 +927,7 @@ int main(int argc, char **argv)
     st = pd_part_build(mesh, &a.part, &part, &diag);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a.estimate, &res, &diag);
+    t_static = now() - t0;
     if (st == PD_OK && a.dynamic) {
         struct sigaction sa;
         memset(&sa, 0, sizeof sa);
@@ -886,12 +935,20 @@ int main(int argc, char **argv)
         sigaction(SIGINT, &sa, NULL);
         a.sim.cancel = &interrupted;
         st = pd_sim_run(part, res, &a.scene, &a.sim, &sim, &diag);
+        t_sim = now() - t0 - t_static;
     }
     if (st == PD_OK && a.group) {
         class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
         st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+    }
+    static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
+    viz_input in = {a.path, part, res, gsim ? gsim : sim, class_of, nclasses,
+                    engine_labels[a.sim.engine], sim ? &a.scene : NULL, measured};
+    if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
+        code = fail_status(st, &diag, NULL);
+        goto done;
     }
     if (st != PD_OK) {
         code = fail_status(st, &diag, a.path);
@@ -907,6 +964,20 @@ int main(int argc, char **argv)
         (transitions_out.f && !out_commit(&transitions_out))) {
         code = EXIT_INTERNAL;
         goto done;
+    }
+    viz_run run = {a.path, a.read.units, &a.estimate, &a.sim, t_static, t_sim, now() - t0, argc,
+                   argv};
+    for (int k = 0; k < VIZ_KINDS; k++) {
+        if (!pic_out[k].f)
+            continue;
+        if ((st = viz_write_file((viz_kind)k, pic_out[k].f, &in, &run, &diag)) != PD_OK) {
+            code = fail_status(st, &diag, NULL);
+            goto done;
+        }
+        if (!out_commit(&pic_out[k])) {
+            code = EXIT_INTERNAL;
+            goto done;
+        }
     }
     if (a.verbose)
         print_summary(&a, part, res);
@@ -926,6 +997,9 @@ int main(int argc, char **argv)
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);
+    for (int k = 0; k < VIZ_KINDS; k++)
+        out_abort(&pic_out[k]);
+    viz_measured_free(measured);
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);

@@ -35,6 +35,7 @@
     PD_SUITE(engine_contact) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
+    PD_SUITE(viz)    \
     PD_SUITE(golden)
 
 #define PD_SUITE(name) void suite_##name(void);

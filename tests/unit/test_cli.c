@@ -9,26 +9,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 #include "check.h"
+#include "files.h"
 #include "suites.h"
 
 #ifndef PD_CLI_PATH
 #define PD_CLI_PATH "build/opt/posedrop"
 #endif
-
-static char *slurp(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *buf = malloc((size_t)n + 1);
-    size_t got = fread(buf, 1, (size_t)n, f);
-    buf[got] = '\0';
-    fclose(f);
-    return buf;
-}
 
 static int write_file(const char *path, const char *text)
 {

@@ -1,0 +1,171 @@
+/* chart.c: the estimates as grouped bars, one group per pose, with the 95%
+ * intervals as whiskers and each pose's thumbnail under its group. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include "base/fail.h"
+#include "viz/viz_internal.h"
+
+enum { BAR_W = 16, BAR_GAP = 2, GROUP_GAP = 22, THUMB = 80, PLOT_H = 300, LEFT = 58,
+       RIGHT = 16, TOP = 40, LEGEND_LINE = 18 };
+
+typedef struct {
+    const char *name;
+    const char *colour;
+} series;
+
+/* The height of the axis: the next round step above the highest bar or
+ * whisker, so that nothing is clipped. */
+static double axis_top(const viz_entry *e, int n, double *step)
+{
+    double top = 0.0;
+    for (int i = 0; i < n; i++) {
+        top = fmax(top, fmax(e[i].p_qs, e[i].p_pqs));
+        if (e[i].has_dyn)
+            top = fmax(top, fmax(e[i].p, e[i].hi));
+        if (e[i].has_meas)
+            top = fmax(top, e[i].meas_ci ? fmax(e[i].mp, e[i].mhi) : e[i].mp);
+    }
+    top = fmin(fmax(top, 0.05), 1.0);
+    *step = top > 0.5 ? 0.1 : top > 0.2 ? 0.05 : top > 0.1 ? 0.02 : 0.01;
+    return fmin(1.0, ceil(top / *step - 1e-9) * *step);
+}
+
+static void bar(vbuf *b, double x, double y0, double hpx, const char *colour)
+{
+    char attrs[32];
+    snprintf(attrs, sizeof attrs, "fill=\"%s\"", colour);
+    viz_rect(b, x, y0 - hpx, BAR_W, hpx, attrs);
+}
+
+static void whisker(vbuf *b, double xc, double ylo, double yhi)
+{
+    viz_xy(b, "<path d=\"M", xc, ylo);
+    viz_xy(b, " L", xc, yhi);
+    viz_xy(b, " M", xc - 4, ylo);
+    viz_xy(b, " L", xc + 4, ylo);
+    viz_xy(b, " M", xc - 4, yhi);
+    viz_xy(b, " L", xc + 4, yhi);
+    vbuf_put(b, "\" fill=\"none\" stroke=\"#111111\" stroke-width=\"1.2\"/>\n");
+}
+
+pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
+{
+    viz_entry *e;
+    int n;
+    pd_status st = viz_entries(in, &e, &n, diag);
+    if (st != PD_OK)
+        return st;
+    series s[4] = {{"QS", "#4e79a7"}, {"PQS", "#f28e2b"}, {NULL, "#59a14f"}, {"measured", "#3b3b3b"}};
+    char dyn_name[96];
+    int has_dyn = e[0].has_dyn, has_meas = e[0].has_meas;
+    if (has_dyn) {
+        snprintf(dyn_name, sizeof dyn_name, "%s, %ld drops%s%s", in->engine ? in->engine : "drops",
+                 in->sim->n, in->scene ? ", initial " : "",
+                 in->scene ? viz_initial_name(in->scene->initial) : "");
+        s[2].name = dyn_name;
+    }
+    int nser = 2 + has_dyn + has_meas;
+    int which[4] = {0, 1, 2, 3};
+    if (!has_dyn)
+        which[2] = 3;
+    double group_w = fmax(nser * (BAR_W + BAR_GAP), THUMB) + GROUP_GAP;
+    double plot_w = n * group_w;
+    int legend_rows = nser;
+    double legend_h = legend_rows * LEGEND_LINE + 8;
+    double w = LEFT + plot_w + RIGHT;
+    if (w < 640)
+        w = 640;
+    double y_top = TOP + legend_h, y0 = y_top + PLOT_H;
+    double h = y0 + 22 + THUMB + 14;
+    char title[512];
+    snprintf(title, sizeof title, "Pose probabilities of %s%s", viz_base_name(in->name),
+             in->class_of ? ", by class" : "");
+    viz_svg_open(b, standalone, w, h, title);
+    vbuf_put(b, "<g class=\"chart\">\n");
+    viz_text(b, 10, 22, 16, "start", 1, "#111111", title);
+    /* Legend: a swatch and name per estimator; with a measured distribution,
+     * each estimate's eq. (16) error and total variation against it. */
+    for (int k = 0; k < nser; k++) {
+        const series *sr = &s[which[k]];
+        double y = TOP + k * LEGEND_LINE;
+        char line[256];
+        snprintf(line, sizeof line, "fill=\"%s\"", sr->colour);
+        viz_rect(b, LEFT, y, 12, 12, line);
+        if (has_meas && which[k] < 3) {
+            double e16, tv;
+            viz_eq16(e, n, which[k], &e16, &tv);
+            snprintf(line, sizeof line, "%s: eq. (16) error %.2f, total variation %.1f%%",
+                     sr->name, e16, tv);
+        } else if (which[k] == 3) {
+            if (in->measured->n)
+                snprintf(line, sizeof line, "measured: %ld observations (%s)", in->measured->n,
+                         viz_base_name(in->measured->path));
+            else
+                snprintf(line, sizeof line, "measured (%s; p without n: no interval)",
+                         viz_base_name(in->measured->path));
+        } else {
+            snprintf(line, sizeof line, "%s", sr->name);
+        }
+        viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", line);
+    }
+    if (has_dyn || (has_meas && e[0].meas_ci))
+        viz_text(b, w - RIGHT, 22, 11, "end", 0, "#555555", "whiskers: 95% intervals");
+    /* Axis and grid. */
+    double step, top = axis_top(e, n, &step);
+    double ppu = PLOT_H / top;
+    for (int t = 0; t * step <= top + 1e-9; t++) {
+        double y = y0 - t * step * ppu;
+        viz_xy(b, "<path d=\"M", LEFT, y);
+        viz_xy(b, " L", LEFT + plot_w, y);
+        vbuf_printf(b, "\" stroke=\"%s\" stroke-width=\"1\"/>\n", t ? "#e3e3e3" : "#111111");
+        char lab[16];
+        snprintf(lab, sizeof lab, "%g%%", 100.0 * t * step);
+        viz_text(b, LEFT - 6, y + 4, 11, "end", 0, "#333333", lab);
+    }
+    vbuf_put(b, "<text x=\"14\" y=\"");
+    vbuf_num(b, y_top + PLOT_H / 2.0);
+    vbuf_put(b, "\" font-size=\"12\" text-anchor=\"middle\" fill=\"#333333\" transform=\"rotate(-90 14 ");
+    vbuf_num(b, y_top + PLOT_H / 2.0);
+    vbuf_put(b, ")\">probability</text>\n");
+    /* Thumbnails: every pose at one scale, like the gallery. */
+    viz_view view;
+    viz_view_default(&view);
+    double ew, eh;
+    viz_pic *pics = viz_pics_build(in, e, n, &view, &ew, &eh);
+    double tscale = fmin((THUMB - 4.0) / ew, (THUMB - 4.0) / eh);
+    for (int i = 0; i < n; i++) {
+        double gx = LEFT + i * group_w + GROUP_GAP / 2.0;
+        double inner = nser * (BAR_W + BAR_GAP) - BAR_GAP;
+        double bx = gx + (group_w - GROUP_GAP - inner) / 2.0;
+        vbuf_printf(b, "<g class=\"group\"><title>Pose %d</title>\n", e[i].number);
+        for (int k = 0; k < nser; k++) {
+            double x = bx + k * (BAR_W + BAR_GAP), xc = x + BAR_W / 2.0;
+            int wk = which[k];
+            double v = wk == 0 ? e[i].p_qs : wk == 1 ? e[i].p_pqs : wk == 2 ? e[i].p : e[i].mp;
+            bar(b, x, y0, v * ppu, s[wk].colour);
+            if (wk == 2)
+                whisker(b, xc, y0 - e[i].lo * ppu, y0 - e[i].hi * ppu);
+            if (wk == 3 && e[i].meas_ci)
+                whisker(b, xc, y0 - e[i].mlo * ppu, y0 - e[i].mhi * ppu);
+        }
+        char lab[16];
+        snprintf(lab, sizeof lab, "%d", e[i].number);
+        double cx = gx + (group_w - GROUP_GAP) / 2.0;
+        viz_text(b, cx, y0 + 16, 12, "middle", 1, "#111111", lab);
+        if (pics)
+            viz_pic_draw(b, in->part, &pics[i], &view, tscale, cx, y0 + 22 + THUMB / 2.0, 0);
+        vbuf_put(b, "</g>\n");
+    }
+    viz_text(b, LEFT + plot_w / 2.0, h - 2, 11, "middle", 0, "#555555",
+             in->class_of ? "pose class (as numbered by --group), drawn as in the gallery"
+                          : "pose (as numbered in the output), drawn as in the gallery");
+    vbuf_put(b, "</g>\n");
+    viz_svg_close(b);
+    int complete = pics != NULL;
+    viz_pics_free(pics, n);
+    free(e);
+    if (!complete || b->failed)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+    return PD_OK;
+}

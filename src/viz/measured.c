@@ -1,0 +1,200 @@
+/* measured.c: reading a measured pose distribution (--measured). */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/fail.h"
+#include "base/stats.h"
+#include "base/text.h"
+#include "viz/viz.h"
+#include "viz/viz_const.h"
+
+/* A file of at most this many poses: more is not a pose table. */
+enum { MAX_POSES = 100000, LINE_MAX_LEN = 4096 };
+
+void viz_measured_free(viz_measured *m)
+{
+    if (!m)
+        return;
+    free(m->p);
+    free(m->lo);
+    free(m->hi);
+    free(m->path);
+    free(m);
+}
+
+/* Splits line (modified) at commas into at most max fields; trims blanks and
+ * a trailing carriage return. Returns the count. */
+static int split(char *line, char **field, int max)
+{
+    int n = 0;
+    char *p = line;
+    for (;;) {
+        char *comma = strchr(p, ',');
+        if (comma)
+            *comma = '\0';
+        while (*p == ' ' || *p == '\t')
+            p++;
+        char *end = p + strlen(p);
+        while (end > p && (end[-1] == ' ' || end[-1] == '\t' || end[-1] == '\r' || end[-1] == '\n'))
+            *--end = '\0';
+        if (n < max)
+            field[n] = p;
+        n++;
+        if (!comma)
+            return n;
+        p = comma + 1;
+    }
+}
+
+static int number(const char *s, double *out)
+{
+    return pd_parse_double(s, strlen(s), out) == PD_NUM_OK;
+}
+
+typedef struct {
+    int pose;
+    double value;
+} row;
+
+pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
+{
+    FILE *f = fopen(path, "r");
+    if (!f)
+        return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    char line[LINE_MAX_LEN];
+    char *field[64];
+    int col_pose = -1, col_count = -1, col_p = -1, col_n = -1, ncols = 0;
+    long lineno = 0;
+    double n_given = -1.0;
+    row *rows = NULL;
+    int nrows = 0, cap = 0, maxpose = 0;
+    pd_status st = PD_OK;
+    while (st == PD_OK && fgets(line, sizeof line, f)) {
+        lineno++;
+        if (!strchr(line, '\n') && !feof(f)) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: line longer than %d characters", path,
+                         lineno, LINE_MAX_LEN - 2);
+            break;
+        }
+        char *p = line;
+        while (*p == ' ' || *p == '\t')
+            p++;
+        if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
+            continue;
+        int nf = split(line, field, 64);
+        if (ncols == 0) {
+            ncols = nf;
+            for (int i = 0; i < nf && i < 64; i++) {
+                if (!strcmp(field[i], "pose")) col_pose = i;
+                else if (!strcmp(field[i], "count")) col_count = i;
+                else if (!strcmp(field[i], "p")) col_p = i;
+                else if (!strcmp(field[i], "n")) col_n = i;
+            }
+            if (col_pose < 0 || (col_count < 0) == (col_p < 0) || (col_n >= 0 && col_p < 0))
+                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a header with the columns "
+                             "pose and count, or pose and p (and optionally n)", path, lineno);
+            continue;
+        }
+        if (nf != ncols) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected %d fields as in the header, found %d",
+                         path, lineno, ncols, nf);
+            break;
+        }
+        double pose, v = 0.0, nv = 0.0;
+        const char *vtext = field[col_count >= 0 ? col_count : col_p];
+        if (!number(field[col_pose], &pose) || pose != floor(pose) || pose < 1 || pose > MAX_POSES) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a pose number from 1 to %d, got '%s'",
+                         path, lineno, MAX_POSES, field[col_pose]);
+            break;
+        }
+        if (col_count >= 0 && (!number(vtext, &v) || v != floor(v) || v < 0 || v > 1e15)) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a count (a whole number >= 0), got '%s'",
+                         path, lineno, vtext);
+            break;
+        }
+        if (col_p >= 0 && (!number(vtext, &v) || v < 0.0 || v > 1.0)) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a probability from 0 to 1, got '%s'",
+                         path, lineno, vtext);
+            break;
+        }
+        if (col_n >= 0) {
+            if (!number(field[col_n], &nv) || nv != floor(nv) || nv < 1 || nv > 1e15 ||
+                (n_given >= 0 && nv != n_given)) {
+                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected n, the same whole number of "
+                             "observations on every row, got '%s'", path, lineno, field[col_n]);
+                break;
+            }
+            n_given = nv;
+        }
+        for (int i = 0; i < nrows; i++)
+            if (rows[i].pose == (int)pose) {
+                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: pose %d given twice", path, lineno,
+                             (int)pose);
+                break;
+            }
+        if (st != PD_OK)
+            break;
+        if (nrows == cap) {
+            cap = cap ? 2 * cap : 16;
+            row *r = realloc(rows, (size_t)cap * sizeof *r);
+            if (!r) {
+                st = pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+                break;
+            }
+            rows = r;
+        }
+        rows[nrows].pose = (int)pose;
+        rows[nrows].value = v;
+        nrows++;
+        if ((int)pose > maxpose)
+            maxpose = (int)pose;
+    }
+    if (st == PD_OK && ferror(f))
+        st = pd_fail(diag, PD_ERR_IO, "%s: read error", path);
+    fclose(f);
+    double total = 0.0;
+    for (int i = 0; i < nrows; i++)
+        total += rows[i].value;
+    if (st == PD_OK && nrows == 0)
+        st = pd_fail(diag, PD_ERR_PARSE, "%s: no %s", path,
+                     ncols ? "rows after the header" : "header (pose,count or pose,p)");
+    else if (st == PD_OK && col_count >= 0 && !(total > 0))
+        st = pd_fail(diag, PD_ERR_RANGE, "%s: the counts add up to 0", path);
+    else if (st == PD_OK && col_p >= 0 && fabs(total - 1.0) > VIZ_MEASURED_SUM_TOL)
+        st = pd_fail(diag, PD_ERR_RANGE, "%s: the p column adds up to %.6g, expected 1 (within %g)",
+                     path, total, VIZ_MEASURED_SUM_TOL);
+    viz_measured *m = NULL;
+    if (st == PD_OK) {
+        m = calloc(1, sizeof *m);
+        int ci = col_count >= 0 || col_n >= 0;
+        if (m) {
+            m->p = calloc((size_t)maxpose, sizeof *m->p);
+            m->lo = ci ? calloc((size_t)maxpose, sizeof *m->lo) : NULL;
+            m->hi = ci ? calloc((size_t)maxpose, sizeof *m->hi) : NULL;
+            m->path = malloc(strlen(path) + 1);
+        }
+        if (!m || !m->p || !m->path || (ci && (!m->lo || !m->hi))) {
+            viz_measured_free(m);
+            m = NULL;
+            st = pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+        }
+    }
+    if (st == PD_OK) {
+        strcpy(m->path, path);
+        m->npose = maxpose;
+        m->n = col_count >= 0 ? (long)total : col_n >= 0 ? (long)n_given : 0;
+        for (int i = 0; i < nrows; i++) {
+            int k = rows[i].pose - 1;
+            m->p[k] = col_count >= 0 ? rows[i].value / total : rows[i].value;
+        }
+        if (m->lo)
+            for (int k = 0; k < maxpose; k++)
+                pd_wilson(lround(m->p[k] * (double)m->n), m->n, PD_Z95, &m->lo[k],
+                          &m->hi[k]);
+        *out = m;
+    }
+    free(rows);
+    return st;
+}
