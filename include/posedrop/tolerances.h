@@ -114,10 +114,12 @@
  * change. Smaller: the cascade above. */
 #define PD_TOL_CONTACT_REL 1e-6
 
-/* Resting contact on a face is simulated as microcollisions: a vertex pressed
- * on the floor falls this far (times L), meets it at the speed of that fall
- * and is stopped dead (e = 0: a resting contact does not bounce, and the Zeno
- * cascade of ever smaller bounces that e > 0 would start is skipped). Why
+/* Resting contact that no contact phase or compliant impact takes (hand-overs,
+ * chatter; faces too with contact_time 0) is simulated as microcollisions: a
+ * vertex pressed on the floor falls this far (times L), meets it at the speed
+ * of that fall, is stopped dead (e = 0: a resting contact does not bounce, and
+ * the Zeno cascade of ever smaller bounces that e > 0 would start is skipped)
+ * and is put back onto the floor (src/sim/drop.c). Why
  * 1e-4: the cost of rocking contact is one collision per fall, so it scales
  * as 1/sqrt(this) (1e-6 made a 32-gon cap take 5000 collisions a drop); the
  * energy test adds this depth to the energy. Stopping the fall damps the
