@@ -15,7 +15,8 @@ void pd_wilson(long k, long n, double z, double *lo, double *hi);
 /* Drops needed so that every one of k pose probabilities is within delta at
  * confidence 1 - alpha at once, in the worst case p = 1/2: the paper's eq.
  * (17) with its missing square restored, (z / (2 delta))^2, and z the
- * Bonferroni quantile Phi^-1(1 - alpha / (2k)) (READINGS.md). */
+ * Bonferroni quantile Phi^-1(1 - alpha / (2k)) (docs/readings.md, "Sample
+ * size, eq. 17"). */
 long pd_sample_size(double delta, double alpha, int k);
 
 #endif

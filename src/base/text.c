@@ -5,7 +5,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/text.h"
-#include "posedrop/tolerances.h"
 
 /* --- text cursor ---------------------------------------------------------- */
 

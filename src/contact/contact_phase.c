@@ -35,7 +35,7 @@
 #include "settle/settle.h"
 #include "base/gsl_adapter.h"
 #include "contact/phase_forces.h"
-#include "posedrop/tolerances.h"
+#include "contact/contact_tol.h"
 #include "base/quat.h"
 #include "base/vec3.h"
 

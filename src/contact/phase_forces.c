@@ -14,7 +14,7 @@
 #include <string.h>
 #include "base/mat3.h"
 #include "contact/phase_forces.h"
-#include "posedrop/tolerances.h"
+#include "contact/contact_tol.h"
 #include "base/quat.h"
 #include "base/vec3.h"
 

@@ -4,7 +4,7 @@
 #include <string.h>
 #include "dynamics/body.h"
 #include "base/fail.h"
-#include "posedrop/tolerances.h"
+#include "dynamics/dynamics_tol.h"
 #include "base/vec3.h"
 
 /* Jacobi sweeps before giving up. A 3x3 symmetric matrix converges

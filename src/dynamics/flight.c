@@ -37,7 +37,7 @@
 #include <string.h>
 #include "dynamics/flight.h"
 #include "base/gsl_adapter.h"
-#include "posedrop/tolerances.h"
+#include "dynamics/dynamics_tol.h"
 #include "base/sincos.h"
 #include "base/vec3.h"
 

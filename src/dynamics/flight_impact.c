@@ -51,6 +51,7 @@
 #include <math.h>
 #include "dynamics/flight.h"
 #include "posedrop/tolerances.h"
+#include "dynamics/dynamics_tol.h"
 #include "base/vec3.h"
 
 /* A sample of the flight: the state, world up in the body frame, and the

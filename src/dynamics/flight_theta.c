@@ -41,7 +41,7 @@
 #include <math.h>
 #include "dynamics/flight_theta.h"
 #include "base/sincos.h"
-#include "posedrop/tolerances.h"
+#include "dynamics/dynamics_tol.h"
 
 static const double PI = 3.14159265358979323846;
 

@@ -35,7 +35,7 @@ extern "C" {
 #include "engines/engine.h"
 #include "engines/engine_contact.h"
 #include "posedrop/bullet.h"
-#include "posedrop/tolerances.h"
+#include "engines/engines_tol.h"
 #include "posedrop/version.h"
 }
 

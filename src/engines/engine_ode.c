@@ -48,7 +48,7 @@
 #include <ode/ode.h>
 #include "engines/engine.h"
 #include "engines/engine_contact.h"
-#include "posedrop/tolerances.h"
+#include "engines/engines_tol.h"
 #include "base/vec3.h"
 
 /* Under the address sanitizer's leak checker: see step_memory_untracked. */

@@ -13,6 +13,7 @@
 #include "base/fail.h"
 #include "posedrop/hull.h"
 #include "posedrop/tolerances.h"
+#include "base/base_tol.h"
 #include "base/vec3.h"
 
 /* Most facet steps a point-location walk may take before the check falls

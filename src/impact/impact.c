@@ -16,7 +16,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include "impact/impact_internal.h"
-#include "posedrop/tolerances.h"
+#include "impact/impact_tol.h"
 
 struct pd_impact_work {
     pd_ode *poisson;   /* dimension NSTATE_P: the impulse */

@@ -12,7 +12,7 @@
  * Poisson's hypothesis (pz_end = (1 + e) pz_c) or Stronge's energetic one
  * (the normal impulse's work during restitution is e^2 times minus its work
  * during compression). The energetic law never adds kinetic energy; Poisson's
- * can with friction in 3-D (READINGS.md).
+ * can with friction in 3-D (docs/readings.md, "The collision law").
  *
  * A multi-contact scheme can call pd_impact_solve per contact with that
  * contact's K and u0; K's off-contact coupling is its business. */

@@ -8,7 +8,7 @@
  * under the energetic law. */
 #include <math.h>
 #include "impact/impact_internal.h"
-#include "posedrop/tolerances.h"
+#include "impact/impact_tol.h"
 
 enum {
     FORM_TAU, /* g = |u_t|: every ordinary step (rhs_tau) */

@@ -29,7 +29,7 @@
 #include <math.h>
 #include <stddef.h>
 #include "posedrop/mass.h"
-#include "posedrop/tolerances.h"
+#include "mesh/mesh_tol.h"
 #include "base/fail.h"
 #include "mesh/mesh_internal.h"
 #include "base/vec3.h"

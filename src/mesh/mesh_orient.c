@@ -28,6 +28,7 @@
 #include <string.h>
 #include "posedrop/mass.h"
 #include "posedrop/tolerances.h"
+#include "mesh/mesh_tol.h"
 #include "base/fail.h"
 #include "mesh/mesh_internal.h"
 #include "base/vec3.h"

@@ -13,6 +13,7 @@
 #include "base/size_range.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
+#include "part/part_tol.h"
 #include "base/vec3.h"
 
 void pd_part_options_default(pd_part_options *options)

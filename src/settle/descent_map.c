@@ -52,7 +52,8 @@
 #include <math.h>
 #include <stdlib.h>
 #include "settle/descent_map.h"
-#include "posedrop/tolerances.h"
+#include "base/base_tol.h"
+#include "settle/settle_tol.h"
 #include "base/vec3.h"
 
 /* The facet the walk rolls to from the part of arc e between unit vectors x

@@ -29,7 +29,7 @@
  * the end without it. */
 #include <math.h>
 #include "settle/flat_rest.h"
-#include "posedrop/tolerances.h"
+#include "settle/settle_tol.h"
 #include "base/vec3.h"
 
 void pd_flat_build(const pd_body *b, const pd_hull *hull, const pd_static_result *descent,

@@ -23,7 +23,7 @@
 #include "base/vec3.h"
 #include "settle/settle.h"
 #include "sim/drop_step.h"
-#include "posedrop/tolerances.h"
+#include "sim/sim_tol.h"
 
 /* Energy per unit weight, m: the height the centre of mass could reach. */
 static double energy_height(const pd_body *b, const pd_state *s, double g)

@@ -19,6 +19,7 @@
 #include "base/gsl_adapter.h"
 #include "sim/markov.h"
 #include "posedrop/tolerances.h"
+#include "sim/sim_tol.h"
 
 /* Two blocks, carved into the arrays below: ints and doubles. */
 struct pd_markov_work {

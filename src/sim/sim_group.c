@@ -6,7 +6,6 @@
 #include "base/fail.h"
 #include "base/stats.h"
 #include "posedrop/symmetry.h"
-#include "posedrop/tolerances.h"
 #include "sim/markov.h"
 
 pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,

@@ -8,7 +8,8 @@
 #include "base/rng.h"
 #include "base/vec3.h"
 #include "contact/contact_phase.h"
-#include "posedrop/tolerances.h"
+#include "base/base_tol.h"
+#include "sim/sim_tol.h"
 #include "sim/sim_model.h"
 
 void pd_sim_model_free(pd_sim_model *m)

@@ -14,6 +14,7 @@
 #include "base/fail.h"
 #include "base/gsl_adapter.h"
 #include "posedrop/tolerances.h"
+#include "static/static_tol.h"
 #include "static/static_internal.h"
 #include "base/vec3.h"
 

@@ -5,6 +5,7 @@
 #include <string.h>
 #include "base/fail.h"
 #include "posedrop/tolerances.h"
+#include "static/static_tol.h"
 #include "static/static_internal.h"
 #include "base/vec3.h"
 

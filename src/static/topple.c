@@ -22,6 +22,8 @@
 #include <stdlib.h>
 #include "base/fail.h"
 #include "posedrop/tolerances.h"
+#include "base/base_tol.h"
+#include "static/static_tol.h"
 #include "static/static_internal.h"
 #include "base/vec3.h"
 

@@ -1,9 +1,9 @@
 #!/bin/sh
 # make check-install (part of make check): posedrop as a user gets it.
 # Installs into a temporary prefix and builds the library example
-# (tests/install/example.c, the program docs/library.md shows) with plain
-# `pkg-config --cflags --libs posedrop`, the shared library; then against the
-# static archive, and a Bullet run through libposedrop-bullet. Outputs are
+# (tests/install/example.c, the program README.md and docs/library.md show)
+# with plain `pkg-config --cflags --libs posedrop`, the shared library; then
+# against the static archive, and a Bullet run through libposedrop-bullet. Outputs are
 # compared with the installed posedrop command on the same part and seed: the
 # same library and seed give the same drops (exact). Also checks that the
 # shared libraries export only the functions the installed headers declare,
@@ -51,12 +51,18 @@ if ! $MAKE --no-print-directory install PREFIX="$prefix" >"$tmp/install.log" 2>&
 fi
 ok
 
-# The program docs/library.md shows is the one built here.
+# The program docs/library.md shows is the one built here; README.md shows
+# lines of it.
 awk '/^## Example/ { e = 1 } e && /^```c$/ { p = 1; next } p && /^```$/ { exit } p' \
     docs/library.md >"$tmp/doc.c"
 sed -n '/^#include/,$p' tests/install/example.c >"$tmp/example-body.c"
 check "docs/library.md's example is tests/install/example.c" \
     sh -c "test -s '$tmp/doc.c' && cmp -s '$tmp/doc.c' '$tmp/example-body.c'"
+awk '/^## Library/ { e = 1 } e && /^```c$/ { p = 1; next } p && /^```$/ { exit } p' \
+    README.md >"$tmp/readme.c"
+check "README.md's excerpt is lines of tests/install/example.c" \
+    sh -c "test -s '$tmp/readme.c' && grep -Fxvf '$tmp/example-body.c' '$tmp/readme.c' | \
+           { ! grep -q .; }"
 check "make install put LICENSE and NOTICE in share/doc/posedrop" \
     test -s "$prefix/share/doc/posedrop/LICENSE" -a -s "$prefix/share/doc/posedrop/NOTICE"
 

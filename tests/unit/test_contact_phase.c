@@ -8,7 +8,7 @@
 #include "drop_fixture.h"
 #include "base/gsl_adapter.h"
 #include "contact/phase_forces.h"
-#include "posedrop/tolerances.h"
+#include "contact/contact_tol.h"
 #include "base/quat.h"
 #include "shapes.h"
 #include "suites.h"

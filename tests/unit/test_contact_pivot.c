@@ -7,7 +7,7 @@
 #include "contact/contact_phase.h"
 #include "contact/contact_pivot.h"
 #include "drop_fixture.h"
-#include "posedrop/tolerances.h"
+#include "contact/contact_tol.h"
 #include "base/quat.h"
 #include "shapes.h"
 #include "suites.h"

@@ -5,7 +5,6 @@
 #include "check.h"
 #include "settle/descent_map.h"
 #include "posedrop/posedrop.h"
-#include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "static/static_internal.h"
 #include "suites.h"

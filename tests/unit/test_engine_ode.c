@@ -8,7 +8,7 @@
 #include "check.h"
 #include "engines/engine.h"
 #include "posedrop/posedrop.h"
-#include "posedrop/tolerances.h"
+#include "engines/engines_tol.h"
 #include "base/quat.h"
 #include "shapes.h"
 #include "suites.h"

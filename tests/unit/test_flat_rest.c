@@ -12,6 +12,7 @@
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"
+#include "settle/settle_tol.h"
 
 static void test_box_facets(void)
 {

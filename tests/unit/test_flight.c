@@ -9,6 +9,7 @@
 #include "base/gsl_adapter.h"
 #include "posedrop/posedrop.h"
 #include "posedrop/tolerances.h"
+#include "dynamics/dynamics_tol.h"
 #include "shapes.h"
 #include "base/sincos.h"
 #include "suites.h"

@@ -11,7 +11,7 @@
 #include "impact/impact.h"
 #include "impact/impact_ray_series.h"
 #include "impact/impact_rays.h"
-#include "posedrop/tolerances.h"
+#include "impact/impact_tol.h"
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"

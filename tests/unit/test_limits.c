@@ -10,6 +10,8 @@
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"
+#include "part/part_tol.h"
+#include "static/static_tol.h"
 
 /* 1 if following next[] from every facet reaches its rest[], a stable facet,
  * in at most nfacets steps with the height falling at every unstable link

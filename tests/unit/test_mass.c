@@ -12,7 +12,6 @@
 #include "base/fail.h"
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"
-#include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"

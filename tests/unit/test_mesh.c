@@ -12,7 +12,6 @@
 #include <unistd.h>
 #include "check.h"
 #include "posedrop/mesh.h"
-#include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "suites.h"
 

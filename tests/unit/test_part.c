@@ -7,6 +7,7 @@
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"
+#include "part/part_tol.h"
 
 static pd_part *const SENTINEL = (pd_part *)&SENTINEL;
 

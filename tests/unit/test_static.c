@@ -95,9 +95,9 @@ static void test_solid_angle(void)
         CHECK_REL(got, rect_omega(a, b, d), 1e-13, "round-off against the closed form");
     }
 
-    /* Where the paper's law-of-cosines route fails (READINGS.md): a facet of
-     * 1e-3 at distance 1 loses most digits, a sliver gives NaN or garbage,
-     * while the atan2 form stays at round-off. */
+    /* Where the paper's law-of-cosines route fails (docs/readings.md, "Solid
+     * angles"): a facet of 1e-3 at distance 1 loses most digits, a sliver
+     * gives NaN or garbage, while the atan2 form stays at round-off. */
     {
         double a = 1e-3, d = 1.0, exact = rect_omega(a, a, d) / 2;
         pd_vec3 p0 = v3(-a / 2, -a / 2, d), p1 = v3(a / 2, -a / 2, d), p2 = v3(a / 2, a / 2, d);
@@ -113,8 +113,9 @@ static void test_solid_angle(void)
     }
 
     /* Fanned from the nearest point, a large facet seen from very close keeps
-     * full precision where a corner fan loses ~1e-12 (READINGS.md's regime
-     * turned around: the tile below is 1 x 0.8 seen from 5e-5). */
+     * full precision where a corner fan loses ~1e-12 (the regime of
+     * docs/readings.md, "Solid angles", turned around: the tile below is
+     * 1 x 0.8 seen from 5e-5). */
     {
         double a = 1, b = 0.8, d = 5e-5, exact = rect_omega(a, b, d);
         pd_vec3 q = v3(0, 0, d); /* the foot: nearest point of the facet */
@@ -519,8 +520,9 @@ static void test_options(void)
         }
         pd_part_free(part);
     }
-    /* READINGS.md: on random polyhedra, descent often lands on facets that
-     * share only a vertex; if it never did, the pivot walk would be dead code. */
+    /* docs/readings.md, "Toppling from a vertex region": on random polyhedra,
+     * descent often lands on facets that share only a vertex; if it never
+     * did, the pivot walk would be dead code. */
     CHECK(vertex_links > 0);
 }
 

@@ -5,7 +5,8 @@
 
 void suite_stats(void)
 {
-    /* READINGS.md's figures for eq. (17) with the square restored. */
+    /* The figures of docs/readings.md, "Sample size, eq. 17": eq. (17) with
+     * the square restored. */
     CHECK_INT(pd_sample_size(0.05, 0.05, 1), 385);
     CHECK_INT(pd_sample_size(0.05, 0.10, 1), 271);
     CHECK_INT(pd_sample_size(0.05, 0.05, 4), 624);

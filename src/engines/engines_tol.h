@@ -1,0 +1,70 @@
+/* engines_tol.h (private): the ODE and Bullet adapters' modelling constants.
+ *
+ * The stepping engines cross-check the impulse simulator. Their contacts are
+ * soft (a penetration spring) and resolved once per fixed time step, so they
+ * need guards the event-driven simulator does not. Lengths relative to the
+ * part's size L, as in posedrop/tolerances.h. */
+#ifndef PD_ENGINES_TOL_H
+#define PD_ENGINES_TOL_H
+
+/* ODE contact points: at most this many per step go to the solver. Three
+ * already fix a resting facet; eight spread over the facet (chosen by farthest
+ * point, deepest first) keep a many-cornered facet (a 32-gon coin) from being
+ * held at one side only, at a cost of 24 constraint rows, which the dense
+ * solver of dWorldStep handles in microseconds. */
+#define PD_ODE_MAX_CONTACTS 8
+
+/* ODE contacts approaching slower than this times sqrt(g L) do not bounce
+ * (ODE's bounce_vel). Why: a resting contact is pressed into the floor by
+ * gravity every step and meets it again at ~g dt plus the spring's
+ * correction speed; with bounce on, a resting part would hop forever instead
+ * of settling. 0.1 sqrt(g L) is the speed of a fall of L/200: a genuine
+ * impact from any drop height of a few L arrives far above it (1 mm onto a
+ * 1 cm part already gives 0.45 sqrt(g L)), while a contact at rest stays below
+ * it for time steps up to 0.1 sqrt(L/g) (3 ms at L = 1 cm; the default is
+ * 1 ms). Larger: slow genuine impacts lose their bounce. Smaller: jitter. */
+#define PD_ODE_BOUNCE_VEL_REL 0.1
+
+/* The floor's stiffness for ODE's soft contacts (soft_erp, soft_cfm): one
+ * contact carrying the part's whole weight sinks this far (times L).
+ * Why 1e-4: the same depth the impulse simulator lets a resting contact fall
+ * (PD_TOL_REST_FALL_REL), so both engines read heights and tilts to the same
+ * 1e-4; as a spring, the part bounces on it at sqrt(g / (1e-4 L)) rad/s,
+ * 1.6 per ms at L = 3.7 cm: ODE's implicit contact step is stable at any
+ * stiffness, and at this one a collision still spans a few steps of 1 ms.
+ * Larger (1e-2 L): the part visibly sinks and tilts 0.6 deg on a rocking
+ * vertex. Smaller: the spring stops being resolved by the time step and ERP
+ * tends to 1, so penetration is pushed out in one step, which ODE's manual
+ * warns adds energy. Scaling with m g / L makes the choice the same for a
+ * 1 cm and a 1 m part. */
+#define PD_ODE_SINK_REL 1e-4
+
+/* Damping ratio of that contact spring: critical, so a contact settles
+ * without ringing; the rebound is ODE's bounce (= restitution) alone, not a
+ * spring oscillation on top. */
+#define PD_ODE_DAMPING_RATIO 1.0
+
+/* Bullet's collision margin, times L: its convex shapes are the hull inflated
+ * by a sphere of this radius (Bullet's default, 0.04 m absolute, is four times
+ * a 1 cm part). The adapter lowers the floor plane by the margin, so heights
+ * against the floor are exact whatever its value; what it still moves is the
+ * contact point, m below the true corner, so friction acts on a lever arm off
+ * by m. Why 1e-3: that lever-arm error (1e-3 of the part's size) is far below
+ * the uncertainty of mu itself, while the margin stays ~1e4 times above the
+ * single-precision round-off of Bullet's coordinates (6e-8 L). Larger: friction
+ * torques visibly wrong (1e-1 L is a tenth of the arm); smaller than ~1e-5:
+ * within a few hundred ulps of float coordinates. */
+#define PD_BULLET_MARGIN_REL 1e-3
+
+/* Bullet contacts approaching slower than this many steps of gravity (g dt) do
+ * not bounce (Bullet's restitution velocity threshold, by default 0.2 m/s
+ * absolute, which is 2/3 of the speed of falling a 1 cm part's own size). A
+ * resting contact closes at g dt per step, the velocity one step of gravity
+ * adds; restitution on it would make the part chatter on the floor. Why 2: it
+ * stays clear of that resting speed (and of the solver's residue on it),
+ * while a genuine bounce kept has fallen at least (2 g dt)^2 / 2g = 2 g dt^2,
+ * 2e-5 m at the default 1/960 s. Larger: real low bounces are killed;
+ * smaller: resting contacts chatter. */
+#define PD_BULLET_BOUNCE_STEPS 2.0
+
+#endif

@@ -1,0 +1,29 @@
+/* mesh_tol.h (private): tolerances of mass properties and shell orientation.
+ * Conventions as in posedrop/tolerances.h. */
+#ifndef PD_MESH_TOL_H
+#define PD_MESH_TOL_H
+
+/* A closed mesh whose enclosed volume is at most this times L^3 has no volume
+ * (a flat or doubled surface, or one whose faces point inwards) and is refused
+ * by pd_mass_compute. Why 1e-12: the volume is a sum of signed tetrahedra taken
+ * from a point of the part, each with round-off of a few 1e-16 of its own
+ * size, so a flat surface of area A comes out at ~1e-16 A L; even a finely
+ * folded surface of a thousand L^2 stays below 1e-13 L^3. A genuine part of
+ * size L has at least one extent much larger than 1e-12 L (a sheet 1 um thick
+ * over a 1 m outline is 1e-6 L^3). Larger: thin but real plates and shims
+ * would be refused. Smaller: round-off of a flat surface could pass as a
+ * volume and give a centre of mass and inertia that are pure noise. */
+#define PD_TOL_VOLUME_REL 1e-12
+
+/* pd_mesh_orient decides whether one connected shell lies inside another by
+ * the winding number of the other shell at a point of the first: 1 inside, 0
+ * outside, exact integers up to round-off of a few 1e-16 per triangle. A point
+ * that lies on the other shell (shells touching along a face) sees 1/2. A
+ * winding number farther than this from every integer is such a touching
+ * point, and another point of the shell is tried. Why 0.25: halfway between
+ * the integer a clean point gives and the 1/2 a touching point gives, so
+ * neither round-off (tiny) nor a touch (exactly 1/2) is mistaken for the
+ * other. */
+#define PD_TOL_WINDING 0.25
+
+#endif

@@ -1,0 +1,43 @@
+/* sim_tol.h (private): tolerances of the drop loops and of the pose chain of
+ * --initial stationary. Conventions as in posedrop/tolerances.h. */
+#ifndef PD_SIM_TOL_H
+#define PD_SIM_TOL_H
+
+/* A contact approaching slower than this times sqrt(g L) (the speed of
+ * falling the part's own size) is resting, not colliding: the drop steps on
+ * and lets it meet the floor again as a microcollision. Why 1e-9:
+ * velocities after a resolved collision carry round-off of ~1e-16 of the
+ * speeds involved (up to ~10 sqrt(g L) for the paper's drops), so 1e-9 is far
+ * above it; a genuine impact after falling even the impact search's height
+ * tolerance (1e-9 L) arrives at sqrt(2e-9) ~ 4e-5 sqrt(g L), far above the
+ * threshold. Larger: slow genuine impacts would be ignored; smaller: a
+ * contact just resolved would be "hit" again by its own round-off. */
+#define PD_TOL_APPROACH_REL 1e-9
+
+/* A stepping engine's drop ends only when the part lies on the facet of its
+ * basin, tilted less than this from it (and its energy is below the basin's
+ * barrier). Why 1 degree (0.0175 rad): soft contacts let a resting part sink
+ * and rock by a fraction of a degree, so much less would wait for settling
+ * that never comes; the energy test already rules out leaving the basin, and
+ * 1 degree is far below any tilt at which a part could still be on its way
+ * to another pose. */
+#define PD_TOL_REST_TILT 0.0174532925199432958
+
+/* Pseudo-drops spread evenly over the poses (those with drops started on
+ * them) before each row of the transition matrix, and mu0, is redrawn for
+ * the stationary intervals. Why: redrawn from the counts alone, a transition
+ * no drop made never appears in a redraw, so a pose that kept every one of
+ * its m drops is a trap in every redrawn chain and its long-run probability
+ * gets an interval of zero width, although the data allow it to be left
+ * with probability up to ~3/m. On known chains with m = 20 drops per row,
+ * the nominal 95% intervals held the truth 47% of the time without
+ * pseudo-drops on a chain with a pose kept 97% of the time, and 94-100% with
+ * 0.5 on every chain tried; at m = 100, 92-98%. Half a drop is Jeffreys's
+ * prior on "does it ever leave" (a Beta(1/2, 1/2) gives each outcome half a
+ * pseudo-count). Larger: intervals widen everywhere for no gain in coverage
+ * (1: 95-100% at m = 20); smaller: traps return. It moves only the intervals
+ * (which are then stretched to hold p, markov.c); p is the long-run
+ * distribution of the counts themselves. */
+#define PD_STATIONARY_PSEUDO_DROPS 0.5
+
+#endif
