@@ -153,7 +153,7 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
  * 2e-4: resting contact falls PD_TOL_REST_FALL_REL (1e-4) per step by
  * design; a part that also turns must not carry another vertex much deeper
  * meanwhile, so that lasting contact stays within 1e-3 L of the floor
- * (docs/method.md); at twice the rest fall the bound costs extra steps only
+ * (docs/contact.md); at twice the rest fall the bound costs extra steps only
  * where the part turns or falls faster than 2 rest falls per rest step. */
 #define PD_REST_SINK_REL 2e-4
 
