@@ -6,49 +6,7 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 #include "contact/compliant.h"
-
-/* The step, as a fraction of the fastest time scale of one contact: its
- * oscillation 1 / omega, shortened by the damping rate the law reaches at
- * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
- * floor, since n springs of one contact's stiffness on a rigid body vibrate
- * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
- * 40 steps per contact duration at e = 0.3 with one contact (850 at the
- * smallest e, 0.01); a flat landing's rebound then comes out within 4e-4 of
- * e, and halving it moves no pose probability beyond sampling noise
- * (tests/unit/test_compliant.c). Larger: the explicit step loses accuracy,
- * and stability beyond 2. */
-#define PD_COMPLIANT_STEP 0.25
-
-/* Vertices within this times L above the floor are watched for contact, and
- * the list is rebuilt once the part may have moved half of it. Why 0.02: a
- * hull's vertices near the floor are few at that height, and rebuilds come
- * every 0.01 L of motion, a few hundred steps of a rocking part. Any value
- * gives the same motion (a vertex can only touch from within the band);
- * only the cost moves. */
-#define PD_COMPLIANT_BAND_REL 0.02
-
-/* Gauss-Seidel sweeps over the contacts' friction impulses per step, at
- * most, and the stop: no impulse moved by more than this times its cone's
- * radius in a sweep. Why 1e-6: the friction impulses are then converged far
- * below the step's own error (PD_COMPLIANT_STEP); sticking faces converge in
- * a few sweeps. 32 only stops a pathological coupling. */
-#define PD_COMPLIANT_SWEEPS 32
-#define PD_COMPLIANT_SWEEP_TOL 1e-6
-
-/* A contact below the floor is resting, not in the middle of a bounce,
- * when it moves either way no faster than resting contact arrives and its
- * spring holds at most this many times the part's weight. Why 4: a part
- * resting or rocking slowly on one vertex or an edge loads it with its
- * weight and the centripetal part of its rocking, well under 4 m g, while
- * a bounce at the resting speed v_rest already compresses its contact to
- * about that much, and every faster bounce to more; the test exists so that
- * a bounce's turning point (speed 0, deepest) is never taken for rest. */
-#define PD_COMPLIANT_REST_LOAD 4.0
-
-/* Steps between two tests of the outcome: the test costs a descent lookup,
- * tens of steps' work; deciding a few steps late changes nothing, since a
- * decided drop stays in its basin. */
-#define PD_COMPLIANT_TEST_EVERY 8
+#include "contact/contact_tol.h"
 
 struct pd_compliant_work {
     int nverts;
@@ -117,17 +75,11 @@ void pd_compliant_work_free(pd_compliant_work *w)
     free(w);
 }
 
-/* Body-frame inverse inertia applied to a. */
-static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 a)
-{
-    return v3(a.x * b->inv_moment[0], a.y * b->inv_moment[1], a.z * b->inv_moment[2]);
-}
-
 /* The inverse mass of the body at r along unit directions a and c, all in
  * the body frame: a.c / m + (r x a) I^-1 (r x c). */
 static double inv_mass(const pd_body *b, pd_vec3 r, pd_vec3 a, pd_vec3 c)
 {
-    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r, a), inv_inertia(b, v3_cross(r, c)));
+    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r, a), pd_body_inv_inertia(b, v3_cross(r, c)));
 }
 
 static void rebuild_candidates(const pd_compliant *c, pd_compliant_work *w, const pd_body *b,
@@ -222,7 +174,6 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 npush++;
             }
         }
-        r->depth = fmax(r->depth, deepest);
         if (nbelow > 0 && speed <= v_rest && load <= PD_COMPLIANT_REST_LOAD * m * g)
             r->rest_depth = fmax(r->rest_depth, deepest);
         if (step > 0) {
@@ -275,7 +226,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
         pd_vec3 wo = s->w;
         s->w = v3_add(s->w, v3(h * b->euler[0] * wo.y * wo.z, h * b->euler[1] * wo.z * wo.x,
                                h * b->euler[2] * wo.x * wo.y));
-        s->w = v3_add(s->w, inv_inertia(b, dw));
+        s->w = v3_add(s->w, pd_body_inv_inertia(b, dw));
 
         /* Coulomb friction: the tangential impulse at each pushing contact
          * that stops its sliding, within its cone, the contacts coupled
@@ -311,7 +262,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     s->v.x += ddx / m;
                     s->v.y += ddy / m;
                     pd_vec3 pb = v3_add(v3_scale(ex, ddx), v3_scale(ey, ddy));
-                    s->w = v3_add(s->w, inv_inertia(b, v3_cross(r_i, pb)));
+                    s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(r_i, pb)));
                     change = fmax(change, fmax(fabs(ddx), fabs(ddy)));
                 }
                 if (change <= stop)

@@ -54,10 +54,9 @@ typedef struct pd_compliant_result {
     pd_compliant_end end;
     int pose;           /* DECIDED: the pose index */
     double time;        /* s the run lasted */
-    double depth;       /* m: the deepest any vertex went below the floor */
-    double rest_depth;  /* m: the same while every contact below the floor
-                           rests (as QUIET has it: slow, lightly loaded), not
-                           the elastic compression of a bounce */
+    double rest_depth;  /* m: the deepest any vertex went below the floor
+                           while every contact rests (as QUIET has it: slow,
+                           lightly loaded), not a bounce's elastic compression */
     long steps;
     int energy_gain;    /* 1: the energy rose across the run and was scaled back */
 } pd_compliant_result;

@@ -4,18 +4,6 @@
 #include "base/gsl_adapter.h"
 #include "contact/compliant_law.h"
 
-/* Relative accuracy of chi and tau: far below anything a drop resolves, and
- * cheap, since a run computes them once. */
-#define PD_COMPLIANT_LAW_TOL 1e-13
-
-/* rk8pd steps one contact may take: the scaled contact lasts a few units of
- * time and the steps at PD_COMPLIANT_LAW_TOL are ~0.05 long, so 1e5 only
- * stops a failure. */
-#define PD_COMPLIANT_LAW_MAX_STEPS 100000
-
-/* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
-#define PD_COMPLIANT_LAW_MAX_HALVINGS 200
-
 static int scaled_law(double t, const double y[], double dydt[], void *user)
 {
     (void)t;
@@ -25,27 +13,25 @@ static int scaled_law(double t, const double y[], double dydt[], void *user)
     return 0;
 }
 
-/* The law with s as the variable, (dt/ds, dv/ds) = (1/v, s''/v): v is far
- * from 0 at the contact's end (it is -e there), so this carries the state
- * from just past s = 0 back onto it exactly. Classical RK4 over n substeps. */
+/* The law with s as the variable: (dt/ds, dv/ds) = (1/v, s''/v). */
+static void henon_rhs(double chi, double s, double v, double *kt, double *kv)
+{
+    *kt = 1.0 / v;
+    *kv = -fmax(0.0, s * (1.0 + chi * v)) / v;
+}
+
+/* v is far from 0 at the contact's end (it is -e there), so the law in s
+ * carries the state from just past s = 0 back onto it exactly (Henon's
+ * trick). Classical RK4 over n substeps. */
 static void henon_to_zero(double chi, double *t, double *s, double *v, int n)
 {
     double ds = -*s / n;
     for (int i = 0; i < n; i++) {
-        double k1t, k1v, k2t, k2v, k3t, k3v, k4t, k4v, ss = *s, vv;
-#define HENON_RHS(S, V, KT, KV)                                                   \
-    do {                                                                          \
-        KT = 1.0 / (V);                                                           \
-        KV = -fmax(0.0, (S) * (1.0 + chi * (V))) / (V);                           \
-    } while (0)
-        HENON_RHS(ss, *v, k1t, k1v);
-        vv = *v + 0.5 * ds * k1v;
-        HENON_RHS(ss + 0.5 * ds, vv, k2t, k2v);
-        vv = *v + 0.5 * ds * k2v;
-        HENON_RHS(ss + 0.5 * ds, vv, k3t, k3v);
-        vv = *v + ds * k3v;
-        HENON_RHS(ss + ds, vv, k4t, k4v);
-#undef HENON_RHS
+        double k1t, k1v, k2t, k2v, k3t, k3v, k4t, k4v, ss = *s;
+        henon_rhs(chi, ss, *v, &k1t, &k1v);
+        henon_rhs(chi, ss + 0.5 * ds, *v + 0.5 * ds * k1v, &k2t, &k2v);
+        henon_rhs(chi, ss + 0.5 * ds, *v + 0.5 * ds * k2v, &k3t, &k3v);
+        henon_rhs(chi, ss + ds, *v + ds * k3v, &k4t, &k4v);
         *t += ds * (k1t + 2.0 * k2t + 2.0 * k3t + k4t) / 6.0;
         *v += ds * (k1v + 2.0 * k2v + 2.0 * k3v + k4v) / 6.0;
         *s = ss + ds;
@@ -59,23 +45,23 @@ pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *ta
     pd_ode *ode = pd_ode_alloc(2, tol, tol);
     if (!ode)
         return PD_ERR_NOMEM;
-    double t = 0.0, h = 1e-3, y[2] = {0.0, 1.0}, dy[2];
+    double t = 0.0, h = PD_COMPLIANT_LAW_FIRST_STEP, y[2] = {0.0, 1.0}, dy[2];
     pd_status st = PD_ERR_NO_CONVERGENCE;
     *s_peak = 0.0;
     for (int k = 0; k < PD_COMPLIANT_LAW_MAX_STEPS; k++) {
         double t0 = t, y0[2] = {y[0], y[1]};
         scaled_law(t, y, dy, &chi);
-        st = pd_ode_step_from(ode, scaled_law, &chi, &t, t + 1e3, &h, y, dy);
+        st = pd_ode_step_from(ode, scaled_law, &chi, &t, t + PD_COMPLIANT_LAW_HORIZON, &h, y, dy);
         if (st != PD_OK)
             break;
         *s_peak = fmax(*s_peak, y[0]);
         if (y[0] <= 0.0 && y[1] < 0.0) {
             /* Past the end: from the step's start, which is inside, along s
-             * to s = 0 (many substeps: the step may be long). */
+             * to s = 0. */
             t = t0;
             y[0] = y0[0];
             y[1] = y0[1];
-            henon_to_zero(chi, &t, &y[0], &y[1], 64);
+            henon_to_zero(chi, &t, &y[0], &y[1], PD_COMPLIANT_LAW_HENON_STEPS);
             *e = -y[1];
             *tau = t;
             break;
@@ -101,7 +87,7 @@ pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law)
             break;
         lo = hi;
         hi *= 2.0;
-        if (hi > 1e6)
+        if (hi > PD_COMPLIANT_LAW_CHI_MAX)
             return PD_ERR_NO_CONVERGENCE;
     }
     for (int k = 0; k < PD_COMPLIANT_LAW_MAX_HALVINGS && hi - lo > PD_COMPLIANT_LAW_TOL * hi; k++) {

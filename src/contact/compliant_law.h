@@ -17,6 +17,7 @@
 #ifndef PD_COMPLIANT_LAW_H
 #define PD_COMPLIANT_LAW_H
 
+#include "contact/contact_tol.h"
 #include "posedrop/status.h"
 
 typedef struct pd_compliant_law {
@@ -27,13 +28,6 @@ typedef struct pd_compliant_law {
     double s_peak;  /* the deepest scaled penetration (at step ends: an estimate) */
     double omega;   /* rad/s: tau / T; k = m omega^2 */
 } pd_compliant_law;
-
-/* Restitution below this is taken as this: at e = 0 the law's chi is
- * infinite (the contact never restores) and its duration with it. Why 0.01:
- * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
- * below what any pose statistic resolves, while chi stays at 100 and a
- * contact takes about 850 of compliant.c's steps. */
-#define PD_COMPLIANT_E_MIN 0.01
 
 /* The law for restitution e in [0, 1] and contact duration T > 0 (s):
  * chi by bisection on e(chi), tau by integrating the scaled law to

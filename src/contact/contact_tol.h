@@ -66,4 +66,81 @@
  * microcollisions go on, so nothing is lost but time. */
 #define PD_PHASE_MAX_STEPS 10000
 
+
+/* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */
+
+/* Restitution below this is taken as this: at e = 0 the law's chi is
+ * infinite (the contact never restores) and its duration with it. Why 0.01:
+ * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
+ * below what any pose statistic resolves, while chi stays at 100 and a
+ * contact takes about 850 of compliant.c's steps. */
+#define PD_COMPLIANT_E_MIN 0.01
+
+/* Relative accuracy of chi and tau: far below anything a drop resolves, and
+ * cheap, since a run computes them once. */
+#define PD_COMPLIANT_LAW_TOL 1e-13
+
+/* rk8pd steps one contact may take: the scaled contact lasts a few units of
+ * time and the steps at PD_COMPLIANT_LAW_TOL are ~0.05 long, so 1e5 only
+ * stops a failure. */
+#define PD_COMPLIANT_LAW_MAX_STEPS 100000
+
+/* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
+#define PD_COMPLIANT_LAW_MAX_HALVINGS 200
+
+/* The step, as a fraction of the fastest time scale of one contact: its
+ * oscillation 1 / omega, shortened by the damping rate the law reaches at
+ * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
+ * floor, since n springs of one contact's stiffness on a rigid body vibrate
+ * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
+ * 40 steps per contact duration at e = 0.3 with one contact (850 at the
+ * smallest e, 0.01); a flat landing's rebound then comes out within 4e-4 of
+ * e, and halving it moves no pose probability beyond sampling noise
+ * (tests/unit/test_compliant.c). Larger: the explicit step loses accuracy,
+ * and stability beyond 2. */
+#define PD_COMPLIANT_STEP 0.25
+
+/* Vertices within this times L above the floor are watched for contact, and
+ * the list is rebuilt once the part may have moved half of it. Why 0.02: a
+ * hull's vertices near the floor are few at that height, and rebuilds come
+ * every 0.01 L of motion, a few hundred steps of a rocking part. Any value
+ * gives the same motion (a vertex can only touch from within the band);
+ * only the cost moves. */
+#define PD_COMPLIANT_BAND_REL 0.02
+
+/* Gauss-Seidel sweeps over the contacts' friction impulses per step, at
+ * most, and the stop: no impulse moved by more than this times its cone's
+ * radius in a sweep. Why 1e-6: the friction impulses are then converged far
+ * below the step's own error (PD_COMPLIANT_STEP); sticking faces converge in
+ * a few sweeps. 32 only stops a pathological coupling. */
+#define PD_COMPLIANT_SWEEPS 32
+#define PD_COMPLIANT_SWEEP_TOL 1e-6
+
+/* A contact below the floor is resting, not in the middle of a bounce,
+ * when it moves either way no faster than resting contact arrives and its
+ * spring holds at most this many times the part's weight. Why 4: a part
+ * resting or rocking slowly on one vertex or an edge loads it with its
+ * weight and the centripetal part of its rocking, well under 4 m g, while
+ * a bounce at the resting speed v_rest already compresses its contact to
+ * about that much, and every faster bounce to more; the test exists so that
+ * a bounce's turning point (speed 0, deepest) is never taken for rest. */
+#define PD_COMPLIANT_REST_LOAD 4.0
+
+/* Steps between two tests of the outcome: the test costs a descent lookup,
+ * tens of steps' work; deciding a few steps late changes nothing, since a
+ * decided drop stays in its basin. */
+#define PD_COMPLIANT_TEST_EVERY 8
+
+/* The scaled law's integration, in its own units (time 1 / omega, the
+ * contact lasting a few units): the first step tried, the horizon no contact
+ * reaches (a stop only: the end is found on s = 0 long before), and the
+ * classical RK4 substeps of the step in s that lands on s = 0 (the step is
+ * at most a few hundredths in s, so 64 substeps leave its error far below
+ * PD_COMPLIANT_LAW_TOL). Bisection on chi gives up above
+ * PD_COMPLIANT_LAW_CHI_MAX (e is 0.01 at chi 100: no e in range needs it). */
+#define PD_COMPLIANT_LAW_FIRST_STEP 1e-3
+#define PD_COMPLIANT_LAW_HORIZON 1e3
+#define PD_COMPLIANT_LAW_HENON_STEPS 64
+#define PD_COMPLIANT_LAW_CHI_MAX 1e6
+
 #endif

@@ -20,11 +20,6 @@
 
 enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
 
-static pd_vec3 inv_inertia(const pd_body *b, pd_vec3 t)
-{
-    return v3(b->inv_moment[0] * t.x, b->inv_moment[1] * t.y, b->inv_moment[2] * t.z);
-}
-
 /* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
  * n + m columns) and B's columns become X's, by Gaussian elimination with
  * partial pivoting; 0 if a pivot falls below PD_TOL_PHASE_PIVOT_REL of A's
@@ -218,7 +213,7 @@ void pd_phase_map(pd_phase *p)
             for (int k = 0; k < 3; k++) {
                 pd_vec3 f = body_axes[k];
                 pd_vec3 a = v3_add(v3_scale(f, 1.0 / b->mass),
-                                   v3_cross(inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
+                                   v3_cross(pd_body_inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
                 p->M[i][j][0][k] = a.x, p->M[i][j][1][k] = a.y, p->M[i][j][2][k] = a.z;
             }
     if (!all_stick(p))
@@ -265,7 +260,7 @@ static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s,
     if (!(fabs(k) > 0.0))
         return 1;
     double lambda = -v3_dot(up, af) / k, lm = lambda / b->mass;
-    out->wdot = v3_add(a0, inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
+    out->wdot = v3_add(a0, pd_body_inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
     out->acc = v3(-cx * lm, -cy * lm, lm - p->g);
     out->fn[0] = lambda;
     out->cone[0] = HUGE_VAL;
@@ -283,7 +278,7 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
     pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
     pd_vec3 w = s->w;
     pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
-    pd_vec3 a0 = v3_neg(inv_inertia(b, v3_cross(w, Iw)));
+    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
     if (!general && p->nc == 1 && p->mode[0] == SLIDE)
         return slide_one(p, CONST_M3(R), s, a0, out);
     /* Per contact: its slip, its sliding force direction n - mu s (body
@@ -357,7 +352,7 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
     for (int j = 0; j < p->nc; j++) {
-        out->wdot = v3_add(out->wdot, inv_inertia(b, v3_cross(p->r[j], f[j])));
+        out->wdot = v3_add(out->wdot, pd_body_inv_inertia(b, v3_cross(p->r[j], f[j])));
         F = v3_add(F, f[j]);
         double fn = v3_dot(f[j], up);
         out->fn[j] = fn;
@@ -396,7 +391,7 @@ int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
             return 0;
         double x = -(s->v.z + v3_dot(up, v3_cross(s->w, p->r[0]))) / k;
         s->v.z += x / b->mass;
-        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[0], v3_scale(up, x))));
+        s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(p->r[0], v3_scale(up, x))));
         return 1;
     }
     const pd_vec3 dir[2] = {up, up};
@@ -411,7 +406,7 @@ int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
     for (int k = 0; k < L.n; k++) {
         pd_vec3 P = v3_scale(L.col[k], x[k][0]);
         s->v = v3_add(s->v, quat_rotate(s->q, v3_scale(P, 1.0 / b->mass)));
-        s->w = v3_add(s->w, inv_inertia(b, v3_cross(p->r[L.c[k]], P)));
+        s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(p->r[L.c[k]], P)));
     }
     return 1;
 }

@@ -88,6 +88,12 @@ static inline double pd_body_kinetic(const pd_body *b, const pd_state *s)
                   b->moment[2] * s->w.z * s->w.z);
 }
 
+/* The body-frame inverse inertia applied to a: diag(1 / moment) a. */
+static inline pd_vec3 pd_body_inv_inertia(const pd_body *b, pd_vec3 a)
+{
+    return v3(a.x * b->inv_moment[0], a.y * b->inv_moment[1], a.z * b->inv_moment[2]);
+}
+
 /* World coordinates of body vertex i in state s. */
 static inline pd_vec3 pd_body_vertex_world(const pd_body *b, const pd_state *s, int i)
 {

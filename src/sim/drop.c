@@ -44,6 +44,7 @@
 #include "settle/settle.h"
 #include "sim/drop.h"
 #include "sim/drop_step.h"
+#include "sim/sim_tol.h"
 #include "dynamics/flight.h"
 #include "impact/impact.h"
 #include "posedrop/tolerances.h"
@@ -148,14 +149,6 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 }
 
 /* --- the drop ----------------------------------------------------------------- */
-
-/* How far a rest step may let a vertex sink below the floor, times L. Why
- * 2e-4: resting contact falls PD_TOL_REST_FALL_REL (1e-4) per step by
- * design; a part that also turns must not carry another vertex much deeper
- * meanwhile, so that lasting contact stays within 1e-3 L of the floor
- * (docs/contact.md); at twice the rest fall the bound costs extra steps only
- * where the part turns or falls faster than 2 rest falls per rest step. */
-#define PD_REST_SINK_REL 2e-4
 
 /* Moves the contacts[0..nc) of s that touch the floor (within the impact
  * search's contact tolerance) to the front, keeping their order, and returns

@@ -40,4 +40,12 @@
  * distribution of the counts themselves. */
 #define PD_STATIONARY_PSEUDO_DROPS 0.5
 
+/* How far a rest step may let a vertex sink below the floor, times L. Why
+ * 2e-4: resting contact falls PD_TOL_REST_FALL_REL (1e-4) per step by
+ * design; a part that also turns must not carry another vertex much deeper
+ * meanwhile, so that lasting contact stays within 1e-3 L of the floor
+ * (docs/contact.md); at twice the rest fall the bound costs extra steps only
+ * where the part turns or falls faster than 2 rest falls per rest step. */
+#define PD_REST_SINK_REL 2e-4
+
 #endif

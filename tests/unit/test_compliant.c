@@ -179,9 +179,18 @@ static pd_state random_touch(const pd_body *b, test_rng *rng, double slide, int 
     return s;
 }
 
-static double total(const pd_body *b, double g, const pd_state *s)
+/* The model of a random convex body (24 points on an ellipsoid, centre of
+ * mass off-centre) in the default scene sc, and a compliant work area for
+ * it (*w, NULL on failure, a check counted); 0 if the model failed. */
+static int random_body(model_fixture *fx, test_rng *rng, pd_scene *sc, pd_compliant_work **w)
 {
-    return total_energy(b, g, s);
+    pd_scene_default(sc);
+    *w = NULL;
+    if (!model_setup(fx, part_random_ellipsoid(rng, 24, 0.7, 0.5, 0.2, 0.1), sc, 1.0))
+        return 0;
+    *w = pd_compliant_work_alloc(fx->model->body);
+    CHECK(*w != NULL);
+    return 1;
 }
 
 /* Energy never rises across a compliant impact: 1e5 random single-vertex
@@ -198,13 +207,11 @@ static void test_energy_random_impacts(void)
     double worst = -HUGE_VAL;
     for (int body = 0; body < 20; body++) {
         pd_scene sc;
-        pd_scene_default(&sc);
         model_fixture fx;
-        if (!model_setup(&fx, part_random_ellipsoid(&rng, 24, 0.7, 0.5, 0.2, 0.1), &sc, 1.0))
+        pd_compliant_work *w;
+        if (!random_body(&fx, &rng, &sc, &w))
             return;
         const pd_body *b = fx.model->body;
-        pd_compliant_work *w = pd_compliant_work_alloc(b);
-        CHECK(w != NULL);
         for (long k = 0; w && k < n / 20; k++) {
             sc.restitution = rng_range(&rng, 0.0, 0.95);
             sc.mu = rng_range(&rng, 0.0, 1.5);
@@ -216,13 +223,13 @@ static void test_energy_random_impacts(void)
             }
             int v;
             pd_state s = random_touch(b, &rng, 2.0 * rng_uniform(&rng), &v);
-            double e0 = total(b, sc.gravity, &s);
+            double e0 = total_energy(b, sc.gravity, &s);
             pd_compliant_result r;
             CHECK_STATUS(pd_compliant_run(&c, w, &fx.model->settle, &sc, &s, 10.0 * T, &r), PD_OK);
             gains += r.energy_gain;
             ended += r.end == PD_COMPLIANT_SEPARATED || r.end == PD_COMPLIANT_QUIET ||
                      r.end == PD_COMPLIANT_DECIDED;
-            worst = fmax(worst, (total(b, sc.gravity, &s) - e0) / e0);
+            worst = fmax(worst, (total_energy(b, sc.gravity, &s) - e0) / e0);
         }
         pd_compliant_work_free(w);
         model_teardown(&fx);
@@ -258,13 +265,11 @@ static void test_rigid_limit(void)
     long n[2] = {0, 0};
     for (int body = 0; body < 10; body++) {
         pd_scene sc;
-        pd_scene_default(&sc);
         model_fixture fx;
-        if (!model_setup(&fx, part_random_ellipsoid(&rng, 24, 0.7, 0.5, 0.2, 0.1), &sc, 1.0))
+        pd_compliant_work *w;
+        if (!random_body(&fx, &rng, &sc, &w))
             return;
         const pd_body *b = fx.model->body;
-        pd_compliant_work *w = pd_compliant_work_alloc(b);
-        CHECK(w != NULL);
         for (int k = 0; w && k < 40; k++) {
             int sliding = k & 1;
             sc.restitution = rng_range(&rng, 0.05, 0.9);
