@@ -47,6 +47,10 @@ typedef struct pd_drop_work {
     double rest_depth;          /* m: the last drop's deepest lasting contact:
                                    a resting contact found below the floor, or
                                    a compliant contact older than its duration */
+    double energy_rise;         /* the last drop's largest rise of its energy
+                                   (kinetic per weight plus the centre's
+                                   height) above its lowest so far, per L: 0
+                                   but for round-off, as no step adds energy */
 } pd_drop_work;
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
