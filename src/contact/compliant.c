@@ -228,9 +228,16 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                                h * b->euler[2] * wo.x * wo.y));
         s->w = v3_add(s->w, pd_body_inv_inertia(b, dw));
 
-        /* Coulomb friction: the tangential impulse at each pushing contact
-         * that stops its sliding, within its cone, the contacts coupled
-         * through the body. */
+        /* Coulomb friction, the contacts coupled through the body (Gauss-
+         * Seidel sweeps): at each pushing contact the tangential impulse
+         * that stops its slip (the slip it would have without its own
+         * friction this step), if that lies within the cone; else the
+         * cone's impulse against the slip's direction, no larger than stops
+         * the slip along that direction. The direction matters: the cone's
+         * point nearest the stopping impulse is not against the slip where
+         * the tangential inverse mass is anisotropic, and that error does
+         * not shrink with the step (it moved a sliding impact's outgoing
+         * velocities by up to 2% of their size at any step). */
         if (mu > 0.0 && npush > 0) {
             for (int j = 0; j < npush; j++) {
                 pd_vec3 r_i = b->verts[w->push[j]];
@@ -248,13 +255,16 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     double ux = s->v.x + v3_dot(wr, ex), uy = s->v.y + v3_dot(wr, ey);
                     double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
                     double det = kxx * kyy - kxy * kxy;
-                    double px = w->ptx[j] - (kyy * ux - kxy * uy) / det;
-                    double py = w->pty[j] - (kxx * uy - kxy * ux) / det;
-                    double cap = mu * w->pn[j], p2 = px * px + py * py;
-                    if (p2 > cap * cap) {
-                        double f = cap / sqrt(p2);
-                        px *= f;
-                        py *= f;
+                    double fx = ux - (kxx * w->ptx[j] + kxy * w->pty[j]);
+                    double fy = uy - (kxy * w->ptx[j] + kyy * w->pty[j]);
+                    double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
+                    double cap = mu * w->pn[j];
+                    if (px * px + py * py > cap * cap) {
+                        double fn = hypot(fx, fy), ax = fx / fn, ay = fy / fn;
+                        double kaa = kxx * ax * ax + 2.0 * kxy * ax * ay + kyy * ay * ay;
+                        double mag = fmin(cap, fn / kaa);
+                        px = -mag * ax;
+                        py = -mag * ay;
                     }
                     double ddx = px - w->ptx[j], ddy = py - w->pty[j];
                     w->ptx[j] = px;
