@@ -188,9 +188,10 @@ static double touching_rise(const pd_body *b, const pd_state *s, const int *cont
 
 /* Lifts s by `lift` back onto the floor, paying out of its kinetic energy
  * for the part of the lift that the centre of mass did not fall (`fell`:
- * how far it fell since the part last touched, as a rest step's fall).
- * The height the centre fell is the speed the collision that follows then
- * stops, as a sinking contact would have lost it; but when the part turned
+ * how far it fell in the rest step just taken; anything below 0 when no
+ * rest step led here). The height the centre fell became speed that the
+ * collision which follows then stops, as a sinking contact would have lost
+ * it; but when the part turned
  * meanwhile the vertex went deeper than the centre fell, and lifting by the
  * difference for free, repeated, kept rocking parts going for ever (a coin
  * upright on its rim, twisting: the same energy after every 3 contacts

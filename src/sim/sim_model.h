@@ -49,8 +49,9 @@ typedef struct pd_drop_work {
                                    a compliant contact older than its duration */
     double energy_rise;         /* the last drop's largest rise of its energy
                                    (kinetic per weight plus the centre's
-                                   height) above its lowest so far, per L: 0
-                                   but for round-off, as no step adds energy */
+                                   height) above its lowest so far, per L:
+                                   about a rest fall at most, what a
+                                   microcollision may turn into motion */
 } pd_drop_work;
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
