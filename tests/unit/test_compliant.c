@@ -316,45 +316,55 @@ static void rk4_step(const limit_case *lc, double y[7], double h, int *ok)
     for (int i = 0; i < 7; i++) y[i] += h / 6.0 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
 }
 
+/* The case of s touching at body vertex vi; *uz0 its approach velocity
+ * and the return value the normal inverse mass there. */
+static double limit_setup(const pd_body *b, const pd_state *s, int vi, double mu, limit_case *lc,
+                          double *uz0)
+{
+    *lc = (limit_case){b, s->q, b->verts[vi], mu, 0.0, 0.0};
+    pd_vec3 up = quat_rotate_inv(s->q, v3(0, 0, 1)), rn = v3_cross(lc->r, up);
+    *uz0 = s->v.z + quat_rotate(s->q, v3_cross(s->w, lc->r)).z;
+    return 1.0 / b->mass + v3_dot(rn, pd_body_inv_inertia(b, rn));
+}
+
 /* Poisson's law by the same integration: to the normal impulse (1 + e)
  * times the compression's, where u_z crosses 0 (located by bisection on
- * RK4 sub-steps). */
+ * RK4 sub-steps). 0 if sliding stopped or the compression did not end. */
 static int poisson_law(const pd_body *b, const pd_state *s, int vi, double mu, double e,
                        pd_state *out)
 {
-    limit_case lc = {b, s->q, b->verts[vi], mu, 0.0, 0.0};
-    pd_vec3 up = quat_rotate_inv(s->q, v3(0, 0, 1));
-    double uz0 = s->v.z + quat_rotate(s->q, v3_cross(s->w, lc.r)).z;
-    double knn = 1.0 / b->mass + v3_dot(v3_cross(lc.r, up), pd_body_inv_inertia(b, v3_cross(lc.r, up)));
+    limit_case lc;
+    double uz0, knn = limit_setup(b, s, vi, mu, &lc, &uz0);
     double h = -uz0 / knn / 20000.0, P = 0.0;
     double y[7] = {s->v.x, s->v.y, s->v.z, s->w.x, s->w.y, s->w.z, 0.0};
-    int ok = 1;
-#define UZ(y) limit_uz(&lc, (y))
-    for (;;) {
+    int ok = 1, compressed = 0;
+    for (long step = 0; step < 1000000 && !compressed; step++) {
         double yn[7];
         memcpy(yn, y, sizeof yn);
         rk4_step(&lc, yn, h, &ok);
         if (!ok)
             return 0;
-        if (UZ(yn) >= 0.0) {
+        if (limit_uz(&lc, yn) >= 0.0) {
             double a = 0.0, c = h;
             for (int it = 0; it < 60; it++) {
                 double m = 0.5 * (a + c), yt[7];
                 memcpy(yt, y, sizeof yt);
                 rk4_step(&lc, yt, m, &ok);
-                if (UZ(yt) < 0.0)
+                if (limit_uz(&lc, yt) < 0.0)
                     a = m;
                 else
                     c = m;
             }
             P += 0.5 * (a + c);
             rk4_step(&lc, y, 0.5 * (a + c), &ok);
-            break;
+            compressed = 1;
+        } else {
+            memcpy(y, yn, sizeof y);
+            P += h;
         }
-        memcpy(y, yn, sizeof y);
-        P += h;
     }
-#undef UZ
+    if (!compressed)
+        return 0;
     double left = e * P;
     long nsteps = (long)ceil(left / h);
     for (long k = 0; k < nsteps && ok; k++)
@@ -377,11 +387,9 @@ static int limit_pushing(const limit_case *lc, const double y[7])
 static int limit_law(const pd_body *b, const pd_state *s, int vi, double mu, double chi,
                      double omega, double v_rest, pd_state *out)
 {
-    limit_case lc = {b, s->q, b->verts[vi], mu, 0.0, 0.0};
-    pd_vec3 up = quat_rotate_inv(s->q, v3(0, 0, 1));
-    double uz0 = s->v.z + quat_rotate(s->q, v3_cross(s->w, lc.r)).z;
+    limit_case lc;
+    double uz0, knn = limit_setup(b, s, vi, mu, &lc, &uz0);
     lc.lambda = chi / fmax(-uz0, v_rest);
-    double knn = 1.0 / b->mass + v3_dot(v3_cross(lc.r, up), pd_body_inv_inertia(b, v3_cross(lc.r, up)));
     lc.k = omega * omega / knn;
     double h = 1.0 / omega / 5000.0; /* tau / omega is about 4 / omega */
     double y[7] = {s->v.x, s->v.y, s->v.z, s->w.x, s->w.y, s->w.z, 0.0};
