@@ -294,8 +294,10 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 /* More than one vertex touching or arriving within a contact
                  * duration, one of them striking: a compliant impact, which
                  * the arriving ones join. Else the exact rigid law at the
-                 * touching vertices alone (a single vertex's impact is its
-                 * limit as the duration shrinks). */
+                 * touching vertices alone: a single vertex's compliant
+                 * impact tends to it as the duration shrinks, exactly but
+                 * where friction turns the sliding (docs/contact.md, the
+                 * rigid limit). */
                 double approach;
                 int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
                 if (nc >= 2 && approach > m->settle.v_rest) {
