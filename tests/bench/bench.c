@@ -14,6 +14,7 @@
 #include <time.h>
 #include <sys/resource.h>
 #include <unistd.h>
+#include "cli_paths.h"
 #include "sim/drop.h"
 #include "posedrop/posedrop.h"
 #include "posedrop/sim.h"
@@ -654,15 +655,6 @@ static void bench_engines(void)
  * drops, output): -j 2 and, when built, posedrop-mpi on two ranks against
  * -j 1, each checked to print the -j 1 run's bytes. */
 
-#ifndef PD_CLI_PATH
-#define PD_CLI_PATH "build/opt/posedrop"
-#endif
-#ifndef PD_CLI_MPI_PATH
-#define PD_CLI_MPI_PATH "build/opt/posedrop-mpi"
-#endif
-#ifndef PD_MPIRUN
-#define PD_MPIRUN "mpirun"
-#endif
 #define BATCH_PART "parts/cap.off"
 enum { BATCH_DROPS = 2000 };
 

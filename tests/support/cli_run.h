@@ -3,11 +3,8 @@
 #ifndef PD_TEST_CLI_RUN_H
 #define PD_TEST_CLI_RUN_H
 
+#include "cli_paths.h"
 #include "files.h" /* slurp */
-
-#ifndef PD_CLI_PATH
-#define PD_CLI_PATH "build/opt/posedrop"
-#endif
 
 /* A scratch directory of the suite (mkdtemp), where run_cmd keeps its
  * captures. */

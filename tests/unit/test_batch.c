@@ -302,12 +302,6 @@ static void test_slurm(void)
     free(err);
 }
 
-#ifndef PD_CLI_MPI_PATH
-#define PD_CLI_MPI_PATH "build/opt/posedrop-mpi"
-#endif
-#ifndef PD_MPIRUN
-#define PD_MPIRUN "mpirun"
-#endif
 /* As root, OpenMPI wants to be told; two ranks on fewer cores is fine here.
  * OpenMPI's own allocations outlive MPI_Finalize, which LeakSanitizer would
  * report under SANITIZE=1. */

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/wait.h>
 #include "check.h"
+#include "cli_paths.h"
 #include "files.h"
 #include "shapes.h"
 #include "suites.h"
@@ -17,10 +18,6 @@
 #include "posedrop/posedrop.h"
 #include "viz/viz_const.h"
 #include "viz/viz_internal.h"
-
-#ifndef PD_CLI_PATH
-#define PD_CLI_PATH "build/opt/posedrop"
-#endif
 
 /* Orthonormal and right-handed: the view is a rotation, so the projection
  * is orthographic and lengths across the screen keep their scale. */
