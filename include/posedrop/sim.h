@@ -271,7 +271,8 @@ PD_API void pd_sim_result_free(pd_sim_result *result);
  * the shard was); pd_sim_result_finish then computes p and its intervals from
  * the sums exactly as pd_sim_run does, so the shards 0..N-1 of a run summed
  * give the unsharded run's result, byte for byte (trials aside: none are
- * kept). PD_ERR_USAGE when a shard does not fit (pose count, initial
+ * kept). scene and options may be NULL (defaults). PD_ERR_USAGE for a NULL
+ * result, sum or shard, or when a shard does not fit (pose count, initial
  * distribution, seed), PD_ERR_NOMEM. */
 PD_API pd_status pd_sim_result_new(int nposes, const pd_scene *scene,
                                    const pd_sim_options *options, pd_sim_result **result,

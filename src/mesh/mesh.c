@@ -45,6 +45,8 @@ pd_status pd_units_parse(const char *text, pd_units *units)
 
 void pd_mesh_read_options_default(pd_mesh_read_options *options)
 {
+    if (!options)
+        return;
     options->format = PD_FORMAT_AUTO;
     options->units = PD_UNITS_M;
 }

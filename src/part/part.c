@@ -18,6 +18,8 @@
 
 void pd_part_options_default(pd_part_options *options)
 {
+    if (!options)
+        return;
     options->com_given = 0;
     options->com = v3(0.0, 0.0, 0.0);
 }

@@ -38,6 +38,8 @@ static const double Z95 = PD_Z95;
 
 void pd_sim_options_default(pd_sim_options *o)
 {
+    if (!o)
+        return;
     memset(o, 0, sizeof *o);
     o->engine = PD_ENGINE_IMPULSE;
     o->dt = 0.0;
@@ -442,9 +444,21 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
 pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *o,
                             pd_sim_result **result, pd_diag *diag)
 {
-    *result = NULL;
-    if (k < 1 || !scene || !o || o->ndrops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: invalid arguments");
+    pd_scene scene_default;
+    pd_sim_options options_default;
+    if (!scene) {
+        pd_scene_default(&scene_default);
+        scene = &scene_default;
+    }
+    if (!o) {
+        pd_sim_options_default(&options_default);
+        o = &options_default;
+    }
+    if (!result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: NULL result");
+    if (k < 1 || o->ndrops < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: %d poses, %ld drops: expected at "
+                       "least one pose and no negative count", k, o->ndrops);
     int stationary = scene->initial == PD_INITIAL_STATIONARY;
     pd_sim_result *r = calloc(1, sizeof *r);
     if (r) {

@@ -14,6 +14,8 @@
 
 void pd_scene_default(pd_scene *s)
 {
+    if (!s)
+        return;
     s->height = 0.12;
     s->belt_speed = 0.05;
     s->mu = 0.3;

@@ -11,7 +11,9 @@
 pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
                                 pd_sim_result **grouped, pd_diag *diag)
 {
-    *grouped = NULL;
+    if (!sim || !class_of || !grouped)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: NULL %s",
+                       !sim ? "sim" : !class_of ? "class_of" : "grouped");
     if (nclasses < 0 || (nclasses == 0 && sim->nposes > 0))
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: %d classes for %d poses",
                        nclasses, sim->nposes);

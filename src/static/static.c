@@ -11,6 +11,8 @@
 
 void pd_static_options_default(pd_static_options *options)
 {
+    if (!options)
+        return;
     options->topple = PD_TOPPLE_DESCENT;
     options->epsilon = 20.0 * M_PI / 180.0;
     options->compare = PD_PQS_COMPARE_RAW;

@@ -41,7 +41,9 @@ static int collect(void *user, const double R[3][3], const int *perm, uint64_t o
 pd_status pd_symmetry_find_by(const pd_part *part, pd_symmetry_method method,
                               pd_symmetry **symmetry, pd_diag *diag)
 {
-    *symmetry = NULL;
+    if (!part || !part->hull || !symmetry)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_symmetry_find: NULL %s",
+                       !part ? "part" : !symmetry ? "symmetry" : "hull in the part");
     rot_list l = {0, 0, NULL, NULL};
     int capped = 0;
     pd_symmetry *s = calloc(1, sizeof *s);
@@ -181,14 +183,19 @@ pd_status pd_pose_classes_by(const pd_part *part, const pd_static_result *res,
                              pd_symmetry_method method, int *class_of, int *nclasses,
                              pd_diag *diag)
 {
+    if (!part || !part->hull || !res || !class_of || !nclasses)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_pose_classes: NULL %s",
+                       !part ? "part" : !res ? "res" : !class_of ? "class_of"
+                                    : !nclasses ? "nclasses" : "hull in the part");
     const pd_hull *h = part->hull;
-    *nclasses = 0;
     for (int i = 0; i < res->nposes; i++)
         if (res->poses[i].facet < 0 || res->poses[i].facet >= h->nfacets)
             return pd_fail(diag, PD_ERR_USAGE, "pose %d rests on facet %d, not a facet of the "
                            "part's hull (%d facets)", i + 1, res->poses[i].facet, h->nfacets);
-    if (res->nposes == 0)
+    if (res->nposes == 0) {
+        *nclasses = 0;
         return PD_OK;
+    }
 
     class_ctx k;
     memset(&k, 0, sizeof k);
