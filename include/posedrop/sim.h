@@ -221,6 +221,11 @@ typedef struct pd_sim_result {
                                shard + t * nshards; p is count / n with Wilson
                                intervals even for PD_INITIAL_STATIONARY, whose
                                chain is estimated once the shards are summed */
+    uint64_t run_fingerprint; /* the run it belongs to: a hash of the part and
+                               pose table (the static result's), the scene and
+                               the options that change outcomes (not threads,
+                               keep_trials or the shard); pd_sim_result_add
+                               refuses a shard whose own differs */
 } pd_sim_result;
 
 /* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
@@ -264,19 +269,21 @@ PD_API pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_
 
 PD_API void pd_sim_result_free(pd_sim_result *result);
 
-/* Summing shards. pd_sim_result_new makes an empty result of nposes poses
- * for the whole run that scene and options describe (its nshards ignored);
+/* Summing shards. pd_sim_result_new makes an empty result for the whole run
+ * of static_result's poses that scene and options describe (its nshards
+ * ignored);
  * pd_sim_result_add adds one shard's counts to it (drops, counts, unsettled,
  * collisions and corrections, the stationary estimator's counts; partial if
  * the shard was); pd_sim_result_finish then computes p and its intervals from
  * the sums exactly as pd_sim_run does, so the shards 0..N-1 of a run summed
  * give the unsharded run's result, byte for byte (trials aside: none are
  * kept). scene and options may be NULL (defaults). PD_ERR_USAGE for a NULL
- * result, sum or shard, or when a shard does not fit (pose count, initial
- * distribution, seed), PD_ERR_NOMEM. */
-PD_API pd_status pd_sim_result_new(int nposes, const pd_scene *scene,
-                                   const pd_sim_options *options, pd_sim_result **result,
-                                   pd_diag *diag);
+ * static_result, result, sum or shard, or a shard of another run (its
+ * run_fingerprint: another part, pose table, scene, seed or drop count),
+ * PD_ERR_NOMEM. */
+PD_API pd_status pd_sim_result_new(const pd_static_result *static_result,
+                                   const pd_scene *scene, const pd_sim_options *options,
+                                   pd_sim_result **result, pd_diag *diag);
 PD_API pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *shard,
                                    pd_diag *diag);
 PD_API pd_status pd_sim_result_finish(pd_sim_result *result, pd_diag *diag);

@@ -11,6 +11,7 @@
 #ifndef POSEDROP_STATIC_H
 #define POSEDROP_STATIC_H
 
+#include <stdint.h>
 #include "posedrop/diag.h"
 #include "posedrop/export.h"
 #include "posedrop/part.h"
@@ -83,6 +84,12 @@ typedef struct pd_static_result {
     pd_pose *poses;     /* by descending p_qs; ties (PD_TOL_PROB_TIE_REL) by
                            normal, lexicographically ascending */
     int nknife;         /* facets with a knife edge (each also warned) */
+    uint64_t part_fingerprint; /* the part it was computed from: a hash of its
+                           size, centre of mass, mass properties and hull.
+                           pd_sim_run and pd_pose_classes refuse a part whose
+                           own differs (PD_ERR_USAGE): another part, or one
+                           changed since, whose hull the pose table does not
+                           index */
 } pd_static_result;
 
 /* Runs QS and PQS on a part. options may be NULL (defaults). On success

@@ -10,9 +10,11 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "base/fail.h"
+#include "base/hash.h"
 #include "base/size_range.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
+#include "part/part_check.h"
 #include "part/part_tol.h"
 #include "base/vec3.h"
 
@@ -197,4 +199,47 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     }
     *part = p;
     return PD_OK;
+}
+
+pd_status pd_part_check(const pd_part *part, const char *who, pd_diag *diag)
+{
+    if (!part)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: NULL part", who);
+    const pd_hull *h = part->hull;
+    if (!part->mesh || !h || h->nfacets < 4 || h->nverts < 4 || !h->verts || !h->normal ||
+        !h->offset || !h->facet_start || !h->facet_vert || !h->facet_adj || !(part->size > 0.0))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: the part is not one pd_part_build made (its "
+                       "mesh or hull is missing)", who);
+    return PD_OK;
+}
+
+static void hash_vec3s(pd_hash *s, const pd_vec3 *v, int n)
+{
+    for (int i = 0; i < n; i++) {
+        double x[3] = {v[i].x, v[i].y, v[i].z};
+        pd_hash_doubles(s, x, 3);
+    }
+}
+
+uint64_t pd_part_fingerprint(const pd_part *p)
+{
+    const pd_hull *h = p->hull;
+    pd_hash s;
+    pd_hash_init(&s, 0x70617274); /* "part" */
+    pd_hash_doubles(&s, &p->size, 1);
+    hash_vec3s(&s, &p->com, 1);
+    int counts[4] = {p->mass_known, h->nverts, h->nfacets, h->facet_start[h->nfacets]};
+    pd_hash_ints(&s, counts, 4);
+    if (p->mass_known) {
+        pd_hash_doubles(&s, &p->mass.volume, 1);
+        hash_vec3s(&s, &p->mass.com, 1);
+        for (int i = 0; i < 3; i++)
+            pd_hash_doubles(&s, p->mass.inertia[i], 3);
+    }
+    hash_vec3s(&s, h->verts, h->nverts);
+    pd_hash_ints(&s, h->facet_start, (long)h->nfacets + 1);
+    pd_hash_ints(&s, h->facet_vert, h->facet_start[h->nfacets]);
+    hash_vec3s(&s, h->normal, h->nfacets);
+    pd_hash_doubles(&s, h->offset, h->nfacets);
+    return s.h;
 }

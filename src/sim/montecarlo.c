@@ -17,10 +17,12 @@
 #include <string.h>
 #include <unistd.h>
 #include "base/fail.h"
+#include "base/hash.h"
 #include "sim/drop.h"
 #include "sim/markov.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
+#include "static/static_check.h"
 
 /* The paper's bootstrap: 20 uniform drops, then drops resting on poses drawn
  * from the running estimate. Rounds of fixed size keep it deterministic; the
@@ -409,10 +411,24 @@ static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
     return PD_OK;
 }
 
+/* Whether r has the arrays its counts promise: per pose counts (and, with
+ * finished, probabilities and intervals), the chain's counts both or
+ * neither. A result the library made always has; a hand-made one is
+ * checked before its arrays are indexed. */
+static int result_arrays(const pd_sim_result *r, int finished)
+{
+    return r->nposes >= 0 && (r->nposes == 0 || r->count) &&
+           (!finished || r->nposes == 0 || (r->p && r->ci_lo && r->ci_hi)) &&
+           !r->first_count == !r->transitions;
+}
+
 pd_status pd_sim_result_finish(pd_sim_result *r, pd_diag *diag)
 {
     if (!r)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_finish: NULL argument");
+    if (!result_arrays(r, 1))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_finish: the result has not the "
+                       "arrays of its %d poses", r->nposes);
     for (int i = 0; i < r->nposes; i++) {
         r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
         pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
@@ -441,8 +457,32 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
     return PD_OK;
 }
 
-pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *o,
-                            pd_sim_result **result, pd_diag *diag)
+/* The identity of a run: the part and pose table the drops map onto, and
+ * every setting that changes an outcome (not threads, trials, the shard, a
+ * cancel flag or a progress callback), so that a shard of another run is
+ * refused by pd_sim_result_add however alike its counts look. */
+static uint64_t run_fingerprint(const pd_static_result *poses, const pd_scene *sc,
+                                const pd_sim_options *o)
+{
+    pd_hash s;
+    pd_hash_init(&s, 0x72756e); /* "run" */
+    pd_hash_u64(&s, poses->part_fingerprint);
+    pd_hash_ints(&s, &poses->nposes, 1);
+    for (int i = 0; i < poses->nposes; i++)
+        pd_hash_ints(&s, &poses->poses[i].facet, 1);
+    double reals[] = {sc->height, sc->belt_speed, sc->mu, sc->restitution, sc->vibration,
+                      sc->gravity, sc->contact_time, o->dt, o->ci_halfwidth, o->time_limit};
+    pd_hash_doubles(&s, reals, (long)(sizeof reals / sizeof reals[0]));
+    int ints[] = {(int)sc->law, (int)sc->initial, (int)o->engine, o->max_collisions};
+    pd_hash_ints(&s, ints, (long)(sizeof ints / sizeof ints[0]));
+    pd_hash_u64(&s, (uint64_t)o->ndrops);
+    pd_hash_u64(&s, (uint64_t)o->max_drops);
+    pd_hash_u64(&s, o->seed);
+    return s.h;
+}
+
+pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene,
+                            const pd_sim_options *o, pd_sim_result **result, pd_diag *diag)
 {
     pd_scene scene_default;
     pd_sim_options options_default;
@@ -454,9 +494,11 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
         pd_sim_options_default(&options_default);
         o = &options_default;
     }
-    if (!result)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: NULL result");
-    if (k < 1 || o->ndrops < 0)
+    if (!poses || !result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: NULL %s",
+                       poses ? "result" : "static_result");
+    int k = poses->nposes;
+    if (k < 1 || !poses->poses || o->ndrops < 0)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: %d poses, %ld drops: expected at "
                        "least one pose and no negative count", k, o->ndrops);
     int stationary = scene->initial == PD_INITIAL_STATIONARY;
@@ -468,6 +510,7 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
         r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
         r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
         r->seed = o->seed;
+        r->run_fingerprint = run_fingerprint(poses, scene, o);
         if (stationary) {
             r->first_count = calloc((size_t)k, sizeof *r->first_count);
             r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
@@ -487,12 +530,18 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
 pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag *diag)
 {
     if (!sum || !s)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: NULL argument");
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: NULL %s", sum ? "shard" : "sum");
+    if (!result_arrays(sum, 1) || !result_arrays(s, 0))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: the %s has not the arrays of "
+                       "its %d poses", result_arrays(sum, 1) ? "shard" : "sum",
+                       result_arrays(sum, 1) ? s->nposes : sum->nposes);
     if (s->nposes != sum->nposes || !s->transitions != !sum->transitions || s->seed != sum->seed ||
-        s->first_drops != sum->first_drops || s->pose_drops != sum->pose_drops)
+        s->first_drops != sum->first_drops || s->pose_drops != sum->pose_drops ||
+        s->run_fingerprint != sum->run_fingerprint)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: the shard is not of this run "
-                       "(%d poses, seed %llu; the run: %d poses, seed %llu)", s->nposes,
-                       (unsigned long long)s->seed, sum->nposes, (unsigned long long)sum->seed);
+                       "(%d poses, seed %llu; the run: %d poses, seed %llu; or another part, "
+                       "scene or drop count)", s->nposes, (unsigned long long)s->seed,
+                       sum->nposes, (unsigned long long)sum->seed);
     size_t k = (size_t)sum->nposes;
     sum->n += s->n;
     sum->unsettled += s->unsettled;
@@ -570,14 +619,17 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         o = *options;
     else
         pd_sim_options_default(&o);
-    if (!part || !poses || !result)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL argument");
-    pd_status st = pd_scene_check(&sc, diag);
+    pd_status st = pd_static_result_check(part, poses, "pd_sim_run", diag);
+    if (st != PD_OK)
+        return st;
+    if (!result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL result");
+    st = pd_scene_check(&sc, diag);
     if (st == PD_OK)
         st = check_options(&o, diag);
     if (st != PD_OK)
         return st;
-    if (poses->nposes < 1 || !poses->poses)
+    if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the static result has no stable pose");
     if (o.nshards < 0 || (o.nshards > 0 && (o.shard < 0 || o.shard >= o.nshards)))
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: shard %d of %d", o.shard + 1, o.nshards);
@@ -593,7 +645,7 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     if (st != PD_OK)
         return st;
     pd_sim_result *r = NULL;
-    st = pd_sim_result_new(poses->nposes, &sc, &o, &r, diag);
+    st = pd_sim_result_new(poses, &sc, &o, &r, diag);
     if (st == PD_OK) {
         r->nshards = o.nshards;
         r->shard = o.nshards ? o.shard : 0;

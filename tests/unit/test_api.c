@@ -1,7 +1,9 @@
 /* test_api.c: the library's contracts with a program: its version, the
  * engines a program can ask for (Bullet only once registered), and
  * pd_sim_run refusing impossible scenes and options with a status that names
- * the field, before any drop runs.
+ * the field, before any drop runs, and calls given two objects that do not
+ * belong together (a static result of another part, a shard of another run)
+ * refusing them.
  *
  * Runs before every other suite that uses Bullet (suites.h), so the first
  * checks see an unregistered Bullet, as a C program that never links
@@ -192,8 +194,163 @@ static void test_impossible_options(const fixture *f)
     REFUSE(o.engine = (pd_engine_kind)3, PD_ERR_USAGE, "engine");
 }
 
+/* A part and its static estimate from a mesh (consumed), or 0. */
+static int part_and_poses(pd_mesh *m, pd_part **part, pd_static_result **res)
+{
+    int ok = mesh_part(m, part, res);
+    CHECK(ok);
+    return ok;
+}
+
+static pd_mesh *read_part(const char *path)
+{
+    pd_mesh *m = NULL;
+    return pd_mesh_read(path, NULL, &m, NULL) == PD_OK ? m : NULL;
+}
+
+/* call must refuse with PD_ERR_USAGE and a message containing what. */
+#define REFUSED(call, d, what)                                                            \
+    do {                                                                                   \
+        pd_diag_init(&(d));                                                                \
+        CHECK_STATUS(call, PD_ERR_USAGE);                                                  \
+        if (!strstr((d).message, what))                                                    \
+            printf("     expected '%s' in the message: %s\n", what, (d).message);          \
+        CHECK(strstr((d).message, what) != NULL);                                          \
+    } while (0)
+
+/* A static result belongs to the part it was computed from: the cube's
+ * drops with the cap's pose table wrote past the end of a 6-facet array
+ * (issue 22), and the cap with the cube's table read the wrong facets. */
+static void test_result_of_another_part(void)
+{
+    pd_part *cube = NULL, *cap = NULL;
+    pd_static_result *cube_res = NULL, *cap_res = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.01, 0.01), &cube, &cube_res) ||
+        !part_and_poses(read_part("parts/cap.off"), &cap, &cap_res))
+        goto done;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 10;
+    o.threads = 1;
+    pd_diag d;
+    pd_sim_result untouched, *r = &untouched;
+    REFUSED(pd_sim_run(cube, cap_res, NULL, &o, &r, &d), d, "another part");
+    REFUSED(pd_sim_run(cap, cube_res, NULL, &o, &r, &d), d, "another part");
+    CHECK(r == &untouched);
+    int cls[256], n = -1;
+    REFUSED(pd_pose_classes(cube, cap_res, cls, &n, &d), d, "another part");
+    REFUSED(pd_pose_classes(cap, cube_res, cls, &n, &d), d, "another part");
+    CHECK_INT(n, -1);
+
+    /* The same mesh built again is the same part: its estimate fits. */
+    pd_part *again = NULL;
+    pd_mesh *m = mesh_box(0.01, 0.01, 0.01);
+    CHECK_STATUS(pd_part_build(m, NULL, &again, NULL), PD_OK);
+    pd_mesh_free(m);
+    CHECK_STATUS(pd_sim_run(again, cube_res, NULL, &o, &r, NULL), PD_OK);
+    if (r != &untouched)
+        pd_sim_result_free(r);
+    r = &untouched;
+    pd_part_free(again);
+
+    /* A part freed and another built in its place (malloc often gives the
+     * same address back): the fingerprint, not the address, decides. */
+    const pd_part *old_address = cube;
+    pd_part_free(cube);
+    cube = NULL;
+    pd_static_result *other_res = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.02, 0.03), &cube, &other_res))
+        goto done;
+    pd_note("api: the box was built %s the freed cube's address\n",
+            (const void *)cube == (const void *)old_address ? "at" : "away from");
+    REFUSED(pd_sim_run(cube, cube_res, NULL, &o, &r, &d), d, "another part");
+    pd_static_result_free(other_res);
+
+    /* A part changed after its estimate (the struct is the caller's to
+     * write): the centre of mass moved by one ulp is another part. */
+    cap->com.x = nextafter(cap->com.x, 1.0);
+    REFUSED(pd_sim_run(cap, cap_res, NULL, &o, &r, &d), d, "another part");
+    cap->com.x = nextafter(cap->com.x, -1.0);
+    CHECK_STATUS(pd_pose_classes(cap, cap_res, cls, &n, NULL), PD_OK);
+
+    /* A pose table edited by hand: each pose on a distinct stable facet. */
+    int f0 = cap_res->poses[0].facet;
+    cap_res->poses[0].facet = cap_res->nfacets;
+    REFUSED(pd_sim_run(cap, cap_res, NULL, &o, &r, &d), d, "not a stable facet");
+    cap_res->poses[0].facet = cap_res->poses[1].facet;
+    REFUSED(pd_pose_classes(cap, cap_res, cls, &n, &d), d, "same facet");
+    cap_res->poses[0].facet = f0;
+    CHECK(r == &untouched);
+done:
+    pd_static_result_free(cube_res);
+    pd_static_result_free(cap_res);
+    pd_part_free(cube);
+    pd_part_free(cap);
+}
+
+/* Shards add up only within their run: the counts of another part's or
+ * another scene's run of the same pose count and seed used to be summed. */
+static void test_shard_of_another_run(void)
+{
+    pd_part *a = NULL, *b = NULL;
+    pd_static_result *ra = NULL, *rb = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.02, 0.03), &a, &ra) ||
+        !part_and_poses(mesh_box(0.01, 0.02, 0.035), &b, &rb))
+        goto done;
+    CHECK_INT(ra->nposes, rb->nposes);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 20;
+    o.threads = 1;
+    o.nshards = 2;
+    pd_scene sc, other_mu;
+    pd_scene_default(&sc);
+    other_mu = sc;
+    other_mu.mu = 0.4;
+    pd_sim_result *sum = NULL, *mine = NULL, *theirs = NULL, *mu = NULL, *threads = NULL;
+    pd_sim_options o2 = o;
+    o2.threads = 2;
+    o2.keep_trials = 1;
+    CHECK_STATUS(pd_sim_result_new(ra, &sc, &o, &sum, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(a, ra, &sc, &o, &mine, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(b, rb, &sc, &o, &theirs, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(a, ra, &other_mu, &o, &mu, NULL), PD_OK);
+    o2.shard = 1;
+    CHECK_STATUS(pd_sim_run(a, ra, &sc, &o2, &threads, NULL), PD_OK);
+    if (sum && mine && theirs && mu && threads) {
+        pd_diag d;
+        REFUSED(pd_sim_result_add(sum, theirs, &d), d, "not of this run");
+        REFUSED(pd_sim_result_add(sum, mu, &d), d, "not of this run");
+        CHECK_INT(sum->n, 0);
+        /* Threads and trials do not change outcomes: those shards fit. */
+        CHECK_STATUS(pd_sim_result_add(sum, mine, NULL), PD_OK);
+        CHECK_STATUS(pd_sim_result_add(sum, threads, NULL), PD_OK);
+        CHECK_INT(sum->n, o.ndrops);
+        /* A hand-made shard without its counts. */
+        pd_sim_result bare = *mine;
+        bare.count = NULL;
+        REFUSED(pd_sim_result_add(sum, &bare, &d), d, "arrays");
+        int one_class[16] = {0};
+        pd_sim_result *g = NULL;
+        REFUSED(pd_sim_result_grouped(&bare, one_class, 1, &g, &d), d, "arrays");
+        CHECK(g == NULL);
+    }
+    pd_sim_result_free(sum);
+    pd_sim_result_free(mine);
+    pd_sim_result_free(theirs);
+    pd_sim_result_free(mu);
+    pd_sim_result_free(threads);
+done:
+    pd_static_result_free(ra);
+    pd_static_result_free(rb);
+    pd_part_free(a);
+    pd_part_free(b);
+}
+
 void suite_api(void)
 {
+    test_result_of_another_part();
+    test_shard_of_another_run();
     test_version();
     fixture f;
     if (!setup(&f))

@@ -313,7 +313,7 @@ static pd_sim_result *new_sum(const fixture *f)
     pd_sim_options so;
     few_drops(&so);
     pd_sim_result *r = NULL;
-    if (pd_sim_result_new(f->res->nposes, NULL, &so, &r, NULL) != PD_OK)
+    if (pd_sim_result_new(f->res, NULL, &so, &r, NULL) != PD_OK)
         return NULL;
     return r;
 }
@@ -332,7 +332,7 @@ static void c_sim_result_new(const fixture *f, int k, outcome *o)
     pd_sim_options so;
     few_drops(&so);
     pd_sim_result *r = SENTINEL;
-    o->st = pd_sim_result_new(f->res->nposes, P(0, &sc), P(1, &so), P(2, &r), P(3, &o->diag));
+    o->st = pd_sim_result_new(P(0, f->res), P(1, &sc), P(2, &so), P(3, &r), P(4, &o->diag));
     settle_output(o, r, pd_sim_result_free);
 }
 
@@ -468,7 +468,7 @@ static const entry table[] = {
     {"pd_shard_drops", "", c_shard_drops},
     {"pd_sim_run", "part static_result ?scene ?options result ?diag", c_sim_run},
     {"pd_sim_result_free", "?result", c_sim_result_free},
-    {"pd_sim_result_new", "?scene ?options result ?diag", c_sim_result_new},
+    {"pd_sim_result_new", "static_result ?scene ?options result ?diag", c_sim_result_new},
     {"pd_sim_result_add", "sum shard ?diag", c_sim_result_add},
     {"pd_sim_result_finish", "result ?diag", c_sim_result_finish},
     {"pd_static_options_default", "?options", c_static_options_default},
