@@ -157,6 +157,13 @@ typedef struct pd_sim_options {
 
 PD_API void pd_sim_options_default(pd_sim_options *options);
 
+/* Whether every field of options is within the range given with it (the
+ * engine one of pd_engine_kind's, shard below nshards, no ci_halfwidth with
+ * shards): PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_USAGE otherwise,
+ * the message naming the field. Whether the engine is linked is
+ * pd_engine_available's question. pd_sim_run calls it first. */
+PD_API pd_status pd_sim_options_check(const pd_sim_options *options, pd_diag *diag);
+
 /* 1 if pd_sim_run can run that engine in this program: the impulse engine and
  * ODE always, Bullet once pd_bullet_register (posedrop/bullet.h) was called. */
 PD_API int pd_engine_available(pd_engine_kind engine);
@@ -230,10 +237,13 @@ typedef struct pd_sim_result {
 
 /* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
  * shard gets the same mix of drops (for PD_INITIAL_STATIONARY, of phases and
- * starting poses), so shards take about as long as each other. */
+ * starting poses), so shards take about as long as each other. 0 when
+ * nshards < 1 (the whole run), -1 for a negative drop. */
 PD_API int pd_shard_of(long drop, int nshards);
 
-/* How many of a run's ndrops drops shard (0-based) of nshards runs. */
+/* How many of a run's ndrops drops shard (0-based) of nshards runs: ndrops
+ * when nshards < 1, 0 for a shard outside 0 .. nshards - 1 or a negative
+ * ndrops. */
 PD_API long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto

@@ -12,6 +12,7 @@
 #include "base/fail.h"
 #include "base/hash.h"
 #include "base/size_range.h"
+#include "mesh/mesh_internal.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
 #include "part/part_check.h"
@@ -101,12 +102,10 @@ static pd_status weld_explains(pd_status st, int nbefore, int nafter, double siz
 
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
-    /* Every size-relative tolerance below needs a finite size, within the
-     * range where products of the part's lengths stay normal doubles. */
+    /* Every size-relative tolerance below needs a finite size (the
+     * coordinates were checked finite), within the range where products of
+     * the part's lengths stay normal doubles. */
     pd_mesh *m = p->mesh;
-    for (int i = 0; i < m->nverts; i++)
-        if (!v3_isfinite(m->verts[i]))
-            return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
     pd_vec3 lo = v3(0.0, 0.0, 0.0), hi = lo;
     for (int i = 0; i < m->nverts; i++) {
         pd_vec3 v = m->verts[i];
@@ -184,13 +183,24 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     else
         pd_part_options_default(&opt);
     if (!mesh || !part)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL argument");
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL %s", mesh ? "part" : "mesh");
+    /* A mesh made by hand gets an input error, not an out-of-memory from
+     * copying a negative count or a crash from an index off its end. */
+    pd_status st = pd_mesh_validate(mesh, "pd_part_build", diag);
+    if (st != PD_OK)
+        return st;
+    if (opt.com_given != 0 && opt.com_given != 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: option com_given is %d: expected 0 "
+                       "or 1", opt.com_given);
+    if (opt.com_given && !v3_isfinite(opt.com))
+        return pd_fail(diag, PD_ERR_NONFINITE, "pd_part_build: the given centre of mass is not "
+                       "finite");
     pd_part *p = calloc(1, sizeof *p);
     if (!p || !(p->mesh = pd_mesh_clone(mesh))) {
         free(p);
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory copying the mesh");
     }
-    pd_status st = build(p, &opt, diag);
+    st = build(p, &opt, diag);
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
             pd_fail(diag, st, "out of memory building the part");

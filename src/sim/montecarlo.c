@@ -62,14 +62,22 @@ void pd_sim_options_default(pd_sim_options *o)
 
 int pd_shard_of(long drop, int nshards)
 {
+    if (drop < 0)
+        return -1;
     return nshards > 0 ? (int)(drop % nshards) : 0;
 }
 
 long pd_shard_drops(long ndrops, int shard, int nshards)
 {
+    if (ndrops < 0)
+        return 0;
     if (nshards <= 0)
         return ndrops;
-    return ndrops > shard ? (ndrops - shard + nshards - 1) / nshards : 0;
+    if (shard < 0 || shard >= nshards)
+        return 0;
+    /* The drops shard, shard + nshards, ... below ndrops; no sum that
+     * could pass LONG_MAX. */
+    return ndrops > shard ? (ndrops - shard - 1) / nshards + 1 : 0;
 }
 
 /* The run's index of a shard's drop number local. */
@@ -560,49 +568,52 @@ pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag 
 
 /* Every field of the options, so that a program's mistake is a clear status
  * rather than a run that ends every drop unsettled (or never ends). The
- * limits are the CLI's where it has the option. */
-static pd_status check_options(const pd_sim_options *o, pd_diag *diag)
+ * command calls it on what its options set, so it accepts nothing that this
+ * refuses. */
+pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
 {
+    if (!o)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_options_check: NULL options");
     const struct {
         const char *name;
         double value;
     } reals[] = {{"dt", o->dt}, {"ci_halfwidth", o->ci_halfwidth}, {"time_limit", o->time_limit}};
     for (size_t i = 0; i < sizeof reals / sizeof reals[0]; i++)
         if (!isfinite(reals[i].value))
-            return pd_fail(diag, PD_ERR_NONFINITE, "pd_sim_run: option %s is %g", reals[i].name,
+            return pd_fail(diag, PD_ERR_NONFINITE, "option %s is %g", reals[i].name,
                            reals[i].value);
     if ((unsigned)o->engine > (unsigned)PD_ENGINE_BULLET)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option engine is %d: expected "
-                       "PD_ENGINE_IMPULSE, PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
-    if (!pd_engine_available(o->engine))
-        return pd_fail(diag, PD_ERR_UNAVAILABLE, "pd_sim_run: the Bullet engine is not in this "
-                       "program: link libposedrop-bullet (pkg-config posedrop-bullet) and call "
-                       "pd_bullet_register() first");
+        return pd_fail(diag, PD_ERR_USAGE, "option engine is %d: expected PD_ENGINE_IMPULSE, "
+                       "PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
     if (o->dt < 0 || o->dt > PD_SIM_DT_MAX)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option dt is %g s: expected 0 (the "
-                       "engine's default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
+        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (the engine's "
+                       "default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
     if (o->ndrops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ndrops is %ld: expected 0 or more",
-                       o->ndrops);
+        return pd_fail(diag, PD_ERR_USAGE, "option ndrops is %ld: expected 0 or more", o->ndrops);
     if (o->threads < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option threads is %d: expected 0 (all "
-                       "cores) or more", o->threads);
+        return pd_fail(diag, PD_ERR_USAGE, "option threads is %d: expected 0 (all cores) or "
+                       "more", o->threads);
     if (o->ci_halfwidth < 0 || o->ci_halfwidth >= 0.5)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ci_halfwidth is %g: expected 0 "
-                       "(a fixed number of drops) or a half-width above 0 and below 0.5",
-                       o->ci_halfwidth);
+        return pd_fail(diag, PD_ERR_USAGE, "option ci_halfwidth is %g: expected 0 (a fixed "
+                       "number of drops) or a half-width above 0 and below 0.5", o->ci_halfwidth);
     if (o->max_drops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_drops is %ld: expected 0 or "
-                       "more", o->max_drops);
+        return pd_fail(diag, PD_ERR_USAGE, "option max_drops is %ld: expected 0 or more",
+                       o->max_drops);
     if (!(o->time_limit > 0))
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option time_limit is %g s: expected a "
-                       "positive time", o->time_limit);
+        return pd_fail(diag, PD_ERR_USAGE, "option time_limit is %g s: expected a positive "
+                       "time", o->time_limit);
     if (o->max_collisions < 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_collisions is %d: expected 1 "
-                       "or more", o->max_collisions);
+        return pd_fail(diag, PD_ERR_USAGE, "option max_collisions is %d: expected 1 or more",
+                       o->max_collisions);
     if (o->keep_trials != 0 && o->keep_trials != 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option keep_trials is %d: expected 0 or 1",
+        return pd_fail(diag, PD_ERR_USAGE, "option keep_trials is %d: expected 0 or 1",
                        o->keep_trials);
+    if (o->nshards < 0 || (o->nshards > 0 && (o->shard < 0 || o->shard >= o->nshards)))
+        return pd_fail(diag, PD_ERR_USAGE, "options nshards %d, shard %d: expected nshards 0 "
+                       "(the whole run), or shard from 0 to nshards - 1", o->nshards, o->shard);
+    if (o->nshards > 0 && o->ci_halfwidth > 0)
+        return pd_fail(diag, PD_ERR_USAGE, "option nshards with ci_halfwidth: a run split into "
+                       "shards needs a fixed number of drops");
     return PD_OK;
 }
 
@@ -626,14 +637,16 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL result");
     st = pd_scene_check(&sc, diag);
     if (st == PD_OK)
-        st = check_options(&o, diag);
+        st = pd_sim_options_check(&o, diag);
     if (st != PD_OK)
         return st;
+    if (!pd_engine_available(o.engine))
+        return pd_fail(diag, PD_ERR_UNAVAILABLE, "pd_sim_run: the Bullet engine is not in this "
+                       "program: link libposedrop-bullet (pkg-config posedrop-bullet) and call "
+                       "pd_bullet_register() first");
     if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the static result has no stable pose");
-    if (o.nshards < 0 || (o.nshards > 0 && (o.shard < 0 || o.shard >= o.nshards)))
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: shard %d of %d", o.shard + 1, o.nshards);
-    if (o.nshards > 0 && (o.ci_halfwidth > 0 || sc.initial == PD_INITIAL_BOOTSTRAP))
+    if (o.nshards > 0 && sc.initial == PD_INITIAL_BOOTSTRAP)
         return pd_fail(diag, PD_ERR_USAGE, "a run split into shards needs a fixed number of "
                        "drops, each independent of the others' outcomes: not a confidence "
                        "half-width, nor the bootstrap start, which draws from the outcomes so far");

@@ -21,6 +21,25 @@ void pd_static_options_default(pd_static_options *options)
     options->band = PD_PQS_BAND_RECT;
 }
 
+pd_status pd_static_options_check(const pd_static_options *o, pd_diag *diag)
+{
+    if (!o)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_static_options_check: NULL options");
+    if ((unsigned)o->topple > (unsigned)PD_TOPPLE_EDGE)
+        return pd_fail(diag, PD_ERR_USAGE, "option topple is %d: expected PD_TOPPLE_DESCENT or "
+                       "PD_TOPPLE_EDGE", (int)o->topple);
+    if (!(o->epsilon >= 0.0 && o->epsilon <= 0.5 * M_PI))
+        return pd_fail(diag, PD_ERR_USAGE, "option epsilon is %g degrees: expected a PQS "
+                       "angle from 0 to 90 degrees", o->epsilon * 180.0 / M_PI);
+    if ((unsigned)o->compare > (unsigned)PD_PQS_COMPARE_QS)
+        return pd_fail(diag, PD_ERR_USAGE, "option compare is %d: expected PD_PQS_COMPARE_RAW "
+                       "or PD_PQS_COMPARE_QS", (int)o->compare);
+    if ((unsigned)o->band > (unsigned)PD_PQS_BAND_EXACT)
+        return pd_fail(diag, PD_ERR_USAGE, "option band is %d: expected PD_PQS_BAND_RECT or "
+                       "PD_PQS_BAND_EXACT", (int)o->band);
+    return PD_OK;
+}
+
 void pd_static_result_free(pd_static_result *result)
 {
     if (!result)
@@ -140,9 +159,8 @@ pd_status pd_static_estimate(const pd_part *part, const pd_static_options *optio
         return st;
     if (!result)
         return pd_fail(diag, PD_ERR_USAGE, "pd_static_estimate: NULL result");
-    if (!(opt.epsilon >= 0.0 && opt.epsilon <= 0.5 * M_PI))
-        return pd_fail(diag, PD_ERR_USAGE, "PQS epsilon must lie in [0, 90] degrees, got %g",
-                       opt.epsilon * 180.0 / M_PI);
+    if ((st = pd_static_options_check(&opt, diag)) != PD_OK)
+        return st;
 
     int n = part->hull->nfacets;
     pd_static_result *res = calloc(1, sizeof *res);

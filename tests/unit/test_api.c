@@ -8,6 +8,7 @@
  * Runs before every other suite that uses Bullet (suites.h), so the first
  * checks see an unregistered Bullet, as a C program that never links
  * libposedrop-bullet does. */
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -347,6 +348,133 @@ done:
     pd_part_free(b);
 }
 
+/* Values a program can put in a struct that no reader or command would:
+ * enum fields outside their enum, a hand-made mesh whose indices or counts
+ * are wrong, a weld tolerance that is not a length. Each is an input error
+ * naming what is wrong, never a run on a guess (topple 9 ran as one of the
+ * rules), "out of memory" (nverts -4) or a crash. */
+static void test_values_checked(const fixture *f)
+{
+    pd_diag d;
+    pd_static_result untouched, *r = &untouched;
+    const struct {
+        size_t at;
+        int value;
+        const char *field;
+    } enums[] = {
+        {offsetof(pd_static_options, topple), 9, "topple"},
+        {offsetof(pd_static_options, topple), -1, "topple"},
+        {offsetof(pd_static_options, band), 9, "band"},
+        {offsetof(pd_static_options, compare), 2, "compare"},
+    };
+    for (size_t i = 0; i < sizeof enums / sizeof enums[0]; i++) {
+        pd_static_options so;
+        pd_static_options_default(&so);
+        *(int *)(void *)((char *)&so + enums[i].at) = enums[i].value;
+        REFUSED(pd_static_estimate(f->part, &so, &r, &d), d, enums[i].field);
+        REFUSED(pd_static_options_check(&so, &d), d, enums[i].field);
+    }
+    pd_static_options so;
+    pd_static_options_default(&so);
+    so.epsilon = NAN;
+    REFUSED(pd_static_estimate(f->part, &so, &r, &d), d, "epsilon");
+    CHECK(r == &untouched);
+    pd_static_options_default(&so);
+    CHECK_STATUS(pd_static_options_check(&so, NULL), PD_OK);
+
+    /* Read options: units 42 used to read as metres, format 9 as "unknown
+     * format". pd_units_scale says 0 for what is no unit. */
+    static const char tet[] = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                              "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    ro.units = (pd_units)42;
+    pd_mesh *m = NULL;
+    REFUSED(pd_mesh_parse(tet, sizeof tet - 1, "t.off", &ro, &m, &d), d, "units");
+    pd_mesh_read_options_default(&ro);
+    ro.format = (pd_mesh_format)9;
+    REFUSED(pd_mesh_parse(tet, sizeof tet - 1, "t.off", &ro, &m, &d), d, "format");
+    CHECK(m == NULL);
+    CHECK(pd_units_scale((pd_units)42) == 0.0);
+    CHECK(pd_units_scale(PD_UNITS_IN) == 0.0254);
+
+    /* Part options: a flag is 0 or 1, a given centre is finite. */
+    pd_mesh *box = mesh_box(0.01, 0.02, 0.03);
+    pd_part *p = NULL;
+    pd_part_options po;
+    pd_part_options_default(&po);
+    po.com_given = 7;
+    REFUSED(pd_part_build(box, &po, &p, &d), d, "com_given");
+    po.com_given = 1;
+    po.com.y = NAN;
+    pd_diag_init(&d);
+    CHECK_STATUS(pd_part_build(box, &po, &p, &d), PD_ERR_NONFINITE);
+    CHECK(strstr(d.message, "centre of mass") != NULL);
+    CHECK(p == NULL);
+
+    /* Hand-made meshes: an index past the end or negative is
+     * PD_ERR_RANGE, a negative count PD_ERR_USAGE. */
+    if (box) {
+        const struct {
+            int tri, corner, value;
+            int nverts;
+            pd_status want;
+            const char *what;
+        } bad[] = {
+            {3, 1, 8, 8, PD_ERR_RANGE, "out of range"},
+            {0, 2, -1, 8, PD_ERR_RANGE, "out of range"},
+            {0, 0, 0, -4, PD_ERR_USAGE, "invalid mesh"},
+        };
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+            pd_mesh *c = pd_mesh_clone(box);
+            if (!c)
+                continue;
+            c->tris[bad[i].tri][bad[i].corner] = bad[i].value;
+            if (bad[i].nverts < 0)
+                c->nverts = bad[i].nverts;
+            pd_diag_init(&d);
+            CHECK_STATUS(pd_part_build(c, NULL, &p, &d), bad[i].want);
+            CHECK(strstr(d.message, bad[i].what) != NULL);
+            CHECK(p == NULL);
+            pd_mass mass;
+            CHECK_STATUS(pd_mass_compute(c, &mass, NULL), bad[i].want);
+            CHECK_STATUS(pd_mesh_weld(c, 1e-9, NULL), bad[i].want);
+            c->nverts = 8;
+            pd_mesh_free(c);
+        }
+        /* Weld tolerances: a length, 0 for bit-identical vertices only. */
+        const double tols[] = {NAN, -1e-9, INFINITY};
+        for (size_t i = 0; i < sizeof tols / sizeof tols[0]; i++) {
+            int merged = -1;
+            CHECK_STATUS(pd_mesh_weld(box, tols[i], &merged), PD_ERR_USAGE);
+            CHECK_INT(merged, -1);
+            CHECK_INT(box->nverts, 8);
+        }
+        CHECK_STATUS(pd_mesh_weld(box, 0.0, NULL), PD_OK);
+    }
+    pd_mesh_free(box);
+
+    /* Shards: a shard outside the run, or counts that would overflow. */
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.nshards = 3;
+    o.shard = 3;
+    REFUSED(pd_sim_options_check(&o, &d), d, "shard");
+    o.nshards = -1;
+    o.shard = 0;
+    REFUSED(pd_sim_options_check(&o, &d), d, "nshards");
+    pd_sim_options_default(&o);
+    o.engine = (pd_engine_kind)9;
+    REFUSED(pd_sim_options_check(&o, &d), d, "engine");
+    pd_sim_options_default(&o);
+    CHECK_STATUS(pd_sim_options_check(&o, NULL), PD_OK);
+    CHECK_INT(pd_shard_of(-3, 2), -1);
+    CHECK_INT(pd_shard_drops(LONG_MAX, -5, 1), 0);
+    CHECK_INT(pd_shard_drops(LONG_MAX, 0, 1), LONG_MAX);
+    CHECK_INT(pd_shard_drops(LONG_MAX, 1, 2), LONG_MAX / 2);
+    CHECK_INT(pd_shard_drops(10, 3, 3), 0);
+}
+
 void suite_api(void)
 {
     test_result_of_another_part();
@@ -358,6 +486,7 @@ void suite_api(void)
     test_engines(&f);
     test_impossible_scenes(&f);
     test_impossible_options(&f);
+    test_values_checked(&f);
     pd_static_result_free(f.poses);
     pd_part_free(f.part);
 }

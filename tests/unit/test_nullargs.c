@@ -262,6 +262,14 @@ static void c_scene_check(const fixture *f, int k, outcome *o)
 
 DEFAULTS(sim_options_default, pd_sim_options)
 
+static void c_sim_options_check(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_sim_options so;
+    pd_sim_options_default(&so);
+    o->st = pd_sim_options_check(P(0, &so), P(1, &o->diag));
+}
+
 static void c_engine_available(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -353,6 +361,14 @@ static void c_sim_result_finish(const fixture *f, int k, outcome *o)
 }
 
 DEFAULTS(static_options_default, pd_static_options)
+
+static void c_static_options_check(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_static_options so;
+    pd_static_options_default(&so);
+    o->st = pd_static_options_check(P(0, &so), P(1, &o->diag));
+}
 
 static void c_static_estimate(const fixture *f, int k, outcome *o)
 {
@@ -462,6 +478,7 @@ static const entry table[] = {
     {"pd_scene_read", "path scene ?diag", c_scene_read},
     {"pd_scene_check", "scene ?diag", c_scene_check},
     {"pd_sim_options_default", "?options", c_sim_options_default},
+    {"pd_sim_options_check", "options ?diag", c_sim_options_check},
     {"pd_engine_available", "", c_engine_available},
     {"pd_engine_register", "engine version", c_engine_register},
     {"pd_shard_of", "", c_shard_of},
@@ -472,6 +489,7 @@ static const entry table[] = {
     {"pd_sim_result_add", "sum shard ?diag", c_sim_result_add},
     {"pd_sim_result_finish", "result ?diag", c_sim_result_finish},
     {"pd_static_options_default", "?options", c_static_options_default},
+    {"pd_static_options_check", "options ?diag", c_static_options_check},
     {"pd_static_estimate", "part ?options result ?diag", c_static_estimate},
     {"pd_static_result_free", "?result", c_static_result_free},
     {"pd_solid_angle_triangle", "", c_solid_angle_triangle},
