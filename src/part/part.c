@@ -11,7 +11,9 @@
 #include <stdlib.h>
 #include "base/fail.h"
 #include "base/hash.h"
+#include "base/mat3.h"
 #include "base/size_range.h"
+#include "hull/hull_mass.h"
 #include "mesh/mesh_internal.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
@@ -64,6 +66,87 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
                    "centre of mass (%.9g, %.9g, %.9g) m lies outside the convex hull, %.3g m "
                    "beyond the facet with normal %.6g, %.6g, %.6g",
                    c.x, c.y, c.z, -worst_gap, n.x, n.y, n.z);
+}
+
+/* The smallest eigenvalue of a symmetric matrix, and its largest in *top. */
+static double eig_min(const double A[3][3], double *top)
+{
+    double e[3], V[3][3];
+    pd_sym_eigen3(A, e, V);
+    *top = e[2];
+    return e[0];
+}
+
+/* What the drops need of a closed mesh's mass properties, checked once here
+ * so that a part the static estimate accepts is one the drops accept: a
+ * positive volume no larger than the hull's, principal moments positive,
+ * second moments positive along every direction and within the hull's
+ * (PD_TOL_INERTIA_REL, PD_TOL_SOLID_SHELL_REL). A surface that passes through
+ * itself counts the volume on the far side of the fold negatively (or twice),
+ * which no solid does. st is pd_mass_compute's status: no volume, when the
+ * hull has some, is shells cancelling, not a flat part. */
+static pd_status check_solid(const pd_part *p, pd_status st, pd_diag *diag)
+{
+    const char *why = "the mesh does not bound a solid: its surface passes through itself or "
+                      "part of it is inside out";
+    if (st == PD_ERR_COPLANAR) {
+        return pd_fail(diag, PD_ERR_ORIENTATION, "%s, or its shells overlap (one taken as a "
+                       "void inside another it crosses): it encloses no volume, though its "
+                       "convex hull holds %.3g m^3", why, p->hull->volume);
+    }
+    if (st != PD_OK)
+        return st;
+    const pd_mass *m = &p->mass;
+    double I[3][3], S[3][3], H[3][3], D[3][3];
+    double tr = m->inertia[0][0] + m->inertia[1][1] + m->inertia[2][2];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            I[i][j] = m->inertia[i][j];
+            S[i][j] = (i == j ? 0.5 * tr : 0.0) - I[i][j];
+        }
+    double i_top, i_min = eig_min(CONST_M3(I), &i_top);
+    double s_top, s_min = eig_min(CONST_M3(S), &s_top);
+    if (!(s_min >= -PD_TOL_INERTIA_REL * s_top))
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s (second moments from %.3g to %.3g m^5 per unit density, principal "
+                       "moments of inertia from %.3g to %.3g m^5: a solid's are positive)",
+                       why, s_min, s_top, i_min, i_top);
+    if (!(i_min > PD_TOL_INERTIA_REL * i_top))
+        return pd_fail(diag, PD_ERR_COLLINEAR,
+                       "the part is too thin for its mass properties to be resolved: its "
+                       "smallest principal moment of inertia is %.3g of its largest, below %g "
+                       "(a rod of radius below %.2g of its length)", i_min / i_top,
+                       PD_TOL_INERTIA_REL, sqrt(PD_TOL_INERTIA_REL / 6.0));
+    /* The hull's, about the mesh's centre of mass. */
+    double hv, R2 = 0.0, area = 0.0;
+    pd_hull_moments(p->hull, m->com, &hv, H);
+    const pd_hull *h = p->hull;
+    for (int v = 0; v < h->nverts; v++) {
+        pd_vec3 d = v3_sub(h->verts[v], m->com);
+        R2 = fmax(R2, v3_dot(d, d));
+    }
+    for (int f = 0; f < h->nfacets; f++) {
+        int k0 = h->facet_start[f], k1 = h->facet_start[f + 1];
+        pd_vec3 a = h->verts[h->facet_vert[k0]];
+        for (int k = k0 + 1; k + 1 < k1; k++)
+            area += 0.5 * v3_norm(v3_cross(v3_sub(h->verts[h->facet_vert[k]], a),
+                                           v3_sub(h->verts[h->facet_vert[k + 1]], a)));
+    }
+    double shell = PD_TOL_SOLID_SHELL_REL * p->size * area;
+    if (m->volume > hv + shell)
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s, or its shells overlap (it encloses %.6g m^3, more than its convex "
+                       "hull's %.6g m^3)", why, m->volume, hv);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            D[i][j] = H[i][j] - S[i][j];
+    double d_top, d_min = eig_min(CONST_M3(D), &d_top), h_top;
+    eig_min(CONST_M3(H), &h_top);
+    if (d_min < -(shell * R2 + PD_TOL_INERTIA_REL * h_top))
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s, or its shells overlap (its second moment along one direction exceeds "
+                       "its convex hull's by %.3g m^5, of %.3g m^5)", why, -d_min, h_top);
+    return PD_OK;
 }
 
 /* The part's origin: the centre of the bounding box [lo, hi] rounded to a
@@ -160,13 +243,18 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     }
 
     if (p->closed) {
-        st = pd_mass_compute(p->mesh, &p->mass, diag);
+        st = check_solid(p, pd_mass_compute(p->mesh, &p->mass, diag), diag);
         if (st == PD_OK)
             p->mass_known = 1;
         else if (!opt->com_given)
             return st;
-        else if (diag)
+        else if (diag) {
+            /* As for an open mesh: the hull and the given centre are all
+             * the estimators need, and the drops take the hull's inertia. */
+            pd_warn(diag, "%s; the given centre of mass and the convex hull's inertia are used",
+                    diag->message);
             diag->message[0] = '\0';
+        }
     }
     p->com = opt->com_given ? com_given : p->mass.com;
     if (!v3_isfinite(p->com))
