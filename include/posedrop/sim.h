@@ -128,7 +128,9 @@ typedef struct pd_sim_options {
     int threads;            /* 0: all cores; at most 256 are used */
     double ci_halfwidth;    /* in (0, 0.5): keep dropping until every pose's 95%
                                interval is at most this wide on each side; 0 */
-    long max_drops;         /* cap for ci_halfwidth runs, >= 0; 10^7 */
+    long max_drops;         /* cap for ci_halfwidth runs, >= 0 (ndrops run
+                               even when more): the run stops there whether
+                               or not the intervals are that narrow; 10^7 */
     double time_limit;      /* s of simulated time per drop, > 0; 20 */
     int max_collisions;     /* per drop, >= 1; 100000 */
     int keep_trials;        /* 1: fill result->trials (one record per drop); 0 */

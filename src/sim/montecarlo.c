@@ -332,12 +332,15 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     /* --ci starts from the drops that guarantee the half-width for every pose
      * at once in the worst case (p = 1/2, Bonferroni over the poses: the
      * corrected eq. 17), then adds batches while an interval is still wider. */
-    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards);
+    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards), cap = want;
     if (o->ci_halfwidth > 0) {
+        /* max_drops bounds the run whatever the half-width asks (1e-7 asks
+         * for ~1e14 drops); the ndrops asked for run in any case. */
+        cap = o->max_drops > want ? o->max_drops : want;
         long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
         want = bound > want ? bound : want;
+        want = want < cap ? want : cap;
     }
-    long cap = o->ci_halfwidth > 0 ? (o->max_drops > want ? o->max_drops : want) : want;
     pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
     double *cdf = malloc(sizeof *cdf * (size_t)r->nposes);
     long *before = malloc(sizeof *before * (size_t)r->nposes);
