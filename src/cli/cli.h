@@ -13,6 +13,14 @@ enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
 
 extern const char *prog;
 
+/* A file the run reads (an input) or writes (an output), with what names it
+ * in messages: a long option's name (option 1: "trials" is shown "--trials")
+ * or a role ("PART", "shard"). */
+typedef struct {
+    const char *what, *path;
+    int output, option;
+} cli_file;
+
 typedef struct {
     const char *path, *trials, *transitions, *com_text;
     pd_mesh_read_options read;
@@ -27,6 +35,8 @@ typedef struct {
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;
     char **merge;                  /* posedrop merge: the shard files (NULL ended) */
+    cli_file *files;               /* every file named, for cli_files_apart (owned) */
+    int nfiles;
 } cli_args;
 
 /* The run after its options: read, estimate, drop (or merge), print. */
@@ -68,6 +78,11 @@ void signals_catch(pd_sim_options *options);
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+
+/* same_file.c: 1 when no output is the same file as an input or as another
+ * output (standard output included when it is a regular file); otherwise 0,
+ * with a message naming both and the file. */
+int cli_files_apart(const cli_file *files, int n);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */
