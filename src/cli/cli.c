@@ -787,6 +787,9 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (optind != argc - 1)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
     note_file(a, NULL, argv[optind], 0);
+    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE)
+        return fail_usage("%s", "--dt sets the time step of the ode and bullet engines only; the "
+                          "impulse engine (the default) has no step and would ignore it");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
     int stationary = a->scene.initial == PD_INITIAL_STATIONARY;
@@ -973,6 +976,12 @@ int cli_run(cli_args *a)
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
     t_static = now() - t0;
+    /* A signal before the drops (or, without drops, before the output)
+     * ends the run here, nothing printed. */
+    if (st == PD_OK && cli_stopped()) {
+        code = cli_interrupt_code();
+        goto done;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
         t_sim = now() - t0 - t_static;
@@ -1062,6 +1071,9 @@ done:
 
 int main(int argc, char **argv)
 {
+    /* Before anything else: a signal in the first moments is caught, not
+     * left to the default action that ends the process unannounced. */
+    signals_install();
     cli_start(&argc, &argv);
     if (argc > 1 && strcmp(argv[1], "merge") == 0)
         return cli_end(cli_merge(argc - 1, argv + 1));

@@ -49,13 +49,17 @@ double cli_clean(double x);
 /* run.c / run_mpi.c. cli_start and cli_end wrap the whole program (MPI's
  * start and end); cli_simulate runs the drops (or sums the shards of a
  * merge); cli_writer says whether this process prints (MPI: rank 0 only);
- * cli_interrupt_code the exit code of a run stopped by a signal. */
+ * cli_interrupt_code (signals.c) the exit code of a run stopped by a
+ * signal. */
 void cli_start(int *argc, char ***argv);
 int cli_end(int code);
 pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_args *a,
                        pd_sim_result **sim, pd_diag *diag);
 int cli_writer(void);
 int cli_interrupt_code(void);
+/* Whether a signal arrived before the drops (MPI: in any rank, so that all
+ * stop together): the run then ends with nothing printed. */
+int cli_stopped(void);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;
@@ -70,10 +74,14 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
 void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_static_result *res,
                 const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s);
 
-/* signals.c: SIGINT and SIGTERM set options->cancel: the drops in flight
- * finish and the result is marked partial; cli_interrupt_code is then
- * 128 + the signal's number (130, 143). */
+/* signals.c: signals_install, the first thing main does, catches SIGINT and
+ * SIGTERM (and unblocks them). signals_catch makes them set options->cancel:
+ * the drops in flight finish and the result is marked partial;
+ * cli_interrupt_code is then 128 + the signal's number (130, 143).
+ * signals_caught: whether one arrived in this process. */
+void signals_install(void);
 void signals_catch(pd_sim_options *options);
+int signals_caught(void);
 
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);

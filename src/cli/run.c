@@ -19,6 +19,11 @@ int cli_writer(void)
     return 1;
 }
 
+int cli_stopped(void)
+{
+    return signals_caught();
+}
+
 double cli_cpu_seconds(void)
 {
     struct timespec t;

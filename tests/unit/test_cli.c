@@ -2,6 +2,7 @@
  * stdout only on success, clear messages on stderr, determinism, and the batch
  * scripts. Runs the built binary (PD_CLI_PATH) from the repository root. */
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -452,6 +453,67 @@ static void test_same_file(void)
     free(cube);
 }
 
+/* Runs posedrop ARGS (words split at spaces) with sig already pending when
+ * it starts: the child blocks sig, sends it to itself and execs posedrop,
+ * which inherits the blocked mask and the pending signal; it is delivered
+ * the moment posedrop unblocks it, however early. Returns the exit status
+ * (-1 if killed); *out is what it printed on stdout. */
+static int run_signalled(int sig, const char *args, char **out)
+{
+    char outp[160], words[512], *argv[32];
+    int argc = 0;
+    snprintf(outp, sizeof outp, "%s/signalled.out", tmpdir);
+    snprintf(words, sizeof words, "%s", args);
+    argv[argc++] = (char *)PD_CLI_PATH;
+    for (char *w = strtok(words, " "); w && argc < 31; w = strtok(NULL, " "))
+        argv[argc++] = w;
+    argv[argc] = NULL;
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        sigset_t set;
+        sigemptyset(&set);
+        sigaddset(&set, sig);
+        if (sigprocmask(SIG_BLOCK, &set, NULL) != 0 || kill(getpid(), sig) != 0 ||
+            !freopen(outp, "w", stdout) || !freopen("/dev/null", "w", stderr))
+            _exit(126);
+        execv(PD_CLI_PATH, argv);
+        _exit(127);
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);
+    *out = slurp(outp);
+    if (!*out)
+        *out = calloc(1, 1);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* A signal at the very start (before options are parsed or the part read)
+ * ends the run with 128 + its number and nothing on stdout, with or without
+ * drops; --dt, which only the stepping engines use, is refused with the
+ * impulse engine instead of ignored. */
+static void test_early_signal(void)
+{
+    const struct {
+        int sig;
+        const char *args;
+    } runs[] = {{SIGINT, "parts/cap.off"}, {SIGINT, "-n 20 parts/cap.off"},
+                {SIGTERM, "-n 20 --trials /dev/null parts/cap.off"}};
+    for (int i = 0; i < 3; i++) {
+        char *out;
+        CHECK_INT(run_signalled(runs[i].sig, runs[i].args, &out), 128 + runs[i].sig);
+        CHECK_INT((int)strlen(out), 0);
+        free(out);
+    }
+    expect_failure("--dt 0.001 -n 10 parts/cap.off", 2, "--dt sets the time step of the ode and "
+                   "bullet engines only");
+    expect_failure("--engine impulse --dt 0.001 parts/cap.off", 2, "--dt");
+    char *out, *err;
+    CHECK_INT(run("--dt 0.002 --engine ode -n 5 parts/cap.off", &out, &err), 0);
+    free(out);
+    free(err);
+}
+
 /* eq16.awk, fed the paper's own columns, must reproduce the errors the paper
  * publishes (Table 1, the cap: QS 10.1, PQS 1.2, dynamic 4.0; Table 4, the
  * square button: 17.2, 10.7, 4.8), to the tables' 0.05 rounding. */
@@ -862,6 +924,7 @@ void suite_cli(void)
     test_dynamic();
     test_output_paths();
     test_same_file();
+    test_early_signal();
     test_eq16();
     test_scripts();
     test_group();
