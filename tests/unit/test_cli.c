@@ -444,6 +444,11 @@ static void test_same_file(void)
     CHECK(strstr(err, "standard output") != NULL);
     free(out);
     free(err);
+    /* A pipe as PART, with its writer there, is read as before. */
+    CHECK_INT(run_cmd("sh -c 'cat parts/cap.off | " PD_CLI_PATH " /dev/stdin'", 1, &out, &err), 0);
+    CHECK(strncmp(out, "pose,", 5) == 0);
+    free(out);
+    free(err);
     /* Devices are no files to lose; the part and the options still run. */
     snprintf(args, sizeof args, "--svg /dev/null --chart /dev/null %s", part);
     CHECK_INT(run(args, &out, &err), 0);
