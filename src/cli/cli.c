@@ -926,7 +926,7 @@ static double now(void)
 int cli_run(cli_args *a)
 {
     /* Before anything is read for the run or written. */
-    if (!cli_files_apart(a->files, a->nfiles))
+    if (cli_any(!cli_files_apart(a->files, a->nfiles)))
         return EXIT_USAGE;
     int code;
     pd_diag diag;
@@ -978,7 +978,7 @@ int cli_run(cli_args *a)
     t_static = now() - t0;
     /* A signal before the drops (or, without drops, before the output)
      * ends the run here, nothing printed. */
-    if (st == PD_OK && cli_stopped()) {
+    if (st == PD_OK && cli_any(signals_caught())) {
         code = cli_interrupt_code();
         goto done;
     }

@@ -57,9 +57,10 @@ pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_arg
                        pd_sim_result **sim, pd_diag *diag);
 int cli_writer(void);
 int cli_interrupt_code(void);
-/* Whether a signal arrived before the drops (MPI: in any rank, so that all
- * stop together): the run then ends with nothing printed. */
-int cli_stopped(void);
+/* Whether mine is true in this process (MPI: in any rank), so that a
+ * decision to stop that one rank makes (a signal, its standard output on an
+ * input) stops them all together. */
+int cli_any(int mine);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;

@@ -35,9 +35,10 @@ int cli_writer(void)
     return rank == 0;
 }
 
-int cli_stopped(void)
+int cli_any(int mine)
 {
-    int mine = signals_caught(), any = 0;
+    int any = 0;
+    mine = mine != 0;
     MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
     return any;
 }
