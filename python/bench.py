@@ -5,13 +5,17 @@
    process, Part.from_file + stable_poses + drop(2000, threads=T): the same
    work, minus the command's process start and printing.
 2. Static estimate of a 20k-facet mesh: the command on an OFF file of the
-   mesh against Part(vertices, faces).stable_poses() from numpy arrays.
+   mesh against Part(vertices, faces).stable_poses() from numpy arrays (and
+   from the file).
 
-Each side is timed REPEAT times, alternating, and the medians compared.
-Prints the ratios (Python over command); asserts nothing. Usage:
+Each side is timed REPEAT times, alternating, and the medians compared,
+both against the command's whole run and against its own clock (--format
+json's wall_s, which leaves out its process start and printing). Prints the
+ratios (Python over command); asserts nothing. Usage:
     python python/bench.py [--repeat N] [--threads T]
 """
 import argparse
+import json
 import statistics
 import subprocess
 import tempfile
@@ -57,19 +61,25 @@ def bumpy_sphere(subdivisions=5, seed=1):
 
 def clock(fn):
     t0 = time.perf_counter()
-    fn()
-    return time.perf_counter() - t0
+    out = fn()
+    return time.perf_counter() - t0, out
 
 
 def compare(label, command, python, repeat):
-    tc, tp = [], []
+    """Runs the command (with --format json, to read its own clock) and the
+    Python call alternately; prints the median times and the ratios."""
+    whole, inner, mine = [], [], []
     for _ in range(repeat):
-        tc.append(clock(command))
-        tp.append(clock(python))
-    c, p = statistics.median(tc), statistics.median(tp)
-    print("%-44s command %8.4f s  python %8.4f s  ratio %.3f  (medians of %d; ranges %.4f-%.4f, "
-          "%.4f-%.4f)" % (label, c, p, p / c, repeat, min(tc), max(tc), min(tp), max(tp)))
-    return p / c
+        t, out = clock(lambda: subprocess.run([str(CLI), "--format", "json", *map(str, command)],
+                                              check=True, capture_output=True, text=True))
+        whole.append(t)
+        inner.append(json.loads(out.stdout)["posedrop"]["wall_s"])
+        mine.append(clock(python)[0])
+    c, i, p = (statistics.median(x) for x in (whole, inner, mine))
+    print("%s (medians of %d)" % (label, repeat))
+    print("    command %.4f s (%.4f-%.4f), of which its own clock %.4f s; python %.4f s "
+          "(%.4f-%.4f)" % (c, min(whole), max(whole), i, p, min(mine), max(mine)))
+    print("    ratio python / command %.3f, python / command's own clock %.3f" % (p / c, p / i))
 
 
 def main():
@@ -78,11 +88,9 @@ def main():
     ap.add_argument("--threads", type=int, default=2)
     args = ap.parse_args()
     cap = ROOT / "parts" / "cap.off"
-    run = lambda *a: subprocess.run([str(CLI), *map(str, a)], check=True,  # noqa: E731
-                                    stdout=subprocess.DEVNULL)
     print("posedrop %s, %s" % (posedrop.__version__, CLI))
-    compare("2000 drops of parts/cap.off, %d threads" % args.threads,
-            lambda: run("-n", 2000, "-j", args.threads, cap),
+    compare("2000 drops of parts/cap.off, %d threads: part, poses and drops" % args.threads,
+            ["-n", 2000, "-j", args.threads, cap],
             lambda: posedrop.Part.from_file(cap).stable_poses().drop(2000, threads=args.threads),
             args.repeat)
     v, f = bumpy_sphere()
@@ -92,11 +100,10 @@ def main():
             out.write("OFF\n%d %d 0\n" % (len(v), len(f)))
             np.savetxt(out, v, fmt="%.17g")
             np.savetxt(out, np.hstack([np.full((len(f), 1), 3), f]), fmt="%d")
-        poses = posedrop.Part(v, f).stable_poses()
-        print("bumpy sphere: %d triangles, %d stable poses" % (len(f), len(poses)))
-        compare("static estimate, %d facets (arrays)" % len(f), lambda: run(off),
-                lambda: posedrop.Part(v, f).stable_poses(), args.repeat)
-        compare("static estimate, %d facets (file)" % len(f), lambda: run(off),
+        n = len(posedrop.Part(v, f).stable_poses())
+        compare("static estimate of a %d-facet mesh (%d stable poses), python from numpy arrays"
+                % (len(f), n), [off], lambda: posedrop.Part(v, f).stable_poses(), args.repeat)
+        compare("the same, python reading the OFF file", [off],
                 lambda: posedrop.Part.from_file(off).stable_poses(), args.repeat)
 
 

@@ -70,7 +70,7 @@ static int diag_finish(warn_box *w)
 {
     int rc = 0;
     for (int i = 0; i < w->n; i++) {
-        if (rc == 0 && PyErr_WarnEx(posedrop_warning, w->msg[i], 1) < 0)
+        if (rc == 0 && PyErr_WarnEx(posedrop_warning, w->msg[i], 2) < 0)
             rc = -1;
         free(w->msg[i]);
     }

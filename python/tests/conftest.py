@@ -45,7 +45,8 @@ def run_cli(*args, check=True):
 
 
 def read_csv(path):
-    rows = list(csv.reader(open(path)))
+    with open(path, newline="") as f:
+        rows = list(csv.reader(f))
     return rows[1:], rows[0]
 
 

@@ -50,7 +50,8 @@ def test_open_mesh_needs_a_centre_of_mass():
     with pytest.raises(InputError) as e:
         posedrop.Part(CUBE_V, faces)
     assert e.value.status == Status.ERR_NOT_CLOSED
-    part = posedrop.Part(CUBE_V, faces, com=[0.005, 0.005, 0.005])
+    with pytest.warns(posedrop.PosedropWarning, match="boundary edge"):
+        part = posedrop.Part(CUBE_V, faces, com=[0.005, 0.005, 0.005])
     assert not part.closed and part.volume is None and len(part.stable_poses()) == 6
 
 
@@ -134,3 +135,30 @@ def test_exceptions_pickle():
     except InputError as e:
         again = pickle.loads(pickle.dumps(e))
         assert (again.status, again.message) == (e.status, e.message)
+
+
+@pytest.mark.filterwarnings("ignore::posedrop.PosedropWarning")
+def test_random_triangle_soups_never_crash():
+    """Arbitrary arrays: a part or an InputError, never a crash, and never a
+    number that is not finite."""
+    rng = np.random.default_rng(3)
+    built = refused = 0
+    for trial in range(300):
+        nv = int(rng.integers(0, 12))
+        v = rng.normal(size=(nv, 3)) * 10.0 ** rng.integers(-6, 4)
+        if nv and trial % 3 == 0:
+            v[rng.integers(0, nv, size=nv // 2)] = v[0]  # duplicates
+        if nv and trial % 5 == 0:
+            v[:, int(rng.integers(0, 3))] = 0.0  # flat
+        nf = int(rng.integers(0, 20))
+        f = rng.integers(0, max(nv, 1), size=(nf, 3))
+        com = None if trial % 2 else rng.normal(size=3) * 0.1
+        try:
+            part = posedrop.Part(v, f, com=com)
+        except InputError:
+            refused += 1
+            continue
+        poses = part.stable_poses()
+        assert np.isfinite(poses.p_qs).all() and np.isfinite(poses.transform).all()
+        built += 1
+    assert refused > 0 and built > 0
