@@ -169,3 +169,14 @@ def test_grouped_drops_equal_command():
              g10(g.ci_hi[c]), str(g.unsettled), "0", " ".join(str(m + 1) for m in members)]
             for c, members in enumerate(g.classes.members)]
     assert mine == [[r[0], *r[8:]] for r in rows]
+
+
+def test_keys_without_an_option_pass_through(tmp_path):
+    """gravity has no option of its own: a scene file for the command, a
+    keyword for Python, the same text to pd_scene_set."""
+    scene = tmp_path / "moon.scene"
+    scene.write_text("gravity = 1.62\ncontact_time = 2e-4\ninitial = bootstrap\n")
+    rows, _, _ = run_cli("-n", "120", "--scene", scene, PARTS / "cap.off")
+    poses = posedrop.Part.from_file(PARTS / "cap.off").stable_poses()
+    drops = poses.drop(120, gravity=1.62, contact_time=2e-4, initial="bootstrap")
+    assert pose_rows(poses, drops) == rows and drops.bootstrap_rounds > 0

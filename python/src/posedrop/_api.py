@@ -333,8 +333,9 @@ class StablePoses:
             restitution_law="energetic", vibration=1.5 (degrees),
             initial="stationary", contact_time="auto"``. Each is handed to
             the library as text (``pd_scene_set``), exactly as in a scene
-            file, so every key and value form the library accepts works,
-            ranges included.
+            file, so every key and value form the library accepts works
+            here too (ranges such as ``mu="0.2:0.5"`` once the scene takes
+            them).
         max_drops, time_limit, max_collisions : int, float, int
             The library's run limits (``pd_sim_options``).
         trials : bool
