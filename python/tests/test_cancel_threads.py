@@ -95,3 +95,27 @@ def test_parts_built_on_many_threads_agree():
     for t in ts:
         t.join()
     assert all(np.array_equal(out[0], o) for o in out)
+
+
+def test_ctrl_c_stops_a_python_process(tmp_path):
+    """A SIGINT from outside, as a terminal's Ctrl-C sends it, while a
+    script is in a long run: the script dies of KeyboardInterrupt, as any
+    Python script does, and does not print a result."""
+    import subprocess
+    import sys
+    script = tmp_path / "long.py"
+    script.write_text(
+        "import sys, posedrop\n"
+        "part = posedrop.Part.from_file(%r)\n"
+        "def progress(done, total):\n"
+        "    print('running', flush=True)\n"
+        "drops = part.drop(%d, threads=2, progress=progress)\n"
+        "print('finished', drops.n)\n" % (str(PARTS / "cap.off"), LONG))
+    child = subprocess.Popen([sys.executable, str(script)], stdout=subprocess.PIPE,
+                             stderr=subprocess.PIPE, text=True)
+    assert child.stdout.readline() == "running\n"
+    child.send_signal(signal.SIGINT)
+    out, err = child.communicate(timeout=300)
+    assert "finished" not in out and "KeyboardInterrupt" in err
+    # Python (3.8 on) ends an uncaught KeyboardInterrupt by SIGINT itself.
+    assert child.returncode == -signal.SIGINT
