@@ -698,10 +698,11 @@ static PyObject *Poses_facets(PosesObject *self, PyObject *unused)
         ((int32_t *)rest)[f] = x->rest;
         ((int32_t *)pose)[f] = -1;
     }
+    /* A stable facet's pose first, then every facet's through its rest. */
     for (int i = 0; i < r->nposes; i++)
-        for (size_t f = 0; f < n; f++)
-            if (r->facets[f].rest == r->poses[i].facet)
-                ((int32_t *)pose)[f] = i;
+        ((int32_t *)pose)[r->poses[i].facet] = i;
+    for (size_t f = 0; f < n; f++)
+        ((int32_t *)pose)[f] = ((int32_t *)pose)[r->facets[f].rest];
     return d;
 }
 
