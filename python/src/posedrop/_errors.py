@@ -43,3 +43,8 @@ class InternalError(PosedropError, RuntimeError):
 
 class PosedropWarning(UserWarning):
     """A warning from the library: faces re-oriented, knife-edge facets, ..."""
+
+
+# Shown and pickled as posedrop.InputError etc., where users import them.
+for _cls in (PosedropError, InputError, InternalError, PosedropWarning):
+    _cls.__module__ = "posedrop"
