@@ -162,3 +162,34 @@ def test_random_triangle_soups_never_crash():
         assert np.isfinite(poses.p_qs).all() and np.isfinite(poses.transform).all()
         built += 1
     assert refused > 0 and built > 0
+
+
+@pytest.mark.filterwarnings("ignore::posedrop.PosedropWarning")
+@pytest.mark.parametrize("name,units", [("cap.off", "m"), ("block.stl", "mm"),
+                                        ("hexnut.obj", "mm")])
+def test_mutated_files_fail_where_the_command_fails(tmp_path, name, units):
+    """Shipped files cut short or with bytes changed: Python builds a part
+    exactly when the command succeeds, and raises InputError exactly when
+    it exits 2, with the command's message."""
+    data = (PARTS / name).read_bytes()
+    rng = np.random.default_rng(len(data))
+    outcomes = set()
+    for k in range(16):
+        b = bytearray(data)
+        if k % 2:
+            b = b[:int(rng.integers(0, len(b)))]
+        else:
+            for i in rng.integers(0, len(b), size=int(rng.integers(1, 4))):
+                b[i] = int(rng.integers(0, 256))
+        path = tmp_path / ("m%d%s" % (k, (PARTS / name).suffix))
+        path.write_bytes(bytes(b))
+        _, _, proc = run_cli("--units", units, path, check=False)
+        assert proc.returncode in (0, 2), proc.stderr
+        if proc.returncode == 0:
+            posedrop.Part.from_file(path, units=units).stable_poses()
+        else:
+            with pytest.raises(InputError) as e:
+                posedrop.Part.from_file(path, units=units).stable_poses()
+            assert e.value.message in proc.stderr
+        outcomes.add(proc.returncode)
+    assert 2 in outcomes
