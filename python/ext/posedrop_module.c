@@ -170,9 +170,11 @@ static int choose(const char *what, const char *const *names, PyObject *value, i
         len += snprintf(msg + len, sizeof msg - (size_t)len, "%s '%s'",
                         i ? (names[i + 1] ? "," : " or") : "", names[i]);
     PyObject *repr = PyObject_Repr(value);
-    if (repr && len < (int)sizeof msg)
-        snprintf(msg + len, sizeof msg - (size_t)len, ", got %s", PyUnicode_AsUTF8(repr));
+    const char *got = repr ? PyUnicode_AsUTF8(repr) : NULL;
+    if (got && len < (int)sizeof msg)
+        snprintf(msg + len, sizeof msg - (size_t)len, ", got %s", got);
     Py_XDECREF(repr);
+    PyErr_Clear(); /* a value without a printable repr is still refused below */
     raise_status(PD_ERR_USAGE, msg);
     return -1;
 }
