@@ -180,3 +180,17 @@ def test_keys_without_an_option_pass_through(tmp_path):
     poses = posedrop.Part.from_file(PARTS / "cap.off").stable_poses()
     drops = poses.drop(120, gravity=1.62, contact_time=2e-4, initial="bootstrap")
     assert pose_rows(poses, drops) == rows and drops.bootstrap_rounds > 0
+
+
+def test_scene_ranges_pass_through():
+    """Ranges (LO:HI) reach the library as text: once the scene takes them,
+    Python gives the command's counts for them with no change here."""
+    poses = posedrop.Part.from_file(PARTS / "cap.off").stable_poses()
+    try:
+        poses.drop(0, mu="0.2:0.5")
+    except posedrop.InputError as e:
+        pytest.skip("this library's scene takes no ranges: %s" % e)
+    rows, _, _ = run_cli("-n", "150", "--mu", "0.2:0.5", "--restitution", "0.1:0.6", "--seed", "3",
+                         PARTS / "cap.off")
+    drops = poses.drop(150, mu="0.2:0.5", restitution="0.1:0.6", seed=3)
+    assert pose_rows(poses, drops) == rows
