@@ -22,19 +22,19 @@ command -v qconvex >/dev/null 2>&1 || missing="$missing qhull-bin"
 command -v python3 >/dev/null 2>&1 || command -v jq >/dev/null 2>&1 || missing="$missing jq"
 # Packages a script asks for (e.g. gnuplot-nox for the cost-accuracy chart),
 # or a group by its name: browser, what make check-browser renders with; mpi,
-# OpenMPI's compiler wrappers and launcher (make MPI=1); python, what
-# `pip install ./python` builds with in a virtual environment (docs/python.md),
-# asked of python3 itself, which need not be Debian's.
+# OpenMPI's compiler wrappers and launcher (make MPI=1).
 for arg in "$@"; do
     case "$arg" in
-    browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
-    mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
     python)
+        # What `pip install ./python` builds with in a virtual environment
+        # (docs/python.md), asked of python3 itself, which need not be Debian's.
         pkgs=""
         python3 -c 'import ensurepip, os, sys, sysconfig
 sys.exit(not os.path.isfile(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' \
             2>/dev/null || pkgs="python3 python3-dev python3-venv"
         ;;
+    browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
+    mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
     *) pkgs=$arg ;;
     esac
     for pkg in $pkgs; do
