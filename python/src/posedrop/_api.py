@@ -248,7 +248,8 @@ class StablePoses:
         the rotation's rows are x, y, z with z = -normal, x = (-z_y, z_x, 0)
         normalised (or (1, 0, 0) for a horizontal facet), y = z x x, and the
         translation is along z only, putting the lowest hull vertex at z = 0.
-        Apply to the mesh's vertices: ``trimesh_mesh.apply_transform(T)``.
+        In metres, as everything the part reports: apply it to the mesh in
+        metres (``trimesh_mesh.apply_transform(T)`` for a mesh in metres).
     area : (k,)
         Area of the resting facet of the hull, m^2.
     height : (k,)
