@@ -188,8 +188,10 @@ def test_sampled_centres_of_mass_as_trimesh():
     assert np.abs(p_pd - posedrop.compute_stable_poses(mesh)[1]).max() > 1e-4
 
 
-def test_transform_rests_the_part_on_its_facet():
-    part = posedrop.Part.from_file(PARTS / "cap.off")
+@pytest.mark.parametrize("name,units", [("cap.off", "m"), ("hexnut.obj", "mm")])
+def test_transform_rests_the_part_on_its_facet(name, units):
+    """In metres, whatever the file's unit."""
+    part = posedrop.Part.from_file(PARTS / name, units=units)
     poses = part.stable_poses()
     for i, T in enumerate(poses.transform):
         R = T[:3, :3]
