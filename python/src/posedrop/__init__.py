@@ -6,12 +6,12 @@ probabilities, and Monte Carlo drops on posedrop's impulse simulator, ODE or
 Bullet. Every number is the library's, the same as the command prints for the
 same part, options and seed.
 
->>> import posedrop, trimesh
->>> part = posedrop.Part.from_trimesh(trimesh.creation.box((0.04, 0.02, 0.01)))
->>> poses = part.stable_poses()
->>> poses.p_qs, poses.transform          # numpy arrays
->>> drops = poses.drop(2000, seed=1, mu=0.5)
->>> drops.count, drops.p, drops.ci_lo, drops.ci_hi
+    import posedrop, trimesh
+    part = posedrop.Part.from_trimesh(trimesh.creation.box((0.04, 0.02, 0.01)))
+    poses = part.stable_poses()
+    poses.p_qs, poses.transform             # numpy arrays
+    drops = poses.drop(2000, seed=1, mu=0.5)
+    drops.count, drops.p, drops.ci_lo, drops.ci_hi
 
 See docs/python.md in the repository.
 """
