@@ -65,7 +65,8 @@ PD_API pd_status pd_pose_classes(const pd_part *part, const pd_static_result *re
  * interval (the same redraws, summed before the percentiles are taken), and
  * its first_count and transitions summed over classes (row and column);
  * stationary_shift is then measured between the classes. class_of has
- * sim->nposes entries in [0, nclasses).
+ * sim->nposes entries in [0, nclasses), and nclasses is at most
+ * sim->nposes (PD_ERR_USAGE otherwise).
  * Free with pd_sim_result_free. PD_ERR_USAGE, PD_ERR_NOMEM. */
 PD_API pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
                                        pd_sim_result **grouped, pd_diag *diag);
