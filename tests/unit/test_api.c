@@ -486,12 +486,13 @@ static void test_values_checked(const fixture *f)
  * ndrops run even when more. */
 static void test_ci_capped(const fixture *f)
 {
-    const long cases[][3] = {{3, 25, 25}, {30, 5, 30}};
-    for (int i = 0; i < 2; i++) {
+    const long cases[][3] = {{3, 25, 25}, {30, 5, 30}, {0, 7, 7}};
+    for (int i = 0; i < 3; i++) {
         pd_sim_options o;
         pd_sim_options_default(&o);
         o.threads = 1;
-        o.ci_halfwidth = 1e-7;
+        /* The last asks for more drops than a long counts. */
+        o.ci_halfwidth = i < 2 ? 1e-7 : 1e-300;
         o.ndrops = cases[i][0];
         o.max_drops = cases[i][1];
         pd_sim_result *r = NULL;
