@@ -48,4 +48,13 @@
  * where the part turns or falls faster than 2 rest falls per rest step. */
 #define PD_REST_SINK_REL 2e-4
 
+/* The most fixed steps a stepping engine's drop may need to reach its time
+ * limit; a run that would need more is refused (pd_sim_run, PD_ERR_RANGE)
+ * with the step and the limit that make it. Why 1e7: ODE and Bullet take 2
+ * to 5 us a step on a small hull, so a drop that runs to its limit costs up
+ * to a minute of CPU; a 1000 m cube's automatic limit (1345 s) at the
+ * default steps takes 1.4e6. Larger: a run of giants on the default step
+ * would take hours; smaller: the 1000 m cube would need a coarser step. */
+#define PD_STEPS_MAX 1e7
+
 #endif
