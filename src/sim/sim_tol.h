@@ -48,6 +48,17 @@
  * where the part turns or falls faster than 2 rest falls per rest step. */
 #define PD_REST_SINK_REL 2e-4
 
+/* The automatic contact time (pd_contact_time_auto) grows with the size L,
+ * so the static compression of a contact under the part's weight, g T^2 /
+ * pi^2, grows as L^2: past 1.2 m it would exceed this share of L (a 10 m
+ * part 1%, a 1000 m cube sinks deeper than its size, with every engine's
+ * drops rocking in the floor until their time limit). The duration is
+ * capped there. Why 1e-3: the depth lasting contact stays within
+ * (docs/contact.md); a 30 m coin with 2.5% left 12 of 30 impulse drops
+ * unsettled, with 0.3% none. Smaller: parts from a few tens of cm would
+ * lose the Hertz duration the scene stands for. */
+#define PD_CONTACT_AUTO_SINK_REL 1e-3
+
 /* The most fixed steps a stepping engine's drop may need to reach its time
  * limit; a run that would need more is refused (pd_sim_run, PD_ERR_RANGE)
  * with the step and the limit that make it. Why 1e7: ODE and Bullet take 2
