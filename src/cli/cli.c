@@ -246,9 +246,14 @@ static int out_commit(out_file *o)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
+                         const pd_scene *scene)
 {
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
+    for (int k = 0; k < PD_NPARAMS; k++)
+        if (scene->range[k].kind != PD_DIST_FIXED)
+            fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
+    fputc('\n', f);
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
@@ -257,6 +262,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
                 t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
+        for (int k = 0; k < PD_NPARAMS; k++)
+            if (scene->range[k].kind != PD_DIST_FIXED)
+                fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
         fputc('\n', f);
     }
 }
@@ -288,7 +296,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
-       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD };
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -390,6 +398,9 @@ static const cli_option options[] = {
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
      "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
      "0: rigid, the paper's model"},
+    {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
+     "angular speed at release, rad/s, about an axis drawn\n"
+     "uniformly for each drop, 0..10000 (0)"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -406,13 +417,22 @@ static const cli_option options[] = {
     {OPT_SCENE, "scene", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
-     "contact_time, each at most once; options given after it\n"
-     "override it"},
+     "contact_time, tumble, each at most once; options given\n"
+     "after it override it.\n"
+     "Ranges: -h, -v, --mu, --restitution, --vibration,\n"
+     "--contact-time and --tumble (and their keys) take LO:HI\n"
+     "as well as a value: each drop draws its own value,\n"
+     "uniformly, or log uniformly with LO:HI:log (the default\n"
+     "for --contact-time, which also takes multiples of auto,\n"
+     "0.3x:3x); the estimates are then over the ranges\n"
+     "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
      "(pose 0: unsettled); with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
-     "within it, numbered as without --group"},
+     "within it, numbered as without --group; then one column\n"
+     "per ranged scene parameter, named by its key, the value\n"
+     "the drop drew (vibration in degrees)"},
     {OPT_TRANSITIONS, "transitions", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -977,7 +997,7 @@ int cli_run(cli_args *a)
     /* The side files before stdout: if one cannot be written in full (a
      * full disk, /dev/full), the run fails with nothing on stdout. */
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of);
+        write_trials(trials_out.f, sim, class_of, &a->scene);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
     if ((trials_out.f && !out_commit(&trials_out)) ||

@@ -19,6 +19,7 @@
 #include "base/fail.h"
 #include "sim/drop.h"
 #include "sim/markov.h"
+#include "sim/scene.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
 
@@ -152,8 +153,16 @@ static void *worker(void *arg)
         int pose = b->pose_cdfs ? stationary_pose(drop, b->pose_drops, b->nposes) : -1;
         if (pose >= 0)
             cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)pose;
-        pd_drop_run(b->model, w, b->scene, b->opt, drop, cdf, &b->out[i - b->first], &gain,
-                    &fallbacks);
+        /* The drop's own scene values: its ranges drawn from the parameters'
+         * stream, which leaves the drop's orientation stream as it is. */
+        pd_trial *out = &b->out[i - b->first];
+        pd_scene drawn;
+        pd_scene_draw(b->scene, b->model->part_size, b->opt->seed, drop, out->param, &drawn);
+        if (pd_drop_material(b->model, w, &drawn) != PD_OK) {
+            out->end = PD_END_FAILED;
+        } else {
+            pd_drop_run(b->model, w, &drawn, b->opt, drop, cdf, out, &gain, &fallbacks);
+        }
         long done = atomic_fetch_add(&b->done, 1) + 1;
         if (b->opt->progress && pthread_equal(pthread_self(), b->caller))
             b->opt->progress(b->opt->progress_user, b->r->n + done, b->planned);
