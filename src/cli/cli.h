@@ -23,6 +23,7 @@ typedef struct {
     int dynamic, facets, group, verbose;
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;
+    const char *sensitivity;       /* --sensitivity FILE */
     int json;                      /* --format json */
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;
@@ -68,6 +69,11 @@ void signals_catch(pd_sim_options *options);
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+
+/* fragile.c: the warnings of a stationary run whose long run rests on its
+ * first drops (several closed classes, or near traps), said without
+ * --verbose. */
+void fragile_warn(const char *path, const pd_sim_result *sim);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */

@@ -95,7 +95,7 @@ typedef struct batch {
     const pd_sim_options *opt;
     const double *init_cdf;
     const double *pose_cdfs; /* not NULL: drop i starts resting on pose
-                               stationary_pose(i, ...) when it is one, whose
+                               pd_stationary_start(i, ...) when it is one, whose
                                point-mass cdf is that row of pose_cdfs (instead
                                of init_cdf) */
     long pose_drops;
@@ -128,7 +128,7 @@ static int cancelled(const pd_sim_options *o)
  * pose 0, ..., pose k-1; the rest (fewer than k+1) are uniform. Interleaved
  * from the first drop, so a run stopped at any point has drops of every
  * phase in proportion. */
-static int stationary_pose(long i, long pose_drops, int k)
+int pd_stationary_start(long i, long pose_drops, int k)
 {
     if (i >= (long)(k + 1) * pose_drops)
         return -1;
@@ -150,7 +150,7 @@ static void *worker(void *arg)
             break;
         long drop = run_index(b->r, i);
         const double *cdf = b->init_cdf;
-        int pose = b->pose_cdfs ? stationary_pose(drop, b->pose_drops, b->nposes) : -1;
+        int pose = b->pose_cdfs ? pd_stationary_start(drop, b->pose_drops, b->nposes) : -1;
         if (pose >= 0)
             cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)pose;
         /* The drop's own scene values: its ranges drawn from the parameters'
@@ -218,7 +218,7 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->count[t[i].pose]++;
         if (!r->transitions)
             continue;
-        int from = stationary_pose(run_index(r, r->n + i), r->pose_drops, r->nposes);
+        int from = pd_stationary_start(run_index(r, r->n + i), r->pose_drops, r->nposes);
         if (from < 0)
             r->first_count[t[i].pose]++;
         else
@@ -368,7 +368,7 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
 
 /* --initial stationary: first_drops drops from uniform orientations and
  * pose_drops resting on each pose, interleaved from the first drop
- * (stationary_pose), so that a run stopped early has drops of every phase and
+ * (pd_stationary_start), so that a run stopped early has drops of every phase and
  * can still give pi. */
 static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
                                   const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)

@@ -253,6 +253,17 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                     "Every direction gravity can have in the part's frame, coloured by the pose "
                     "that quasi-static motion from it ends in: each colour's share of the sphere "
                     "is that pose's QS probability.", viz_sphere, in, diag);
+    if (st == PD_OK && in->sensitivity && in->sensitivity->nparams > 0) {
+        vbuf_put(b, "<section id=\"sensitivity\"><h2>What each ranged parameter moves</h2>\n"
+                    "<p class=\"note\">The scene's ranges are drawn anew for every drop, so the "
+                    "estimates above are over the ranges. For each pose, the first-order "
+                    "index is the share of its variance that one parameter explains alone "
+                    "(docs/uncertainty.md).</p>\n");
+        viz_sensitivity_words(b, in);
+        vbuf_put(b, "<figure>\n");
+        st = viz_sensitivity(in, 0, b, diag);
+        vbuf_put(b, "</figure></section>\n");
+    }
     if (st == PD_OK) {
         table_section(b, in, e, n);
         run_section(b, run, in->sim, in->scene);

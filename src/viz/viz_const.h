@@ -35,4 +35,10 @@
  * outside. */
 #define VIZ_MEASURED_SUM_TOL 0.01
 
+/* The sensitivity's words call a parameter one that moves a pose when the
+ * lower end of its index's 95% interval is above this: a share of the
+ * pose's variance clear of noise, yet below what a designer would act on
+ * anyway. */
+#define VIZ_SENS_DETECT 0.01
+
 #endif

@@ -28,6 +28,7 @@
     PD_SUITE(compliant) \
     PD_SUITE(sim)    \
     PD_SUITE(ranges) \
+    PD_SUITE(sensitivity) \
     PD_SUITE(markov) \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \

@@ -233,7 +233,8 @@ static void test_restitution_table(void)
 
 /* The command: a zero-width range prints the fixed run's bytes; --trials
  * names the ranged columns; shards of a ranged run merge into it, and not
- * with shards of other ranges; bad ranges are refused before any work. */
+ * with shards of other ranges; bad ranges are refused before any work; a
+ * fragile long run is said on stderr. */
 static void test_command(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-ranges-XXXXXX");
@@ -292,6 +293,18 @@ static void test_command(void)
     snprintf(cmd, sizeof cmd, "--scene %s -n 5 %s", path, BOX);
     snprintf(where, sizeof where, "%s:2: gravity: takes one value", path);
     expect_failure(cmd, 2, where);
+    /* A stationary run whose long run rests on its first drops says so
+     * without --verbose: the box's two broad faces each keep every drop
+     * started on them (two closed classes), a coin's chain mixes. */
+    CHECK_INT(run("-n 700 --initial stationary " BOX, &out, &err), 0);
+    CHECK(err && strstr(err, "the long run is fragile") && strstr(err, "2 closed classes") &&
+          strstr(err, "{pose 1}, {pose 2}") && strstr(err, "100 uniform first drops"));
+    free(out);
+    free(err);
+    CHECK_INT(run("-n 700 --initial stationary parts/canonical/coin_h0.5.off", &out, &err), 0);
+    CHECK(err && !strstr(err, "fragile"));
+    free(out);
+    free(err);
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)
         printf("     could not remove %s\n", tmpdir);
