@@ -129,6 +129,7 @@ pd_status pd_compliant_table_init(double e_lo, double e_hi, pd_compliant_table *
         pd_status st = pd_compliant_law_init(e, 1.0, &law);
         if (st != PD_OK)
             return st;
+        t->one = law;
         t->y[0][i] = law.e < 1.0 ? law.chi * law.e / (1.0 - law.e) : 0.0;
         t->y[1][i] = log(law.tau);
         t->y[2][i] = law.s_peak;
@@ -145,24 +146,28 @@ pd_status pd_compliant_table_init(double e_lo, double e_hi, pd_compliant_table *
 void pd_compliant_table_law(const pd_compliant_table *t, double e, double T, pd_compliant_law *law)
 {
     e = fmax(e, PD_COMPLIANT_E_MIN);
-    double v[3] = {t->y[0][0], t->y[1][0], t->y[2][0]};
-    if (t->n > 1) {
-        /* Cubic Lagrange interpolation through the four nodes around x,
-         * shifted inwards at the ends: error of order dx^4 everywhere. */
-        double x = (log(e) - t->x_lo) / t->dx;
-        int i = (int)floor(x) - 1;
-        i = i < 0 ? 0 : i > t->n - 4 ? t->n - 4 : i;
-        double w[4];
-        for (int j = 0; j < 4; j++) {
-            w[j] = 1.0;
-            for (int k = 0; k < 4; k++)
-                if (k != j)
-                    w[j] *= (x - (i + k)) / (double)(j - k);
-        }
-        for (int q = 0; q < 3; q++)
-            v[q] = w[0] * t->y[q][i] + w[1] * t->y[q][i + 1] + w[2] * t->y[q][i + 2] +
-                   w[3] * t->y[q][i + 3];
+    if (t->n == 1) {
+        /* One restitution: its exact law, as pd_compliant_law_init gives
+         * it for duration T (chi, tau, s_peak do not depend on T). */
+        *law = t->one;
+        law->T = T;
+        law->omega = law->tau / T;
+        return;
     }
+    /* Cubic Lagrange interpolation through the four nodes around x, shifted
+     * inwards at the ends: error of order dx^4 everywhere. */
+    double x = (log(e) - t->x_lo) / t->dx, v[3], w[4];
+    int i = (int)floor(x) - 1;
+    i = i < 0 ? 0 : i > t->n - 4 ? t->n - 4 : i;
+    for (int j = 0; j < 4; j++) {
+        w[j] = 1.0;
+        for (int k = 0; k < 4; k++)
+            if (k != j)
+                w[j] *= (x - (i + k)) / (double)(j - k);
+    }
+    for (int q = 0; q < 3; q++)
+        v[q] = w[0] * t->y[q][i] + w[1] * t->y[q][i + 1] + w[2] * t->y[q][i + 2] +
+               w[3] * t->y[q][i + 3];
     law->e = e;
     law->T = T;
     law->chi = e < 1.0 ? v[0] * (1.0 - e) / e : 0.0;

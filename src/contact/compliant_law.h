@@ -50,6 +50,7 @@ pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *ta
 enum { PD_COMPLIANT_TABLE_NODES = 65 };
 typedef struct pd_compliant_table {
     int n;          /* nodes (1 when the range is one restitution) */
+    pd_compliant_law one; /* n == 1: the exact law, for T = 1 */
     double x_lo, dx; /* log of the lowest restitution, the nodes' step in log e */
     double y[3][PD_COMPLIANT_TABLE_NODES]; /* chi e / (1 - e), log tau, s_peak at the nodes */
 } pd_compliant_table;

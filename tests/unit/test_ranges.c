@@ -219,13 +219,19 @@ static void test_restitution_table(void)
      * what a restitution is known to (a few percent at best). */
     CHECK(table_error(0.05, 0.9) < 1e-7);
     CHECK(table_error(0.01, 1.0) < 1e-5);
-    /* At a node and for a one-restitution table: the exact law itself. */
+    /* A one-restitution table (a range of zero width): the exact law
+     * itself, byte for byte, whatever the restitution and duration. */
     pd_compliant_table t;
-    pd_compliant_law exact, table;
-    CHECK_STATUS(pd_compliant_table_init(0.3, 0.3, &t), PD_OK);
-    CHECK_STATUS(pd_compliant_law_init(0.3, 2e-4, &exact), PD_OK);
-    pd_compliant_table_law(&t, 0.3, 2e-4, &table);
-    CHECK(memcmp(&exact, &table, sizeof exact) == 0);
+    const double es[] = {0.0, 0.11, 0.3, 0.37, 0.93, 1.0}, ts[] = {2e-4, 1e-3, 3.7e-5};
+    for (int i = 0; i < 6; i++) {
+        CHECK_STATUS(pd_compliant_table_init(es[i], es[i], &t), PD_OK);
+        for (int j = 0; j < 3; j++) {
+            pd_compliant_law exact, table;
+            CHECK_STATUS(pd_compliant_law_init(es[i], ts[j], &exact), PD_OK);
+            pd_compliant_table_law(&t, es[i], ts[j], &table);
+            CHECK(memcmp(&exact, &table, sizeof exact) == 0);
+        }
+    }
     CHECK_STATUS(pd_compliant_table_init(0.5, 0.3, &t), PD_ERR_RANGE);
 }
 
