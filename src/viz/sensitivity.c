@@ -10,7 +10,7 @@
 #include "viz/viz_const.h"
 #include "viz/viz_internal.h"
 
-enum { CELL_W = 150, ROW_H = 46, LEFT = 70, TOP = 64, BAR_H = 12 };
+enum { CELL_W = 150, ROW_H = 46, LEFT = 70, TOP = 78, BAR_H = 12 };
 
 /* The parameter as a designer names it. */
 static const char *human(pd_scene_param p)
@@ -26,6 +26,15 @@ static const pd_sensitivity_row *row_of(const pd_sensitivity *s, int pose, int c
     return &s->rows[(size_t)pose * (size_t)s->nparams + (size_t)col];
 }
 
+/* Whether a parameter moves a pose beyond the drops' noise: its lower and
+ * upper thirds' 95% intervals are apart, or its index's interval is clear
+ * of VIZ_SENS_DETECT. */
+static int moves(const pd_sensitivity_row *r)
+{
+    return r->p_low_hi < r->p_high_lo || r->p_high_hi < r->p_low_lo ||
+           r->index_lo > VIZ_SENS_DETECT;
+}
+
 pd_status viz_sensitivity(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
 {
     const pd_sensitivity *s = in->sensitivity;
@@ -36,12 +45,25 @@ pd_status viz_sensitivity(const viz_input *in, int standalone, vbuf *b, pd_diag 
     snprintf(title, sizeof title, "What moves each pose of %s (%ld drops, initial %s)",
              viz_base_name(in->name), s->n,
              in->scene ? viz_initial_name(in->scene->initial) : "?");
-    viz_svg_open(b, standalone, w < 520 ? 520 : w, h, title);
+    viz_svg_open(b, standalone, w < 620 ? 620 : w, h, title);
     vbuf_put(b, "<g class=\"sensitivity\">\n");
     viz_text(b, 10, 22, 15, "start", 1, "#111111", title);
-    viz_text(b, 10, 40, 11, "start", 0, "#555555",
-             "bar: share of the pose's variance the parameter explains (first-order index, "
-             "95% interval); below: p in the range's lower -> upper third");
+    /* A pose indicator's index is small even for a parameter that moves
+     * it a lot (its variance is mostly the fall's own randomness), so the
+     * bars fill at the first of 0.1, 0.2, 0.5, 1 that holds every interval. */
+    double top = 0.0, full_index = 1.0;
+    for (int i = 0; i < s->nposes * s->nparams; i++)
+        top = fmax(top, s->rows[i].index_hi);
+    static const double scales[] = {0.1, 0.2, 0.5, 1.0};
+    for (int i = 3; i >= 0; i--)
+        if (top <= scales[i])
+            full_index = scales[i];
+    char sub[160];
+    snprintf(sub, sizeof sub, "bar: first-order index, the share of the pose's variance the "
+             "parameter explains (a full bar: %g), 95%% interval;", full_index);
+    viz_text(b, 10, 38, 11, "start", 0, "#555555", sub);
+    viz_text(b, 10, 51, 11, "start", 0, "#555555",
+             "dark: it moves the pose. Below: p in the range's lower -> upper third.");
     for (int col = 0; col < s->nparams; col++)
         viz_text(b, LEFT + col * CELL_W + CELL_W / 2.0, TOP - 6, 12, "middle", 1, "#111111",
                  human(s->param[col]));
@@ -54,11 +76,12 @@ pd_status viz_sensitivity(const viz_input *in, int standalone, vbuf *b, pd_diag 
             const pd_sensitivity_row *r = row_of(s, pose, col);
             double x = LEFT + col * CELL_W + 6, full = CELL_W - 12;
             viz_rect(b, x, y + 6, full, BAR_H, "fill=\"#f0f0f0\"");
+            double u = full / full_index;
             if (r->index > 0.0)
-                viz_rect(b, x, y + 6, r->index * full, BAR_H,
-                         r->index_lo > VIZ_SENS_DETECT ? "fill=\"#4e79a7\"" : "fill=\"#b7c6d8\"");
-            viz_xy(b, "<path d=\"M", x + r->index_lo * full, y + 12);
-            viz_xy(b, " L", x + r->index_hi * full, y + 12);
+                viz_rect(b, x, y + 6, r->index * u, BAR_H,
+                         moves(r) ? "fill=\"#4e79a7\"" : "fill=\"#b7c6d8\"");
+            viz_xy(b, "<path d=\"M", x + r->index_lo * u, y + 12);
+            viz_xy(b, " L", x + r->index_hi * u, y + 12);
             vbuf_put(b, "\" stroke=\"#111111\" stroke-width=\"1.2\"/>\n");
             snprintf(lab, sizeof lab, "%.2f [%.2f, %.2f]", r->index, r->index_lo, r->index_hi);
             viz_text(b, x, y + 30, 10, "start", 0, "#111111", lab);
@@ -81,39 +104,36 @@ void viz_sensitivity_words(vbuf *b, const viz_input *in)
     const char *what = in->class_of ? "Class" : "Pose";
     vbuf_put(b, "<ul class=\"words\">\n");
     for (int pose = 0; pose < s->nposes; pose++) {
-        int top = 0;
-        double sum = 0.0;
+        /* The parameters that move it, by index. */
+        int order[PD_NPARAMS], n = 0;
         for (int col = 0; col < s->nparams; col++) {
-            const pd_sensitivity_row *r = row_of(s, pose, col);
-            if (r->index > row_of(s, pose, top)->index)
-                top = col;
-            if (r->index_lo > VIZ_SENS_DETECT)
-                sum += r->index;
+            if (!moves(row_of(s, pose, col)))
+                continue;
+            int at = n++;
+            while (at > 0 && row_of(s, pose, order[at - 1])->index < row_of(s, pose, col)->index) {
+                order[at] = order[at - 1];
+                at--;
+            }
+            order[at] = col;
         }
-        const pd_sensitivity_row *t = row_of(s, pose, top);
         vbuf_printf(b, "<li>%s %d: ", what, pose + 1);
-        if (!(t->index_lo > VIZ_SENS_DETECT)) {
-            vbuf_put(b, "no ranged parameter moves it measurably (every index's interval reaches "
-                        "down to 1% of its variance); its variation is the drop's own "
-                        "randomness.</li>\n");
+        if (n == 0) {
+            vbuf_printf(b, "no ranged parameter moves it beyond the noise of %ld drops; it "
+                           "is decided by how the part happens to fall.</li>\n", s->n);
             continue;
         }
-        vbuf_printf(b, "depends %son %s (%.0f%% of its variance, 95%% %.0f-%.0f%%): %.1f%% of "
-                       "the drops in the lower third of its range end here, %.1f%% in the "
-                       "upper third.", t->index >= 0.5 ? "mostly " : "", human(t->param),
-                    100 * t->index, 100 * t->index_lo, 100 * t->index_hi, 100 * t->p_low,
-                    100 * t->p_high);
-        int others = 0;
-        for (int col = 0; col < s->nparams; col++) {
-            const pd_sensitivity_row *r = row_of(s, pose, col);
-            if (col == top || !(r->index_lo > VIZ_SENS_DETECT))
-                continue;
-            vbuf_printf(b, "%s %s (%.0f%%)", others++ ? "," : " Also", human(r->param),
-                        100 * r->index);
+        const pd_sensitivity_row *t = row_of(s, pose, order[0]);
+        int mostly = n == 1 || t->index >= 2.0 * row_of(s, pose, order[1])->index;
+        vbuf_printf(b, "depends %son %s: %.1f%% of the drops in the lower third of its range "
+                       "end here, %.1f%% in the upper third (index %.2f, 95%% %.2f-%.2f).",
+                    mostly ? "mostly " : "", human(t->param), 100 * t->p_low, 100 * t->p_high,
+                    t->index, t->index_lo, t->index_hi);
+        for (int i = 1; i < n; i++) {
+            const pd_sensitivity_row *r = row_of(s, pose, order[i]);
+            vbuf_printf(b, "%s %s (%.1f%% to %.1f%%)", i > 1 ? "," : " Also", human(r->param),
+                        100 * r->p_low, 100 * r->p_high);
         }
-        vbuf_printf(b, "%s The ranged parameters alone explain %.0f%% of its variance; the rest "
-                       "is the drop's own randomness (its orientation) and their joint "
-                       "effects.</li>\n", others ? "." : "", 100 * sum);
+        vbuf_printf(b, "%s</li>\n", n > 1 ? "." : "");
     }
     vbuf_put(b, "</ul>\n");
 }
