@@ -1022,8 +1022,10 @@ int cli_run(cli_args *a)
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     }
-    if (st == PD_OK && sim && sim->trials && pd_scene_ranged(&a->scene) &&
-        (a->sensitivity || a->pictures[VIZ_REPORT]))
+    /* The report shows it when the drops' records were kept (not across
+     * MPI ranks); --sensitivity needs them. */
+    if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
+        (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
         st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
