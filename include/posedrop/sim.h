@@ -319,6 +319,10 @@ PD_API long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
  * (same numbering as its poses). options and scene may be NULL (defaults).
+ * A scene with ranges has each drop draw its own values (pd_scene_draw, kept
+ * in its trial record): p is then over the ranges; posedrop/sensitivity.h
+ * says which parameter moves which pose. A contact_time range whose high end
+ * is above 1 s for this part is PD_ERR_RANGE.
  *
  * PD_INITIAL_STATIONARY estimates the belt's pose-to-pose chain: with k
  * poses, m = ndrops / (k + 1) drops start resting on each pose (on its facet,

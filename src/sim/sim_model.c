@@ -67,7 +67,9 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
                    : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(part->size)
                                              : ct->hi;
-    if (st == PD_OK && ct_hi > 1.0)
+    /* A drawn duration obeys the value's range; auto itself is the part's
+     * and has none. */
+    if (st == PD_OK && ct->kind != PD_DIST_FIXED && ct_hi > 1.0)
         st = pd_fail(diag, PD_ERR_RANGE, "scene contact_time: the range reaches %g s for this "
                      "part: expected at most 1 s", ct_hi);
     m->compliant_any = !m->engine && ct_hi > 0.0;
