@@ -140,6 +140,26 @@ static void test_records(void)
     r->trials = NULL;
     CHECK_STATUS(pd_sim_sensitivity(r, &sc, 0.01, NULL, 0, &s, NULL), PD_ERR_USAGE);
     pd_sim_result_free(r);
+
+    /* A stationary run's records: only the drops started uniform count,
+     * 1000 of 3000 with two poses (drops 0, 3, 6, ...). */
+    sc.initial = PD_INITIAL_STATIONARY;
+    CHECK_STATUS(pd_sim_result_new(2, &sc, &o, &r, NULL), PD_OK);
+    if (!r)
+        return;
+    r->trials = calloc((size_t)o.ndrops, sizeof *r->trials);
+    r->n = r->trials ? o.ndrops : 0;
+    for (long t = 0; t < r->n; t++) {
+        pd_scene_draw(&sc, 0.01, o.seed, t, r->trials[t].param, NULL);
+        r->trials[t].end = PD_END_SETTLED;
+        r->trials[t].pose = t % 3 == 0 ? r->trials[t].param[PD_PARAM_MU] > 0.5 : 0;
+    }
+    CHECK_STATUS(pd_sim_sensitivity(r, &sc, 0.01, NULL, 0, &s, NULL), PD_OK);
+    CHECK(s && s->n == 1000 && r->pose_drops == 1000 && s->rows[0].index > 0.95);
+    pd_sensitivity_free(s);
+    free(r->trials);
+    r->trials = NULL;
+    pd_sim_result_free(r);
 }
 
 /* Real drops: without friction nothing acts along the floor, so the belt's
