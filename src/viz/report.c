@@ -258,7 +258,12 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                     "<p class=\"note\">The scene's ranges are drawn anew for every drop, so the "
                     "estimates above are over the ranges. For each pose, the first-order "
                     "index is the share of its variance that one parameter explains alone "
-                    "(docs/uncertainty.md).</p>\n");
+                    "(docs/uncertainty.md).");
+        if (in->scene && in->scene->initial == PD_INITIAL_STATIONARY)
+            vbuf_printf(b, " A stationary run's sensitivity is that of its first drops: the "
+                        "%ld settled drops started from uniform orientations.",
+                        in->sensitivity->n);
+        vbuf_put(b, "</p>\n");
         viz_sensitivity_words(b, in);
         vbuf_put(b, "<figure>\n");
         st = viz_sensitivity(in, 0, b, diag);
