@@ -223,8 +223,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     }
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
-    if (w->compliant)
-        pd_compliant_work_watch(w->compliant, o->cancel);
+    if (w->compliant_work)
+        pd_compliant_work_watch(w->compliant_work, o->cancel);
     w->rest_depth = 0.0;
     double t = 0.0, g = sc->gravity;
     /* Resting contact advances by the time to fall rest_fall, so that a
@@ -282,7 +282,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
             if ((st = pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                            m->contact_time, w->contacts, PD_MAX_CONTACTS,
+                                            w->contact_time, w->contacts, PD_MAX_CONTACTS,
                                             &imp)) != PD_OK) {
                 pd_drop_failed(out, PD_STAGE_IMPACT_SEARCH, st);
                 break;
@@ -314,7 +314,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             }
             rest_from = -HUGE_VAL;
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
-            if (m->compliant_on) {
+            if (w->compliant_on) {
                 /* More than one vertex touching or arriving within a contact
                  * duration, one of them striking: a compliant impact, which
                  * the arriving ones join. Else the exact rigid law at the
@@ -326,7 +326,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
                 if (nc >= 2 && approach > m->settle.v_rest) {
                     pd_compliant_result cr;
-                    st = pd_compliant_run(&m->compliant, w->compliant, &m->settle, sc, &s,
+                    st = pd_compliant_run(&w->compliant, w->compliant_work, &m->settle, sc, &s,
                                           o->time_limit - t, &cr);
                     if (st != PD_OK) {
                         pd_drop_failed(out, PD_STAGE_COMPLIANT, st);
@@ -366,7 +366,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
-                resolved = out->collisions - before < PD_MAX_ROUNDS && m->contact_time == 0.0;
+                resolved = out->collisions - before < PD_MAX_ROUNDS && w->contact_time == 0.0;
                 f_at = -1.0;
                 continue;
             }

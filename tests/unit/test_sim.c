@@ -421,10 +421,10 @@ static void test_cancel_compliant(void)
             low = fmin(low, pd_body_vertex_world(m->body, &s, i).z);
         s.x.z = -low;
         pd_cancel_flag stop = set;
-        pd_compliant_work_watch(d.w->compliant, &stop);
+        pd_compliant_work_watch(d.w->compliant_work, &stop);
         pd_compliant_result cr;
-        CHECK_STATUS(pd_compliant_run(&m->compliant, d.w->compliant, &m->settle, &sc, &s, 1.0,
-                                      &cr), PD_OK);
+        CHECK_STATUS(pd_compliant_run(&m->compliant, d.w->compliant_work, &m->settle, &sc, &s,
+                                      1.0, &cr), PD_OK);
         CHECK(set ? cr.end == PD_COMPLIANT_CANCELLED && cr.steps == 0 && cr.time == 0.0
                   : cr.end != PD_COMPLIANT_CANCELLED && cr.steps > 0);
     }
