@@ -444,6 +444,107 @@ static void c_version(const fixture *f, int k, outcome *o)
     o->st = pd_version() ? PD_OK : PD_ERR_INTERNAL;
 }
 
+static void c_first_order_index(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    double x[8] = {1, 2, 3, 4, 5, 6, 7, 8}, y[8] = {0, 1, 0, 1, 1, 1, 0, 1};
+    double s = -7, lo = -7, hi = -7;
+    o->st = pd_first_order_index(P(0, x), P(1, y), 8, 1, P(2, &s), P(3, &lo), P(4, &hi),
+                                 P(5, &o->diag));
+    o->touched = o->st != PD_OK && (s != -7 || lo != -7 || hi != -7);
+}
+
+/* A run with its trial records, which pd_sim_sensitivity reads. */
+static pd_sim_result *recorded_run(const fixture *f)
+{
+    pd_sim_options so;
+    few_drops(&so);
+    so.keep_trials = 1;
+    pd_sim_result *r = NULL;
+    return pd_sim_run(f->part, f->res, NULL, &so, &r, NULL) == PD_OK ? r : NULL;
+}
+
+static void c_sim_sensitivity(const fixture *f, int k, outcome *o)
+{
+    pd_sim_result *r = recorded_run(f);
+    pd_scene sc;
+    pd_scene_default(&sc);
+    pd_sensitivity *s = SENTINEL;
+    o->st = r ? pd_sim_sensitivity(P(0, r), P(1, &sc), f->part->size, P(2, f->class_of),
+                                   f->nclasses, P(3, &s), P(4, &o->diag))
+              : PD_ERR_INTERNAL;
+    settle_output(o, s, pd_sensitivity_free);
+    pd_sim_result_free(r);
+}
+
+static void c_sensitivity_free(const fixture *f, int k, outcome *o)
+{
+    pd_sim_result *r = recorded_run(f);
+    pd_scene sc;
+    pd_scene_default(&sc);
+    pd_sensitivity *s = NULL;
+    o->st = r ? pd_sim_sensitivity(r, &sc, f->part->size, NULL, 0, &s, NULL) : PD_ERR_INTERNAL;
+    free_unless_null(k, s, pd_sensitivity_free);
+    pd_sim_result_free(r);
+}
+
+static void c_scene_param_name(const fixture *f, int k, outcome *o)
+{
+    (void)f, (void)k;
+    o->st = pd_scene_param_name(PD_PARAM_MU) ? PD_OK : PD_ERR_INTERNAL;
+}
+
+/* The scene's read-only helpers take a NULL scene as no scene: an empty
+ * text, no range, the middle quantile, the default scene's time limit;
+ * the draw does nothing without a scene or somewhere to put its values. */
+static void c_scene_format(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    char buf[64];
+    pd_scene_format(P(0, &sc), PD_PARAM_MU, P(1, buf), sizeof buf);
+    o->st = PD_OK;
+}
+
+static void c_scene_ranged(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    o->st = pd_scene_ranged(P(0, &sc)) == 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_scene_draw(const fixture *f, int k, outcome *o)
+{
+    pd_scene sc, drawn;
+    pd_scene_default(&sc);
+    double values[PD_NPARAMS];
+    pd_scene_draw(P(0, &sc), f->part->size, 1, 3, P(1, values), P(2, &drawn));
+    o->st = PD_OK;
+}
+
+static void c_scene_quantile(const fixture *f, int k, outcome *o)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    o->st = pd_scene_quantile(P(0, &sc), PD_PARAM_MU, f->part->size, 0.3) == 0.5 ? PD_OK
+                                                                              : PD_ERR_INTERNAL;
+}
+
+static void c_drop_stage_name(const fixture *f, int k, outcome *o)
+{
+    (void)f, (void)k;
+    o->st = pd_drop_stage_name(PD_STAGE_NONE) ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_time_limit_auto(const fixture *f, int k, outcome *o)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    o->st = pd_time_limit_auto(f->part->size, P(0, &sc)) > 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
 /* --- the table ------------------------------------------------------------- */
 
 typedef struct {
@@ -500,6 +601,16 @@ static const entry table[] = {
     {"pd_pose_classes", "part res class_of nclasses ?diag", c_pose_classes},
     {"pd_sim_result_grouped", "sim class_of grouped ?diag", c_sim_result_grouped},
     {"pd_version", "", c_version},
+    {"pd_first_order_index", "x y index lo hi ?diag", c_first_order_index},
+    {"pd_sim_sensitivity", "result scene ?class_of out ?diag", c_sim_sensitivity},
+    {"pd_sensitivity_free", "?sensitivity", c_sensitivity_free},
+    {"pd_scene_param_name", "", c_scene_param_name},
+    {"pd_scene_format", "?scene ?buf", c_scene_format},
+    {"pd_scene_ranged", "?scene", c_scene_ranged},
+    {"pd_scene_draw", "?scene ?values ?drawn", c_scene_draw},
+    {"pd_scene_quantile", "?scene", c_scene_quantile},
+    {"pd_drop_stage_name", "", c_drop_stage_name},
+    {"pd_time_limit_auto", "?scene", c_time_limit_auto},
 };
 enum { NTABLE = sizeof table / sizeof table[0] };
 
@@ -587,9 +698,11 @@ static int parse_declarations(char *text, declaration *decl, int n, int max)
             int depth = 0;
             for (c = q; c < close && (depth > 0 || *c != ','); c++)
                 depth += *c == '(' ? 1 : *c == ')' ? -1 : 0;
-            if (memchr(q, '*', (size_t)(c - q)) || memchr(q, '[', (size_t)(c - q))) {
+            const char *bracket = memchr(q, '[', (size_t)(c - q));
+            if (memchr(q, '*', (size_t)(c - q)) || bracket) {
+                /* The name comes before an array's bounds. */
                 char param[64];
-                last_identifier(q, c, param, sizeof param);
+                last_identifier(q, bracket ? bracket : c, param, sizeof param);
                 size_t len = strlen(d->pointers);
                 snprintf(d->pointers + len, sizeof d->pointers - len, "%s%s", len ? " " : "",
                          param);
