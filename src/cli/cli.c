@@ -945,6 +945,8 @@ int cli_run(cli_args *a)
         goto done;
     }
     st = pd_part_build(mesh, &a->part, &part, &diag);
+    if (st == PD_OK && !a->merge && cli_writer())
+        plausible_warn(a, part);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
     t_static = now() - t0;

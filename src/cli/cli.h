@@ -1,7 +1,8 @@
 /* cli.h: what the files of the posedrop command share. cli.c parses the
  * options and prints CSV; run.c (or run_mpi.c in posedrop-mpi) runs the
  * drops; shard.c writes and merges shards; json_out.c prints --format json;
- * progress.c draws the progress line; sha256.c hashes the part file. */
+ * progress.c draws the progress line; sha256.c hashes the part file;
+ * plausible.c warns of a part or drop height out of scale. */
 #ifndef PD_CLI_CLI_H
 #define PD_CLI_CLI_H
 
@@ -68,6 +69,11 @@ void signals_catch(pd_sim_options *options);
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+
+/* plausible.c: warns on stderr when the part's size, or the drop height
+ * against it, suggests a unit mistaken (a file in millimetres read as
+ * metres). */
+void plausible_warn(const cli_args *a, const pd_part *part);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */

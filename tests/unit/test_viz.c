@@ -557,6 +557,18 @@ static void test_command(void)
                           "initial uniform", "200 drops", "timings", "posedrop --group -n 200"};
     for (int i = 0; i < 8; i++)
         CHECK(r && strstr(r, said[i]));
+    /* The automatic contact time by name and with the value used (the
+     * scene's -1 is a code, not a duration); the size up front. */
+    char auto_time[64];
+    pd_mesh *mesh;
+    pd_part *part;
+    pd_static_result *res;
+    load("parts/insulator_cap.off", &mesh, &part, &res);
+    snprintf(auto_time, sizeof auto_time, "contact time auto (%.4g s for this part",
+             part ? pd_contact_time_auto(part->size) : -1.0);
+    unload(mesh, part, res);
+    CHECK(r && strstr(r, auto_time) && !strstr(r, "contact time -"));
+    CHECK(r && strstr(r, "<p class=\"size\">The part is <strong>"));
     /* Same pictures with one thread. */
     snprintf(cmd, sizeof cmd, PD_CLI_PATH " --group -n 200 -j 1 --svg build/viz-test-g1.svg "
              "--measured %s parts/insulator_cap.off > /dev/null 2>&1", meas);
