@@ -17,18 +17,19 @@
 # PQS "less than a second", dynamic simulation "approximately two hours").
 # --chart-only redraws from an existing DIR/cost-accuracy.csv.
 set -u
+. "$(dirname "$0")/args.sh"
 outdir=results
 seeds=3
 tables=""
 chart_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
-        -o) outdir=$2; shift 2 ;;
-        -s) seeds=$2; shift 2 ;;
-        -d) tables=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
+        -s) args_value "$@"; args_count -s "$2"; seeds=$2; shift 2 ;;
+        -d) args_value "$@"; tables=$2; shift 2 ;;
         --chart-only) chart_only=1; shift ;;
         --help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-        *) echo "cost-accuracy.sh: unknown argument '$1'" >&2; exit 2 ;;
+        *) args_die "unknown argument '$1'" ;;
     esac
 done
 here=$(cd "$(dirname "$0")/.." && pwd)

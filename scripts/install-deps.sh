@@ -27,6 +27,9 @@ for arg in "$@"; do
     case "$arg" in
     browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
     mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
+    *[!a-z0-9+.-]* | [!a-z0-9]*)
+        echo "install-deps.sh: '$arg' is not a Debian package name (nor browser or mpi)" >&2
+        exit 2 ;;
     *) pkgs=$arg ;;
     esac
     for pkg in $pkgs; do

@@ -22,6 +22,7 @@
 # probability on both sides, the column the parts were fitted on (the paper
 # numbers its poses by physical frequency).
 set -u
+. "$(dirname "$0")/args.sh"
 n=2000
 initial=stationary
 contact_time=
@@ -29,13 +30,13 @@ outdir=results
 tables=""
 while [ $# -gt 0 ]; do
     case "$1" in
-        -n) n=$2; shift 2 ;;
-        -i) initial=$2; shift 2 ;;
-        -t) contact_time=$2; shift 2 ;;
-        -o) outdir=$2; shift 2 ;;
-        -d) tables=$2; shift 2 ;;
+        -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
+        -i) args_value "$@"; initial=$2; shift 2 ;;
+        -t) args_value "$@"; contact_time=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
+        -d) args_value "$@"; tables=$2; shift 2 ;;
         --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-        *) echo "paper.sh: unknown argument '$1'" >&2; exit 2 ;;
+        *) args_die "unknown argument '$1'" ;;
     esac
 done
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -46,7 +47,11 @@ if [ -z "$tables" ]; then
         [ -f "$t" ] && { tables=$t; break; }
     done
 fi
-[ -f "$tables" ] || { echo "paper.sh: the paper's measured tables not found (give -d FILE)" >&2; exit 2; }
+[ -f "$tables" ] || args_die "the paper's measured tables not found (give -d FILE)"
+# -i and -t as posedrop reads them, on a static run of one part (milliseconds),
+# so that a bad value is refused once, before any drop.
+why=$("$bin" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
+    "$here/parts/cap.off" 2>&1 >/dev/null) || args_die "$(printf '%s' "$why" | head -n 1)"
 mkdir -p "$outdir" || exit 2
 status=0
 for part in insulator_cap white_button rect_black_button square_black_button; do
