@@ -13,7 +13,7 @@
 # CONTACT_TIME, s, the duration of one contact (posedrop's default when not
 # given; 0: the rigid model): --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
-# (default results/) and prints each table: the paper's QS, PQS, dynamic and
+# (default results/) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
@@ -53,6 +53,22 @@ fi
 why=$("$bin" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
     "$here/parts/cap.off" 2>&1 >/dev/null) || args_die "$(printf '%s' "$why" | head -n 1)"
 mkdir -p "$outdir" || exit 2
+# What the tables' blocks and rows are, so that the output reads without
+# docs/validation.md.
+cat <<EOF
+Tables 1-4 of Goldberg, Mirtich et al., "Part Pose Statistics: Estimators and
+Experiments", with posedrop's columns beside the paper's; every figure in percent.
+  left block, the paper's:  QS and PQS estimates, Dyn its dynamic simulation,
+                            Phys the physical tests (the reference)
+  right block, posedrop's:  QS and PQS estimates, and $n drops (initial $initial)
+                            on posedrop's impulse engine, ODE and Bullet
+  pose  numbered as the paper numbers them (by physical frequency); posedrop's
+        pose classes are paired with them by rank of their QS probability
+  e16   the paper's eq. (16) error against the physical tests: the sum over poses
+        of p_phys |p - p_phys| (0: exact; mass on poses never seen costs nothing)
+  TV    total-variation distance from the physical tests: half the sum of
+        |p - p_phys|, mass on poses never seen included
+EOF
 status=0
 for part in insulator_cap white_button rect_black_button square_black_button; do
     file="$here/parts/$part.off"
@@ -107,6 +123,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 if (paper[prank[j], 1] > paper[prank[i], 1]) { t = prank[i]; prank[i] = prank[j]; prank[j] = t }
             for (r = 1; r <= np; r++) rank_of[prank[r]] = r
             printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d; initial %s)\n", part, trials, ks, np, initial
+            printf "%4s | %-27s | %s\n", "", "the paper", "posedrop"
             printf "%4s | %6s %6s %6s %6s | %6s %6s %7s %6s %6s\n", "pose", "QS", "PQS", "Dyn", "Phys",
                    "QS", "PQS", "impulse", "ODE", "Bullet"
             for (p = 1; p <= np; p++) {
