@@ -70,11 +70,15 @@ Experiments", with posedrop's columns beside the paper's; every figure in percen
         |p - p_phys|, mass on poses never seen included
 EOF
 status=0
+runs=0
+start_s=$SECONDS
 for part in insulator_cap white_button rect_black_button square_black_button; do
     file="$here/parts/$part.off"
     [ -f "$file" ] || { echo "paper.sh: $file missing" >&2; status=1; continue; }
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
+        runs=$((runs + 1))
+        echo "paper.sh: $part on $engine, run $runs of 12, $((SECONDS - start_s)) s so far" >&2
         start=$(date +%s.%N)
         "$bin" --group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
             --engine "$engine" "$file" \

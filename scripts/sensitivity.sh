@@ -49,6 +49,8 @@ for v in 0 0.1 0.3 0.5 0.7 0.9; do point restitution "$v" p -n "$n" --initial st
 for v in 0.01 0.03 0.06 0.12 0.25 0.5; do point height "$v" p -n "$n" --initial stationary -h "$v"; done
 for v in 0 5 10 15 20 30 45; do point epsilon "$v" p_pqs --epsilon "$v"; done
 
+command -v gnuplot >/dev/null 2>&1 || echo "sensitivity.sh: gnuplot is missing: installing the" \
+    "Debian package gnuplot-nox with apt-get (scripts/install-deps.sh, through sudo when not root)" >&2
 command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||
     { echo "sensitivity.sh: gnuplot missing; $csv written, no chart" >&2; exit 1; }
 poses=$(awk -F, 'NR > 1 { print $3 }' "$csv" | sort -n -u | tr '\n' ' ')
