@@ -41,9 +41,13 @@ mkdir -p "$outdir" || exit 2
 csv="$outdir/crosscheck.csv"
 echo "part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled" > "$csv"
 status=0
+runs=0
+start_s=$SECONDS
 for part in "${parts[@]}"; do
     name=$(basename "${part%.*}")
     for engine in impulse ode bullet; do
+        runs=$((runs + 1))
+        echo "crosscheck.sh: $part on $engine, run $runs of $((3 * ${#parts[@]})), $((SECONDS - start_s)) s so far" >&2
         out="$outdir/$name.$engine.csv"
         start=$(date +%s.%N)
         if ! "$bin" "${opts[@]}" -n "$n" --engine "$engine" --trials "$outdir/$name.$engine.trials.csv" \
