@@ -13,6 +13,14 @@ enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
 
 extern const char *prog;
 
+/* A file the run reads (an input) or writes (an output), with what names it
+ * in messages: a long option's name (option 1: "trials" is shown "--trials")
+ * or a role ("PART", "shard"). */
+typedef struct {
+    const char *what, *path;
+    int output, option;
+} cli_file;
+
 typedef struct {
     const char *path, *trials, *transitions, *com_text;
     pd_mesh_read_options read;
@@ -27,6 +35,8 @@ typedef struct {
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;
     char **merge;                  /* posedrop merge: the shard files (NULL ended) */
+    cli_file *files;               /* every file named, for cli_files_apart (owned) */
+    int nfiles;
 } cli_args;
 
 /* Axis-aligned normals come out with round-off components like 1e-17; print

@@ -360,6 +360,9 @@ static double now(void)
 
 int cli_run(cli_args *a)
 {
+    /* Before anything is read for the run or written. */
+    if (cli_any(!cli_files_apart(a->files, a->nfiles)))
+        return EXIT_USAGE;
     int code;
     pd_diag diag;
     pd_diag_init(&diag);
@@ -410,6 +413,12 @@ int cli_run(cli_args *a)
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
     t_static = now() - t0;
+    /* A signal before the drops (or, without drops, before the output)
+     * ends the run here, nothing printed. */
+    if (st == PD_OK && cli_any(signals_caught())) {
+        code = cli_interrupt_code();
+        goto done;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
         t_sim = now() - t0 - t_static;

@@ -10,7 +10,6 @@
  * one run, reads the part again (its SHA-256 must not have changed), sums
  * the counts and prints through cli_run what the unsharded run prints. */
 #include <errno.h>
-#include <getopt.h>
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdlib.h>
