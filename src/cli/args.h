@@ -31,6 +31,7 @@ typedef struct {
     int dynamic, facets, group, verbose;
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;
+    const char *sensitivity;       /* --sensitivity FILE */
     int json;                      /* --format json */
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;

@@ -28,7 +28,8 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
-       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD };
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
+       OPT_SENSITIVITY };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -131,6 +132,9 @@ static const cli_option options[] = {
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
      "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
      "0: rigid, the paper's model"},
+    {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
+     "angular speed at release, rad/s, about an axis drawn\n"
+     "uniformly for each drop, 0..10000 (0)"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -147,13 +151,30 @@ static const cli_option options[] = {
     {OPT_SCENE, "scene", ARG_INPUT, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
-     "contact_time, each at most once; options given after it\n"
-     "override it"},
+     "contact_time, tumble, each at most once; options given\n"
+     "after it override it.\n"
+     "Ranges: -h, -v, --mu, --restitution, --vibration,\n"
+     "--contact-time and --tumble (and their keys) take LO:HI\n"
+     "as well as a value: each drop draws its own value,\n"
+     "uniformly, or log uniformly with LO:HI:log (the default\n"
+     "for --contact-time, which also takes multiples of auto,\n"
+     "0.3x:3x); the estimates are then over the ranges\n"
+     "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
      "(pose 0: unsettled); with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
-     "within it, numbered as without --group"},
+     "within it, numbered as without --group; then one column\n"
+     "per ranged scene parameter, named by its key, the value\n"
+     "the drop drew (vibration in degrees)"},
+    {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
+     "with ranges, what each ranged parameter moves, as CSV:\n"
+     "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
+     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi: the\n"
+     "pose's probability in the lower and upper third of the\n"
+     "range (95% Wilson) and the first-order index, the share\n"
+     "of the pose's variance the parameter explains (95%\n"
+     "bootstrap interval; docs/uncertainty.md)"},
     {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -388,6 +409,10 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.keep_trials = 1;
         break;
     case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_SENSITIVITY:
+        a->sensitivity = arg;
+        a->sim.keep_trials = 1;
+        break;
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
@@ -538,6 +563,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (stationary && a->sim.ci_halfwidth > 0)
         return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
                           "number of drops over the poses in advance: give -n");
+    if (a->sensitivity && (!a->dynamic || !pd_scene_ranged(&a->scene) || a->sim.nshards))
+        return fail_usage("%s", "--sensitivity needs drops (-n or --ci) of a scene with a range "
+                          "(such as --mu 0.2:0.5), and does not go with --shard");
+    /* The report says what each ranged parameter moves. */
+    if (a->pictures[VIZ_REPORT] && a->dynamic && pd_scene_ranged(&a->scene))
+        a->sim.keep_trials = 1;
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)

@@ -2,9 +2,10 @@
  * in posedrop-mpi) runs the drops; shard.c writes, reads and sums shards;
  * json_out.c prints --format json; progress.c draws the progress line;
  * sha256.c hashes the part file; plausible.c warns of a part or drop height
- * out of scale; signals.c catches SIGINT and SIGTERM; same_file.c keeps
- * outputs off inputs. The commands above it: cli.c (posedrop's options),
- * merge.c (posedrop merge). */
+ * out of scale; fragile.c of a stationary estimate that rests on few drops;
+ * signals.c catches SIGINT and SIGTERM; same_file.c keeps outputs off
+ * inputs. The commands above it: cli.c (posedrop's options), merge.c
+ * (posedrop merge). */
 #ifndef PD_CLI_CLI_H
 #define PD_CLI_CLI_H
 
@@ -66,6 +67,11 @@ void plausible_warn(const cli_args *a, const pd_part *part);
  * output (standard output included when it is a regular file); otherwise 0,
  * with a message naming both and the file. */
 int cli_files_apart(const cli_file *files, int n);
+
+/* fragile.c: the warnings of a stationary run whose long run rests on its
+ * first drops (several closed classes, or near traps), said without
+ * --verbose. */
+void fragile_warn(const char *path, const pd_sim_result *sim);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */

@@ -227,9 +227,14 @@ static int out_commit(out_file *o)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
+                         const pd_scene *scene)
 {
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
+    for (int k = 0; k < PD_NPARAMS; k++)
+        if (scene->range[k].kind != PD_DIST_FIXED)
+            fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
+    fputc('\n', f);
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
@@ -238,6 +243,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
                 t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
+        for (int k = 0; k < PD_NPARAMS; k++)
+            if (scene->range[k].kind != PD_DIST_FIXED)
+                fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
         fputc('\n', f);
     }
 }
@@ -257,6 +265,21 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
         for (int j = 0; j < k; j++)
             fprintf(f, "%d,%d,%ld,%.10g\n", i, j + 1, row[j],
                     total ? (double)row[j] / (double)total : 0.0);
+    }
+}
+
+/* --sensitivity: one row per pose (class with --group) and ranged
+ * parameter, numbered as in the output. */
+static void write_sensitivity(FILE *f, const pd_sensitivity *s)
+{
+    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
+               "index,index_lo,index_hi\n");
+    for (int i = 0; i < s->nposes * s->nparams; i++) {
+        const pd_sensitivity_row *r = &s->rows[i];
+        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
+                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
+                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
+                r->index_lo, r->index_hi);
     }
 }
 
@@ -341,8 +364,10 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
                         "variation) from the distribution it started from%s\n", prog, a->path,
                 sim->bootstrap_rounds, sim->stationarity,
                 sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
-    if (sim->transitions && sim->nshards == 0)
+    if (sim->transitions && sim->nshards == 0) {
         print_stationary_summary(a, sim);
+        fragile_warn(a->path, sim);
+    }
     if (a->verbose && sim->n)
         fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
                 (double)sim->collisions / (double)sim->n);
@@ -377,9 +402,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
-                 (!a->transitions || out_open(&transitions_out, a->transitions));
+                 (!a->transitions || out_open(&transitions_out, a->transitions)) &&
+                 (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
         opened = !a->pictures[k] || out_open(&pic_out[k], a->pictures[k]);
     /* A measured distribution is read before the work too. */
@@ -392,6 +418,7 @@ int cli_run(cli_args *a)
     if (!opened) {
         out_abort(&trials_out);
         out_abort(&transitions_out);
+        out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
             out_abort(&pic_out[k]);
         return EXIT_USAGE;
@@ -401,6 +428,7 @@ int cli_run(cli_args *a)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
+    pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
     if (st != PD_OK) {
@@ -434,9 +462,14 @@ int cli_run(cli_args *a)
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     }
+    /* The report shows it when the drops' records were kept (not across
+     * MPI ranks); --sensitivity needs them. */
+    if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
+        (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
+        st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured};
+                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
     if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -448,11 +481,14 @@ int cli_run(cli_args *a)
     /* The side files before stdout: if one cannot be written in full (a
      * full disk, /dev/full), the run fails with nothing on stdout. */
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of);
+        write_trials(trials_out.f, sim, class_of, &a->scene);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
+    if (sens_out.f)
+        write_sensitivity(sens_out.f, sens);
     if ((trials_out.f && !out_commit(&trials_out)) ||
-        (transitions_out.f && !out_commit(&transitions_out))) {
+        (transitions_out.f && !out_commit(&transitions_out)) ||
+        (sens_out.f && !out_commit(&sens_out))) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -494,6 +530,8 @@ int cli_run(cli_args *a)
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);
+    out_abort(&sens_out);
+    pd_sensitivity_free(sens);
     for (int k = 0; k < VIZ_KINDS; k++)
         out_abort(&pic_out[k]);
     viz_measured_free(measured);

@@ -434,6 +434,8 @@ static void test_script_refusals(void)
         {"paper.sh -i foo", "paper.sh: posedrop: --initial: initial: expected uniform, bootstrap"},
         {"paper.sh -n 0", "paper.sh: -n: expected a whole number"},
         {"slurm-array.sh -N", "slurm-array.sh: -N needs a value"},
+        {"sensitivity.sh -n", "sensitivity.sh: -n needs a value"},
+        {"sensitivity.sh -i foo $R/parts/cap.off", "sensitivity.sh: posedrop: --initial: initial"},
         {"fuzz.sh x off", "fuzz.sh: SECONDS: expected a whole number"},
         {"fuzz.sh 5 nosuch", "fuzz.sh: no target 'nosuch' built"},
         {"lint-layers.sh --x", "lint-layers.sh: takes no arguments"},

@@ -392,7 +392,7 @@ static void test_placement(void)
         if (!parts[k])
             continue;
         CHECK_STATUS(pd_static_estimate(parts[k], NULL, &res, NULL), PD_OK);
-        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL};
+        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL};
         CHECK_STATUS(viz_gallery(&in, 1, &b[k], NULL), PD_OK);
         CHECK_STATUS(viz_sphere(&in, 1, &b[k], NULL), PD_OK);
         pd_static_result_free(res);
@@ -802,8 +802,10 @@ static void test_layout(void)
             class_of[i] = i < n ? i : n - 1;
         sim.nposes = meas.npose = n;
         for (int dyn = 0; dyn < 2; dyn++) { /* the long name with the long labels */
-            viz_input in = {names[dyn], part, res, dyn ? &sim : NULL, class_of, n,
-                            "impulse", dyn ? &scene : NULL, dyn ? &meas : NULL};
+            viz_input in = {.name = names[dyn], .part = part, .res = res,
+                            .sim = dyn ? &sim : NULL, .class_of = class_of, .nclasses = n,
+                            .engine = "impulse", .scene = dyn ? &scene : NULL,
+                            .measured = dyn ? &meas : NULL};
             pd_status (*const draw[3])(const viz_input *, int, vbuf *, pd_diag *) = {
                 viz_gallery, viz_chart, viz_sphere};
             static const char *const kind[3] = {"gallery", "chart", "sphere"};
