@@ -29,7 +29,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -102,6 +102,11 @@ static const cli_option options[] = {
     {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
      "time step of ode (default 0.001) or bullet (1/960),\n"
      "above 0 and at most 0.01"},
+    {OPT_TIME_LIMIT, "time-limit", ARG_TEXT, "S", REAL("auto or a time in s", 0, 1e9, 1, 0), NULL, NULL,
+     "simulated seconds a drop may take before it ends\n"
+     "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
+     "(default): 100 (sqrt(L/g) + sqrt(2h/g)) for a part of size\n"
+     "L dropped from h, 19.8 s for a 1 cm cube from 0.12 m"},
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},
@@ -162,7 +167,9 @@ static const cli_option options[] = {
      "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
-     "(pose 0: unsettled); with --group, pose is the class\n"
+     "(pose 0: unsettled; end: settled, time_limit,\n"
+     "collision_limit or failed:STAGE:STATUS, docs/cli.md);\n"
+     "with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
      "within it, numbered as without --group; then one column\n"
      "per ranged scene parameter, named by its key, the value\n"
@@ -394,6 +401,13 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
     case OPT_DT: a->sim.dt = x; break;
+    case OPT_TIME_LIMIT: {
+        int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        a->sim.time_limit = strcmp(arg, "auto") == 0 ? PD_TIME_LIMIT_AUTO : x;
+        break;
+    }
     case OPT_SCENE: {
         pd_diag d;
         pd_diag_init(&d);

@@ -98,13 +98,31 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     free(pose_of);
 }
 
-static const char *end_name(pd_drop_end e)
+/* A status as one word of the end column: its fixed name with blanks as
+ * underscores ("no convergence": no_convergence). */
+static void status_word(pd_status st, char *buf, size_t size)
 {
-    switch (e) {
+    snprintf(buf, size, "%s", pd_status_str(st));
+    for (char *c = buf; *c; c++)
+        if (*c == ' ' || *c == '-' || *c == '/')
+            *c = '_';
+}
+
+/* How a drop ended, as the end column of --trials and --verbose write it:
+ * settled, time_limit, collision_limit, or failed:STAGE:STATUS (where a
+ * solver failed and how, docs/cli.md). */
+static const char *end_name(const pd_trial *t, char *buf, size_t size)
+{
+    switch (t->end) {
     case PD_END_SETTLED: return "settled";
     case PD_END_TIME_LIMIT: return "time_limit";
     case PD_END_COLLISION_LIMIT: return "collision_limit";
-    default: return "failed";
+    default: {
+        char st[64];
+        status_word(t->status, st, sizeof st);
+        snprintf(buf, size, "failed:%s:%s", pd_drop_stage_name(t->stage), st);
+        return buf;
+    }
     }
 }
 
@@ -239,8 +257,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
         long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        char end[96];
         fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", drop + 1, t->q0[0], t->q0[1],
-                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
+                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t, end, sizeof end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
         for (int k = 0; k < PD_NPARAMS; k++)
@@ -342,14 +361,65 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
             outside ? "" : " (no sign that they differ)");
 }
 
+/* Why the drops that did not settle ended: how many at each limit (the
+ * time limit with its value) and how many failed, with where and how the
+ * first failed; --verbose adds a line per such drop when --trials kept
+ * them. A merged result from shard files has no breakdown, only the count. */
+static void print_unsettled(const cli_args *a, const pd_sim_result *sim)
+{
+    if (sim->time_limited + sim->collision_limited + sim->failed != sim->unsettled) {
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
+                        "a solver failed) and are in no count\n", prog, a->path, sim->unsettled,
+                sim->n);
+        return;
+    }
+    fprintf(stderr, "%s: %s: %ld of %ld drops did not settle and are in no count:", prog,
+            a->path, sim->unsettled, sim->n);
+    const char *sep = "";
+    if (sim->time_limited) {
+        fprintf(stderr, " %ld at the time limit (%.6g s simulated; --time-limit)",
+                sim->time_limited, sim->time_limit);
+        sep = ",";
+    }
+    if (sim->collision_limited) {
+        fprintf(stderr, "%s %ld at the collision limit (%d collisions)", sep,
+                sim->collision_limited, a->sim.max_collisions);
+        sep = ",";
+    }
+    if (sim->failed) {
+        char st[64];
+        status_word(sim->failed_status, st, sizeof st);
+        fprintf(stderr, "%s %ld failed", sep, sim->failed);
+        if (sim->first_failed >= 0) /* not known after posedrop-mpi's sums */
+            fprintf(stderr, " (the first, drop %ld: failed:%s:%s)", sim->first_failed + 1,
+                    pd_drop_stage_name(sim->failed_stage), st);
+    }
+    fputc('\n', stderr);
+    /* Enough lines to see the pattern; the rest are in the --trials file. */
+    enum { VERBOSE_DROPS = 20 };
+    long shown = 0;
+    for (long i = 0; a->verbose && sim->trials && i < sim->n; i++) {
+        const pd_trial *t = &sim->trials[i];
+        if (t->end == PD_END_SETTLED)
+            continue;
+        if (shown++ == VERBOSE_DROPS) {
+            fprintf(stderr, "%s: and %ld more drops that did not settle, in %s\n", a->path,
+                    sim->unsettled - VERBOSE_DROPS, a->trials);
+            break;
+        }
+        char end[96];
+        long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        fprintf(stderr, "%s: drop %ld: %s after %.6g s simulated, %d collisions\n", a->path,
+                drop + 1, end_name(t, end, sizeof end), t->time, t->collisions);
+    }
+}
+
 /* What every dynamic run reports, whether or not --verbose: drops that could
  * not be classified and collisions the law had to correct are never silent. */
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
 {
     if (sim->unsettled)
-        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
-                        "the engine failed) and are in no count\n", prog, a->path, sim->unsettled,
-                sim->n);
+        print_unsettled(a, sim);
     if (sim->energy_gain)
         fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
                         "friction, resolved by the energetic law; or a compliant impact's step, "
@@ -527,6 +597,12 @@ int cli_run(cli_args *a)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
     if (code == 0 && sim && sim->partial)
         code = cli_interrupt_code();
+    else if (code == 0 && sim && sim->n > 0 && sim->failed == sim->n) {
+        /* Not one drop ran to an end the model defines: the rows hold the
+         * static estimates only, and a script must not take them for a run. */
+        fprintf(stderr, "%s: %s: every drop failed: no dynamic estimate\n", prog, a->path);
+        code = EXIT_INTERNAL;
+    }
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);

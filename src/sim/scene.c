@@ -13,6 +13,7 @@
 #include "base/rng.h"
 #include "posedrop/sim.h"
 #include "sim/scene.h"
+#include "sim/sim_tol.h"
 
 void pd_scene_default(pd_scene *s)
 {
@@ -33,8 +34,13 @@ double pd_contact_time_auto(double size)
 {
     /* The Hertz estimate for the paper's scene (docs/contact.md) and the
      * size it was made for, a 1 cm cube's diagonal. */
-    const double t_ref = 5e-4, size_ref = 0.01 * sqrt(3.0);
-    return t_ref * size / size_ref;
+    const double t_ref = 5e-4, size_ref = 0.01 * sqrt(3.0), g_ref = 9.81;
+    /* No longer than a contact that the part's weight, under the estimate's
+     * gravity, presses PD_CONTACT_AUTO_SINK_REL of its size into the floor:
+     * a contact of duration T is a spring of angular frequency pi / T,
+     * which sinks g (T / pi)^2 under the weight. */
+    double t_sink = M_PI * sqrt(PD_CONTACT_AUTO_SINK_REL * size / g_ref);
+    return fmin(t_ref * size / size_ref, t_sink);
 }
 
 typedef struct {
