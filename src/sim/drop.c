@@ -186,6 +186,12 @@ static double touching_rise(const pd_body *b, const pd_state *s, const int *cont
     return rise;
 }
 
+/* Kinetic plus potential energy per unit weight: a height, m. */
+static double energy_height(const pd_body *b, const pd_state *s, double g)
+{
+    return pd_body_kinetic(b, s) / (b->mass * g) + s->x.z;
+}
+
 /* Lifts s by `lift` back onto the floor, paying out of its kinetic energy
  * for the part of the lift that the centre of mass did not fall (`fell`:
  * how far it fell in the rest step just taken; anything below 0 when no
@@ -237,7 +243,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     double rest_from = -HUGE_VAL; /* the centre's height before the rest step just taken */
     w->energy_rise = 0.0;
     for (;;) {
-        double e_now = pd_body_kinetic(m->body, &s) / (m->body->mass * g) + s.x.z;
+        double e_now = energy_height(m->body, &s, g);
         e_low = fmin(e_low, e_now);
         w->energy_rise = fmax(w->energy_rise, (e_now - e_low) / m->body->size);
         int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
@@ -375,6 +381,15 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         double speed = fabs(s.v.z) + v3_norm(s.w) * m->body->rmax;
         if (speed * dt > PD_REST_SINK_REL * m->body->size)
             dt = PD_REST_SINK_REL * m->body->size / speed;
+        /* Nor long enough for the turn to carry a vertex deeper, beyond the
+         * centre's fall, than the kinetic energy can pay for lifting the part
+         * back (lift_onto_floor), or than the outcome test allows for
+         * (PD_REST_TURN_REL): lifted partly for free, a slowly rocking part
+         * gained height every step and never settled below a low barrier. */
+        double turn = v3_norm(s.w) * m->body->rmax;
+        double payable = fmax(energy_height(m->body, &s, g) - s.x.z, m->settle.margin);
+        if (turn * dt > payable)
+            dt = payable / turn;
         f_at += dt;
         rest_from = s.x.z;
         if (pd_flight_eval(&f, f_at, &s) != PD_OK)

@@ -9,6 +9,7 @@
 #include "base/vec3.h"
 #include "contact/contact_phase.h"
 #include "base/base_tol.h"
+#include "posedrop/tolerances.h"
 #include "sim/sim_tol.h"
 #include "sim/sim_model.h"
 
@@ -56,6 +57,14 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     pd_status st = pd_body_build(part, &m->body, diag);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
+    if (st == PD_OK && !m->engine) {
+        /* The impulse engine puts every resting contact back onto the floor
+         * and pays for it (src/sim/drop.c), so its energy reads low by what
+         * an unpaid return may add at most, not by a rest fall; it tells
+         * heights apart to its contact tolerance. */
+        m->settle.margin = PD_REST_TURN_REL * m->body->size;
+        m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
+    }
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
                           ? pd_contact_time_auto(part->size)
                           : scene->contact_time;

@@ -48,4 +48,18 @@
  * where the part turns or falls faster than 2 rest falls per rest step. */
 #define PD_REST_SINK_REL 2e-4
 
+/* The energy per unit weight, times L, that a rest step's return onto the
+ * floor may add where the motion is too slow to pay for it (src/sim/drop.c:
+ * the step is cut so that its turn carries no vertex deeper, beyond the
+ * centre's fall, than the kinetic energy can lift back, or than this); the
+ * impulse engine's outcome test allows for it (pd_settle.margin). Why 1e-8:
+ * it must stay below the lowest barrier a part's basins are told apart by
+ * (two stable facets meeting at a ridge of 0.1 degree: 3e-7 L on the
+ * 2 x 1 x 1 roof box of the tests), and each order of magnitude smaller
+ * shortens the slowest rest steps about threefold (the step goes as
+ * sqrt(this) where the kinetic energy is this small). Larger: shallower
+ * ridges rock until the time limit; smaller: more rest steps as a part
+ * comes to rest. */
+#define PD_REST_TURN_REL 1e-8
+
 #endif
