@@ -12,24 +12,12 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 #include "check.h"
+#include "drops_scale.h"
 #include "contact/compliant.h"
 #include "drop_fixture.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
 #include "suites.h"
-
-/* The sanitizer build runs every check, on fewer drops where a statistic
- * allows it (the statistical tests keep their level at any count). */
-#if defined(__SANITIZE_ADDRESS__)
-#define DROPS_SCALE 4
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define DROPS_SCALE 4
-#endif
-#endif
-#ifndef DROPS_SCALE
-#define DROPS_SCALE 1
-#endif
 
 /* --- a model of any part, at any tolerance scale ---------------------------- */
 

@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "drops_scale.h"
 #include "base/gsl_adapter.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
@@ -162,19 +163,6 @@ static void small_parts_ode(void)
         release(r, poses, part);
     }
 }
-
-/* The sanitizer build runs the same checks on fewer drops (the bounds below
- * are statistical and keep their level at any count). */
-#if defined(__SANITIZE_ADDRESS__)
-#define DROPS_SCALE 4
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define DROPS_SCALE 4
-#endif
-#endif
-#ifndef DROPS_SCALE
-#define DROPS_SCALE 1
-#endif
 
 /* A part whose two stable facets meet at a shallow ridge of `deg` degrees (a
  * 2 x 1 x 1 cm box with a roof for a bottom, mesh_roof_box): the energy
