@@ -72,13 +72,22 @@ typedef struct pd_scene {
 /* contact_time's default: the duration a Hertz contact of a plastic part on a
  * rubber belt takes at the drop's speed, 5e-4 s for a 1 cm cube, in
  * proportion to the part's size for geometrically similar parts (Hertz: the
- * duration goes as (m^2 / (R E^2 v))^(1/5), with the mass m ~ L^3 and the
- * corner radius R ~ L: as L). docs/contact.md. */
+ * duration goes as (m^2 / (R E^2 v))^(1/5), with the mass m from the part's
+ * volume and the corner radius R ~ L: as L for similar parts;
+ * pd_contact_time_auto_part). docs/contact.md. */
 #define PD_CONTACT_TIME_AUTO (-1.0)
 
 /* The duration PD_CONTACT_TIME_AUTO stands for, for a part of size L (the
- * bounding-box diagonal, m): 5e-4 s times L over a 1 cm cube's diagonal. */
+ * bounding-box diagonal, m) shaped like a cube: 5e-4 s times L over a 1 cm
+ * cube's diagonal. */
 PD_API double pd_contact_time_auto(double size);
+
+/* The duration PD_CONTACT_TIME_AUTO stands for, for part: Hertz's
+ * (m^2 / R)^(1/5) with the mass from the part's volume and the corner
+ * radius in proportion to its size, 5e-4 s (V / 1 cm^3)^(2/5) (1.73 cm /
+ * L)^(1/5); pd_contact_time_auto(L) for a cube, in proportion to L for
+ * geometrically similar parts. */
+PD_API double pd_contact_time_auto_part(const pd_part *part);
 
 PD_API void pd_scene_default(pd_scene *scene);
 

@@ -66,7 +66,7 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
     }
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
-                          ? pd_contact_time_auto(part->size)
+                          ? pd_contact_time_auto_part(part)
                           : scene->contact_time;
     if (st == PD_OK && !m->engine && m->contact_time > 0.0) {
         m->compliant_on = 1;
