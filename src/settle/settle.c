@@ -71,6 +71,7 @@ pd_status pd_settle_build(const pd_part *part, const pd_body *body, const pd_sta
     st->v_rest = 2.0 * sqrt(2.0 * gravity * st->rest_fall);
     st->margin = st->rest_fall;
     st->still = 0.0;
+    st->patch = 0.0;
     return PD_OK;
 }
 

@@ -38,6 +38,10 @@ typedef struct pd_settle {
                                    can tell (pd_settle_outcome); 0: no such
                                    test */
     double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
+    double patch;               /* m: the radius of the contact patch under the
+                                   part's weight, whose friction resists spin
+                                   about the floor's normal (docs/contact.md,
+                                   "Drilling friction"); 0: a point contact */
 } pd_settle;
 
 /* Builds everything the test needs for part (whose rigid body is body) and

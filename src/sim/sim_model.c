@@ -75,6 +75,13 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         if (st != PD_OK)
             st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
                          "time %g s could not be set up", scene->restitution, m->contact_time);
+        /* A contact carrying the part's weight at the part's mass sinks
+         * g / omega^2 by the compliant law; a corner of radius R pressed
+         * that deep touches over a patch of radius sqrt(R g) / omega
+         * (Hertz's geometry, a^2 = R d). */
+        else
+            m->settle.patch = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity) /
+                              m->compliant.law.omega;
     }
     if (st != PD_OK) {
         pd_sim_model_free(m);
