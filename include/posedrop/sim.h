@@ -136,6 +136,12 @@ PD_API double pd_contact_time_auto(double size);
  * geometrically similar parts. */
 PD_API double pd_contact_time_auto_part(const pd_part *part);
 
+/* The length whose pd_contact_time_auto is the part's own,
+ * pd_contact_time_auto_part(part) / pd_contact_time_auto(1): what
+ * pd_scene_draw, pd_scene_quantile and pd_sim_sensitivity take as
+ * part_size (the part's size for a cube). */
+PD_API double pd_contact_time_auto_size(const pd_part *part);
+
 PD_API void pd_scene_default(pd_scene *scene);
 
 /* Sets one setting by name, as in a scene file or on a command line:
@@ -166,7 +172,8 @@ PD_API int pd_scene_ranged(const pd_scene *scene);
 
 /* The values drop `drop` of a run seeded `seed` uses, one per parameter
  * (values[PD_NPARAMS], stored units; contact_time resolved for a part of
- * size part_size: never PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
+ * auto size part_size, pd_contact_time_auto_size: never
+ * PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
  * the scene with every range replaced by that drop's value (fixed). Fixed
  * parameters keep their field's value. The draw of parameter i depends on
  * (seed, drop, i) only. drawn may be NULL; scene must pass pd_scene_check. */
@@ -176,7 +183,7 @@ PD_API void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed
 /* Where value v of parameter param falls in its distribution: its
  * cumulative probability in [0, 1] (0.5 for a fixed or zero-width one).
  * For a contact_time range in multiples of auto, v is in s and part_size
- * the part's size. */
+ * the part's pd_contact_time_auto_size. */
 PD_API double pd_scene_quantile(const pd_scene *scene, pd_scene_param param, double part_size,
                                 double v);
 

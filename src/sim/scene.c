@@ -52,6 +52,11 @@ double pd_contact_time_auto_part(const pd_part *part)
            pow(CONTACT_SIZE_REF / part->size, 0.2);
 }
 
+double pd_contact_time_auto_size(const pd_part *part)
+{
+    return pd_contact_time_auto_part(part) / pd_contact_time_auto(1.0);
+}
+
 typedef struct {
     const char *key;
     size_t field;  /* offsetof the double in pd_scene */

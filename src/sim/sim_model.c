@@ -66,15 +66,17 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->settle.margin = PD_REST_TURN_REL * m->body->size;
         m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
     }
-    m->part_size = part->size;
+    /* Auto, fixed or as a range's multiple, from one length, so that a
+     * zero-width range gives the fixed run's bytes. */
+    m->part_size = pd_contact_time_auto_size(part);
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
-                          ? pd_contact_time_auto_part(part)
+                          ? pd_contact_time_auto(m->part_size)
                           : scene->contact_time;
     const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
     m->material_ranged = scene->range[PD_PARAM_MU].kind != PD_DIST_FIXED ||
                          e->kind != PD_DIST_FIXED || ct->kind != PD_DIST_FIXED;
     double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
-                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(part->size)
+                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(m->part_size)
                                              : ct->hi;
     /* A drawn duration obeys the value's range; auto itself is the part's
      * and has none. */
