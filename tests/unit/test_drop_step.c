@@ -3,6 +3,7 @@
  * records whatever the thread count, and the drops settle (shallow ridges,
  * needles and flat pyramids on the impulse engine too). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -164,6 +165,20 @@ static void small_parts_ode(void)
     }
 }
 
+/* Checks that none of r's drops failed and at most max_unsettled ended at a
+ * limit, saying which part (what) when any did not settle. */
+static void check_ends(const pd_sim_result *r, long max_unsettled, const char *what)
+{
+    long failed = 0;
+    for (long i = 0; i < r->n; i++)
+        failed += r->trials[i].end == PD_END_FAILED;
+    if (r->unsettled)
+        printf("     %s: %ld of %ld drops unsettled, %ld failed\n", what, r->unsettled, r->n,
+               failed);
+    CHECK_INT(failed, 0);
+    CHECK(r->unsettled <= max_unsettled);
+}
+
 /* A part whose two stable facets meet at a shallow ridge of `deg` degrees (a
  * 2 x 1 x 1 cm box with a roof for a bottom, mesh_roof_box): the energy
  * barrier between the two poses is c (1 - cos(deg / 2)) for the centre of
@@ -190,14 +205,9 @@ static void ridge_settles(pd_engine_kind engine, double deg, long drops)
     o.keep_trials = 1;
     pd_sim_result *r = run_drops(ok && nroof == 2, part, poses, &o);
     if (r) {
-        long failed = 0;
-        for (long i = 0; i < r->n; i++)
-            failed += r->trials[i].end == PD_END_FAILED;
-        if (r->unsettled)
-            printf("     engine %d, ridge %g deg: %ld of %ld drops unsettled, %ld failed\n",
-                   (int)engine, deg, r->unsettled, r->n, failed);
-        CHECK_INT(failed, 0);
-        CHECK(r->unsettled <= drops / 200);
+        char what[64];
+        snprintf(what, sizeof what, "engine %d, ridge %g deg", (int)engine, deg);
+        check_ends(r, drops / 200, what);
         long a = r->count[roof[0]], b = r->count[roof[1]];
         /* |a - b| against 3.29 sigma of a fair split of a + b. */
         CHECK(fabs((double)(a - b)) <= 3.29 * sqrt((double)(a + b)) + 1.0);
@@ -222,14 +232,9 @@ static void needles_settle(double length, double aspect, long drops)
     o.keep_trials = 1;
     pd_sim_result *r = run_drops(ok, part, poses, &o);
     if (r) {
-        long failed = 0;
-        for (long i = 0; i < r->n; i++)
-            failed += r->trials[i].end == PD_END_FAILED;
-        if (r->unsettled)
-            printf("     needle %g m, aspect %g: %ld of %ld drops unsettled, %ld failed\n", length,
-                   aspect, r->unsettled, r->n, failed);
-        CHECK_INT(failed, 0);
-        CHECK(r->unsettled <= drops / 200);
+        char what[64];
+        snprintf(what, sizeof what, "needle %g m, aspect %g", length, aspect);
+        check_ends(r, drops / 200, what);
     }
     release(r, poses, part);
 }
@@ -261,14 +266,9 @@ static void pyramids_settle(long drops)
             o.keep_trials = 1;
             pd_sim_result *r = run_drops(ok, part, poses, &o);
             if (r) {
-                long failed = 0;
-                for (long k = 0; k < r->n; k++)
-                    failed += r->trials[k].end == PD_END_FAILED;
-                if (r->unsettled)
-                    printf("     pyramid %d sides, h/r %g: %ld of %ld drops unsettled, %ld failed\n",
-                           sides[i], ratios[j], r->unsettled, r->n, failed);
-                CHECK_INT(failed, 0);
-                CHECK(r->unsettled <= (3 * drops + 99) / 100);
+                char what[64];
+                snprintf(what, sizeof what, "pyramid %d sides, h/r %g", sides[i], ratios[j]);
+                check_ends(r, (3 * drops + 99) / 100, what);
                 unsettled += r->unsettled;
                 total += r->n;
             }
