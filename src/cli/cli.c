@@ -135,7 +135,7 @@ static const cli_option options[] = {
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
-     "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
+     "5e-4 s for a 1 cm cube, as (volume^2 / size)^(1/5);\n"
      "0: rigid, the paper's model"},
     {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
      "angular speed at release, rad/s, about an axis drawn\n"

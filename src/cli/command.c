@@ -536,7 +536,8 @@ int cli_run(cli_args *a)
      * MPI ranks); --sensitivity needs them. */
     if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
         (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
-        st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
+        st = pd_sim_sensitivity(sim, &a->scene, pd_contact_time_auto_size(part), class_of,
+                                nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
                     engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};

@@ -12,6 +12,7 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 #include "check.h"
+#include "drops_scale.h"
 #include "contact/compliant.h"
 #include "drop_fixture.h"
 #include "posedrop/posedrop.h"
@@ -20,18 +21,9 @@
 
 /* make check runs the statistical tests on a tenth (random impacts) or a
  * quarter (convergence) of make check-full's trials, and the sanitizer build
- * on a quarter of that again: every check runs, and the statistical tests
- * keep their level at any count, with less power to see a small effect. */
-#if defined(__SANITIZE_ADDRESS__)
-#define DROPS_SCALE 4
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define DROPS_SCALE 4
-#endif
-#endif
-#ifndef DROPS_SCALE
-#define DROPS_SCALE 1
-#endif
+ * on a quarter of that again (drops_scale.h): every check runs, and the
+ * statistical tests keep their level at any count, with less power to see a
+ * small effect. */
 
 /* --- a model of any part, at any tolerance scale ---------------------------- */
 
