@@ -27,7 +27,9 @@ constants of 6-20 ms, damping ratios of 0.23-0.37 for the same e) left every
 drop rocking or spinning in a limit cycle, or unstable, over 20 s
 (2026-11-27). Rest: linear speed and
 the fastest point's speed from turning below 1 mm/s over 0.1 s (checked
-every 10 steps), or 20 s. Only mj_step's own CPU time is counted (the
+every 10 steps; --rest-speed, --rest-time), or 20 s. The ratio scales with
+how long MuJoCo runs, so the simulated seconds per drop of both are printed
+too. Only mj_step's own CPU time is counted (the
 Python checks between calls are not), each drop's least over --passes runs.
 Both sides are timed in CPU seconds, which the machine's other work disturbs
 less than wall-clock time.
@@ -52,8 +54,8 @@ E_TARGET = 0.3
 G = 9.81
 DT = 0.002
 TIMECONST = 2 * DT  # MuJoCo's stiffest stable contact at this step
-REST_SPEED = 1e-3   # m/s
-REST_TIME = 0.1     # s
+REST_SPEED = 1e-3   # m/s (--rest-speed)
+REST_TIME = 0.1     # s (--rest-time)
 CHECK_EVERY = 10    # steps
 TIME_LIMIT = 20.0   # s
 
@@ -195,14 +197,25 @@ def uniform_quats(n, seed):
     return out
 
 
-def mj_drops(mujoco, name, dampratio, quats, passes):
+def posedrop_sim_time(exe, off, n, seed, tmp):
+    """Mean simulated seconds per drop (the trials' time column), untimed."""
+    trials = os.path.join(tmp, "trials.csv")
+    subprocess.run([exe, "-n", str(n), "-j", "1", "--seed", str(seed), "--trials", trials, off],
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+    with open(trials) as f:
+        rows = [r.split(",") for r in f.read().strip().splitlines()]
+    col = rows[0].index("time")
+    return sum(float(r[col]) for r in rows[1:]) / (len(rows) - 1)
+
+
+def mj_drops(mujoco, name, dampratio, quats, passes, rest_speed, rest_time):
     """Least mj_step seconds per drop over passes (all drops; the settled
     ones alone), mean steps, unsettled."""
     v, f = part_mesh(name)
     model = mujoco.MjModel.from_xml_string(mjcf(name, v, f, dampratio))
     data = mujoco.MjData(model)
     rmax = max(math.sqrt(x * x + y * y + z * z) for x, y, z in v)
-    need = int(round(REST_TIME / (CHECK_EVERY * DT)))
+    need = max(1, int(round(rest_time / (CHECK_EVERY * DT))))
     best = [math.inf] * len(quats)
     steps = unset = 0
     settled = [True] * len(quats)
@@ -218,7 +231,7 @@ def mj_drops(mujoco, name, dampratio, quats, passes):
                 qv = data.qvel
                 lin = math.sqrt(qv[0] ** 2 + qv[1] ** 2 + qv[2] ** 2)
                 ang = math.sqrt(qv[3] ** 2 + qv[4] ** 2 + qv[5] ** 2) * rmax
-                quiet = quiet + 1 if max(lin, ang) < REST_SPEED else 0
+                quiet = quiet + 1 if max(lin, ang) < rest_speed else 0
                 if quiet >= need:
                     break
                 if nstep * DT >= TIME_LIMIT:
@@ -241,6 +254,10 @@ def main():
     ap.add_argument("--passes", type=int, default=3, help="timed passes, least taken (3)")
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--parts", default=",".join(PARTS))
+    ap.add_argument("--rest-speed", type=float, default=REST_SPEED,
+                    help="MuJoCo's rest: speeds below this, m/s (%g)" % REST_SPEED)
+    ap.add_argument("--rest-time", type=float, default=REST_TIME,
+                    help="MuJoCo's rest: for this long, s (%g)" % REST_TIME)
     a = ap.parse_args()
     try:
         import mujoco
@@ -273,16 +290,23 @@ def main():
     print("%-5s %12s %6s %12s %12s %9s %8s %8s %8s" % ("part", "posedrop us", "unset", "mujoco us",
                                                      "mj settled", "mj steps", "mj unset", "ratio",
                                                      "settled"))
+    sim_times = []
     with tempfile.TemporaryDirectory() as tmp:
         for name in parts:
             off = os.path.join(tmp, name + ".off")
             write_off(off, *part_mesh(name))
             pd, pd_unset = posedrop_per_drop(a.posedrop, off, a.n, a.passes, a.seed)
-            mj, mj_ok, mj_steps, mj_unset = mj_drops(mujoco, name, dampratio, quats, a.passes)
+            pd_sim = posedrop_sim_time(a.posedrop, off, a.n, a.seed, tmp)
+            mj, mj_ok, mj_steps, mj_unset = mj_drops(mujoco, name, dampratio, quats, a.passes,
+                                                     a.rest_speed, a.rest_time)
+            sim_times.append((name, pd_sim, mj_steps * DT))
             ratio = "%7.1fx %7.1fx" % (mj / pd, mj_ok / pd) if pd > 0 else "      -       -"
             print("%-5s %12.1f %6d %12.1f %12.1f %9.0f %8d %s" % (name, 1e6 * pd, pd_unset, 1e6 * mj,
                                                                 1e6 * mj_ok, mj_steps, mj_unset, ratio))
             sys.stdout.flush()
+    print("simulated seconds per drop, each to its own end (posedrop: decided; MuJoCo: rest as above):")
+    for name, pd_sim, mj_sim in sim_times:
+        print("%-5s posedrop %.3f s, MuJoCo %.3f s" % (name, pd_sim, mj_sim))
     load = os.getloadavg()
     print("load average at the end %.1f %.1f %.1f" % load)
     return 0
