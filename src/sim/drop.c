@@ -142,11 +142,13 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
         }
         s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
         ww = v3_add(ww, m3_vec(CONST_M3(J), v3_cross(c, res.p)));
-        if (m->settle.patch > 0.0 && J[2][2] > 0.0) {
-            /* Drilling friction over the contact's patch (docs/contact.md):
-             * an angular impulse about the normal of at most (2/3) mu a
-             * times the normal impulse, against the spin and never
-             * reversing it, so that it only takes energy. */
+        if (e == 0.0 && m->settle.patch > 0.0 && J[2][2] > 0.0) {
+            /* Resting contact: drilling friction over its patch
+             * (docs/contact.md), an angular impulse about the normal of at
+             * most (2/3) mu a times the normal impulse, against the spin
+             * and never reversing it, so that it only takes energy. An
+             * impact keeps the rigid law (Poisson's), the compliant law's
+             * limit. */
             double cap = 2.0 / 3.0 * sc->mu * m->settle.patch * res.p.z;
             double dl = fmax(-cap, fmin(cap, -ww.z / J[2][2]));
             ww = v3_add(ww, v3_scale(v3(J[0][2], J[1][2], J[2][2]), dl));
