@@ -10,6 +10,7 @@
 #ifndef POSEDROP_SIM_H
 #define POSEDROP_SIM_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include "posedrop/diag.h"
 #include "posedrop/export.h"
@@ -47,6 +48,41 @@ typedef enum pd_initial {
                                chain (see pd_sim_run) */
 } pd_initial;
 
+/* The scene parameters that take a range as well as a value, in this order
+ * (the columns of --trials and the rows of a sensitivity). gravity, the
+ * restitution law and the initial mode take one value each. */
+typedef enum pd_scene_param {
+    PD_PARAM_HEIGHT = 0,
+    PD_PARAM_BELT_SPEED,
+    PD_PARAM_MU,
+    PD_PARAM_RESTITUTION,
+    PD_PARAM_VIBRATION,
+    PD_PARAM_CONTACT_TIME,
+    PD_PARAM_TUMBLE,
+    PD_NPARAMS
+} pd_scene_param;
+
+/* How a parameter is given. */
+typedef enum pd_dist_kind {
+    PD_DIST_FIXED = 0,  /* the scene field's own value, for every drop */
+    PD_DIST_UNIFORM,    /* each drop draws uniformly from [lo, hi] */
+    PD_DIST_LOG_UNIFORM /* each drop draws log uniformly from [lo, hi], 0 < lo:
+                           for a quantity known to within a factor (the
+                           contact time) */
+} pd_dist_kind;
+
+/* A parameter's distribution. lo and hi are in the field's stored unit (m,
+ * m/s, rad for vibration and rad/s for tumble, s for contact_time) and obey
+ * the field's range; lo <= hi, and lo == hi draws lo for every drop, the same
+ * run, byte for byte, as the fixed value lo. */
+typedef struct pd_dist {
+    pd_dist_kind kind;
+    double lo, hi;
+    int auto_multiple; /* contact_time only: lo and hi are multiples of the
+                          PD_CONTACT_TIME_AUTO duration of the part, 1e-3 to
+                          1e3 (written 0.3x:3x) */
+} pd_dist;
+
 /* What a drop is made of. Filled by pd_scene_default, then edited. */
 typedef struct pd_scene {
     double height;          /* m, lowest point of the part above the floor at release; 0.12 */
@@ -67,6 +103,17 @@ typedef struct pd_scene {
                                throughout (the paper's model).
                                PD_CONTACT_TIME_AUTO (the default): a plastic part
                                on a rubber belt, pd_contact_time_auto() */
+    double tumble;          /* rad/s: the part's angular speed at release, about
+                               an axis uniform over the sphere, drawn for each
+                               drop (a part tipping over a belt's edge, a
+                               tossed die); 0 */
+    pd_dist range[PD_NPARAMS]; /* per parameter: PD_DIST_FIXED (pd_scene_default)
+                               uses the field above; a range replaces it, each
+                               drop drawing its own value from (seed, drop,
+                               parameter), a stream apart from the drop's
+                               orientation, so results do not depend on threads,
+                               shards or engine, and a scene without ranges
+                               runs exactly as it would without this field */
 } pd_scene;
 
 /* contact_time's default: the duration a Hertz contact of a plastic part on a
@@ -94,10 +141,44 @@ PD_API void pd_scene_default(pd_scene *scene);
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed, mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
- * (uniform|bootstrap|stationary), gravity, contact_time (s, or auto). PD_ERR_USAGE for
- * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
- * of range; the scene is unchanged on failure. */
+ * (uniform|bootstrap|stationary), gravity, contact_time (s, or auto),
+ * tumble (rad/s). A plain value sets the field and makes it fixed. Every
+ * parameter of pd_scene_param also takes a range "LO:HI", optionally
+ * followed by "uniform" or "log" (log uniform; the default for contact_time,
+ * which spans decades, uniform for the others); contact_time's range may be
+ * multiples of auto, "0.3x:3x". PD_ERR_USAGE for an unknown key, PD_ERR_PARSE
+ * for a bad value, PD_ERR_RANGE for a value out of range; the scene is
+ * unchanged on failure. Its ranges are those of pd_scene_check, the one
+ * validator of a scene. */
 PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
+
+/* The name of a parameter ("height", ..., "tumble"), NULL out of range. */
+PD_API const char *pd_scene_param_name(pd_scene_param param);
+
+/* A parameter's setting as text pd_scene_set reads, in its text's unit
+ * (degrees for vibration), numbers with %.6g: "0.3", "0.2:0.5",
+ * "0.3x:3x log", "auto". Returns buf. */
+PD_API const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *buf,
+                                   size_t size);
+
+/* Whether any parameter of scene is a range. */
+PD_API int pd_scene_ranged(const pd_scene *scene);
+
+/* The values drop `drop` of a run seeded `seed` uses, one per parameter
+ * (values[PD_NPARAMS], stored units; contact_time resolved for a part of
+ * size part_size: never PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
+ * the scene with every range replaced by that drop's value (fixed). Fixed
+ * parameters keep their field's value. The draw of parameter i depends on
+ * (seed, drop, i) only. drawn may be NULL; scene must pass pd_scene_check. */
+PD_API void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed, long drop,
+                          double values[PD_NPARAMS], pd_scene *drawn);
+
+/* Where value v of parameter param falls in its distribution: its
+ * cumulative probability in [0, 1] (0.5 for a fixed or zero-width one).
+ * For a contact_time range in multiples of auto, v is in s and part_size
+ * the part's size. */
+PD_API double pd_scene_quantile(const pd_scene *scene, pd_scene_param param, double part_size,
+                                double v);
 
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
  * what it holds; a key set twice is refused. Errors name the file and line. */
@@ -106,8 +187,12 @@ PD_API pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
 /* Whether every field of a scene is one pd_scene_set would accept: height 0
  * to 1000 m, belt_speed -1000 to 1000 m/s, mu 0 to 10, restitution 0 to 1,
  * vibration 0 to pi rad (180 degrees), gravity 0.001 to 1000 m/s^2,
- * contact_time 0 to 1 s or PD_CONTACT_TIME_AUTO, and law and initial one of
- * their enum values.
+ * contact_time 0 to 1 s or PD_CONTACT_TIME_AUTO, tumble 0 to 10^4 rad/s, no
+ * value non-zero below the smallest normal double (2.2e-308), law and
+ * initial one of their enum values, and every range valid (its kind, both
+ * ends in the field's range, lo <= hi, lo > 0 for log uniform, multiples of
+ * auto for contact_time only). The one validator of a scene: pd_scene_set,
+ * pd_sim_run and the command all use it.
  * PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_RANGE for a value out of
  * range; the message names the field. pd_sim_run calls it first. */
 PD_API pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag);
@@ -187,6 +272,7 @@ typedef struct pd_trial {
     int collisions;     /* impulses applied (impulse engine; 0 for stepping engines) */
     double time;        /* simulated s */
     pd_drop_end end;
+    double param[PD_NPARAMS]; /* the scene values this drop used (pd_scene_draw) */
 } pd_trial;
 
 typedef struct pd_sim_result {
@@ -242,6 +328,10 @@ PD_API long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
  * (same numbering as its poses). options and scene may be NULL (defaults).
+ * A scene with ranges has each drop draw its own values (pd_scene_draw, kept
+ * in its trial record): p is then over the ranges; posedrop/sensitivity.h
+ * says which parameter moves which pose. A contact_time range whose high end
+ * is above 1 s for this part is PD_ERR_RANGE.
  *
  * PD_INITIAL_STATIONARY estimates the belt's pose-to-pose chain: with k
  * poses, m = ndrops / (k + 1) drops start resting on each pose (on its facet,

@@ -246,9 +246,14 @@ static int out_commit(out_file *o)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
+                         const pd_scene *scene)
 {
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
+    for (int k = 0; k < PD_NPARAMS; k++)
+        if (scene->range[k].kind != PD_DIST_FIXED)
+            fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
+    fputc('\n', f);
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
@@ -257,6 +262,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
                 t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
+        for (int k = 0; k < PD_NPARAMS; k++)
+            if (scene->range[k].kind != PD_DIST_FIXED)
+                fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
         fputc('\n', f);
     }
 }
@@ -279,6 +287,21 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
     }
 }
 
+/* --sensitivity: one row per pose (class with --group) and ranged
+ * parameter, numbered as in the output. */
+static void write_sensitivity(FILE *f, const pd_sensitivity *s)
+{
+    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
+               "index,index_lo,index_hi\n");
+    for (int i = 0; i < s->nposes * s->nparams; i++) {
+        const pd_sensitivity_row *r = &s->rows[i];
+        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
+                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
+                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
+                r->index_lo, r->index_hi);
+    }
+}
+
 /* --- the options ------------------------------------------------------------
  * One table drives the parsing (getopt's arrays are built from it), the
  * checking of every value (one number reader and one message form, shared
@@ -288,7 +311,8 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
-       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD };
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
+       OPT_SENSITIVITY };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -391,6 +415,9 @@ static const cli_option options[] = {
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
      "5e-4 s for a 1 cm cube, as (volume^2 / size)^(1/5);\n"
      "0: rigid, the paper's model"},
+    {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
+     "angular speed at release, rad/s, about an axis drawn\n"
+     "uniformly for each drop, 0..10000 (0)"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -407,13 +434,30 @@ static const cli_option options[] = {
     {OPT_SCENE, "scene", ARG_INPUT, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
-     "contact_time, each at most once; options given after it\n"
-     "override it"},
+     "contact_time, tumble, each at most once; options given\n"
+     "after it override it.\n"
+     "Ranges: -h, -v, --mu, --restitution, --vibration,\n"
+     "--contact-time and --tumble (and their keys) take LO:HI\n"
+     "as well as a value: each drop draws its own value,\n"
+     "uniformly, or log uniformly with LO:HI:log (the default\n"
+     "for --contact-time, which also takes multiples of auto,\n"
+     "0.3x:3x); the estimates are then over the ranges\n"
+     "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
      "(pose 0: unsettled); with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
-     "within it, numbered as without --group"},
+     "within it, numbered as without --group; then one column\n"
+     "per ranged scene parameter, named by its key, the value\n"
+     "the drop drew (vibration in degrees)"},
+    {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
+     "with ranges, what each ranged parameter moves, as CSV:\n"
+     "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
+     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi: the\n"
+     "pose's probability in the lower and upper third of the\n"
+     "range (95% Wilson) and the first-order index, the share\n"
+     "of the pose's variance the parameter explains (95%\n"
+     "bootstrap interval; docs/uncertainty.md)"},
     {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -648,6 +692,10 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.keep_trials = 1;
         break;
     case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_SENSITIVITY:
+        a->sensitivity = arg;
+        a->sim.keep_trials = 1;
+        break;
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
@@ -798,6 +846,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (stationary && a->sim.ci_halfwidth > 0)
         return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
                           "number of drops over the poses in advance: give -n");
+    if (a->sensitivity && (!a->dynamic || !pd_scene_ranged(&a->scene) || a->sim.nshards))
+        return fail_usage("%s", "--sensitivity needs drops (-n or --ci) of a scene with a range "
+                          "(such as --mu 0.2:0.5), and does not go with --shard");
+    /* The report says what each ranged parameter moves. */
+    if (a->pictures[VIZ_REPORT] && a->dynamic && pd_scene_ranged(&a->scene))
+        a->sim.keep_trials = 1;
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
@@ -906,8 +960,10 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
                         "variation) from the distribution it started from%s\n", prog, a->path,
                 sim->bootstrap_rounds, sim->stationarity,
                 sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
-    if (sim->transitions && sim->nshards == 0)
+    if (sim->transitions && sim->nshards == 0) {
         print_stationary_summary(a, sim);
+        fragile_warn(a->path, sim);
+    }
     if (a->verbose && sim->n)
         fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
                 (double)sim->collisions / (double)sim->n);
@@ -942,9 +998,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
-                 (!a->transitions || out_open(&transitions_out, a->transitions));
+                 (!a->transitions || out_open(&transitions_out, a->transitions)) &&
+                 (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
         opened = !a->pictures[k] || out_open(&pic_out[k], a->pictures[k]);
     /* A measured distribution is read before the work too. */
@@ -957,6 +1014,7 @@ int cli_run(cli_args *a)
     if (!opened) {
         out_abort(&trials_out);
         out_abort(&transitions_out);
+        out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
             out_abort(&pic_out[k]);
         return EXIT_USAGE;
@@ -966,6 +1024,7 @@ int cli_run(cli_args *a)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
+    pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
     if (st != PD_OK) {
@@ -997,9 +1056,14 @@ int cli_run(cli_args *a)
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     }
+    /* The report shows it when the drops' records were kept (not across
+     * MPI ranks); --sensitivity needs them. */
+    if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
+        (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
+        st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured};
+                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
     if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -1011,11 +1075,14 @@ int cli_run(cli_args *a)
     /* The side files before stdout: if one cannot be written in full (a
      * full disk, /dev/full), the run fails with nothing on stdout. */
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of);
+        write_trials(trials_out.f, sim, class_of, &a->scene);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
+    if (sens_out.f)
+        write_sensitivity(sens_out.f, sens);
     if ((trials_out.f && !out_commit(&trials_out)) ||
-        (transitions_out.f && !out_commit(&transitions_out))) {
+        (transitions_out.f && !out_commit(&transitions_out)) ||
+        (sens_out.f && !out_commit(&sens_out))) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -1057,6 +1124,8 @@ int cli_run(cli_args *a)
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);
+    out_abort(&sens_out);
+    pd_sensitivity_free(sens);
     for (int k = 0; k < VIZ_KINDS; k++)
         out_abort(&pic_out[k]);
     viz_measured_free(measured);

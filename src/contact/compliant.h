@@ -70,6 +70,10 @@ typedef struct pd_compliant_work pd_compliant_work;
 pd_status pd_compliant_init(double e, double T, const pd_body *b, double tol_scale,
                             pd_compliant *c);
 
+/* The model for a law already made (pd_compliant_law_init or a table's). */
+void pd_compliant_from_law(const pd_compliant_law *law, const pd_body *b, double tol_scale,
+                           pd_compliant *c);
+
 pd_compliant_work *pd_compliant_work_alloc(const pd_body *b);
 void pd_compliant_work_free(pd_compliant_work *w);
 

@@ -282,7 +282,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
             if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                      m->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+                                      w->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
                 break;
             if (imp.kind == PD_IMPACT_NONE) {
                 t = o->time_limit;
@@ -307,7 +307,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             }
             rest_from = -HUGE_VAL;
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
-            if (m->compliant_on) {
+            if (w->compliant_on) {
                 /* More than one vertex touching or arriving within a contact
                  * duration, one of them striking: a compliant impact, which
                  * the arriving ones join. Else the exact rigid law at the
@@ -319,7 +319,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
                 if (nc >= 2 && approach > m->settle.v_rest) {
                     pd_compliant_result cr;
-                    pd_status cs = pd_compliant_run(&m->compliant, w->compliant, &m->settle, sc,
+                    pd_status cs = pd_compliant_run(&w->compliant, w->compliant_work, &m->settle, sc,
                                                     &s, o->time_limit - t, &cr);
                     if (cs != PD_OK)
                         break;
@@ -351,7 +351,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
-                resolved = out->collisions - before < PD_MAX_ROUNDS && m->contact_time == 0.0;
+                resolved = out->collisions - before < PD_MAX_ROUNDS && w->contact_time == 0.0;
                 f_at = -1.0;
                 continue;
             }

@@ -19,6 +19,7 @@
 #include "base/fail.h"
 #include "sim/drop.h"
 #include "sim/markov.h"
+#include "sim/scene.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
 
@@ -94,7 +95,7 @@ typedef struct batch {
     const pd_sim_options *opt;
     const double *init_cdf;
     const double *pose_cdfs; /* not NULL: drop i starts resting on pose
-                               stationary_pose(i, ...) when it is one, whose
+                               pd_stationary_start(i, ...) when it is one, whose
                                point-mass cdf is that row of pose_cdfs (instead
                                of init_cdf) */
     long pose_drops;
@@ -127,7 +128,7 @@ static int cancelled(const pd_sim_options *o)
  * pose 0, ..., pose k-1; the rest (fewer than k+1) are uniform. Interleaved
  * from the first drop, so a run stopped at any point has drops of every
  * phase in proportion. */
-static int stationary_pose(long i, long pose_drops, int k)
+int pd_stationary_start(long i, long pose_drops, int k)
 {
     if (i >= (long)(k + 1) * pose_drops)
         return -1;
@@ -149,11 +150,19 @@ static void *worker(void *arg)
             break;
         long drop = run_index(b->r, i);
         const double *cdf = b->init_cdf;
-        int pose = b->pose_cdfs ? stationary_pose(drop, b->pose_drops, b->nposes) : -1;
+        int pose = b->pose_cdfs ? pd_stationary_start(drop, b->pose_drops, b->nposes) : -1;
         if (pose >= 0)
             cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)pose;
-        pd_drop_run(b->model, w, b->scene, b->opt, drop, cdf, &b->out[i - b->first], &gain,
-                    &fallbacks);
+        /* The drop's own scene values: its ranges drawn from the parameters'
+         * stream, which leaves the drop's orientation stream as it is. */
+        pd_trial *out = &b->out[i - b->first];
+        pd_scene drawn;
+        pd_scene_draw(b->scene, b->model->part_size, b->opt->seed, drop, out->param, &drawn);
+        if (pd_drop_material(b->model, w, &drawn) != PD_OK) {
+            out->end = PD_END_FAILED;
+        } else {
+            pd_drop_run(b->model, w, &drawn, b->opt, drop, cdf, out, &gain, &fallbacks);
+        }
         long done = atomic_fetch_add(&b->done, 1) + 1;
         if (b->opt->progress && pthread_equal(pthread_self(), b->caller))
             b->opt->progress(b->opt->progress_user, b->r->n + done, b->planned);
@@ -209,7 +218,7 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->count[t[i].pose]++;
         if (!r->transitions)
             continue;
-        int from = stationary_pose(run_index(r, r->n + i), r->pose_drops, r->nposes);
+        int from = pd_stationary_start(run_index(r, r->n + i), r->pose_drops, r->nposes);
         if (from < 0)
             r->first_count[t[i].pose]++;
         else
@@ -359,7 +368,7 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
 
 /* --initial stationary: first_drops drops from uniform orientations and
  * pose_drops resting on each pose, interleaved from the first drop
- * (stationary_pose), so that a run stopped early has drops of every phase and
+ * (pd_stationary_start), so that a run stopped early has drops of every phase and
  * can still give pi. */
 static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
                                   const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)

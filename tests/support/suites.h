@@ -27,6 +27,8 @@
     PD_SUITE(contact_pivot) \
     PD_SUITE(compliant) \
     PD_SUITE(sim)    \
+    PD_SUITE(ranges) \
+    PD_SUITE(sensitivity) \
     PD_SUITE(markov) \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \

@@ -921,7 +921,8 @@ static void test_wmax(void)
     const double aspect[] = {1.0, 3.0, 30.0, 300.0, 1000.0};
     double worst_over = 0.0, needle_ratio = 0.0;
     for (int k = 0; k < 5; k++) {
-        pd_body *b = body_or_free(part_of_mesh(mesh_box(1.0, 1.3 / aspect[k], 1.0 / aspect[k])));
+        pd_part *part = part_of_mesh(mesh_box(1.0, 1.3 / aspect[k], 1.0 / aspect[k]));
+        pd_body *b = body_or_free(part);
         if (!b)
             continue;
         for (int trial = 0; trial < 40; trial++) {
@@ -955,6 +956,7 @@ static void test_wmax(void)
             needle_ratio = f.wmax / wbig;
         }
         pd_body_free(b);
+        pd_part_free(part);
     }
     /* The motion's own |w| is computed to ~1e-12 (the flight's series). */
     CHECK(worst_over <= 1e-9);
