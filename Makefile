@@ -104,7 +104,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-full check-install test bench demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+.PHONY: all check check-full check-install test bench bench-mujoco demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
         check-browser figures mpi
 .DEFAULT_GOAL := all
 
@@ -244,6 +244,14 @@ bench: deps
 	@$(MAKE) --no-print-directory $(BENCH_BIN) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
 	$(BENCH_BIN) $(BENCH)
 
+# The cost of a drop against MuJoCo (scripts/bench-mujoco.py), which needs the
+# mujoco Python package: not a dependency, not part of make check. It uses
+# .venv/bin/python when the git-ignored .venv exists, else python3.
+MUJOCO_PY ?= $(if $(wildcard .venv/bin/python),.venv/bin/python,python3)
+bench-mujoco: deps
+	@$(MAKE) --no-print-directory $(CLI)
+	$(MUJOCO_PY) scripts/bench-mujoco.py --posedrop $(CLI) $(BENCH_MUJOCO)
+
 # make fuzz: libFuzzer targets built with clang (installed on first use) for
 # the OFF, STL and OBJ readers, scene files and the part build (mesh in, part
 # model and static estimate out), each run for FUZZ_SECONDS from the seeds in
@@ -317,6 +325,7 @@ help:
 	@echo "make check-full make check with the long statistical runs (CI runs both)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
+	@echo "make bench-mujoco  cost per drop against MuJoCo (pip install mujoco; see the script)"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
 	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"
