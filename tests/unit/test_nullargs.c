@@ -545,6 +545,19 @@ static void c_time_limit_auto(const fixture *f, int k, outcome *o)
     o->st = pd_time_limit_auto(f->part->size, P(0, &sc)) > 0 ? PD_OK : PD_ERR_INTERNAL;
 }
 
+/* A duration or length of the part, 0 for no part. */
+static void c_contact_time_auto_part(const fixture *f, int k, outcome *o)
+{
+    double t = pd_contact_time_auto_part(P(0, f->part));
+    o->st = k == 0 ? (t == 0.0 ? PD_OK : PD_ERR_INTERNAL) : t > 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_contact_time_auto_size(const fixture *f, int k, outcome *o)
+{
+    double l = pd_contact_time_auto_size(P(0, f->part));
+    o->st = k == 0 ? (l == 0.0 ? PD_OK : PD_ERR_INTERNAL) : l > 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
 /* --- the table ------------------------------------------------------------- */
 
 typedef struct {
@@ -611,6 +624,8 @@ static const entry table[] = {
     {"pd_scene_quantile", "?scene", c_scene_quantile},
     {"pd_drop_stage_name", "", c_drop_stage_name},
     {"pd_time_limit_auto", "?scene", c_time_limit_auto},
+    {"pd_contact_time_auto_part", "?part", c_contact_time_auto_part},
+    {"pd_contact_time_auto_size", "?part", c_contact_time_auto_size},
 };
 enum { NTABLE = sizeof table / sizeof table[0] };
 
