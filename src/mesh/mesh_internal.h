@@ -11,4 +11,13 @@
  * PD_ERR_RANGE or PD_ERR_NONFINITE. */
 pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag);
 
+/* Finds two triangles of a welded mesh whose relative interiors cross
+ * (exact signs of orientation: sharing a vertex or an edge, or touching
+ * without crossing, is not crossing; coplanar pairs are not examined).
+ * *ta < *tb are their indices and *at a point of the crossing (rounded), or
+ * *ta = *tb = -1 when there is none. PD_OK or PD_ERR_NOMEM. Near-linear in
+ * the triangles for a surface whose triangles are small against it (sort and
+ * sweep of their bounding boxes along x). */
+pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at);
+
 #endif

@@ -149,6 +149,25 @@ static pd_status check_solid(const pd_part *p, pd_status st, pd_diag *diag)
     return PD_OK;
 }
 
+/* A surface that crosses itself bounds no solid, though the overlap may
+ * leave the moments within the hull's (two cubes offset along a diagonal
+ * count their common part twice): refused, naming the two triangles (of the
+ * welded mesh) and a point of their crossing in the file's frame. */
+static pd_status check_no_crossing(const pd_part *p, pd_diag *diag)
+{
+    int ta, tb;
+    pd_vec3 at;
+    if (pd_mesh_self_crossing(p->mesh, &ta, &tb, &at) != PD_OK)
+        return PD_ERR_NOMEM;
+    if (ta < 0)
+        return PD_OK;
+    at = v3_add(at, p->origin);
+    return pd_fail(diag, PD_ERR_ORIENTATION,
+                   "the mesh does not bound a solid: its surface passes through itself "
+                   "(triangles %d and %d of the welded mesh, counted from 0, cross at "
+                   "(%.9g, %.9g, %.9g) m)", ta, tb, at.x, at.y, at.z);
+}
+
 /* The part's origin: the centre of the bounding box [lo, hi] rounded to a
  * multiple of u, the least power of two above the size L (L < u <= 2 L).
  * Positions relative to it are within 1.5 L per axis, so everything computed
@@ -244,6 +263,10 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 
     if (p->closed) {
         st = check_solid(p, pd_mass_compute(p->mesh, &p->mass, diag), diag);
+        if (st == PD_OK)
+            st = check_no_crossing(p, diag);
+        if (st == PD_ERR_NOMEM)
+            return st;
         if (st == PD_OK)
             p->mass_known = 1;
         else if (!opt->com_given)

@@ -11,6 +11,8 @@
 #include <string.h>
 #include <unistd.h>
 #include "check.h"
+#include "base/vec3.h"
+#include "mesh/mesh_internal.h"
 #include "posedrop/mesh.h"
 #include "shapes.h"
 #include "suites.h"
@@ -767,6 +769,189 @@ static void test_clone_size(void)
     CHECK_NEAR(pd_mesh_size(NULL), 0.0, 0.0, "definition: no vertices");
 }
 
+/* Exact reference for two triangles of small integer coordinates (every
+ * product below is an integer far under 2^53): their relative interiors
+ * cross when each has vertices strictly on both sides of the other's plane
+ * and the open chords the two cut from the planes' common line overlap.
+ * Positions along that line are fractions num / den, den > 0, compared by
+ * cross-multiplication. Written apart from the library's formulation (which
+ * compares the chords by two orientation signs). */
+typedef long long ll;
+static ll det3(const ll a[3], const ll b[3], const ll c[3], const ll d[3])
+{
+    ll u[3], v[3], w[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = b[k] - a[k];
+        v[k] = c[k] - a[k];
+        w[k] = d[k] - a[k];
+    }
+    return u[0] * (v[1] * w[2] - v[2] * w[1]) + u[1] * (v[2] * w[0] - v[0] * w[2]) +
+           u[2] * (v[0] * w[1] - v[1] * w[0]);
+}
+
+static void normal_of(ll t[3][3], ll n[3])
+{
+    ll u[3], v[3];
+    for (int k = 0; k < 3; k++) {
+        u[k] = t[1][k] - t[0][k];
+        v[k] = t[2][k] - t[0][k];
+    }
+    n[0] = u[1] * v[2] - u[2] * v[1];
+    n[1] = u[2] * v[0] - u[0] * v[2];
+    n[2] = u[0] * v[1] - u[1] * v[0];
+}
+
+static ll dotl(const ll a[3], const ll b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+
+/* The chord of t on the plane of o: its two ends along dir, lo <= hi. */
+static void chord(ll t[3][3], ll o[3][3], const ll dir[3], ll num[2], ll den[2])
+{
+    int n = 0;
+    for (int a = 0; a < 3 && n < 2; a++) {
+        int b = (a + 1) % 3;
+        ll da = det3(o[0], o[1], o[2], t[a]), db = det3(o[0], o[1], o[2], t[b]);
+        if (da == 0) {
+            num[n] = dotl(dir, t[a]);
+            den[n++] = 1;
+        } else if ((da > 0 && db < 0) || (da < 0 && db > 0)) {
+            ll e[3] = {t[b][0] - t[a][0], t[b][1] - t[a][1], t[b][2] - t[a][2]};
+            ll dd = da - db, sg = dd < 0 ? -1 : 1;
+            num[n] = sg * (dotl(dir, t[a]) * dd + da * dotl(dir, e));
+            den[n++] = sg * dd;
+        }
+    }
+    if (num[0] * den[1] > num[1] * den[0]) {
+        ll x = num[0], y = den[0];
+        num[0] = num[1];
+        den[0] = den[1];
+        num[1] = x;
+        den[1] = y;
+    }
+}
+
+static int straddles(ll t[3][3], ll o[3][3])
+{
+    int pos = 0, neg = 0;
+    for (int i = 0; i < 3; i++) {
+        ll d = det3(o[0], o[1], o[2], t[i]);
+        pos |= d > 0;
+        neg |= d < 0;
+    }
+    return pos && neg;
+}
+
+static int cross_ref(ll p[3][3], ll q[3][3])
+{
+    if (!straddles(p, q) || !straddles(q, p))
+        return 0;
+    ll np[3], nq[3], dir[3], pn[2], pd[2], qn[2], qd[2];
+    normal_of(p, np);
+    normal_of(q, nq);
+    dir[0] = np[1] * nq[2] - np[2] * nq[1];
+    dir[1] = np[2] * nq[0] - np[0] * nq[2];
+    dir[2] = np[0] * nq[1] - np[1] * nq[0];
+    chord(p, q, dir, pn, pd);
+    chord(q, p, dir, qn, qd);
+    /* max(lo) < min(hi): each chord starts before the other ends. */
+    return pn[0] * qd[1] < qn[1] * pd[0] && qn[0] * pd[1] < pn[1] * qd[0];
+}
+
+/* pd_mesh_self_crossing on two triangles against the reference, over random
+ * small integer triangles (degenerate contacts are frequent: vertices on
+ * the other's plane, on its edges, shared vertices and edges), and on a
+ * mesh of many such triangles against every pair's reference. */
+static void test_self_crossing(void)
+{
+    test_rng rng = {20261127};
+    int agree = 0, crossings = 0, trials = 20000;
+    for (int it = 0; it < trials; it++) {
+        int R = 1 + (int)(rng_uniform(&rng) * 3.0);
+        ll c[6][3];
+        for (int i = 0; i < 6; i++)
+            for (int k = 0; k < 3; k++)
+                c[i][k] = (ll)(rng_uniform(&rng) * (2 * R + 1)) - R;
+        int tri[2][3] = {{0, 1, 2}, {3, 4, 5}};
+        double u = rng_uniform(&rng);
+        if (u < 0.3)
+            tri[1][0] = 0; /* a shared vertex */
+        if (u < 0.05)
+            tri[1][1] = 1; /* and a shared edge */
+        ll p[3][3], q[3][3];
+        for (int i = 0; i < 3; i++)
+            for (int k = 0; k < 3; k++) {
+                p[i][k] = c[tri[0][i]][k];
+                q[i][k] = c[tri[1][i]][k];
+            }
+        pd_vec3 v[6];
+        for (int i = 0; i < 6; i++)
+            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
+        pd_mesh m = {6, v, 2, tri};
+        int ta, tb;
+        pd_vec3 at;
+        pd_status st = pd_mesh_self_crossing(&m, &ta, &tb, &at);
+        int want = cross_ref(p, q);
+        crossings += want;
+        agree += st == PD_OK && (ta >= 0) == want;
+        if ((ta >= 0) != want && trials - agree < 4)
+            printf("     triangles (%g %g %g)(%g %g %g)(%g %g %g) and (%g %g %g)(%g %g %g)(%g %g "
+                   "%g): reference %d\n", v[tri[0][0]].x, v[tri[0][0]].y, v[tri[0][0]].z,
+                   v[tri[0][1]].x, v[tri[0][1]].y, v[tri[0][1]].z, v[tri[0][2]].x,
+                   v[tri[0][2]].y, v[tri[0][2]].z, v[tri[1][0]].x, v[tri[1][0]].y,
+                   v[tri[1][0]].z, v[tri[1][1]].x, v[tri[1][1]].y, v[tri[1][1]].z,
+                   v[tri[1][2]].x, v[tri[1][2]].y, v[tri[1][2]].z, want);
+    }
+    CHECK_INT(agree, trials);
+    /* Both answers occur often enough for the comparison to mean something. */
+    CHECK(crossings > trials / 20 && crossings < trials - trials / 20);
+
+    /* Many triangles: the sweep finds a crossing exactly when some pair
+     * crosses, and the pair it names does. */
+    for (int it = 0; it < 200; it++) {
+        enum { NV = 12, NT = 6 };
+        pd_vec3 v[NV];
+        ll c[NV][3];
+        int tri[NT][3];
+        for (int i = 0; i < NV; i++) {
+            for (int k = 0; k < 3; k++)
+                c[i][k] = (ll)(rng_uniform(&rng) * 9.0) - 4;
+            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
+        }
+        for (int t = 0; t < NT; t++)
+            for (int k = 0; k < 3; k++)
+                tri[t][k] = (int)(rng_uniform(&rng) * NV);
+        int any = 0, named = 0, ta, tb;
+        for (int a = 0; a < NT; a++)
+            for (int b = a + 1; b < NT; b++) {
+                ll p[3][3], q[3][3];
+                int sh = 0;
+                for (int i = 0; i < 3; i++)
+                    for (int j = 0; j < 3; j++)
+                        sh += tri[a][i] == tri[b][j];
+                for (int i = 0; i < 3; i++)
+                    for (int k = 0; k < 3; k++) {
+                        p[i][k] = c[tri[a][i]][k];
+                        q[i][k] = c[tri[b][i]][k];
+                    }
+                any |= sh < 2 && cross_ref(p, q);
+            }
+        pd_mesh m = {NV, v, NT, tri};
+        pd_vec3 at;
+        CHECK_STATUS(pd_mesh_self_crossing(&m, &ta, &tb, &at), PD_OK);
+        if (ta >= 0) {
+            ll p[3][3], q[3][3];
+            for (int i = 0; i < 3; i++)
+                for (int k = 0; k < 3; k++) {
+                    p[i][k] = c[tri[ta][i]][k];
+                    q[i][k] = c[tri[tb][i]][k];
+                }
+            named = ta < tb && cross_ref(p, q);
+        }
+        CHECK_INT(ta >= 0, any);
+        if (ta >= 0)
+            CHECK(named);
+    }
+}
+
 void suite_mesh(void)
 {
     test_off();
@@ -781,4 +966,5 @@ void suite_mesh(void)
     test_prefixes();
     test_weld();
     test_clone_size();
+    test_self_crossing();
 }

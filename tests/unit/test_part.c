@@ -243,11 +243,17 @@ static void test_folded_through(void)
     pd_mesh_free(orig);
 }
 
-/* Two unit boxes, the second moved by dx along x, as one mesh of two
- * shells. */
-static pd_mesh *two_boxes(const pd_mesh *a, const pd_mesh *b, double dx)
+/* Two unit boxes, the second moved by dx, as one mesh of two shells. */
+static pd_mesh *two_boxes(pd_vec3 dx)
 {
-    pd_mesh *m = calloc(1, sizeof *m);
+    pd_mesh *a = mesh_box(1, 1, 1), *b = mesh_box(1, 1, 1), *m = calloc(1, sizeof *m);
+    CHECK(a && b && m);
+    if (!a || !b || !m) {
+        pd_mesh_free(a);
+        pd_mesh_free(b);
+        free(m);
+        return NULL;
+    }
     m->nverts = a->nverts + b->nverts;
     m->ntris = a->ntris + b->ntris;
     m->verts = malloc(sizeof *m->verts * (size_t)m->nverts);
@@ -255,13 +261,15 @@ static pd_mesh *two_boxes(const pd_mesh *a, const pd_mesh *b, double dx)
     for (int i = 0; i < a->nverts; i++)
         m->verts[i] = a->verts[i];
     for (int i = 0; i < b->nverts; i++)
-        m->verts[a->nverts + i] = v3_add(b->verts[i], v3(dx, 0, 0));
+        m->verts[a->nverts + i] = v3_add(b->verts[i], dx);
     for (int t = 0; t < a->ntris; t++)
         for (int c = 0; c < 3; c++)
             m->tris[t][c] = a->tris[t][c];
     for (int t = 0; t < b->ntris; t++)
         for (int c = 0; c < 3; c++)
             m->tris[a->ntris + t][c] = b->tris[t][c] + a->nverts;
+    pd_mesh_free(a);
+    pd_mesh_free(b);
     return m;
 }
 
@@ -272,29 +280,144 @@ static pd_mesh *two_boxes(const pd_mesh *a, const pd_mesh *b, double dx)
  * convex hull holds. Either way the mass properties are no solid's. */
 static void test_overlapping_shells(void)
 {
-    pd_mesh *a = mesh_box(1, 1, 1), *b = mesh_box(1, 1, 1);
-    if (!a || !b) {
-        CHECK(a && b);
-        pd_mesh_free(a);
-        pd_mesh_free(b);
-        return;
-    }
-    pd_mesh *m = two_boxes(a, b, 0.5);
+    pd_mesh *m = two_boxes(v3(0.5, 0, 0));
     expect_refused(m, NULL, PD_ERR_ORIENTATION, "encloses no volume, though its convex hull");
     pd_mesh_free(m);
-    m = two_boxes(a, b, 0.7);
+    m = two_boxes(v3(0.7, 0, 0));
     expect_refused(m, NULL, PD_ERR_ORIENTATION, "more than its convex hull");
     pd_mesh_free(m);
     /* Apart, the same two boxes are one part of two shells. */
-    m = two_boxes(a, b, 2.0);
+    m = two_boxes(v3(2.0, 0, 0));
     pd_part *p = NULL;
     CHECK_STATUS(pd_part_build(m, NULL, &p, NULL), PD_OK);
     if (p)
         CHECK_REL(p->mass.volume, 2.0, 1e-12, "two unit boxes, closed form");
     pd_part_free(p);
     pd_mesh_free(m);
-    pd_mesh_free(a);
-    pd_mesh_free(b);
+}
+
+/* The crossing point a refusal names, from its message; NaN when absent. */
+static pd_vec3 crossing_point(const char *msg)
+{
+    const char *at = strstr(msg, "cross at (");
+    pd_vec3 c = v3(NAN, NAN, NAN);
+    if (at && sscanf(at, "cross at (%lf, %lf, %lf)", &c.x, &c.y, &c.z) != 3)
+        c = v3(NAN, NAN, NAN);
+    return c;
+}
+
+/* Two unit boxes offset by 0.7 along each axis: the overlap (0.3^3) counts
+ * twice, but the volume (2 m^3) and moments stay within the hull's, so only
+ * a test of the surface against itself sees it. The crossing lies on the
+ * boundary of the common box [0.2, 0.5]^3 (box centred at the origin), and
+ * so does the point named, once the placement is undone, wherever the pair
+ * is moved, turned and scaled (1e-3 to 1e3): the decision is exact, the
+ * point is printed with 9 significant digits of coordinates up to 6.2 box
+ * edges from the origin (moved by 5 edges), 3.1e-8 of an edge at most, so
+ * it is checked to 1e-7 of the edge.
+ * With a given centre of mass the part is built with a warning and without
+ * the mesh's mass properties. */
+static void test_surface_crosses_itself(void)
+{
+    test_rng rng = {2026112722};
+    const double scales[] = {1.0, 1e-3, 1e3, 0.37};
+    for (int k = 0; k < 4; k++) {
+        pd_mesh *m = two_boxes(v3(0.7, 0.7, 0.7));
+        if (!m)
+            return;
+        double R[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+        pd_vec3 t = v3(0, 0, 0);
+        if (k > 0) {
+            rng_rotation(&rng, R);
+            t = v3_scale(rng_unit_vector(&rng), 5.0 * scales[k]);
+            mesh_transform(m, CR(R), scales[k], t);
+        }
+        expect_refused(m, NULL, PD_ERR_ORIENTATION, "its surface passes through itself (triangles");
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_part *p = NULL;
+        pd_part_build(m, NULL, &p, &d);
+        pd_vec3 c = v3_sub(crossing_point(d.message), t), u;
+        /* Undo x -> s R x + t: u = R^T (x - t) / s. */
+        u.x = (R[0][0] * c.x + R[1][0] * c.y + R[2][0] * c.z) / scales[k];
+        u.y = (R[0][1] * c.x + R[1][1] * c.y + R[2][1] * c.z) / scales[k];
+        u.z = (R[0][2] * c.x + R[1][2] * c.y + R[2][2] * c.z) / scales[k];
+        double e = 1e-7, lo = fmin(fmin(u.x, u.y), u.z), hi = fmax(fmax(u.x, u.y), u.z);
+        if (!(lo >= 0.2 - e && hi <= 0.5 + e && (fabs(lo - 0.2) <= e || fabs(hi - 0.5) <= e)))
+            printf("     scale %g: crossing named at %g, %g, %g (unplaced)\n", scales[k], u.x,
+                   u.y, u.z);
+        CHECK(lo >= 0.2 - e && hi <= 0.5 + e);
+        CHECK(fabs(lo - 0.2) <= e || fabs(hi - 0.5) <= e);
+        if (k == 0) {
+            pd_part_options o;
+            pd_part_options_default(&o);
+            o.com_given = 1;
+            o.com = v3(0.35, 0.35, 0.35);
+            pd_diag_init(&d);
+            CHECK_STATUS(pd_part_build(m, &o, &p, &d), PD_OK);
+            CHECK_INT(d.nwarnings, 1);
+            if (p)
+                CHECK_INT(p->mass_known, 0);
+            pd_part_free(p);
+        }
+        pd_mesh_free(m);
+    }
+}
+
+/* Touching is not crossing: a tetrahedron whose corner rests on the inside
+ * of another's face (two vertices at the same point, not welded: the point
+ * lies within a face), and one that shares a corner with it, are parts
+ * whose volume is the two tetrahedra's (1/6 each, closed form). A convex
+ * hull of random points crosses nothing. */
+static void test_touching_is_not_crossing(void)
+{
+    static const pd_vec3 apex[2][4] = {
+        {{0.25, 0.25, 0.5}, {1, 1, 2}, {2, 1, 1}, {1, 2, 1}},
+        {{1, 0, 0}, {2, 0, 0}, {2, 1, 0}, {2, 0, 1}},
+    };
+    for (int k = 0; k < 2; k++) {
+        pd_mesh *m = calloc(1, sizeof *m);
+        m->nverts = 8;
+        m->verts = malloc(sizeof *m->verts * 8);
+        m->ntris = 8;
+        m->tris = malloc(sizeof *m->tris * 8);
+        const pd_vec3 base[4] = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+        const int t[4][3] = {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}};
+        for (int i = 0; i < 4; i++) {
+            m->verts[i] = base[i];
+            m->verts[4 + i] = apex[k][i];
+            for (int c = 0; c < 3; c++) {
+                m->tris[i][c] = t[i][c];
+                m->tris[4 + i][c] = t[i][c] + 4;
+            }
+        }
+        double v2 = fabs(v3_dot(v3_sub(apex[k][1], apex[k][0]),
+                                v3_cross(v3_sub(apex[k][2], apex[k][0]),
+                                         v3_sub(apex[k][3], apex[k][0])))) / 6.0;
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_part *p = NULL;
+        CHECK_STATUS(pd_part_build(m, NULL, &p, &d), PD_OK);
+        if (!p)
+            printf("     touching tetrahedra %d: %s\n", k, d.message);
+        if (p)
+            CHECK_REL(p->mass.volume, 1.0 / 6.0 + v2, 1e-12, "two tetrahedra, closed form");
+        pd_part_free(p);
+        pd_mesh_free(m);
+    }
+    test_rng rng = {99};
+    pd_vec3 pts[60];
+    for (int i = 0; i < 60; i++)
+        pts[i] = v3_scale(rng_unit_vector(&rng), rng_range(&rng, 0.9, 1.0));
+    pd_mesh *m = convex_mesh(pts, 60);
+    pd_part *p = NULL;
+    CHECK(m != NULL);
+    if (m)
+        CHECK_STATUS(pd_part_build(m, NULL, &p, NULL), PD_OK);
+    if (p)
+        CHECK_INT(p->mass_known, 1);
+    pd_part_free(p);
+    pd_mesh_free(m);
 }
 
 /* The checks of a solid refuse none of the shipped parts, printed with 6 to
@@ -371,6 +494,8 @@ void suite_part(void)
     test_shipped_parts_are_solids();
     test_folded_through();
     test_overlapping_shells();
+    test_surface_crosses_itself();
+    test_touching_is_not_crossing();
     test_box();
     test_refusals();
     test_orientation();
