@@ -43,9 +43,9 @@
 
 /* The part's thickness: its least width across a facet's plane (m, part
  * frame or any: a width does not depend on it). A convex body's least width
- * is across a facet or between two edges; the facets' widths bound it from
- * above by at most a factor of sqrt(3) or so, enough for the scales it
- * sets. */
+ * is across a facet or between two edges; the least facet width is that
+ * or more (equal for boxes, prisms and flat pyramids, the parts whose
+ * thinness matters here). */
 static inline double pd_engine_hull_width(const pd_hull *h)
 {
     double width = INFINITY;
