@@ -155,6 +155,22 @@ struct hull_floor_create : btCollisionAlgorithmCreateFunc {
     }
 };
 
+/* The unit Bullet is handed masses in: the power of two nearest the part's
+ * mass (so the conversion is exact), which makes the body's mass of order 1.
+ * Nothing of the motion depends on it (gravity is an acceleration, friction
+ * and restitution are ratios, the contact law's springs are per effective
+ * mass, and no mass is read back), but Bullet's solver has absolute limits:
+ * a 300 m cube of 2.7e7 kg met the floor with its contact found and no
+ * impulse applied, and fell through it (a 100 m one of 1e6 kg was held);
+ * handed its mass in units of 2^25 kg (0.8 of one) it rests, and so does a
+ * 1000 m cube. */
+static double mass_unit(double mass)
+{
+    int e;
+    double f = std::frexp(mass, &e); /* mass = f 2^e, 0.5 <= f < 1 */
+    return std::ldexp(1.0, f < M_SQRT1_2 ? e - 1 : e);
+}
+
 struct pd_engine_world {
     btDefaultCollisionConfiguration config;
     hull_floor_create hull_floor;
@@ -178,8 +194,10 @@ struct pd_engine_world {
           floor(btVector3(0, 0, 1), btScalar(-margin)),
           floor_body(btRigidBody::btRigidBodyConstructionInfo(0, nullptr, &floor)),
           body(btRigidBody::btRigidBodyConstructionInfo(
-              btScalar(b->mass), nullptr, &hull,
-              btVector3(btScalar(b->moment[0]), btScalar(b->moment[1]), btScalar(b->moment[2])))),
+              btScalar(b->mass / mass_unit(b->mass)), nullptr, &hull,
+              btVector3(btScalar(b->moment[0] / mass_unit(b->mass)),
+                        btScalar(b->moment[1] / mass_unit(b->mass)),
+                        btScalar(b->moment[2] / mass_unit(b->mass))))),
           dt(btScalar(step)),
           step_s(step),
           size_m(b->size),

@@ -107,8 +107,6 @@ static const struct {
     {"needle 1 mm x 100", PD_ENGINE_IMPULSE, 3},
     {"needle 1 mm x 1000", PD_ENGINE_IMPULSE, 3},
     {"cube 0.1 mm", PD_ENGINE_IMPULSE, 5},
-    /* The stepping engines' own: not the impulse engine's fixes. */
-    {"cube 1000 m", PD_ENGINE_BULLET, 4},
     {NULL, PD_ENGINE_IMPULSE, 0},
 };
 
