@@ -28,9 +28,9 @@
  * for an engine to stand for the scene's contact by that law. The engines
  * meet the floor at the hull's vertices only, so a penetration of the order
  * of the thickness puts corners of the far side below the floor, and the
- * part rests part way through it (measured: a 1 m x 3.3 mm rod at the
- * automatic contact time of 10 ms, omega ~ 300 rad/s, lands at 4.7 m/s,
- * sinks 2.6 mm and stays there on an edge, 3 of 100 drops on ODE). The
+ * part rests part way through it (measured: a 1 m x 3.3 mm rod at a
+ * contact time of 29 to 30 ms, omega ~ 90 rad/s, resolved by ODE's 1 ms
+ * step, came to rest 2.6 mm deep on an edge in 3 of 100 drops). The
  * spring-dashpot's deepest point at approach speed v is below v / omega (its
  * undamped amplitude); with v / omega above this share of the thickness the
  * engine keeps its own contact, as for a contact the step cannot resolve.
