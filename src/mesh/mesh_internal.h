@@ -17,7 +17,7 @@ pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag);
  * *ta < *tb are their indices and *at a point of the crossing (rounded), or
  * *ta = *tb = -1 when there is none. PD_OK or PD_ERR_NOMEM. Near-linear in
  * the triangles for a surface whose triangles are small against it (sort and
- * sweep of their bounding boxes along x). */
+ * sweep of their bounding boxes along the axis that suits them best). */
 pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at);
 
 #endif

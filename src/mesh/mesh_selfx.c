@@ -9,21 +9,22 @@
  * segment of their boundaries, are never reported: touching is not
  * crossing. Coplanar pairs are not examined (they touch, or overlap within
  * one plane, which the moment checks see as area, not as volume). */
+#include <math.h>
 #include <stdlib.h>
 #include "base/predicates.h"
 #include "base/vec3.h"
 #include "mesh/mesh_internal.h"
 
 typedef struct box {
-    double lo[3], hi[3];
+    double lo[3], hi[3], key; /* key: lo along the sweep's axis */
     int t;
 } box;
 
 static int box_cmp(const void *pa, const void *pb)
 {
     const box *a = pa, *b = pb;
-    if (a->lo[0] != b->lo[0])
-        return a->lo[0] < b->lo[0] ? -1 : 1;
+    if (a->key != b->key)
+        return a->key < b->key ? -1 : 1;
     return (a->t > b->t) - (a->t < b->t);
 }
 
@@ -163,13 +164,34 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at)
         }
         bx[t].t = t;
     }
-    /* Sort and sweep along x: each triangle meets only those whose x range
-     * starts within its own; y and z ranges then prune before the exact
-     * test. The first crossing pair in sweep order is the one reported. */
+    /* Sort and sweep along one axis: each triangle meets only those whose
+     * range along it starts within its own; the other two ranges then prune
+     * before the exact test. The axis is the one along which the triangles'
+     * ranges are shortest against the mesh's (the pairs the sweep visits go
+     * as their ratio): a part long along x made of long triangles is swept
+     * across. The first crossing pair in sweep order is the one reported. */
+    int ax = 0;
+    double best = HUGE_VAL;
+    for (int k = 0; k < 3; k++) {
+        double lo = HUGE_VAL, hi = -HUGE_VAL, ext = 0.0;
+        for (int t = 0; t < m->ntris; t++) {
+            lo = fmin(lo, bx[t].lo[k]);
+            hi = fmax(hi, bx[t].hi[k]);
+            ext += bx[t].hi[k] - bx[t].lo[k];
+        }
+        double r = hi > lo ? ext / (hi - lo) : HUGE_VAL;
+        if (r < best) {
+            best = r;
+            ax = k;
+        }
+    }
+    for (int t = 0; t < m->ntris; t++)
+        bx[t].key = bx[t].lo[ax];
     qsort(bx, (size_t)m->ntris, sizeof *bx, box_cmp);
     for (int a = 0; a < m->ntris && *ta < 0; a++) {
-        for (int b = a + 1; b < m->ntris && bx[b].lo[0] <= bx[a].hi[0]; b++) {
-            if (bx[b].lo[1] > bx[a].hi[1] || bx[b].hi[1] < bx[a].lo[1] ||
+        for (int b = a + 1; b < m->ntris && bx[b].key <= bx[a].hi[ax]; b++) {
+            if (bx[b].lo[0] > bx[a].hi[0] || bx[b].hi[0] < bx[a].lo[0] ||
+                bx[b].lo[1] > bx[a].hi[1] || bx[b].hi[1] < bx[a].lo[1] ||
                 bx[b].lo[2] > bx[a].hi[2] || bx[b].hi[2] < bx[a].lo[2])
                 continue;
             const int *A = m->tris[bx[a].t], *B = m->tris[bx[b].t];
