@@ -1209,7 +1209,7 @@ static PyObject *Drops_sensitivity(DropsObject *self, PyObject *args)
         return NULL;
     }
     size_t m = (size_t)s->nposes * (size_t)s->nparams;
-    PyObject *d = PyDict_New(), *params = PyList_New(0);
+    PyObject *d = PyDict_New(), *params = d ? PyList_New(0) : NULL;
     int bad = !d || put(d, "params", params) || put(d, "n", PyLong_FromLong(s->n)) ||
               put(d, "nposes", PyLong_FromLong(s->nposes));
     for (int k = 0; !bad && k < s->nparams; k++) {

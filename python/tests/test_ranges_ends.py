@@ -188,3 +188,17 @@ def test_bad_time_limits(value, status):
     with pytest.raises(InputError) as e:
         posedrop.Part.from_file(CAP).drop(10, time_limit=value)
     assert e.value.status == status and "time_limit" in str(e.value)
+
+
+def test_failed_end_words_are_the_documented_ones():
+    """No public input makes a drop fail (tests/unit/test_sim.c reaches one
+    through the drop loop), so the words of failed:STAGE:STATUS are checked
+    against the stable names docs/cli.md gives for the end column."""
+    from posedrop import _api
+    assert _api._STAGE_NAMES[1:] == ("settle", "flight", "impact_search", "collision",
+                                     "compliant", "contact_phase", "engine_reset", "engine_step")
+    words = {s: _api._STATUS_WORDS[s] for s in (Status.ERR_NO_CONVERGENCE, Status.ERR_NONFINITE,
+                                                Status.ERR_NOMEM, Status.ERR_INTERNAL,
+                                                Status.ERR_USAGE, Status.ERR_RANGE)}
+    assert list(words.values()) == ["no_convergence", "non_finite_number", "out_of_memory",
+                                    "internal_error", "invalid_argument", "value_out_of_range"]

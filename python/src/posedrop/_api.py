@@ -509,10 +509,10 @@ class Trials:
         self.end = _i32(d["trial_end"])
         self.stage = _i32(d["trial_stage"])
         self.status = _i32(d["trial_status"])
-        self.end_text = np.array([END_NAMES[e] if e != _FAILED else
-                                  "failed:%s:%s" % (_STAGE_NAMES[g], _STATUS_WORDS[t])
-                                  for e, g, t in zip(self.end.tolist(), self.stage.tolist(),
-                                                     self.status.tolist())], dtype=str)
+        text = np.array(END_NAMES, dtype=object)[self.end]
+        for i in np.flatnonzero(self.end == _FAILED):
+            text[i] = "failed:%s:%s" % (_STAGE_NAMES[self.stage[i]], _STATUS_WORDS[self.status[i]])
+        self.end_text = text.astype(str)
         drawn = _f64(d["trial_param"], len(self.pose), len(PARAM_NAMES))
         self.params = {}
         for name in d["ranged"]:
