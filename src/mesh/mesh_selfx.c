@@ -36,6 +36,14 @@ static int orient(const pd_vec3 *a, const pd_vec3 *b, const pd_vec3 *c, const pd
 {
     if (d == a || d == b || d == c || a == b || a == c || b == c)
         return 0;
+    /* Four points with one coordinate equal lie in a plane of that axis,
+     * exactly: the usual flat face of a part, fanned into triangles that
+     * share a corner and whose boxes all meet, would send every pair to the
+     * exact fallback. */
+    if ((a->x == b->x && a->x == c->x && a->x == d->x) ||
+        (a->y == b->y && a->y == c->y && a->y == d->y) ||
+        (a->z == b->z && a->z == c->z && a->z == d->z))
+        return 0;
     return pd_orient3d(a, b, c, d);
 }
 
@@ -60,7 +68,7 @@ static int side(const pd_vec3 *const q[3], const pd_vec3 *const p[3], int s[3])
             return 0;
         if (known[i])
             continue;
-        s[i] = pd_orient3d(q[0], q[1], q[2], p[i]);
+        s[i] = orient(q[0], q[1], q[2], p[i]);
         pos += s[i] > 0;
         neg += s[i] < 0;
         left--;
@@ -136,6 +144,99 @@ static int cross(const pd_vec3 *p[3], const pd_vec3 *q[3], pd_vec3 *at)
     return 1;
 }
 
+/* Is triangle t's area zero, exactly? Its corners are collinear when their
+ * projections on all three coordinate planes are; each projection's
+ * orientation is that of orient3d with the points flattened onto the plane
+ * and the fourth raised by 1 above the first (exact: the lift and the zeros
+ * add no rounding). */
+static int degenerate(const pd_mesh *m, int t)
+{
+    const pd_vec3 *v[3] = {&m->verts[m->tris[t][0]], &m->verts[m->tris[t][1]],
+                           &m->verts[m->tris[t][2]]};
+    for (int k = 0; k < 3; k++) {
+        pd_vec3 f[3];
+        for (int i = 0; i < 3; i++)
+            f[i] = k == 0 ? v3(v[i]->y, v[i]->z, 0) : k == 1 ? v3(v[i]->z, v[i]->x, 0)
+                                                             : v3(v[i]->x, v[i]->y, 0);
+        pd_vec3 up = v3(f[0].x, f[0].y, 1.0);
+        if (pd_orient3d(&f[0], &f[1], &f[2], &up) != 0)
+            return 0;
+    }
+    return 1;
+}
+
+static int root(int *up, int t)
+{
+    while (up[t] != t)
+        t = up[t] = up[up[t]];
+    return t;
+}
+
+typedef struct edge {
+    int a, b, t;
+} edge;
+
+static int edge_cmp(const void *pa, const void *pb)
+{
+    const edge *x = pa, *y = pb;
+    if (x->a != y->a)
+        return x->a < y->a ? -1 : 1;
+    if (x->b != y->b)
+        return x->b < y->b ? -1 : 1;
+    return (x->t > y->t) - (x->t < y->t);
+}
+
+/* Flat patches: triangles joined through shared edges to neighbours in
+ * their plane, exactly (neither of the two degenerate, the fourth corner on
+ * the plane of the other three); *up[t] names t's patch. Two triangles of
+ * one patch lie in one plane (each step keeps the plane: two corners of the
+ * edge and a third not on their line), and coplanar pairs are never found
+ * crossing, so the sweep skips them: a flat face fanned into many triangles
+ * about one corner would otherwise test every pair of them, each sign an
+ * exact zero. */
+static pd_status flat_patches(const pd_mesh *m, int *up)
+{
+    size_t ne = 3 * (size_t)m->ntris;
+    edge *e = malloc(sizeof *e * ne);
+    char *flat = malloc((size_t)m->ntris);
+    if (!e || !flat) {
+        free(e);
+        free(flat);
+        return PD_ERR_NOMEM;
+    }
+    for (int t = 0; t < m->ntris; t++) {
+        up[t] = t;
+        flat[t] = !degenerate(m, t);
+        for (int k = 0; k < 3; k++) {
+            int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
+            e[3 * (size_t)t + (size_t)k] = (edge){a < b ? a : b, a < b ? b : a, t};
+        }
+    }
+    qsort(e, ne, sizeof *e, edge_cmp);
+    for (size_t i = 0; i + 1 < ne; i++) {
+        const edge *x = &e[i], *y = &e[i + 1];
+        if (x->a != y->a || x->b != y->b || !flat[x->t] || !flat[y->t])
+            continue;
+        int c = -1, d = -1;
+        for (int k = 0; k < 3; k++) {
+            int vx = m->tris[x->t][k], vy = m->tris[y->t][k];
+            if (vx != x->a && vx != x->b)
+                c = vx;
+            if (vy != x->a && vy != x->b)
+                d = vy;
+        }
+        if (c < 0 || d < 0 || c == d)
+            continue;
+        if (orient(&m->verts[x->a], &m->verts[x->b], &m->verts[c], &m->verts[d]) == 0) {
+            int rx = root(up, x->t), ry = root(up, y->t);
+            up[rx > ry ? rx : ry] = rx > ry ? ry : rx;
+        }
+    }
+    free(e);
+    free(flat);
+    return PD_OK;
+}
+
 static int shared(const int a[3], const int b[3])
 {
     int n = 0;
@@ -151,8 +252,12 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at)
     if (m->ntris < 2)
         return PD_OK;
     box *bx = malloc(sizeof *bx * (size_t)m->ntris);
-    if (!bx)
+    int *up = malloc(sizeof *up * (size_t)m->ntris);
+    if (!bx || !up || flat_patches(m, up) != PD_OK) {
+        free(bx);
+        free(up);
         return PD_ERR_NOMEM;
+    }
     for (int t = 0; t < m->ntris; t++) {
         const pd_vec3 *v[3] = {&m->verts[m->tris[t][0]], &m->verts[m->tris[t][1]],
                                &m->verts[m->tris[t][2]]};
@@ -195,7 +300,7 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at)
                 bx[b].lo[2] > bx[a].hi[2] || bx[b].hi[2] < bx[a].lo[2])
                 continue;
             const int *A = m->tris[bx[a].t], *B = m->tris[bx[b].t];
-            if (shared(A, B) >= 2)
+            if (shared(A, B) >= 2 || root(up, bx[a].t) == root(up, bx[b].t))
                 continue;
             const pd_vec3 *p[3] = {&m->verts[A[0]], &m->verts[A[1]], &m->verts[A[2]]};
             const pd_vec3 *q[3] = {&m->verts[B[0]], &m->verts[B[1]], &m->verts[B[2]]};
@@ -207,5 +312,6 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at)
         }
     }
     free(bx);
+    free(up);
     return PD_OK;
 }
