@@ -28,6 +28,7 @@
     PD_SUITE(compliant) \
     PD_SUITE(sim)    \
     PD_SUITE(markov) \
+    PD_SUITE(fit)    \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \
