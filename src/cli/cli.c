@@ -135,12 +135,6 @@ static const char *end_name(pd_drop_end e)
  * that looks like a result, nor destroys the one it would replace. Anything
  * else (a device such as /dev/stdout, a pipe) is opened and written as it
  * is; a write error there (/dev/full) is caught when it is closed. */
-typedef struct {
-    const char *path;
-    char *target; /* where the temporary is renamed to (a symbolic link resolved) */
-    char *tmp;    /* NULL when path is written directly */
-    FILE *f;
-} out_file;
 
 static int out_fail(const char *path, const char *why)
 {
@@ -148,7 +142,7 @@ static int out_fail(const char *path, const char *why)
     return 0;
 }
 
-static int out_open(out_file *o, const char *path)
+int out_open(out_file *o, const char *path)
 {
     memset(o, 0, sizeof *o);
     o->path = path;
@@ -210,7 +204,7 @@ static int out_open(out_file *o, const char *path)
 }
 
 /* Drops what was written (on any failure of the run). */
-static void out_abort(out_file *o)
+void out_abort(out_file *o)
 {
     if (o->f)
         fclose(o->f);
@@ -222,7 +216,7 @@ static void out_abort(out_file *o)
 }
 
 /* Closes with every write error caught, then puts the file in place. */
-static int out_commit(out_file *o)
+int out_commit(out_file *o)
 {
     int ok = fflush(o->f) == 0 && !ferror(o->f);
     int err = errno;
@@ -474,6 +468,8 @@ static void usage(FILE *out)
     fprintf(out,
         "usage: %s [options] PART\n"
         "       %s merge [options] SHARD...   (sums shards: see 'posedrop merge --help')\n"
+        "       %s fit [options] --fit SPEC --part PART --measured CSV ...\n"
+        "                             (calibrates the scene: see 'posedrop fit --help')\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
         "flat surface and prints one CSV row per stable pose:\n"
@@ -489,7 +485,7 @@ static void usage(FILE *out)
         "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
-        "\n", prog, prog);
+        "\n", prog, prog, prog);
     for (int i = 0; i < NOPTIONS; i++) {
         const cli_option *o = &options[i];
         if (o->kind == ARG_HEADING) {
@@ -1040,6 +1036,8 @@ int main(int argc, char **argv)
     cli_start(&argc, &argv);
     if (argc > 1 && strcmp(argv[1], "merge") == 0)
         return cli_end(cli_merge(argc - 1, argv + 1));
+    if (argc > 1 && strcmp(argv[1], "fit") == 0)
+        return cli_end(cli_fit(argc - 1, argv + 1));
     cli_args a;
     int code = parse_args(argc, argv, &a);
     return cli_end(code >= 0 ? code : cli_run(&a));

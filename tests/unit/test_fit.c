@@ -7,7 +7,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "check.h"
+#include "cli_run.h"
 #include "base/gsl_adapter.h"
 #include "fit/fit_engine.h"
 #include "posedrop/posedrop.h"
@@ -389,6 +391,92 @@ static void test_errors(void)
     box_free(&b);
 }
 
+/* posedrop fit as a user runs it: refused input (exit 2, nothing on
+ * stdout, a message naming the problem), and a small fit whose scene file
+ * --scene reads back and whose rows sum to one per part. */
+static void test_command(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-fit-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        CHECK(!"cannot create a temporary directory");
+        return;
+    }
+    char counts[128], scene[128], params[128], args[1024];
+    snprintf(counts, sizeof counts, "%s/box.csv", tmpdir);
+    snprintf(scene, sizeof scene, "%s/fitted.scene", tmpdir);
+    snprintf(params, sizeof params, "%s/params.csv", tmpdir);
+    write_file(counts, "pose,count\n1,240\n2,48\n3,12\n");
+    const char *box = "--part parts/canonical/box_1x2x3.off";
+    snprintf(args, sizeof args, "fit %s --measured %s", box, counts);
+    expect_failure(args, 2, "nothing to fit");
+    snprintf(args, sizeof args, "fit --fit mu %s --measured %s", box, counts);
+    expect_failure(args, 2, "KEY=LO:HI");
+    snprintf(args, sizeof args, "fit --fit mu=0.5:0.2 %s --measured %s", box, counts);
+    expect_failure(args, 2, "LO < HI");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:x %s --measured %s", box, counts);
+    expect_failure(args, 2, "two numbers");
+    snprintf(args, sizeof args, "fit --fit colour=0:1 %s --measured %s", box, counts);
+    expect_failure(args, 2, "colour");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s", box);
+    expect_failure(args, 2, "--measured");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 --predict parts/canonical/box_1x2x3.off");
+    expect_failure(args, 2, "no part to fit");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s/none.csv", box, tmpdir);
+    expect_failure(args, 2, "none.csv");
+    char many[128];
+    snprintf(many, sizeof many, "%s/many.csv", tmpdir);
+    write_file(many, "pose,count\n1,1\n9,2\n");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
+    expect_failure(args, 2, "pose 9");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 -n 5 %s --measured %s", box, counts);
+    expect_failure(args, 2, "number of drops");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s/no/dir/x", box,
+             counts, tmpdir);
+    expect_failure(args, 2, "no/dir");
+
+    snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7 -n 100 --max-evals 5 --points 2 "
+             "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s", box,
+             counts, scene, params);
+    char *out = NULL, *err = NULL;
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(out && strncmp(out, "part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n", 53) == 0);
+    double sum[2] = {0, 0};
+    int rows = 0;
+    for (const char *line = out ? strchr(out, '\n') : NULL; line && line[1]; line = strchr(line + 1, '\n')) {
+        char role[16];
+        int pose;
+        double p_best, p, lo, hi;
+        const char *c = strchr(line + 1, ',');
+        if (!c || sscanf(c + 1, "%15[a-z],%d,", role, &pose) != 2)
+            break;
+        const char *f = c + 1;
+        for (int i = 0; i < 4 && f; i++) /* role, pose, count, p_measured */
+            f = strchr(f, ',') ? strchr(f, ',') + 1 : NULL;
+        if (!f || sscanf(f, "%lf,%lf,%lf,%lf", &p_best, &p, &lo, &hi) != 4)
+            break;
+        sum[strcmp(role, "fitted") != 0] += p;
+        CHECK(lo <= p && p <= hi);
+        rows++;
+    }
+    CHECK_INT(rows, 3 + 2);
+    CHECK_NEAR(sum[0], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
+    CHECK_NEAR(sum[1], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
+    CHECK(err && strstr(err, "restitution = ") != NULL);
+    free(out);
+    free(err);
+    /* The scene file is one --scene reads. */
+    snprintf(args, sizeof args, "--scene %s -n 10 parts/canonical/box_1x2x3.off", scene);
+    CHECK_INT(run(args, &out, &err), 0);
+    free(out);
+    free(err);
+    char *ptext = slurp(params);
+    CHECK(ptext && strncmp(ptext, "parameter,value,lo,hi,mean,range_lo,range_hi\nrestitution,", 57) == 0);
+    free(ptext);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    CHECK(system(cmd) == 0);
+}
+
 void suite_fit(void)
 {
     test_likelihood_hand();
@@ -397,4 +485,5 @@ void suite_fit(void)
     test_coverage_crn();
     test_recovery();
     test_errors();
+    test_command();
 }
