@@ -61,8 +61,8 @@ typedef struct pd_fit_options {
                            uniform, bootstrap and stationary are each fitted and the
                            one of highest maximised likelihood kept; 0 */
     int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150 */
-    int npoints;        /* likelihood-weighted points per round (3 rounds), >= 1;
-                           0: 8 (d + 1) for d parameters */
+    int npoints;        /* likelihood-weighted points per round (3 to 6 rounds),
+                           >= 1; 0: 8 (d + 1) for d parameters */
     double alpha;       /* pseudo-count added to every class's simulated count
                            (Dirichlet smoothing), > 0; 0.5 (Jeffreys) */
 } pd_fit_options;

@@ -13,7 +13,10 @@
 #include "posedrop/fit.h"
 
 enum {
-    ROUNDS = 3,           /* weighting rounds: the whole box, then two around the maximum */
+    MIN_ROUNDS = 3,       /* weighting rounds: the whole box, then at least two around the maximum */
+    MAX_ROUNDS = 6,       /* ... and more, each narrower, while the weight sits on fewer
+                             effective points than a round has (a likelihood of thousands
+                             of drops is far narrower than the box) */
     DESIGN_PER_PARAM = 4, /* the search's starting design: 4 d + 1 points */
 };
 /* The simplex stops when its size in u is below this: 0.02 in u is 0.005 of
@@ -219,7 +222,7 @@ static void weights(int d, int n, const double *z, const double *lt, const box *
 pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
                     fit_weighed *out, int *evals, pd_diag *diag)
 {
-    int d = pb->d, np = pb->nparts, total = ROUNDS * s->npoints;
+    int d = pb->d, np = pb->nparts, total = MAX_ROUNDS * s->npoints;
     size_t ksum = 0;
     for (int i = 0; i < np; i++)
         ksum += (size_t)pb->k[i];
@@ -256,11 +259,14 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
         }
         out->temper = ntot ? tsum / (double)ntot : 1.0;
     }
-    box b[ROUNDS];
+    box b[MAX_ROUNDS];
     double half[PD_FIT_MAX_PARAMS];
     int n = 0;
     long index = 1;
-    for (int r = 0; st == PD_OK && r < ROUNDS; r++) {
+    double ess = 0.0;
+    for (int r = 0; st == PD_OK && r < MAX_ROUNDS; r++) {
+        if (r >= MIN_ROUNDS && ess >= s->npoints)
+            break;
         for (int i = 0; i < d; i++) {
             if (r == 0) {
                 half[i] = 0.5;
@@ -295,14 +301,16 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
                 sims[(size_t)n * (size_t)np + (size_t)i] = nsim[i];
             }
         }
-        if (st == PD_OK)
+        if (st == PD_OK) {
             weights(d, n, z, lt, b, r + 1, w);
+            double sw2 = 0.0;
+            for (int j = 0; j < n; j++)
+                sw2 += w[j] * w[j];
+            ess = 1.0 / sw2;
+        }
     }
     if (st == PD_OK) {
-        double sw2 = 0.0;
-        for (int j = 0; j < n; j++)
-            sw2 += w[j] * w[j];
-        out->ess = 1.0 / sw2;
+        out->ess = ess;
         out->npoints = n;
         for (int i = 0; i < d; i++) {
             double m = 0.0;

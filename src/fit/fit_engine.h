@@ -48,10 +48,12 @@ typedef struct fit_weighed {
     int npoints;
 } fit_weighed;
 
-/* Evaluates theta (the search's maximum) with every part, then 3 rounds of
+/* Evaluates theta (the search's maximum) with every part, then rounds of
  * s->npoints quasi-random points: the whole box, then boxes around theta
- * shrunk to the weighted spread, all weighed by their tempered likelihood
- * over the density they were drawn from (the balance heuristic). */
+ * shrunk to the weighted spread (at least 3 rounds, at most 6, stopping once
+ * the effective sample size reaches s->npoints), all weighed by their
+ * tempered likelihood over the density they were drawn from (the balance
+ * heuristic). */
 pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
                     fit_weighed *out, int *evals, pd_diag *diag);
 
