@@ -432,6 +432,11 @@ int cli_fit(int argc, char **argv)
             code = fit_fail("--part %s: expected its --measured CSV after it%s", in[i].path, "");
     if (code < 0 && nfitted == 0)
         code = fit_fail("no part to fit: give --part PART --measured CSV%s%s", "", "");
+    /* The command offers every engine: it links libposedrop-bullet. */
+    if (code < 0 && pd_bullet_register() != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine could not be registered\n", prog);
+        code = EXIT_INTERNAL;
+    }
     if (code < 0 && scene_path && pd_scene_read(scene_path, &scene, &diag) != PD_OK) {
         fprintf(stderr, "%s: %s\n", prog, diag.message);
         code = EXIT_USAGE;
