@@ -99,6 +99,10 @@ typedef struct pd_fit_result {
     double pvalue;
     double temper;      /* the weights' exponent: 1 / (1 + n / nsim) for equal shares
                            (docs/calibration.md: the simulation's own error) */
+    double dispersion;  /* >= 1: the parts' X^2 at the best fit over what the data's
+                           and the simulation's noise explain; the weights' log-
+                           likelihood is divided by it, widening the intervals by
+                           its square root when no value reproduces the counts */
     int npoints;        /* weighted points */
     double ess;         /* their effective sample size (sum w)^2 / sum w^2 */
     int evaluations;    /* likelihood evaluations, all searches and points */

@@ -275,6 +275,9 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
     }
     fprintf(stderr, "%s: fit: all parts: X^2 = %.2f, df %d, p = %.3g; log-likelihood %.2f\n",
             prog, r->chi2, r->df, r->pvalue, r->loglik);
+    if (r->dispersion > 1.0)
+        fprintf(stderr, "%s: fit: X^2 is %.3g times what the noise explains: the intervals are "
+                "widened by its square root for the model's misfit\n", prog, r->dispersion);
     fprintf(stderr, "%s: fit: %d evaluations, %ld drops simulated, %d weighted values (effective "
             "%.1f, likelihood tempered by %.3f for the simulation's error); %.1f s wall, "
             "%.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints, r->ess, r->temper, wall,

@@ -344,7 +344,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         plo[i] = r->parts[i].lo;
         phi[i] = r->parts[i].hi;
     }
-    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 0.0, 0.0, 0};
+    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 0.0, 1.0, 0.0, 0};
     if (st == PD_OK)
         st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
     if (st == PD_OK) {
@@ -360,6 +360,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         st = scene_at(&m, best_theta, &r->scene, diag);
         r->initial = chosen;
         r->temper = w.temper;
+        r->dispersion = w.dispersion;
         r->ess = w.ess;
         r->npoints = w.npoints;
         r->loglik = 0.0;

@@ -258,6 +258,24 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             tsum += (double)n / (1.0 + (double)n / nsim[i]);
         }
         out->temper = ntot ? tsum / (double)ntot : 1.0;
+        /* Overdispersion: X^2 beyond what the data's and the simulation's
+         * noise explain is the model's own misfit, and widens the
+         * weights' spread by its square root (quasi-likelihood). */
+        double x2 = 0.0, expect = 0.0;
+        int df = -d;
+        for (int i = 0; i < np; i++) {
+            if (!pb->count[i])
+                continue;
+            long n = 0;
+            for (int j = 0; j < pb->k[i]; j++)
+                n += pb->count[i][j];
+            x2 += fit_chi2(pb->k[i], pb->count[i], out->p_best[i]);
+            expect += (double)(pb->k[i] - 1) * (1.0 + (double)n / nsim[i]);
+            df += pb->k[i] - 1;
+        }
+        /* Without a degree of freedom left, X^2 says nothing of the fit. */
+        expect *= df > 0 ? (double)df / (double)(df + d) : 0.0;
+        out->dispersion = df > 0 && x2 > expect ? x2 / expect : 1.0;
     }
     box b[MAX_ROUNDS];
     double half[PD_FIT_MAX_PARAMS];
@@ -294,6 +312,7 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             for (int i = 0; i < d; i++)
                 zj[i] = b[r].lo[i] + (b[r].hi[i] - b[r].lo[i]) * fit_halton(index, i);
             st = evaluate(&c, zj, 1, &l, &lt[n]);
+            lt[n] /= out->dispersion;
             double *sj = store + (size_t)n * ksum;
             for (int i = 0; st == PD_OK && i < np; i++) {
                 memcpy(sj, p[i], sizeof *sj * (size_t)pb->k[i]);

@@ -44,11 +44,15 @@ typedef struct fit_weighed {
     double *const *p;         /* per part, k[i]: averaged */
     double *const *plo, *const *phi; /* per part, k[i]: 95% interval */
     double temper;            /* the count-weighted mean of the parts' exponents */
+    double dispersion;        /* X^2 at theta over what the noise explains
+                                 (sum (k_i - 1)(1 + n_i / nsim_i) - d), at least 1:
+                                 the tempered log-likelihood is divided by it */
     double ess;
     int npoints;
 } fit_weighed;
 
-/* Evaluates theta (the search's maximum) with every part, then rounds of
+/* Evaluates theta (the search's maximum) with every part (and its
+ * dispersion from there), then rounds of
  * s->npoints quasi-random points: the whole box, then boxes around theta
  * shrunk to the weighted spread (at least 3 rounds, at most 6, stopping once
  * the effective sample size reaches s->npoints), all weighed by their

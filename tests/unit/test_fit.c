@@ -103,7 +103,7 @@ static void test_search_closed_form(void)
         phi0[2], phi1[2], nsb[2];
     double *pb_best[] = {pbest0, pbest1}, *pp[] = {p0, p1}, *plo[] = {plo0, plo1},
            *phi[] = {phi0, phi1};
-    fit_weighed w = {wlo, whi, wmean, pb_best, nsb, pp, plo, phi, 0, 0, 0};
+    fit_weighed w = {wlo, whi, wmean, pb_best, nsb, pp, plo, phi, 0, 1, 0, 0};
     fit_settings s2 = {200, 64};
     CHECK_STATUS(fit_weigh(&pb, &s2, theta, &w, &evals, &diag), PD_OK);
     const double one[] = {1.0}, a[] = {41.0}, b[] = {61.0};
@@ -116,6 +116,49 @@ static void test_search_closed_form(void)
     CHECK_NEAR(w.temper, 1.0, 1e-12, "nsim 1e15: no simulation error to carry");
     pd_note("closed-form weighting: [%.4f, %.4f] against Beta's [%.4f, %.4f], ESS %.1f of %d\n",
             wlo[0], whi[0], qlo, qhi, w.ess, w.npoints);
+}
+
+/* A model that cannot fit: p = (theta, (1 - theta) / 2, (1 - theta) / 2)
+ * against counts 30, 60, 10, known exactly. */
+static pd_status misfit_model(void *user, const double *theta, int all, double *const *p,
+                              double *nsim, pd_diag *diag)
+{
+    (void)user;
+    (void)all;
+    (void)diag;
+    p[0][0] = theta[0];
+    p[0][1] = p[0][2] = 0.5 * (1.0 - theta[0]);
+    nsim[0] = 1e15;
+    return PD_OK;
+}
+
+static void test_dispersion(void)
+{
+    const long c[] = {30, 60, 10};
+    const long *count[] = {c};
+    const int k[] = {3};
+    const double lo[] = {0.05}, hi[] = {0.95};
+    fit_problem pb = {1, lo, hi, 1, k, count, 0.5, misfit_model, NULL};
+    fit_settings s = {200, 32};
+    double theta[1], l, wlo[1], whi[1], wmean[1], pb0[3], p0[3], l0[3], h0[3], nsb[1];
+    double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
+    fit_weighed w = {wlo, whi, wmean, pbb, nsb, pp, pl, ph, 0, 1, 0, 0};
+    int evals = 0;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(fit_search(&pb, &s, theta, &l, &evals, &diag), PD_OK);
+    CHECK_NEAR(theta[0], 0.3, 0.0045, "the simplex's size tolerance mapped to theta");
+    CHECK_STATUS(fit_weigh(&pb, &s, theta, &w, &evals, &diag), PD_OK);
+    /* One degree of freedom of two classes' worth of X^2 after one fitted
+     * parameter: the noise explains 2 * 1/2 = 1, so the dispersion is X^2
+     * itself, about 35.7 at theta = 0.3. */
+    const double pt[] = {theta[0], 0.5 * (1 - theta[0]), 0.5 * (1 - theta[0])};
+    CHECK_NEAR(w.dispersion, fit_chi2(3, c, pt), 1e-6, "alpha / nsim = 5e-16 relative");
+    CHECK(w.dispersion > 30);
+    /* The interval is widened by sqrt(35.7) = 6: the plain one (Beta(31, 71)
+     * again, 0.19 wide) would be at least 3 times narrower. */
+    CHECK(whi[0] - wlo[0] > 3 * 0.19);
+    pd_note("dispersion %.2f: interval [%.3f, %.3f]\n", w.dispersion, wlo[0], whi[0]);
 }
 
 /* A simulated model with common random numbers: S uniforms fixed for the
@@ -159,7 +202,7 @@ static void crn_fit(test_rng *rng, double truth, long n, int S, double *lo, doub
     fit_settings s = {150, 16};
     double theta[1], l, wmean[1], pb0[2], p0[2], l0[2], h0[2], nsb[1];
     double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
-    fit_weighed w = {lo, hi, wmean, pbb, nsb, pp, pl, ph, 0, 0, 0};
+    fit_weighed w = {lo, hi, wmean, pbb, nsb, pp, pl, ph, 0, 1, 0, 0};
     int evals = 0;
     pd_diag diag;
     pd_diag_init(&diag);
@@ -487,6 +530,7 @@ void suite_fit(void)
     test_likelihood_hand();
     test_beta_mixture();
     test_search_closed_form();
+    test_dispersion();
     test_coverage_crn();
     test_recovery();
     test_errors();
