@@ -25,6 +25,14 @@ command -v python3 >/dev/null 2>&1 || command -v jq >/dev/null 2>&1 || missing="
 # OpenMPI's compiler wrappers and launcher (make MPI=1).
 for arg in "$@"; do
     case "$arg" in
+    python)
+        # What `pip install ./python` builds with in a virtual environment
+        # (docs/python.md), asked of python3 itself, which need not be Debian's.
+        pkgs=""
+        python3 -c 'import ensurepip, os, sys, sysconfig
+sys.exit(not os.path.isfile(os.path.join(sysconfig.get_paths()["include"], "Python.h")))' \
+            2>/dev/null || pkgs="python3 python3-dev python3-venv"
+        ;;
     browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
     mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
     *) pkgs=$arg ;;

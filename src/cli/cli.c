@@ -291,7 +291,8 @@ typedef enum {
     ARG_WHOLE,   /* a whole number obeying rule */
     ARG_CHOICE,  /* one of choices */
     ARG_VEC3,    /* X,Y,Z, each a number obeying rule */
-    ARG_FILE,    /* a path */
+    ARG_INPUT,   /* a path the run reads */
+    ARG_OUTPUT,  /* a path the run writes: never the same file as another it reads or writes */
     ARG_TEXT,    /* a value apply() reads itself */
     ARG_SCENE    /* a scene setting: the library checks it by key, as in scene files */
 } arg_kind;
@@ -397,17 +398,17 @@ static const cli_option options[] = {
      "Needs N >= 10 (k+1); does not go with --ci. The uniform\n"
      "and resting drops are interleaved from the first drop, so\n"
      "an interrupted run has both in proportion"},
-    {OPT_SCENE, "scene", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_SCENE, "scene", ARG_INPUT, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
      "contact_time, each at most once; options given after it\n"
      "override it"},
-    {OPT_TRIALS, "trials", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
      "(pose 0: unsettled); with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
      "within it, numbered as without --group"},
-    {OPT_TRANSITIONS, "transitions", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
      "(numbered as in the output, classes with --group);\n"
@@ -428,15 +429,15 @@ static const cli_option options[] = {
     {OPT_VERBOSE, "verbose", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
      "a summary of the part (and of the drops) on stderr"},
     HEADING("pictures (docs/figures.md):"),
-    {OPT_SVG, "svg", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_SVG, "svg", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "gallery of the stable poses (classes with --group), SVG"},
-    {OPT_CHART, "chart", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_CHART, "chart", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "the estimates as grouped bars with 95% intervals, SVG"},
-    {OPT_SPHERE, "sphere", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_SPHERE, "sphere", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "gravity directions coloured by the pose QS ends in, SVG"},
-    {OPT_REPORT, "report", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_REPORT, "report", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one HTML file: part, gallery, chart, sphere, run"},
-    {OPT_MEASURED, "measured", ARG_FILE, "FILE", NO_RULE, NULL, NULL,
+    {OPT_MEASURED, "measured", ARG_INPUT, "FILE", NO_RULE, NULL, NULL,
      "a measured distribution shown beside the estimates: CSV\n"
      "with columns pose,count or pose,p[,n], numbered as the\n"
      "output (classes with --group)"},
@@ -709,6 +710,19 @@ static int ambiguous(const char *arg)
     return matches > 1;
 }
 
+/* Notes a file the run reads or writes. Every input given is read (each
+ * --scene in turn); an output given again replaces the earlier one, as only
+ * the last is written. option NULL: the PART file. */
+static void note_file(cli_args *a, const char *option, const char *path, int output)
+{
+    int i = 0;
+    while (output && i < a->nfiles && strcmp(a->files[i].what, option) != 0)
+        i++;
+    if (!output || i == a->nfiles)
+        i = a->nfiles++;
+    a->files[i] = (cli_file){option ? option : "PART", path, output, option != NULL};
+}
+
 /* Returns -1 to go on, or an exit code. */
 static int parse_args(int argc, char **argv, cli_args *a)
 {
@@ -731,6 +745,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
     memset(a, 0, sizeof *a);
     a->argc = argc;
     a->argv = argv;
+    /* Each file named takes at least one word of argv (the PART one more). */
+    if (!(a->files = calloc((size_t)argc + 1, sizeof *a->files))) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        return EXIT_INTERNAL;
+    }
     pd_mesh_read_options_default(&a->read);
     pd_part_options_default(&a->part);
     pd_static_options_default(&a->estimate);
@@ -756,11 +775,17 @@ static int parse_args(int argc, char **argv, cli_args *a)
                                   : "unknown option '%s'",
                               argv[optind - 1]);
         code = take(a, o, optarg);
+        if (code < 0 && (o->kind == ARG_INPUT || o->kind == ARG_OUTPUT))
+            note_file(a, o->name, optarg, o->kind == ARG_OUTPUT);
     }
     if (code >= 0)
         return code;
     if (optind != argc - 1)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
+    note_file(a, NULL, argv[optind], 0);
+    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE)
+        return fail_usage("%s", "--dt sets the time step of the ode and bullet engines only; the "
+                          "impulse engine (the default) has no step and would ignore it");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
     int stationary = a->scene.initial == PD_INITIAL_STATIONARY;
@@ -896,6 +921,9 @@ static double now(void)
 
 int cli_run(cli_args *a)
 {
+    /* Before anything is read for the run or written. */
+    if (cli_any(!cli_files_apart(a->files, a->nfiles)))
+        return EXIT_USAGE;
     int code;
     pd_diag diag;
     pd_diag_init(&diag);
@@ -944,6 +972,12 @@ int cli_run(cli_args *a)
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
     t_static = now() - t0;
+    /* A signal before the drops (or, without drops, before the output)
+     * ends the run here, nothing printed. */
+    if (st == PD_OK && cli_any(signals_caught())) {
+        code = cli_interrupt_code();
+        goto done;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
         t_sim = now() - t0 - t_static;
@@ -1033,6 +1067,9 @@ done:
 
 int main(int argc, char **argv)
 {
+    /* Before anything else: a signal in the first moments is caught, not
+     * left to the default action that ends the process unannounced. */
+    signals_install();
     cli_start(&argc, &argv);
     if (argc > 1 && strcmp(argv[1], "merge") == 0)
         return cli_end(cli_merge(argc - 1, argv + 1));
@@ -1040,5 +1077,8 @@ int main(int argc, char **argv)
         return cli_end(cli_fit(argc - 1, argv + 1));
     cli_args a;
     int code = parse_args(argc, argv, &a);
-    return cli_end(code >= 0 ? code : cli_run(&a));
+    if (code < 0)
+        code = cli_run(&a);
+    free(a.files);
+    return cli_end(code);
 }

@@ -13,6 +13,14 @@ enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
 
 extern const char *prog;
 
+/* A file the run reads (an input) or writes (an output), with what names it
+ * in messages: a long option's name (option 1: "trials" is shown "--trials")
+ * or a role ("PART", "shard"). */
+typedef struct {
+    const char *what, *path;
+    int output, option;
+} cli_file;
+
 typedef struct {
     const char *path, *trials, *transitions, *com_text;
     pd_mesh_read_options read;
@@ -27,6 +35,8 @@ typedef struct {
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;
     char **merge;                  /* posedrop merge: the shard files (NULL ended) */
+    cli_file *files;               /* every file named, for cli_files_apart (owned) */
+    int nfiles;
 } cli_args;
 
 /* The run after its options: read, estimate, drop (or merge), print. */
@@ -39,13 +49,18 @@ double cli_clean(double x);
 /* run.c / run_mpi.c. cli_start and cli_end wrap the whole program (MPI's
  * start and end); cli_simulate runs the drops (or sums the shards of a
  * merge); cli_writer says whether this process prints (MPI: rank 0 only);
- * cli_interrupt_code the exit code of a run stopped by a signal. */
+ * cli_interrupt_code (signals.c) the exit code of a run stopped by a
+ * signal. */
 void cli_start(int *argc, char ***argv);
 int cli_end(int code);
 pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_args *a,
                        pd_sim_result **sim, pd_diag *diag);
 int cli_writer(void);
 int cli_interrupt_code(void);
+/* Whether mine is true in this process (MPI: in any rank), so that a
+ * decision to stop that one rank makes (a signal, its standard output on an
+ * input) stops them all together. */
+int cli_any(int mine);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 
 /* A side file written to a temporary beside its path and renamed onto it
@@ -77,14 +92,23 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
 void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_static_result *res,
                 const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s);
 
-/* signals.c: SIGINT and SIGTERM set options->cancel: the drops in flight
- * finish and the result is marked partial; cli_interrupt_code is then
- * 128 + the signal's number (130, 143). */
+/* signals.c: signals_install, the first thing main does, catches SIGINT and
+ * SIGTERM (and unblocks them). signals_catch makes them set options->cancel:
+ * the drops in flight finish and the result is marked partial;
+ * cli_interrupt_code is then 128 + the signal's number (130, 143).
+ * signals_caught: whether one arrived in this process. */
+void signals_install(void);
 void signals_catch(pd_sim_options *options);
+int signals_caught(void);
 
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+
+/* same_file.c: 1 when no output is the same file as an input or as another
+ * output (standard output included when it is a regular file); otherwise 0,
+ * with a message naming both and the file. */
+int cli_files_apart(const cli_file *files, int n);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */

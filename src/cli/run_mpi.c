@@ -35,6 +35,14 @@ int cli_writer(void)
     return rank == 0;
 }
 
+int cli_any(int mine)
+{
+    int any = 0;
+    mine = mine != 0;
+    MPI_Allreduce(&mine, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    return any;
+}
+
 static double own_cpu_seconds(void)
 {
     struct timespec t;

@@ -655,11 +655,23 @@ int cli_merge(int argc, char **argv)
         ok = 0;
     }
     int code = EXIT_USAGE;
+    /* The shards and their part are inputs; --transitions the one output. */
+    if (ok && !(a.files = calloc((size_t)nshard_files + 2, sizeof *a.files))) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        code = EXIT_INTERNAL;
+        ok = 0;
+    }
     if (ok) {
+        for (int i = 0; i < nshard_files; i++)
+            a.files[a.nfiles++] = (cli_file){"shard", argv[optind + i], 0, 0};
+        a.files[a.nfiles++] = (cli_file){"the shards' part", path, 0, 0};
+        if (a.transitions)
+            a.files[a.nfiles++] = (cli_file){"transitions", a.transitions, 1, 1};
         a.dynamic = 1;
         a.merge = argv + optind;
         code = cli_run(&a);
     }
+    free(a.files);
     free_shards();
     return code;
 }

@@ -1,5 +1,7 @@
 /* signals.c: a long run stopped by SIGINT (Ctrl-C) or SIGTERM (a batch
- * system's time limit, kill) still prints the drops done, marked partial. */
+ * system's time limit, kill) still prints the drops done, marked partial;
+ * one that arrives before the drops start stops the run with nothing
+ * printed. */
 #include <signal.h>
 #include <string.h>
 #include "cli/cli.h"
@@ -13,14 +15,30 @@ static void on_signal(int sig)
     atomic_store(&caught, sig);
 }
 
-void signals_catch(pd_sim_options *options)
+void signals_install(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigaction(SIGINT, &sa, NULL);
     sigaction(SIGTERM, &sa, NULL);
+    /* A parent may start the command with them blocked, one already
+     * pending: taken now, it is caught like any later one. */
+    sigset_t set;
+    sigemptyset(&set);
+    sigaddset(&set, SIGINT);
+    sigaddset(&set, SIGTERM);
+    sigprocmask(SIG_UNBLOCK, &set, NULL);
+}
+
+void signals_catch(pd_sim_options *options)
+{
     options->cancel = &caught;
+}
+
+int signals_caught(void)
+{
+    return atomic_load(&caught) != 0;
 }
 
 int cli_interrupt_code(void)

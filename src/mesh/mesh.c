@@ -1,12 +1,14 @@
 /* mesh.c: units, reading a mesh file whole, telling its format, and the small
  * operations on a pd_mesh (clone, size, free). */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include "mesh/mesh_internal.h"
 #include "mesh/mesh_reader.h"
 #include "posedrop/mesh.h"
@@ -66,42 +68,82 @@ static pd_mesh_format by_extension(const char *name)
     return PD_FORMAT_AUTO;
 }
 
-static pd_mesh_format by_content(const unsigned char *d, size_t size)
+/* d holds the first n bytes of a file of size bytes (all of it, or the head
+ * pd_mesh_read checks first). */
+static pd_mesh_format by_content(const unsigned char *d, size_t n, size_t size)
 {
     /* Binary STL has no magic number; its size formula is the signature. */
-    if (size >= 84) {
-        uint32_t n = (uint32_t)d[80] | (uint32_t)d[81] << 8 | (uint32_t)d[82] << 16 |
-                     (uint32_t)d[83] << 24;
-        if (84 + 50 * (uint64_t)n == size && pd_stl_is_binary(d, size))
+    if (n >= 84) {
+        uint32_t count = (uint32_t)d[80] | (uint32_t)d[81] << 8 | (uint32_t)d[82] << 16 |
+                         (uint32_t)d[83] << 24;
+        if (84 + 50 * (uint64_t)count == size)
             return PD_FORMAT_STL;
     }
     /* The first word of the text, past '#' comments (which STL lacks, but its
      * first word "solid" is on a line without one). */
     pd_text t;
-    pd_text_init(&t, d, size, "", '#', 0);
+    pd_text_init(&t, d, n, "", '#', 0);
     const char *s;
-    size_t n;
-    if (pd_text_token_any(&t, &s, &n)) {
-        if (pd_off_is_keyword(s, n))
+    size_t len;
+    if (pd_text_token_any(&t, &s, &len)) {
+        if (pd_off_is_keyword(s, len))
             return PD_FORMAT_OFF;
-        if (pd_text_is(s, n, "solid"))
+        if (pd_stl_is_solid(s, len))
             return PD_FORMAT_STL;
-        if (pd_obj_is_keyword(s, n))
+        if (pd_obj_is_keyword(s, len))
             return PD_FORMAT_OBJ;
     }
     return PD_FORMAT_AUTO;
 }
 
-static pd_mesh_format detect(const unsigned char *d, size_t size, const char *name)
+static pd_mesh_format detect(const unsigned char *d, size_t n, size_t size, const char *name)
 {
-    pd_mesh_format f = by_content(d, size);
+    pd_mesh_format f = by_content(d, n, size);
     if (f == PD_FORMAT_AUTO)
         f = by_extension(name);
     /* Bytes no text format contains: the only binary format read is STL, so
      * a damaged one gets STL's message (a size that does not add up). */
-    if (f == PD_FORMAT_AUTO && size > 0 && memchr(d, 0, size < 84 ? size : 84))
+    if (f == PD_FORMAT_AUTO && n > 0 && memchr(d, 0, n < 84 ? n : 84))
         f = PD_FORMAT_STL;
     return f;
+}
+
+static pd_status unknown_format(size_t size, const char *name, pd_diag *diag)
+{
+    if (size == 0)
+        return pd_fail(diag, PD_ERR_FORMAT,
+                       "%s: empty file of unknown format (name it .off, .stl or .obj)", name);
+    return pd_fail(diag, PD_ERR_FORMAT,
+                   "%s: unknown format: neither OFF, STL nor OBJ (use --format to say which)",
+                   name);
+}
+
+/* The first n bytes of a file of size bytes: what each reader checks first,
+ * refused here as the whole file's reading would refuse it. */
+static pd_status check_head(const unsigned char *head, size_t n, size_t size, const char *name,
+                            pd_mesh_format f, pd_diag *diag)
+{
+    if (f == PD_FORMAT_AUTO) {
+        f = detect(head, n, size, name);
+        /* Unknown by its first word: the rest cannot change that (unless
+         * the head holds no word at all). */
+        pd_text t;
+        pd_text_init(&t, head, n, "", '#', 0);
+        const char *s;
+        size_t len;
+        if (f == PD_FORMAT_AUTO && pd_text_token_any(&t, &s, &len))
+            return unknown_format(size, name, diag);
+    }
+    switch (f) {
+    case PD_FORMAT_OFF:
+        return pd_off_check_head((const char *)head, n, name, diag);
+    case PD_FORMAT_OBJ:
+        return pd_obj_check_head((const char *)head, n, name, diag);
+    case PD_FORMAT_STL:
+        return pd_stl_check_head(head, n, size, name, diag);
+    default:
+        return PD_OK;
+    }
 }
 
 /* --- reading ---------------------------------------------------------------- */
@@ -122,7 +164,7 @@ pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
     const unsigned char *d = data;
     pd_mesh_format f = options->format;
     if (f == PD_FORMAT_AUTO)
-        f = detect(d, size, name);
+        f = detect(d, size, size, name);
     switch (f) {
     case PD_FORMAT_OFF:
         return pd_off_read((const char *)d, size, name, scale, mesh, diag);
@@ -134,34 +176,44 @@ pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
     default:
         break;
     }
-    if (size == 0)
-        return pd_fail(diag, PD_ERR_FORMAT,
-                       "%s: empty file of unknown format (name it .off, .stl or .obj)", name);
-    return pd_fail(diag, PD_ERR_FORMAT,
-                   "%s: unknown format: neither OFF, STL nor OBJ (use --format to say which)",
-                   name);
+    return unknown_format(size, name, diag);
 }
 
+/* The bytes read first from a regular file, before the rest: far more than
+ * any reader's header or first keyword, and the window in which ASCII STL's
+ * structure is looked for (16 KiB). */
+#define HEAD_BYTES ((size_t)1 << 16)
+
 /* Reads the whole file, up to max bytes; works for pipes too, which have no
- * size to ask for. */
-static pd_status slurp(FILE *f, const char *path, size_t max, unsigned char **out, size_t *size,
-                       pd_diag *diag)
+ * size to ask for. A regular file larger than its head has its head checked
+ * (check_head) before the rest is read. */
+static pd_status slurp(int fd, const char *path, size_t max, pd_mesh_format format,
+                       unsigned char **out, size_t *size, pd_diag *diag)
 {
     struct stat sb;
-    int fd = fileno(f);
-    if (fstat(fd, &sb) == 0) {
-        if (S_ISDIR(sb.st_mode))
-            return pd_fail(diag, PD_ERR_IO, "%s: is a directory, not a mesh file", path);
-        /* A regular file's size is known: refuse it before reading. */
-        if (S_ISREG(sb.st_mode) && (uintmax_t)sb.st_size > max)
-            return pd_fail(diag, PD_ERR_RANGE, "%s: %jd bytes; posedrop reads mesh files of at "
-                           "most %zu bytes", path, (intmax_t)sb.st_size, max);
-    }
-    size_t cap = 1 << 16, n = 0;
+    if (fstat(fd, &sb) != 0)
+        return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
+    if (S_ISDIR(sb.st_mode))
+        return pd_fail(diag, PD_ERR_IO, "%s: is a directory, not a mesh file", path);
+    int regular = S_ISREG(sb.st_mode);
+    /* A regular file's size is known: refuse it before reading. */
+    if (regular && (uintmax_t)sb.st_size > max)
+        return pd_fail(diag, PD_ERR_RANGE, "%s: %jd bytes; posedrop reads mesh files of at "
+                       "most %zu bytes", path, (intmax_t)sb.st_size, max);
+    size_t cap = HEAD_BYTES, n = 0;
+    int head_checked = !regular || (size_t)sb.st_size <= HEAD_BYTES;
     unsigned char *buf = malloc(cap);
     if (!buf)
         return pd_fail(diag, PD_ERR_NOMEM, "%s: out of memory", path);
     for (;;) {
+        if (n == cap && !head_checked) {
+            pd_status st = check_head(buf, n, (size_t)sb.st_size, path, format, diag);
+            if (st != PD_OK) {
+                free(buf);
+                return st;
+            }
+            head_checked = 1;
+        }
         if (n == cap) {
             if (n > max) {
                 free(buf);
@@ -179,17 +231,22 @@ static pd_status slurp(FILE *f, const char *path, size_t max, unsigned char **ou
             buf = q;
             cap = next;
         }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0) {
-            if (ferror(f)) {
-                int err = errno;
-                free(buf);
-                return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path,
-                               err ? strerror(err) : "read error");
-            }
-            break;
+        ssize_t got = read(fd, buf + n, cap - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            int err = errno;
+            free(buf);
+            return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(err));
         }
+        if (got == 0)
+            break;
+        n += (size_t)got;
+    }
+    if (n == 0 && S_ISFIFO(sb.st_mode)) {
+        free(buf);
+        return pd_fail(diag, PD_ERR_IO, "%s: a named pipe that gave nothing to read (no "
+                       "program was writing to it)", path);
     }
     *out = buf;
     *size = n;
@@ -201,16 +258,22 @@ pd_status pd_mesh_read_capped(const char *path, const pd_mesh_read_options *opti
 {
     if (!path || !mesh)
         return pd_fail(diag, PD_ERR_USAGE, "pd_mesh_read: NULL %s", path ? "mesh" : "path");
-    errno = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return pd_fail(diag, PD_ERR_IO, "%s: cannot open: %s", path,
-                       errno ? strerror(errno) : "unknown error");
+    /* Without O_NONBLOCK, opening a named pipe waits for a writer, for ever
+     * if none comes; once open, reads wait for data as usual. */
+    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    if (fd < 0)
+        return pd_fail(diag, PD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
+    int flags = fcntl(fd, F_GETFL);
+    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) < 0) {
+        int err = errno;
+        close(fd);
+        return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(err));
+    }
     unsigned char *data = NULL;
     size_t size = 0;
-    errno = 0;
-    pd_status st = slurp(f, path, max_bytes, &data, &size, diag);
-    fclose(f);
+    pd_mesh_format format = options ? options->format : PD_FORMAT_AUTO;
+    pd_status st = slurp(fd, path, max_bytes, format, &data, &size, diag);
+    close(fd);
     if (st != PD_OK)
         return st;
     st = pd_mesh_parse(data, size, path, options, mesh, diag);

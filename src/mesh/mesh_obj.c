@@ -4,8 +4,9 @@
  * corners are checked for form and ignored; so are the lines for texture
  * coordinates, normals, groups, smoothing, materials and free-form geometry.
  * The optional w of "v x y z w" is ignored: it weights rational curves, and
- * some exporters put other data there, so dividing by it would move vertices
- * for no gain. */
+ * some exporters put other data there (a colour), so dividing by it would
+ * move vertices for no gain. Like OFF's extra vertex data it must be numbers
+ * (pd_vertex_rest). */
 #include <string.h>
 #include "mesh/mesh_reader.h"
 #include "posedrop/tolerances.h"
@@ -122,11 +123,33 @@ static pd_status read_vertex(pd_text *t, pd_diag *diag, double scale, pd_build *
         st = pd_text_coord(t, diag, "a y coordinate", scale, &v.y);
     if (st == PD_OK)
         st = pd_text_coord(t, diag, "a z coordinate", scale, &v.z);
+    if (st == PD_OK)
+        st = pd_vertex_rest(t, diag);
     if (st == PD_OK && (st = pd_build_vert(b, v)) != PD_OK)
         return st == PD_ERR_RANGE
                    ? pd_text_fail(t, diag, st, "more than %d vertices", PD_MAX_ELEMENTS)
                    : pd_text_fail(t, diag, st, "out of memory");
     return st;
+}
+
+/* A line's first word that is no OBJ keyword nor could be an exporter's. */
+static pd_status not_keyword(pd_text *t, pd_diag *diag, const char *s, size_t n)
+{
+    char shown[48];
+    return pd_text_fail(t, diag, PD_ERR_PARSE, "expected an OBJ keyword, found %s",
+                        pd_text_show(shown, sizeof shown, s, n));
+}
+
+pd_status pd_obj_check_head(const char *head, size_t n, const char *name, pd_diag *diag)
+{
+    pd_text t;
+    pd_text_init(&t, head, n, name, '#', 1);
+    const char *s;
+    size_t len;
+    if (!pd_text_next_line(&t) || !pd_text_token(&t, &s, &len) ||
+        pd_obj_is_keyword(s, len) || looks_like_keyword(s, len))
+        return PD_OK;
+    return not_keyword(&t, diag, s, len);
 }
 
 pd_status pd_obj_read(const char *data, size_t size, const char *name, double scale,
@@ -136,7 +159,6 @@ pd_status pd_obj_read(const char *data, size_t size, const char *name, double sc
     pd_text_init(&t, data, size, name, '#', 1);
     pd_build b = {0};
     pd_status st = PD_OK;
-    char shown[48];
     while (st == PD_OK && pd_text_next_line(&t)) {
         const char *s;
         size_t n;
@@ -146,8 +168,7 @@ pd_status pd_obj_read(const char *data, size_t size, const char *name, double sc
         else if (n == 1 && s[0] == 'f')
             st = read_face(&t, diag, &b);
         else if (!is_ignored(s, n) && !looks_like_keyword(s, n))
-            st = pd_text_fail(&t, diag, PD_ERR_PARSE, "expected an OBJ keyword, found %s",
-                              pd_text_show(shown, sizeof shown, s, n));
+            st = not_keyword(&t, diag, s, n);
     }
     if (st == PD_OK && b.ntris == 0)
         st = pd_fail(diag, PD_ERR_PARSE, "%s: no faces (OBJ without 'f' lines)", name);

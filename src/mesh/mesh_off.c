@@ -2,7 +2,9 @@
  *
  * Records are lines: a vertex line starts with its three coordinates and a
  * face line with its vertex count and indices; whatever follows (colours,
- * normals, texture coordinates) is ignored. '#' starts a comment anywhere. */
+ * normals, texture coordinates) is ignored, but a vertex line's extra
+ * tokens must be numbers (pd_vertex_rest, as in OBJ). '#' starts a comment
+ * anywhere. */
 #include <string.h>
 #include "mesh/mesh_reader.h"
 #include "posedrop/tolerances.h"
@@ -57,17 +59,43 @@ static pd_status read_count(pd_text *t, pd_diag *diag, int any_line, const char 
     return PD_OK;
 }
 
+/* The header keyword, the first token of the file. */
+static pd_status header_keyword(pd_text *t, pd_diag *diag, off_kind *kind)
+{
+    const char *s;
+    size_t n;
+    char shown[48];
+    if (!pd_text_token_any(t, &s, &n))
+        return pd_fail(diag, PD_ERR_PARSE, "%s: expected OFF header, found an empty file", t->name);
+    if (!parse_keyword(s, n, kind))
+        return pd_text_fail(t, diag, PD_ERR_PARSE, "expected OFF header, found %s",
+                            pd_text_show(shown, sizeof shown, s, n));
+    return PD_OK;
+}
+
+pd_status pd_off_check_head(const char *head, size_t n, const char *name, pd_diag *diag)
+{
+    pd_text t;
+    pd_text_init(&t, head, n, name, '#', 0);
+    pd_text probe = t;
+    const char *s;
+    size_t len;
+    off_kind kind;
+    /* No token yet (a head of comments): the rest decides. */
+    if (!pd_text_token_any(&probe, &s, &len))
+        return PD_OK;
+    return header_keyword(&t, diag, &kind);
+}
+
 static pd_status read_header(pd_text *t, pd_diag *diag, long long *nv, long long *nf)
 {
     const char *s;
     size_t n;
     char shown[48];
     off_kind kind;
-    if (!pd_text_token_any(t, &s, &n))
-        return pd_fail(diag, PD_ERR_PARSE, "%s: expected OFF header, found an empty file", t->name);
-    if (!parse_keyword(s, n, &kind))
-        return pd_text_fail(t, diag, PD_ERR_PARSE, "expected OFF header, found %s",
-                            pd_text_show(shown, sizeof shown, s, n));
+    pd_status hst = header_keyword(t, diag, &kind);
+    if (hst != PD_OK)
+        return hst;
     if (kind.four)
         return pd_text_fail(t, diag, PD_ERR_FORMAT,
                             "4OFF (4-D homogeneous vertices) is not supported, only 3-D OFF");
@@ -138,6 +166,9 @@ static pd_status read_vertex(pd_text *t, pd_diag *diag, double scale, pd_vec3 *v
                                 "smallest normal double, 2.2e-308",
                                 pd_text_show(shown, sizeof shown, s, n));
     }
+    pd_status st = pd_vertex_rest(t, diag);
+    if (st != PD_OK)
+        return st;
     /* Scales are at most 1 (metres per unit), so scaling cannot overflow. */
     v->x = c[0] * scale;
     v->y = c[1] * scale;

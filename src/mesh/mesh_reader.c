@@ -181,3 +181,24 @@ void pd_vmap_free(pd_vmap *m)
     free(m->slot);
     m->slot = NULL;
 }
+
+/* --- vertex lines -------------------------------------------------------------- */
+
+pd_status pd_vertex_rest(pd_text *t, pd_diag *diag)
+{
+    const char *s;
+    size_t n;
+    char shown[48];
+    while (pd_text_token(t, &s, &n)) {
+        double ignored;
+        int rc = pd_parse_double(s, n, &ignored);
+        if (rc == PD_NUM_BAD)
+            return pd_text_fail(t, diag, PD_ERR_PARSE, "expected a number after the vertex's "
+                                "coordinates (a colour, weight or normal), found %s",
+                                pd_text_show(shown, sizeof shown, s, n));
+        if (rc == PD_NUM_NONFINITE)
+            return pd_text_fail(t, diag, PD_ERR_NONFINITE, "non-finite number %s after the "
+                                "vertex's coordinates", pd_text_show(shown, sizeof shown, s, n));
+    }
+    return PD_OK;
+}

@@ -58,14 +58,37 @@ pd_status pd_vmap_init(pd_vmap *m, size_t expected);
 int pd_vmap_find_or_add(pd_vmap *m, const pd_vec3 *verts, int i);
 void pd_vmap_free(pd_vmap *m);
 
+/* --- vertex lines -------------------------------------------------------------- */
+
+/* The rest of a vertex line after its three coordinates: OFF's colour,
+ * normal and texture coordinates, OBJ's weight or colour, all numbers the
+ * readers ignore. One rule for both formats: each must read as a finite
+ * number (base/number.c), or the line is refused with its token ('abc',
+ * 'nan', '1e999'), as a bad coordinate is. */
+pd_status pd_vertex_rest(pd_text *t, pd_diag *diag);
+
 /* --- readers ------------------------------------------------------------------ */
 
 /* 1 if the token is an OFF header keyword ([ST][C][N][4][n]OFF). */
 int pd_off_is_keyword(const char *s, size_t n);
 /* 1 if the token is a keyword that starts OBJ lines (v, f, vt, g, ...). */
 int pd_obj_is_keyword(const char *s, size_t n);
+/* 1 if the token is "solid", also with a UTF-8 byte-order mark glued to it
+ * (one after a comment line, where the text cursor does not skip it). */
+int pd_stl_is_solid(const char *s, size_t n);
 /* 1 if the data must be read as binary STL rather than ASCII. */
 int pd_stl_is_binary(const unsigned char *data, size_t size);
+
+/* The checks each reader makes first, on the first n bytes (head) of a file
+ * of size bytes, so that a file whose start is already wrong (1 GiB of NUL
+ * bytes) is refused without reading the rest: OFF's header keyword, OBJ's
+ * first keyword, binary STL's triangle count against the size. Each refuses
+ * only what the whole file's reading would refuse, with the same message;
+ * PD_OK otherwise (the rest is then read). */
+pd_status pd_off_check_head(const char *head, size_t n, const char *name, pd_diag *diag);
+pd_status pd_obj_check_head(const char *head, size_t n, const char *name, pd_diag *diag);
+pd_status pd_stl_check_head(const unsigned char *head, size_t n, size_t size, const char *name,
+                            pd_diag *diag);
 
 /* Each reads the whole input, scaling coordinates by scale. On failure *mesh
  * is untouched and diag says what and where. */

@@ -28,6 +28,15 @@ static double le_float(const unsigned char *p)
     return (double)f;
 }
 
+int pd_stl_is_solid(const char *s, size_t n)
+{
+    if (n > 3 && memcmp(s, "\xEF\xBB\xBF", 3) == 0) {
+        s += 3;
+        n -= 3;
+    }
+    return pd_text_is(s, n, "solid");
+}
+
 static int starts_with_solid(const unsigned char *d, size_t size)
 {
     size_t i = 0;
@@ -51,12 +60,43 @@ static int has_ascii_structure(const unsigned char *d, size_t size)
     const char *s;
     size_t n;
     while (pd_text_next_line(&t) && pd_text_token(&t, &s, &n)) {
-        if (pd_text_is(s, n, "solid"))
+        if (pd_stl_is_solid(s, n))
             solid = 1;
         else if (solid && (pd_text_is(s, n, "facet") || pd_text_is(s, n, "endsolid")))
             return 1;
     }
     return 0;
+}
+
+/* What a file that is not binary STL looks like, for the messages: NULL
+ * when its first bytes hold a byte no text has (a NUL or another control
+ * byte: binary data), else by its first word past '#' comment lines:
+ * "ASCII STL", "OFF", "OBJ" or "text". Bytes 80-83 of text make a triangle
+ * count of at least 0x09090909, beyond PD_MAX_ELEMENTS, so no valid binary
+ * STL passes for text here. */
+static const char *text_kind(const unsigned char *d, size_t size)
+{
+    enum { LOOK = 4096 };
+    size_t look = size < LOOK ? size : LOOK;
+    if (look == 0)
+        return NULL;
+    for (size_t i = 0; i < look; i++)
+        if (d[i] < 0x20 && d[i] != '\t' && d[i] != '\n' && d[i] != '\v' && d[i] != '\f' &&
+            d[i] != '\r')
+            return NULL;
+    pd_text t;
+    pd_text_init(&t, d, size, "", '#', 0);
+    const char *s;
+    size_t n;
+    if (!pd_text_token_any(&t, &s, &n))
+        return "text";
+    if (pd_stl_is_solid(s, n))
+        return "ASCII STL";
+    if (pd_off_is_keyword(s, n))
+        return "OFF";
+    if (pd_obj_is_keyword(s, n))
+        return "OBJ";
+    return "text";
 }
 
 int pd_stl_is_binary(const unsigned char *data, size_t size)
@@ -69,8 +109,10 @@ int pd_stl_is_binary(const unsigned char *data, size_t size)
      * bytes, or one with ASCII STL's structure. */
     if (size >= COUNT_END && COUNT_END + (uint64_t)RECORD * le32(data + HEADER) == size)
         return 1;
+    const char *kind;
     int text = (starts_with_solid(data, size) && memchr(data, 0, size) == NULL) ||
-               has_ascii_structure(data, size);
+               has_ascii_structure(data, size) ||
+               ((kind = text_kind(data, size)) != NULL && strcmp(kind, "ASCII STL") == 0);
     return !text;
 }
 
@@ -90,14 +132,26 @@ static int add_corner(pd_build *b, pd_vmap *map, pd_vec3 v, pd_status *st)
     return i;
 }
 
-static pd_status read_binary(const unsigned char *d, size_t size, const char *name, double scale,
-                             pd_build *b, pd_vmap *map, pd_diag *diag)
+/* Binary STL's header against the file's size: the first 84 bytes and the
+ * size are all it reads, so a file's start can be checked before the rest
+ * of it is read (pd_stl_check_head). Text that is no ASCII STL (an OBJ or
+ * OFF file given as STL, text without "solid") is named for what it looks
+ * like instead of read as a triangle count. */
+static pd_status binary_header(const unsigned char *d, size_t avail, size_t size,
+                               const char *name, pd_diag *diag, uint32_t *count)
 {
+    const char *kind = text_kind(d, avail);
+    int fits = size >= COUNT_END && COUNT_END + (uint64_t)RECORD * le32(d + HEADER) == size;
+    if (kind && !fits)
+        return pd_fail(diag, PD_ERR_FORMAT,
+                       "%s: does not look like binary STL (%zu bytes of text, not 84 plus 50 per "
+                       "triangle) nor like ASCII STL (no 'solid' line first): it looks like %s",
+                       name, size, strcmp(kind, "text") == 0 ? "text of no mesh format" : kind);
     if (size < COUNT_END)
         return pd_fail(diag, PD_ERR_PARSE,
                        "%s: truncated binary STL: %zu bytes, the header alone needs %d", name,
                        size, COUNT_END);
-    uint32_t n = le32(d + HEADER);
+    uint32_t n = *count = le32(d + HEADER);
     if (n > PD_MAX_ELEMENTS)
         return pd_fail(diag, PD_ERR_RANGE,
                        "%s: binary STL declares %lu triangles; the limit is %d", name,
@@ -111,8 +165,32 @@ static pd_status read_binary(const unsigned char *d, size_t size, const char *na
                        (unsigned long long)COUNT_END + (unsigned long long)RECORD * n, size, have);
     if (n == 0)
         return pd_fail(diag, PD_ERR_PARSE, "%s: no faces (binary STL with 0 triangles)", name);
+    return PD_OK;
+}
+
+pd_status pd_stl_check_head(const unsigned char *head, size_t n, size_t size, const char *name,
+                            pd_diag *diag)
+{
+    /* Only a start that both the head and the whole file send to the binary
+     * reader: a NUL byte among the first bytes (never text), without ASCII
+     * STL's structure (looked for in a window the head holds). */
+    enum { LOOK = 4096 };
+    if (n < COUNT_END || COUNT_END + (uint64_t)RECORD * le32(head + HEADER) == size ||
+        !memchr(head, 0, n < LOOK ? n : LOOK) || has_ascii_structure(head, n))
+        return PD_OK;
+    uint32_t count;
+    return binary_header(head, n, size, name, diag, &count);
+}
+
+static pd_status read_binary(const unsigned char *d, size_t size, const char *name, double scale,
+                             pd_build *b, pd_vmap *map, pd_diag *diag)
+{
+    uint32_t n;
+    pd_status st = binary_header(d, size, size, name, diag, &n);
+    if (st != PD_OK)
+        return st;
     /* A closed mesh has about half as many vertices as triangles. */
-    pd_status st = pd_build_reserve(b, n / 2 + 3, n);
+    st = pd_build_reserve(b, n / 2 + 3, n);
     if (st == PD_OK)
         st = pd_vmap_init(map, n / 2 + 3);
     if (st != PD_OK)
@@ -219,7 +297,7 @@ static pd_status read_ascii(const unsigned char *d, size_t size, const char *nam
     char shown[48];
     /* One or more solids, each "solid [name]" ... "endsolid [name]". */
     while (pd_text_token_any(&t, &s, &n)) {
-        if (!pd_text_is(s, n, "solid"))
+        if (!pd_stl_is_solid(s, n))
             return pd_text_fail(&t, diag, PD_ERR_PARSE, "expected 'solid'%s, found %s",
                                 b->ntris ? " or end of file" : "",
                                 pd_text_show(shown, sizeof shown, s, n));

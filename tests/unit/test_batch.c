@@ -94,6 +94,17 @@ static const char *shard(const char *name, const char *args)
     return path[n++ % 8];
 }
 
+/* A copy of a shipped part in the scratch directory, at path. */
+static void copy_part(const char *from, const char *name, char *path, size_t size)
+{
+    char cmd[512], *out, *err;
+    snprintf(path, size, "%s/%s", tmpdir, name);
+    snprintf(cmd, sizeof cmd, "cp %s %s", from, path);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+}
+
 static void expect_merge_failure(const char *a, const char *b, const char *mention)
 {
     char cmd[512];
@@ -125,11 +136,7 @@ static void test_merge_refusals(void)
 
     /* The part changed after the shards ran. */
     char part[128];
-    snprintf(part, sizeof part, "%s/moved.off", tmpdir);
-    snprintf(cmd, sizeof cmd, "cp parts/cap.off %s", part);
-    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
-    free(out);
-    free(err);
+    copy_part("parts/cap.off", "moved.off", part, sizeof part);
     snprintf(cmd, sizeof cmd, "-n 20 --shard 1/1 %s", part);
     const char *moved = shard("moved", cmd);
     snprintf(cmd, sizeof cmd, "(echo '# touched' >>%s)", part);
@@ -149,6 +156,45 @@ static void test_merge_refusals(void)
     expect_failure("--shard 1/2 --svg /tmp/posedrop-never.svg -n 10 parts/cap.off", 2, "pictures");
     expect_failure("merge", 2, "expected the shard files");
     expect_failure("merge --format xml x", 2, "--format");
+}
+
+/* merge writes no output onto its inputs: --transitions onto a shard, onto
+ * the shards' part or onto merge's own standard output; each file stays as
+ * it was, byte for byte, and nothing is printed. */
+static void test_merge_same_file(void)
+{
+    char part[128], args[512], cmd[1024], *out, *err;
+    copy_part(BOX, "box.off", part, sizeof part);
+    snprintf(args, sizeof args, "-n 140 --initial stationary --shard 1/2 %s", part);
+    const char *t1 = shard("st1", args);
+    snprintf(args, sizeof args, "-n 140 --initial stationary --shard 2/2 %s", part);
+    const char *t2 = shard("st2", args);
+    char *shard1 = slurp(t1), *box = slurp(part);
+    snprintf(args, sizeof args, "merge --transitions %s %s %s", t1, t1, t2);
+    expect_failure(args, 2, "is the same file as shard");
+    snprintf(args, sizeof args, "merge --transitions %s %s %s", part, t1, t2);
+    expect_failure(args, 2, "is the same file as the shards' part");
+    snprintf(cmd, sizeof cmd, "sh -c '" PD_CLI_PATH " merge --transitions %s/tm2.csv %s %s >>%s'",
+             tmpdir, t1, t2, t1);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 2);
+    CHECK(strstr(err, "standard output") != NULL);
+    free(out);
+    free(err);
+    char *now1 = slurp(t1), *now_box = slurp(part);
+    CHECK(shard1 && now1 && strcmp(shard1, now1) == 0);
+    CHECK(box && now_box && strcmp(box, now_box) == 0);
+    free(shard1);
+    free(now1);
+    free(box);
+    free(now_box);
+    /* posedrop-mpi shares the check. */
+    if (access(PD_CLI_MPI_PATH, X_OK) == 0) {
+        snprintf(args, sizeof args, PD_CLI_MPI_PATH " -n 5 --trials %s %s", part, part);
+        CHECK_INT(run_cmd(args, 1, &out, &err), 2);
+        CHECK(out[0] == '\0' && strstr(err, "is the same file as PART") != NULL);
+        free(out);
+        free(err);
+    }
 }
 
 /* SIGTERM stops a run as SIGINT does: the drops done are printed, marked
@@ -371,6 +417,7 @@ void suite_batch(void)
     test_merge_equals_run();
     test_side_files();
     test_merge_refusals();
+    test_merge_same_file();
     test_sigterm();
     test_progress();
     test_json();

@@ -2,6 +2,7 @@
  * stdout only on success, clear messages on stderr, determinism, and the batch
  * scripts. Runs the built binary (PD_CLI_PATH) from the repository root. */
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -376,6 +377,148 @@ static void test_output_paths(void)
     free(err);
 }
 
+/* A hard (soft 0) or symbolic link to path at name. */
+static int link_file_ok(const char *path, const char *name, int soft)
+{
+    char real[4096];
+    if (!soft)
+        return link(path, name) == 0;
+    return realpath(path, real) && symlink(real, name) == 0;
+}
+
+/* A refused run that names path as an output: exit 2, nothing on stdout, a
+ * message naming both files, and path as it was, byte for byte (or still
+ * absent, when want is NULL). */
+static void expect_kept(const char *args, const char *path, const char *want, const char *mention)
+{
+    expect_failure(args, 2, mention);
+    char *now = slurp(path);
+    CHECK(want ? now && strcmp(now, want) == 0 : now == NULL);
+    free(now);
+}
+
+/* An output never overwrites an input, nor another output: the part, a scene
+ * or measured file, by the same name, another spelling, a hard or symbolic
+ * link; two outputs on one name (existing or not); standard output
+ * redirected onto an output. Devices may be named twice. */
+static void test_same_file(void)
+{
+    char part[160], scene[160], measured[160], link[160], name[160], args[1024], cmd[1024];
+    char *cube = slurp("parts/canonical/cube.off"), *out, *err;
+    snprintf(part, sizeof part, "%s/c.off", tmpdir);
+    snprintf(scene, sizeof scene, "%s/s.scene", tmpdir);
+    snprintf(measured, sizeof measured, "%s/m.csv", tmpdir);
+    CHECK(cube && write_file(part, cube));
+    CHECK(write_file(scene, "mu = 0.4\n") && write_file(measured, "pose,count\n1,5\n"));
+    const char *opts[] = {"-n 5 --trials", "-n 5 --svg", "--chart", "--sphere", "--report",
+                          "-n 140 --initial stationary --transitions"};
+    for (int i = 0; i < 6; i++) {
+        snprintf(args, sizeof args, "%s %s %s", opts[i], part, part);
+        expect_kept(args, part, cube, "is the same file as PART");
+    }
+    snprintf(args, sizeof args, "-n 5 --scene %s --trials %s %s", scene, scene, part);
+    expect_kept(args, scene, "mu = 0.4\n", "--trials");
+    snprintf(args, sizeof args, "--measured %s --chart %s %s", measured, measured, part);
+    expect_kept(args, measured, "pose,count\n1,5\n", "is the same file as --measured");
+    /* Another spelling of the same name, a hard link and a symbolic link. */
+    snprintf(args, sizeof args, "--svg %s/../%s/c.off %s", tmpdir, strrchr(tmpdir, '/') + 1, part);
+    expect_kept(args, part, cube, "is the same file as PART");
+    snprintf(link, sizeof link, "%s/hard.off", tmpdir);
+    CHECK(link_file_ok(part, link, 0));
+    snprintf(args, sizeof args, "-n 5 --trials %s %s", link, part);
+    expect_kept(args, part, cube, "is the same file as PART");
+    snprintf(link, sizeof link, "%s/soft.off", tmpdir);
+    CHECK(link_file_ok(part, link, 1));
+    snprintf(args, sizeof args, "--svg %s %s", link, part);
+    expect_kept(args, part, cube, "is the same file as PART");
+    /* Two outputs on one name: nothing is written, whether it exists or not. */
+    snprintf(name, sizeof name, "%s/x", tmpdir);
+    snprintf(args, sizeof args, "-n 5 --trials %s --svg %s %s", name, name, part);
+    expect_kept(args, name, NULL, "--trials");
+    CHECK(write_file(name, "mine\n"));
+    snprintf(args, sizeof args, "--chart %s --report %s/./x %s", name, tmpdir, part);
+    expect_kept(args, name, "mine\n", "two outputs may not share a file");
+    /* Standard output onto an output. */
+    snprintf(cmd, sizeof cmd, "sh -c '" PD_CLI_PATH " -n 5 --trials %s %s >%s'", name, part, name);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 2);
+    CHECK(strstr(err, "standard output") != NULL);
+    free(out);
+    free(err);
+    /* A pipe as PART, with its writer there, is read as before. */
+    CHECK_INT(run_cmd("sh -c 'cat parts/cap.off | " PD_CLI_PATH " /dev/stdin'", 1, &out, &err), 0);
+    CHECK(strncmp(out, "pose,", 5) == 0);
+    free(out);
+    free(err);
+    /* Devices are no files to lose; the part and the options still run. */
+    snprintf(args, sizeof args, "--svg /dev/null --chart /dev/null %s", part);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(strncmp(out, "pose,", 5) == 0);
+    free(out);
+    free(err);
+    free(cube);
+}
+
+/* Runs posedrop ARGS (words split at spaces) with sig already pending when
+ * it starts: the child blocks sig, sends it to itself and execs posedrop,
+ * which inherits the blocked mask and the pending signal; it is delivered
+ * the moment posedrop unblocks it, however early. Returns the exit status
+ * (-1 if killed); *out is what it printed on stdout. */
+static int run_signalled(int sig, const char *args, char **out)
+{
+    char outp[160], words[512], *argv[32];
+    int argc = 0;
+    snprintf(outp, sizeof outp, "%s/signalled.out", tmpdir);
+    snprintf(words, sizeof words, "%s", args);
+    argv[argc++] = (char *)PD_CLI_PATH;
+    for (char *w = strtok(words, " "); w && argc < 31; w = strtok(NULL, " "))
+        argv[argc++] = w;
+    argv[argc] = NULL;
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        sigset_t set;
+        sigemptyset(&set);
+        sigaddset(&set, sig);
+        if (sigprocmask(SIG_BLOCK, &set, NULL) != 0 || kill(getpid(), sig) != 0 ||
+            !freopen(outp, "w", stdout) || !freopen("/dev/null", "w", stderr))
+            _exit(126);
+        execv(PD_CLI_PATH, argv);
+        _exit(127);
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);
+    *out = slurp(outp);
+    if (!*out)
+        *out = calloc(1, 1);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+/* A signal at the very start (before options are parsed or the part read)
+ * ends the run with 128 + its number and nothing on stdout, with or without
+ * drops; --dt, which only the stepping engines use, is refused with the
+ * impulse engine instead of ignored. */
+static void test_early_signal(void)
+{
+    const struct {
+        int sig;
+        const char *args;
+    } runs[] = {{SIGINT, "parts/cap.off"}, {SIGINT, "-n 20 parts/cap.off"},
+                {SIGTERM, "-n 20 --trials /dev/null parts/cap.off"}};
+    for (int i = 0; i < 3; i++) {
+        char *out;
+        CHECK_INT(run_signalled(runs[i].sig, runs[i].args, &out), 128 + runs[i].sig);
+        CHECK_INT((int)strlen(out), 0);
+        free(out);
+    }
+    expect_failure("--dt 0.001 -n 10 parts/cap.off", 2, "--dt sets the time step of the ode and "
+                   "bullet engines only");
+    expect_failure("--engine impulse --dt 0.001 parts/cap.off", 2, "--dt");
+    char *out, *err;
+    CHECK_INT(run("--dt 0.002 --engine ode -n 5 parts/cap.off", &out, &err), 0);
+    free(out);
+    free(err);
+}
+
 /* eq16.awk, fed the paper's own columns, must reproduce the errors the paper
  * publishes (Table 1, the cap: QS 10.1, PQS 1.2, dynamic 4.0; Table 4, the
  * square button: 17.2, 10.7, 4.8), to the tables' 0.05 rounding. */
@@ -432,6 +575,48 @@ static void test_scripts(void)
     all = slurp(path);
     CHECK(all != NULL && strstr(all, "\ncap,1,") != NULL && strstr(all, "broken") == NULL);
     free(all);
+
+    /* The batch writes nothing onto what it reads or writes: a part where
+     * its own results or marks go (DIR/x.failed is removed at the start of
+     * each part, DIR/x.csv replaced), a part whose results would be all.csv,
+     * a side file every part's run would write, a scene file as --trials. */
+    char *cube = slurp("parts/canonical/cube.off");
+    snprintf(cmd, sizeof cmd, "(mkdir -p %s/b3 && cp parts/canonical/cube.off %s/b3/x.failed && "
+             "cp parts/canonical/cube.off %s/b3/y.csv && cp parts/canonical/cube.off %s/all.off && "
+             "echo 'mu = 0.4' >%s/b3.scene)", tmpdir, tmpdir, tmpdir, tmpdir, tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    const char *refused[][2] = {
+        {"-o %s/b3 -- %s/b3/x.failed", "is the same file as part"},
+        {"-o %s/b3 -- %s/b3/y.csv", "is the same file as part"},
+        {"-o %s/b4 -- %s/all.off", "(all results)"},
+        {"-o %s/b5 --trials %s/t.csv -- parts/cap.off parts/button.off", "each of the 2 parts"},
+        {"-o %s/b6 -n 5 --trials %s/b3.scene --scene %s/b3.scene -- parts/cap.off", "--scene"},
+    };
+    for (int i = 0; i < 5; i++) {
+        char fmt[256];
+        snprintf(fmt, sizeof fmt, "scripts/posedrop-batch %s", refused[i][0]);
+        snprintf(cmd, sizeof cmd, fmt, tmpdir, tmpdir, tmpdir);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 2);
+        if (!strstr(err, refused[i][1]))
+            printf("     %s: %s", cmd, err);
+        CHECK(strstr(err, refused[i][1]) != NULL);
+        free(out);
+        free(err);
+    }
+    const char *kept[] = {"b3/x.failed", "b3/y.csv", "all.off"};
+    for (int i = 0; i < 3; i++) {
+        snprintf(path, sizeof path, "%s/%s", tmpdir, kept[i]);
+        char *now = slurp(path);
+        CHECK(cube && now && strcmp(now, cube) == 0);
+        free(now);
+    }
+    snprintf(path, sizeof path, "%s/b3.scene", tmpdir);
+    char *sc = slurp(path);
+    CHECK(sc && strcmp(sc, "mu = 0.4\n") == 0);
+    free(sc);
+    free(cube);
 }
 
 /* Column k (from 0) of a CSV row, as a number; the row is the line starting
@@ -743,6 +928,8 @@ void suite_cli(void)
     test_results();
     test_dynamic();
     test_output_paths();
+    test_same_file();
+    test_early_signal();
     test_eq16();
     test_scripts();
     test_group();

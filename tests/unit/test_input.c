@@ -4,6 +4,9 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 #include "check.h"
 #include "mesh/mesh_reader.h"
@@ -61,6 +64,128 @@ static void test_stl_kind(void)
     expect(pd_mesh_parse(bin, sizeof bin, "b.stl", &ro, &m, &d), PD_ERR_PARSE, &d,
            "truncated binary STL");
     CHECK(m == NULL);
+
+    /* More than 16 KiB of comment lines before "solid", and a comment line
+     * before a byte-order mark: ASCII STL still, by content and by format. */
+    size_t cap = 32768 + sizeof tetra, len = 0;
+    char *big = malloc(cap);
+    CHECK(big != NULL);
+    if (!big)
+        return;
+    while (len < 20000)
+        len += (size_t)snprintf(big + len, cap - len, "# a comment line of an exporter, %zu\n", len);
+    len += (size_t)snprintf(big + len, cap - len, "%s", tetra);
+    char bom[1024];
+    int bl = snprintf(bom, sizeof bom, "# exported\n\xEF\xBB\xBF%s", tetra);
+    for (int forced = 0; forced < 2; forced++) {
+        ro.format = forced ? PD_FORMAT_STL : PD_FORMAT_AUTO;
+        CHECK_STATUS(pd_mesh_parse(big, len, "long.stl", &ro, &m, &d), PD_OK);
+        CHECK(m && m->ntris == 4);
+        pd_mesh_free(m);
+        m = NULL;
+        CHECK_STATUS(pd_mesh_parse(bom, (size_t)bl, forced ? "bom.stl" : "bom.dat", &ro, &m, &d), PD_OK);
+        CHECK(m && m->ntris == 4);
+        pd_mesh_free(m);
+        m = NULL;
+    }
+    free(big);
+    /* Other text given as STL says it is no STL, binary or ASCII, and what
+     * it looks like; never a triangle count made of its bytes. */
+    static const char *const other[][2] = {
+        {"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", "it looks like OBJ"},
+        {"# a long comment line, long enough to pass the 84 bytes of a binary STL header\n"
+         "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", "it looks like OFF"},
+        {"hello, world\n", "it looks like text of no mesh format"},
+    };
+    ro.format = PD_FORMAT_STL;
+    for (int i = 0; i < 3; i++) {
+        expect(pd_mesh_parse(other[i][0], strlen(other[i][0]), "o.stl", &ro, &m, &d),
+               PD_ERR_FORMAT, &d, "does not look like binary STL");
+        CHECK(strstr(d.message, other[i][1]) != NULL && strstr(d.message, "declares") == NULL);
+        CHECK(m == NULL);
+    }
+}
+
+/* Bytes this process has read so far (Linux's /proc/self/io), or -1. */
+static long long bytes_read(void)
+{
+    FILE *f = fopen("/proc/self/io", "r");
+    long long n = -1;
+    if (f) {
+        if (fscanf(f, "rchar: %lld", &n) != 1)
+            n = -1;
+        fclose(f);
+    }
+    return n;
+}
+
+/* A 1 GiB file of NUL bytes (sparse) is refused by its first bytes, the
+ * reader's first check, without the rest being read: OFF by its name (the
+ * header), OBJ by --format (the first keyword), STL otherwise (the triangle
+ * count against the size). */
+static void test_head_first(void)
+{
+    char dir[] = "/tmp/posedrop-head-XXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    static const char *const names[] = {"zeros.off", "zeros.obj", "zeros.bin"};
+    static const char *const said[] = {"zeros.off:1: expected OFF header",
+                                       "zeros.obj:1: expected an OBJ keyword",
+                                       "zeros.bin: no faces (binary STL with 0 triangles)"};
+    for (int i = 0; i < 3; i++) {
+        char path[128];
+        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
+        int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0600);
+        CHECK(fd >= 0 && ftruncate(fd, (off_t)1 << 30) == 0);
+        if (fd >= 0)
+            close(fd);
+        pd_mesh_read_options ro;
+        pd_mesh_read_options_default(&ro);
+        ro.format = i == 1 ? PD_FORMAT_OBJ : PD_FORMAT_AUTO;
+        pd_mesh *m = NULL;
+        pd_diag d;
+        pd_diag_init(&d);
+        long long before = bytes_read();
+        pd_status st = pd_mesh_read(path, &ro, &m, &d);
+        long long after = bytes_read();
+        CHECK(st != PD_OK && m == NULL);
+        if (!strstr(d.message, said[i]))
+            printf("     wanted '%s' in: %s\n", said[i], d.message);
+        CHECK(strstr(d.message, said[i]) != NULL);
+        /* The head is 64 KiB; a whole read would be 1 GiB. */
+        if (before >= 0 && after >= 0)
+            CHECK(after - before < (1 << 20));
+        else
+            printf("     /proc/self/io unreadable: bytes read not checked\n");
+        remove(path);
+    }
+    remove(dir);
+}
+
+/* A named pipe with no writer: refused at once with a message, where open()
+ * used to wait for a writer for ever. Run in a child with a watchdog alarm,
+ * so that a regression fails (killed by SIGALRM) instead of hanging the
+ * suite; the bound is no measure, a fixed run returns at once. */
+static void test_fifo(void)
+{
+    char dir[] = "/tmp/posedrop-fifo-XXXXXX", path[128];
+    CHECK(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/p.off", dir);
+    CHECK(mkfifo(path, 0600) == 0);
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        alarm(120);
+        pd_mesh *m = NULL;
+        pd_diag d;
+        pd_diag_init(&d);
+        pd_status st = pd_mesh_read(path, NULL, &m, &d);
+        _exit(st == PD_ERR_IO && strstr(d.message, "named pipe") ? 0 : 1);
+    }
+    int status = 0;
+    CHECK(pid > 0 && waitpid(pid, &status, 0) == pid);
+    CHECK(WIFEXITED(status) && WEXITSTATUS(status) == 0);
+    remove(path);
+    remove(dir);
 }
 
 void suite_input(void)
@@ -124,4 +249,6 @@ void suite_input(void)
            "the limit is 67108864");
     CHECK(m == NULL);
     test_stl_kind();
+    test_head_first();
+    test_fifo();
 }

@@ -409,6 +409,44 @@ static void test_obj(void)
     pd_mesh_free(m);
 }
 
+/* Extra tokens on a vertex line (OFF's colour, OBJ's w) follow one rule in
+ * both readers: numbers, taken and ignored; anything else ('abc', 'nan',
+ * '1e999') refused with the same status and message, naming the line. */
+static void test_vertex_rest(void)
+{
+    static const char *const bad[] = {"abc", "nan", "1e999", "-inf", "0x"};
+    static const pd_status want[] = {PD_ERR_PARSE, PD_ERR_NONFINITE, PD_ERR_NONFINITE,
+                                     PD_ERR_NONFINITE, PD_ERR_PARSE};
+    for (int i = 0; i < 6; i++) {
+        const char *tok = i < 5 ? bad[i] : "0.5 1 0.25 1"; /* a colour: accepted */
+        char off[256], obj[256];
+        snprintf(off, sizeof off, "OFF\n4 4 0\n0 0 0\n1 0 0 %s\n0 1 0\n0 0 1\n"
+                 "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n", tok);
+        snprintf(obj, sizeof obj, "v 0 0 0\nv 1 0 0 %s\nv 0 1 0\nv 0 0 1\n"
+                 "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n", tok);
+        pd_mesh *mo = NULL, *mj = NULL;
+        pd_diag dof, dobj;
+        pd_status so = parse_as(off, "v.off", PD_FORMAT_AUTO, PD_UNITS_M, &mo, &dof);
+        pd_status sj = parse_as(obj, "v.obj", PD_FORMAT_AUTO, PD_UNITS_M, &mj, &dobj);
+        CHECK_STATUS(so, i < 5 ? want[i] : PD_OK);
+        CHECK_STATUS(sj, i < 5 ? want[i] : PD_OK);
+        if (i < 5) {
+            /* The same words after "v.off:4: " and "v.obj:2: ". */
+            const char *mo_text = strstr(dof.message, ": "), *mj_text = strstr(dobj.message, ": ");
+            CHECK(strncmp(dof.message, "v.off:4: ", 9) == 0 &&
+                  strncmp(dobj.message, "v.obj:2: ", 9) == 0);
+            CHECK(mo_text && mj_text && strcmp(mo_text, mj_text) == 0);
+            CHECK(strstr(dof.message, tok) != NULL);
+            if (!mo_text || !mj_text || strcmp(mo_text, mj_text) != 0)
+                printf("     %s\n     %s\n", dof.message, dobj.message);
+        } else {
+            CHECK(mo && mj && mo->nverts == 4 && mj->nverts == 4);
+        }
+        pd_mesh_free(mo);
+        pd_mesh_free(mj);
+    }
+}
+
 /* --- format, units, files ---------------------------------------------------- */
 
 static void test_format(void)
@@ -427,8 +465,11 @@ static void test_format(void)
     expect_bad("# nothing but comments\n", "x.OFF", PD_ERR_PARSE, "x.OFF: expected OFF header");
     /* ...and an explicit format is obeyed. */
     expect_bad_as(tetra_off, "tetra.off", PD_FORMAT_OBJ, PD_ERR_PARSE, "tetra.off:4: expected an OBJ keyword");
-    /* Not ASCII STL, so binary: its "count" is bytes of text, far too many. */
-    expect_bad_as(tetra_off, "tetra.off", PD_FORMAT_STL, PD_ERR_RANGE, "tetra.off: binary STL declares");
+    /* Neither ASCII STL nor binary: said so, and what it looks like, never
+     * bytes of text read as a triangle count. */
+    expect_bad_as(tetra_off, "tetra.off", PD_FORMAT_STL, PD_ERR_FORMAT,
+                  "tetra.off: does not look like binary STL (162 bytes of text, not 84 plus 50 per "
+                  "triangle) nor like ASCII STL (no 'solid' line first): it looks like OFF");
     CHECK_STATUS(parse_as(tetra_off, "x.txt", PD_FORMAT_OFF, PD_UNITS_M, &m, &d), PD_OK);
     pd_mesh_free(m);
     /* Unrecognisable. */
@@ -733,6 +774,7 @@ void suite_mesh(void)
     test_stl_ascii();
     test_stl_binary();
     test_obj();
+    test_vertex_rest();
     test_format();
     test_units();
     test_files();
