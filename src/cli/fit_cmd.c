@@ -446,6 +446,22 @@ int cli_fit(int argc, char **argv)
     }
     out_file outs[3] = {{0}};
     const char *paths[3] = {out_path, params_path, gof_path};
+    /* No output may land on an input or on another output. */
+    static cli_file files[2 * MAX_PARTS + 4];
+    int nfiles = 0;
+    static const char *const out_names[3] = {"out", "params", "gof"};
+    for (int i = 0; i < nin; i++) {
+        files[nfiles++] = (cli_file){in[i].measured ? "part" : "predict", in[i].path, 0, 1};
+        if (in[i].measured)
+            files[nfiles++] = (cli_file){"measured", in[i].measured, 0, 1};
+    }
+    if (scene_path)
+        files[nfiles++] = (cli_file){"scene", scene_path, 0, 1};
+    for (int k = 0; k < 3; k++)
+        if (paths[k])
+            files[nfiles++] = (cli_file){out_names[k], paths[k], 1, 1};
+    if (code < 0 && !cli_files_apart(files, nfiles))
+        code = EXIT_USAGE;
     for (int k = 0; code < 0 && k < 3; k++)
         if (paths[k] && !out_open(&outs[k], paths[k]))
             code = EXIT_USAGE;

@@ -482,6 +482,12 @@ static void test_command(void)
              counts, tmpdir);
     expect_failure(args, 2, "no/dir");
 
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s", box, counts,
+             counts);
+    expect_failure(args, 2, "box.csv");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s --gof %s", box,
+             counts, scene, scene);
+    expect_failure(args, 2, "fitted.scene");
     snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7 -n 100 --max-evals 5 --points 2 "
              "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s", box,
              counts, scene, params);
