@@ -1,28 +1,40 @@
 #!/usr/bin/env bash
-# sensitivity.sh: how each pose probability moves with the scene, one
-# parameter at a time (the paper notes that only dynamic simulation can study
-# this; epsilon is PQS's own parameter).
+# sensitivity.sh: how each pose class moves with the scene, from one run with
+# ranges (docs/uncertainty.md) instead of a sweep per parameter.
 #
-#   scripts/sensitivity.sh [-n DROPS] [-o DIR] [-- POSEDROP-OPTIONS...] PART
+#   scripts/sensitivity.sh [-n DROPS] [-i INITIAL] [-o DIR] [-- POSEDROP-OPTIONS...] PART
 #
-# Sweeps mu, restitution and drop height around the paper's scene with the
-# impulse simulator (DROPS drops each, default 1000, pose classes grouped;
-# initial poses the belt's long run, --initial stationary, which needs at
-# least 10 (k + 1) drops for k stable poses),
-# and epsilon with PQS; writes DIR/<part>-sensitivity.csv (parameter, value,
-# pose, p, ci_lo, ci_hi) and a chart DIR/<part>-sensitivity.png and .svg:
-# one panel per parameter, one line per pose class with its 95% band.
+# One impulse run of DROPS drops (default 2000), pose classes grouped, with
+# mu 0:1.2, restitution 0:0.9, drop height 0.01:0.5 m (log uniform) and the
+# contact time 0.3x:3x auto (log uniform) each drawn anew for every drop;
+# INITIAL (default uniform, the plain run's) is the initial mode, named on
+# the chart; with stationary, the curves and indices use the drops started
+# from uniform orientations. POSEDROP-OPTIONS come after the ranges, so they
+# can change them (e.g. -- --mu 0.2:0.6). Writes DIR (default results/):
+#   <part>-sensitivity.csv  posedrop --sensitivity: per class and parameter,
+#                           p in the range's lower and upper thirds and the
+#                           first-order index with its 95% interval;
+#   <part>-curves.csv       parameter,value,pose,n,p,ci_lo,ci_hi: the drops
+#                           binned by the value they drew (8 bins of equal
+#                           count), each class's share with its 95% interval,
+#                           and PQS against epsilon (its own parameter);
+#   <part>-sensitivity.png and .svg: one panel per parameter, a line per
+#                           class with its band, each class's index in the
+#                           key. Unlike a sweep, each curve is averaged over
+#                           the other parameters' ranges.
 set -u
-n=1000
+n=2000
+initial=uniform
 outdir=results
 opts=()
 part=""
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) n=$2; shift 2 ;;
+        -i) initial=$2; shift 2 ;;
         -o) outdir=$2; shift 2 ;;
         --) shift; while [ $# -gt 1 ]; do opts+=("$1"); shift; done ;;
-        --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) part=$1; shift ;;
     esac
 done
@@ -32,48 +44,107 @@ bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
 [ -n "$bin" ] || { echo "sensitivity.sh: posedrop not built (run make)" >&2; exit 2; }
 mkdir -p "$outdir" || exit 2
 name=$(basename "${part%.*}")
-csv="$outdir/$name-sensitivity.csv"
-echo "parameter,value,pose,p,ci_lo,ci_hi" > "$csv"
+sens="$outdir/$name-sensitivity.csv"
+curves="$outdir/$name-curves.csv"
+trials="$outdir/$name-trials.csv"
+out="$outdir/$name-run.csv"
 
-# point PARAMETER VALUE COLUMN POSEDROP-ARGS...: the classes' rows of one run.
-point() {
-    local param=$1 value=$2 column=$3; shift 3
-    "$bin" --group "${opts[@]}" "$@" "$part" 2>/dev/null | awk -F, -v OFS=, -v param="$param" \
-        -v value="$value" -v column="$column" '
+"$bin" --group -n "$n" --initial "$initial" --mu 0:1.2 --restitution 0:0.9 -h 0.01:0.5:log \
+    --contact-time 0.3x:3x "${opts[@]}" --sensitivity "$sens" --trials "$trials" "$part" \
+    > "$out" || exit 1
+# The stationary split: k ungrouped poses, m = n / (k + 1) drops started
+# resting on each, interleaved with uniform ones from the first drop.
+k=$("$bin" "${opts[@]}" "$part" | awk 'END { print NR - 1 }')
+
+echo "parameter,value,pose,n,p,ci_lo,ci_hi" > "$curves"
+# Every ranged column of the trials: drops sorted by the value, 8 bins of
+# equal count, each class's share and its Wilson interval.
+awk -F, -v OFS=, -v initial="$initial" -v k="$k" -v n="$n" '
+    NR == 1 {
+        for (i = 1; i <= NF; i++) c[$i] = i
+        np = 0
+        for (i = c["end"] + 1; i <= NF; i++) if ($i != "member") param[++np] = $i
+        next
+    }
+    {
+        d = $c["drop"] - 1; m = int(n / (k + 1))
+        if (initial == "stationary" && d < (k + 1) * m && d % (k + 1) != 0) next
+        if ($c["end"] != "settled") next
+        rows++; pose[rows] = $c["pose"]; if ($c["pose"] > npose) npose = $c["pose"]
+        for (j = 1; j <= np; j++) val[j, rows] = $c[param[j]]
+    }
+    function wilson(x, t, z,   p, den, mid, half) {
+        p = x / t; den = 1 + z * z / t; mid = (p + z * z / (2 * t)) / den
+        half = z * sqrt(p * (1 - p) / t + z * z / (4 * t * t)) / den
+        lo = mid - half; hi = mid + half; if (lo < 0) lo = 0; if (hi > 1) hi = 1
+    }
+    END {
+        for (j = 1; j <= np; j++) {
+            # Rank by value (insertion into an index list sorted by value).
+            delete ord
+            for (r = 1; r <= rows; r++) {
+                s = r
+                while (s > 1 && val[j, ord[s - 1]] + 0 > val[j, r] + 0) { ord[s] = ord[s - 1]; s-- }
+                ord[s] = r
+            }
+            for (b = 0; b < 8; b++) {
+                first = int(b * rows / 8) + 1; last = int((b + 1) * rows / 8)
+                if (last < first) continue
+                delete cnt; sum = 0
+                for (s = first; s <= last; s++) { cnt[pose[ord[s]]]++; sum += val[j, ord[s]] }
+                t = last - first + 1
+                for (p = 1; p <= npose; p++) {
+                    wilson(cnt[p] + 0, t, 1.959963984540054)
+                    printf "%s,%.6g,%d,%d,%.6g,%.6g,%.6g\n", param[j], sum / t, p, t, (cnt[p] + 0) / t, lo, hi
+                }
+            }
+        }
+    }' "$trials" >> "$curves"
+for v in 0 5 10 15 20 30 45; do
+    "$bin" --group "${opts[@]}" --epsilon "$v" "$part" 2>/dev/null | awk -F, -v OFS=, -v value="$v" '
         NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
-        { lo = ("ci_lo" in c) ? $c["ci_lo"] : $c[column]; hi = ("ci_hi" in c) ? $c["ci_hi"] : $c[column]
-          print param, value, $c["pose"], $c[column], lo, hi }' >> "$csv"
-}
-for v in 0 0.1 0.2 0.3 0.5 0.8 1.2; do point mu "$v" p -n "$n" --initial stationary --mu "$v"; done
-for v in 0 0.1 0.3 0.5 0.7 0.9; do point restitution "$v" p -n "$n" --initial stationary --restitution "$v"; done
-for v in 0.01 0.03 0.06 0.12 0.25 0.5; do point height "$v" p -n "$n" --initial stationary -h "$v"; done
-for v in 0 5 10 15 20 30 45; do point epsilon "$v" p_pqs --epsilon "$v"; done
+        { print "epsilon", value, $c["pose"], "", $c["p_pqs"], $c["p_pqs"], $c["p_pqs"] }' >> "$curves"
+done
 
 command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||
-    { echo "sensitivity.sh: gnuplot missing; $csv written, no chart" >&2; exit 1; }
-poses=$(awk -F, 'NR > 1 { print $3 }' "$csv" | sort -n -u | tr '\n' ' ')
+    { echo "sensitivity.sh: gnuplot missing; $sens and $curves written, no chart" >&2; exit 1; }
+params=$(awk -F, 'NR > 1 && !seen[$1]++ { printf "%s ", $1 }' "$curves")
+npanel=$(echo $params | wc -w)
+poses=$(awk -F, 'NR > 1 { print $3 }' "$curves" | sort -n -u | tr '\n' ' ')
+drops=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "n") col = i } NR == 2 { print $col }' "$out")
+# Each class's index per parameter, for the keys: "pose 2 (S 0.45)".
+keys=$(awk -F, 'NR > 1 { printf "%s:%s:%.2f ", $2, $1, $11 }' "$sens")
+cols=$(( npanel > 2 ? 3 : npanel ))
+rowsn=$(( (npanel + cols - 1) / cols ))
 for term in png svg; do
     gnuplot <<GP
 set datafile separator ","
-set terminal ${term} size 1100,800 noenhanced $( [ "$term" = png ] && echo "font ',10'" )
+set terminal ${term} size $((cols * 420)),$((rowsn * 330 + 40)) noenhanced $( [ "$term" = png ] && echo "font ',9'" )
 set output "$outdir/$name-sensitivity.${term}"
-set multiplot layout 2,2 title "$name: pose probabilities against the scene (95% bands; pose classes)"
+set multiplot layout $rowsn,$cols title "$name: pose classes over the scene's ranges, one run of $drops drops, initial $initial (95% bands; S: first-order index)"
 set ylabel "probability"
 set yrange [0:1]
 set grid
 set key top right
-array label[4] = ["friction mu ($n drops each)", "restitution e", "drop height, m", "PQS epsilon, degrees"]
-array key[4] = ["mu", "restitution", "height", "epsilon"]
-do for [k = 1:4] {
-    set title label[k]
-    set xlabel label[k]
-    if (k == 3) { set logscale x } else { unset logscale x }
-    plot for [p in "$poses"] "< grep '^".key[k].",' $csv | awk -F, '\$3 == ".p."'" \
-         using 2:5:6 with filledcurves fs transparent solid 0.15 lc (p+0) notitle, \
-         for [p in "$poses"] "< grep '^".key[k].",' $csv | awk -F, '\$3 == ".p."'" \
-         using 2:4 with linespoints lc (p+0) title "pose ".p
+keys = "$keys"
+array label[7] = ["mu", "restitution", "height", "contact_time", "belt_speed", "vibration", "tumble"]
+array unit[7] = ["friction mu", "restitution e", "drop height, m", "contact time, s", "belt speed, m/s", "vibration, deg", "tumble, rad/s"]
+index_of(p, par) = (pos = strstrt(keys, par.":".p.":"), pos ? real(substr(keys, pos + strlen(par.":".p.":"), pos + strlen(par.":".p.":") + 3)) : -1)
+do for [par in "$params"] {
+    xl = par
+    do for [i = 1:7] { if (label[i] eq par) { xl = unit[i] } }
+    if (par eq "epsilon") { xl = "PQS epsilon, degrees (static)" }
+    set title xl
+    set xlabel xl
+    if (par eq "height" || par eq "contact_time") { set logscale x } else { unset logscale x }
+    plot for [p in "$poses"] "< grep '^".par.",' $curves | awk -F, '\$3 == ".p."'" \
+         using 2:6:7 with filledcurves fs transparent solid 0.15 lc (p+0) notitle, \
+         for [p in "$poses"] "< grep '^".par.",' $curves | awk -F, '\$3 == ".p."'" \
+         using 2:5 with linespoints lc (p+0) \
+         title (par eq "epsilon" ? "pose ".p : sprintf("pose %s (S %.2f)", p, index_of(p, par)))
 }
 unset multiplot
 GP
 done
-echo "wrote $csv and $outdir/$name-sensitivity.png, .svg" >&2
+rm -f "$trials"
+echo "wrote $sens, $curves and $outdir/$name-sensitivity.png, .svg (initial $initial)" >&2

@@ -21,6 +21,7 @@
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"
 #include "posedrop/part.h"
+#include "posedrop/sensitivity.h"
 #include "posedrop/sim.h"
 #include "posedrop/static.h"
 #include "posedrop/status.h"

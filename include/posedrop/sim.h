@@ -10,6 +10,7 @@
 #ifndef POSEDROP_SIM_H
 #define POSEDROP_SIM_H
 
+#include <stddef.h>
 #include <stdint.h>
 #include "posedrop/diag.h"
 #include "posedrop/export.h"
@@ -47,6 +48,41 @@ typedef enum pd_initial {
                                chain (see pd_sim_run) */
 } pd_initial;
 
+/* The scene parameters that take a range as well as a value, in this order
+ * (the columns of --trials and the rows of a sensitivity). gravity, the
+ * restitution law and the initial mode take one value each. */
+typedef enum pd_scene_param {
+    PD_PARAM_HEIGHT = 0,
+    PD_PARAM_BELT_SPEED,
+    PD_PARAM_MU,
+    PD_PARAM_RESTITUTION,
+    PD_PARAM_VIBRATION,
+    PD_PARAM_CONTACT_TIME,
+    PD_PARAM_TUMBLE,
+    PD_NPARAMS
+} pd_scene_param;
+
+/* How a parameter is given. */
+typedef enum pd_dist_kind {
+    PD_DIST_FIXED = 0,  /* the scene field's own value, for every drop */
+    PD_DIST_UNIFORM,    /* each drop draws uniformly from [lo, hi] */
+    PD_DIST_LOG_UNIFORM /* each drop draws log uniformly from [lo, hi], 0 < lo:
+                           for a quantity known to within a factor (the
+                           contact time) */
+} pd_dist_kind;
+
+/* A parameter's distribution. lo and hi are in the field's stored unit (m,
+ * m/s, rad for vibration and rad/s for tumble, s for contact_time) and obey
+ * the field's range; lo <= hi, and lo == hi draws lo for every drop, the same
+ * run, byte for byte, as the fixed value lo. */
+typedef struct pd_dist {
+    pd_dist_kind kind;
+    double lo, hi;
+    int auto_multiple; /* contact_time only: lo and hi are multiples of the
+                          PD_CONTACT_TIME_AUTO duration of the part, 1e-3 to
+                          1e3 (written 0.3x:3x) */
+} pd_dist;
+
 /* What a drop is made of. Filled by pd_scene_default, then edited. */
 typedef struct pd_scene {
     double height;          /* m, lowest point of the part above the floor at release; 0.12 */
@@ -67,6 +103,17 @@ typedef struct pd_scene {
                                throughout (the paper's model).
                                PD_CONTACT_TIME_AUTO (the default): a plastic part
                                on a rubber belt, pd_contact_time_auto() */
+    double tumble;          /* rad/s: the part's angular speed at release, about
+                               an axis uniform over the sphere, drawn for each
+                               drop (a part tipping over a belt's edge, a
+                               tossed die); 0 */
+    pd_dist range[PD_NPARAMS]; /* per parameter: PD_DIST_FIXED (pd_scene_default)
+                               uses the field above; a range replaces it, each
+                               drop drawing its own value from (seed, drop,
+                               parameter), a stream apart from the drop's
+                               orientation, so results do not depend on threads,
+                               shards or engine, and a scene without ranges
+                               runs exactly as it would without this field */
 } pd_scene;
 
 /* contact_time's default: the duration a Hertz contact of a plastic part on a
@@ -77,7 +124,10 @@ typedef struct pd_scene {
 #define PD_CONTACT_TIME_AUTO (-1.0)
 
 /* The duration PD_CONTACT_TIME_AUTO stands for, for a part of size L (the
- * bounding-box diagonal, m): 5e-4 s times L over a 1 cm cube's diagonal. */
+ * bounding-box diagonal, m): 5e-4 s times L over a 1 cm cube's diagonal, up
+ * to pi sqrt(1e-3 L / 9.81 m/s^2), the duration at which the part's weight
+ * would press a contact 1e-3 of its size into the floor (it binds above
+ * L = 1.2 m: 0.1 s for a 10 m part, 1.3 s for a 1000 m cube). */
 PD_API double pd_contact_time_auto(double size);
 
 PD_API void pd_scene_default(pd_scene *scene);
@@ -85,10 +135,44 @@ PD_API void pd_scene_default(pd_scene *scene);
 /* Sets one setting by name, as in a scene file or on a command line:
  * height, belt_speed, mu, restitution, restitution_law
  * (poisson|energetic), vibration (degrees), initial
- * (uniform|bootstrap|stationary), gravity, contact_time (s, or auto). PD_ERR_USAGE for
- * an unknown key, PD_ERR_PARSE for a bad value, PD_ERR_RANGE for a value out
- * of range; the scene is unchanged on failure. */
+ * (uniform|bootstrap|stationary), gravity, contact_time (s, or auto),
+ * tumble (rad/s). A plain value sets the field and makes it fixed. Every
+ * parameter of pd_scene_param also takes a range "LO:HI", optionally
+ * followed by "uniform" or "log" (log uniform; the default for contact_time,
+ * which spans decades, uniform for the others); contact_time's range may be
+ * multiples of auto, "0.3x:3x". PD_ERR_USAGE for an unknown key, PD_ERR_PARSE
+ * for a bad value, PD_ERR_RANGE for a value out of range; the scene is
+ * unchanged on failure. Its ranges are those of pd_scene_check, the one
+ * validator of a scene. */
 PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *value, pd_diag *diag);
+
+/* The name of a parameter ("height", ..., "tumble"), NULL out of range. */
+PD_API const char *pd_scene_param_name(pd_scene_param param);
+
+/* A parameter's setting as text pd_scene_set reads, in its text's unit
+ * (degrees for vibration), numbers with %.6g: "0.3", "0.2:0.5",
+ * "0.3x:3x log", "auto". Returns buf. */
+PD_API const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *buf,
+                                   size_t size);
+
+/* Whether any parameter of scene is a range. */
+PD_API int pd_scene_ranged(const pd_scene *scene);
+
+/* The values drop `drop` of a run seeded `seed` uses, one per parameter
+ * (values[PD_NPARAMS], stored units; contact_time resolved for a part of
+ * size part_size: never PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
+ * the scene with every range replaced by that drop's value (fixed). Fixed
+ * parameters keep their field's value. The draw of parameter i depends on
+ * (seed, drop, i) only. drawn may be NULL; scene must pass pd_scene_check. */
+PD_API void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed, long drop,
+                          double values[PD_NPARAMS], pd_scene *drawn);
+
+/* Where value v of parameter param falls in its distribution: its
+ * cumulative probability in [0, 1] (0.5 for a fixed or zero-width one).
+ * For a contact_time range in multiples of auto, v is in s and part_size
+ * the part's size. */
+PD_API double pd_scene_quantile(const pd_scene *scene, pd_scene_param param, double part_size,
+                                double v);
 
 /* Reads "key = value" lines ('#' comments, blank lines) into scene, on top of
  * what it holds; a key set twice is refused. Errors name the file and line. */
@@ -97,8 +181,12 @@ PD_API pd_status pd_scene_read(const char *path, pd_scene *scene, pd_diag *diag)
 /* Whether every field of a scene is one pd_scene_set would accept: height 0
  * to 1000 m, belt_speed -1000 to 1000 m/s, mu 0 to 10, restitution 0 to 1,
  * vibration 0 to pi rad (180 degrees), gravity 0.001 to 1000 m/s^2,
- * contact_time 0 to 1 s or PD_CONTACT_TIME_AUTO, and law and initial one of
- * their enum values.
+ * contact_time 0 to 1 s or PD_CONTACT_TIME_AUTO, tumble 0 to 10^4 rad/s, no
+ * value non-zero below the smallest normal double (2.2e-308), law and
+ * initial one of their enum values, and every range valid (its kind, both
+ * ends in the field's range, lo <= hi, lo > 0 for log uniform, multiples of
+ * auto for contact_time only). The one validator of a scene: pd_scene_set,
+ * pd_sim_run and the command all use it.
  * PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_RANGE for a value out of
  * range; the message names the field. pd_sim_run calls it first. */
 PD_API pd_status pd_scene_check(const pd_scene *scene, pd_diag *diag);
@@ -108,8 +196,31 @@ typedef enum pd_drop_end {
     PD_END_SETTLED = 0,  /* energy below its basin's barrier: outcome final */
     PD_END_TIME_LIMIT,   /* simulated time ran out: counted, never classified */
     PD_END_COLLISION_LIMIT, /* too many collisions (a Zeno-like cascade) */
-    PD_END_FAILED        /* the collision solver could not finish (counted) */
+    PD_END_FAILED        /* a solver could not go on: which one is the trial's
+                            stage, and how its status (counted) */
 } pd_drop_end;
+
+/* Where a failed drop (PD_END_FAILED) failed; PD_STAGE_NONE for any other
+ * end. The names pd_drop_stage_name gives are stable: the command prints
+ * them in the end column of --trials (docs/cli.md). */
+typedef enum pd_drop_stage {
+    PD_STAGE_NONE = 0,
+    PD_STAGE_SETTLE,        /* "settle": whether the drop is decided (energy
+                               barriers, the descent map) */
+    PD_STAGE_FLIGHT,        /* "flight": the torque-free flight between contacts */
+    PD_STAGE_IMPACT_SEARCH, /* "impact_search": the time of the next impact */
+    PD_STAGE_COLLISION,     /* "collision": the rigid frictional impulse law */
+    PD_STAGE_COMPLIANT,     /* "compliant": a compliant impact */
+    PD_STAGE_CONTACT_PHASE, /* "contact_phase": lasting contact on a vertex or an edge */
+    PD_STAGE_ENGINE_RESET,  /* "engine_reset": the stepping engine refused the release */
+    PD_STAGE_ENGINE_STEP,   /* "engine_step": a step of the stepping engine (ODE's
+                               internal error, a non-finite state) */
+    PD_STAGE_COUNT
+} pd_drop_stage;
+
+/* "settle", "flight", ... as above; "none" for PD_STAGE_NONE, "unknown" out
+ * of range. Never NULL. */
+PD_API const char *pd_drop_stage_name(pd_drop_stage stage);
 
 typedef enum pd_engine_kind {
     PD_ENGINE_IMPULSE = 0, /* posedrop's own: closed-form flight, frictional impulses */
@@ -129,7 +240,9 @@ typedef struct pd_sim_options {
     double ci_halfwidth;    /* in (0, 0.5): keep dropping until every pose's 95%
                                interval is at most this wide on each side; 0 */
     long max_drops;         /* cap for ci_halfwidth runs, >= 0; 10^7 */
-    double time_limit;      /* s of simulated time per drop, > 0; 20 */
+    double time_limit;      /* s of simulated time per drop, > 0, or
+                               PD_TIME_LIMIT_AUTO (0, the default):
+                               pd_time_limit_auto for the part and scene */
     int max_collisions;     /* per drop, >= 1; 100000 */
     int keep_trials;        /* 1: fill result->trials (one record per drop); 0 */
     pd_cancel_flag *cancel; /* may be NULL; see below */
@@ -149,11 +262,31 @@ typedef struct pd_sim_options {
 /* Cancelling a run: point options->cancel at an atomic_int holding 0 and
  * store non-zero into it (atomic_store) from any thread, or from a signal
  * handler (atomic_int is lock-free wherever posedrop builds, which C11 asks
- * of an object a handler touches). The drops under way finish, no new one
- * starts, and pd_sim_run returns PD_OK with result->partial set and the
- * first result->n drops of the run counted (each the drop it would be in a
- * full run, whatever the thread count). The flag is only read, never reset:
- * clear it before the next run. */
+ * of an object a handler touches). The drops under way stop too (each reads
+ * the flag between its steps, whatever the part), no new one starts, and
+ * pd_sim_run returns PD_OK with result->partial set and the first
+ * result->n drops of the run counted, each whole (a drop stopped part way is
+ * not counted, nor any drop after it), each the drop it would be in a full
+ * run, whatever the thread count. The flag is only read, never reset: clear
+ * it before the next run. */
+
+/* time_limit's default: each drop's limit is pd_time_limit_auto's. */
+#define PD_TIME_LIMIT_AUTO 0.0
+
+/* The automatic limit, in units of the drop's own times: the part's natural
+ * time sqrt(L/g) (how long it takes to topple over its own size) plus the
+ * fall from the drop height, sqrt(2 h / g). The slowest drops measured to
+ * rest on ordinary parts (cubes, boxes and coins from 1 mm to 10 m, the
+ * shipped caps, on all three engines) took 37 of these units; 100 leaves
+ * them a margin of more than 2.5 (docs/limits.md). For a 1 cm cube dropped
+ * 0.12 m it is 19.8 s; for a 1000 m cube, 1345 s. */
+#define PD_TIME_LIMIT_UNITS 100.0
+
+/* PD_TIME_LIMIT_UNITS (sqrt(size / g) + sqrt(2 height / g)) in s, for a part
+ * of that size (m, the bounding-box diagonal, pd_part.size) dropped in that
+ * scene (its height, the top of its range if it has one, and gravity);
+ * scene NULL: the default scene's. */
+PD_API double pd_time_limit_auto(double size, const pd_scene *scene);
 
 PD_API void pd_sim_options_default(pd_sim_options *options);
 
@@ -178,6 +311,9 @@ typedef struct pd_trial {
     int collisions;     /* impulses applied (impulse engine; 0 for stepping engines) */
     double time;        /* simulated s */
     pd_drop_end end;
+    pd_drop_stage stage; /* PD_END_FAILED: where it failed, else PD_STAGE_NONE */
+    pd_status status;    /* PD_END_FAILED: how (e.g. PD_ERR_NO_CONVERGENCE), else PD_OK */
+    double param[PD_NPARAMS]; /* the scene values this drop used (pd_scene_draw) */
 } pd_trial;
 
 typedef struct pd_sim_result {
@@ -185,7 +321,17 @@ typedef struct pd_sim_result {
     long n;                 /* drops run */
     long *count;            /* per pose: drops that settled there */
     double *p, *ci_lo, *ci_hi; /* count / n and its 95% Wilson interval */
-    long unsettled;         /* drops that hit a limit or failed (not in any count) */
+    long unsettled;         /* drops that hit a limit or failed (not in any count):
+                               the sum of the next three */
+    long time_limited;      /* drops that ended at the time limit */
+    long collision_limited; /* drops that ended at the collision limit */
+    long failed;            /* drops that failed (PD_END_FAILED) */
+    long first_failed;      /* the first failed drop's number in the run (from 0),
+                               -1 if none */
+    pd_drop_stage failed_stage; /* where it failed */
+    pd_status failed_status;    /* and how */
+    double time_limit;      /* s: the limit the drops ran with (options->time_limit,
+                               or pd_time_limit_auto's) */
     long energy_gain;       /* collisions that would have added energy: under
                                Poisson's law with friction (resolved with the
                                energetic law instead), or by a compliant impact's
@@ -233,6 +379,10 @@ PD_API long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
  * (same numbering as its poses). options and scene may be NULL (defaults).
+ * A scene with ranges has each drop draw its own values (pd_scene_draw, kept
+ * in its trial record): p is then over the ranges; posedrop/sensitivity.h
+ * says which parameter moves which pose. A contact_time range whose high end
+ * is above 1 s for this part is PD_ERR_RANGE.
  *
  * PD_INITIAL_STATIONARY estimates the belt's pose-to-pose chain: with k
  * poses, m = ndrops / (k + 1) drops start resting on each pose (on its facet,

@@ -117,13 +117,31 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     free(pose_of);
 }
 
-static const char *end_name(pd_drop_end e)
+/* A status as one word of the end column: its fixed name with blanks as
+ * underscores ("no convergence": no_convergence). */
+static void status_word(pd_status st, char *buf, size_t size)
 {
-    switch (e) {
+    snprintf(buf, size, "%s", pd_status_str(st));
+    for (char *c = buf; *c; c++)
+        if (*c == ' ' || *c == '-' || *c == '/')
+            *c = '_';
+}
+
+/* How a drop ended, as the end column of --trials and --verbose write it:
+ * settled, time_limit, collision_limit, or failed:STAGE:STATUS (where a
+ * solver failed and how, docs/cli.md). */
+static const char *end_name(const pd_trial *t, char *buf, size_t size)
+{
+    switch (t->end) {
     case PD_END_SETTLED: return "settled";
     case PD_END_TIME_LIMIT: return "time_limit";
     case PD_END_COLLISION_LIMIT: return "collision_limit";
-    default: return "failed";
+    default: {
+        char st[64];
+        status_word(t->status, st, sizeof st);
+        snprintf(buf, size, "failed:%s:%s", pd_drop_stage_name(t->stage), st);
+        return buf;
+    }
     }
 }
 
@@ -240,17 +258,26 @@ int out_commit(out_file *o)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
-static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of)
+static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
+                         const pd_scene *scene)
 {
-    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s\n", class_of ? ",member" : "");
+    fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
+    for (int k = 0; k < PD_NPARAMS; k++)
+        if (scene->range[k].kind != PD_DIST_FIXED)
+            fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
+    fputc('\n', f);
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
         long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        char end[96];
         fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", drop + 1, t->q0[0], t->q0[1],
-                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
+                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t, end, sizeof end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
+        for (int k = 0; k < PD_NPARAMS; k++)
+            if (scene->range[k].kind != PD_DIST_FIXED)
+                fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
         fputc('\n', f);
     }
 }
@@ -273,6 +300,21 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
     }
 }
 
+/* --sensitivity: one row per pose (class with --group) and ranged
+ * parameter, numbered as in the output. */
+static void write_sensitivity(FILE *f, const pd_sensitivity *s)
+{
+    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
+               "index,index_lo,index_hi\n");
+    for (int i = 0; i < s->nposes * s->nparams; i++) {
+        const pd_sensitivity_row *r = &s->rows[i];
+        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
+                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
+                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
+                r->index_lo, r->index_hi);
+    }
+}
+
 /* --- the options ------------------------------------------------------------
  * One table drives the parsing (getopt's arrays are built from it), the
  * checking of every value (one number reader and one message form, shared
@@ -282,7 +324,8 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_PQS_BAND, OPT_FACETS, OPT_HELP, OPT_VERSION, OPT_VERBOSE, OPT_CI, OPT_SEED,
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
-       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD };
+       OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
+       OPT_SENSITIVITY, OPT_TIME_LIMIT };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -355,6 +398,11 @@ static const cli_option options[] = {
     {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
      "time step of ode (default 0.001) or bullet (1/960),\n"
      "above 0 and at most 0.01"},
+    {OPT_TIME_LIMIT, "time-limit", ARG_TEXT, "S", REAL("auto or a time in s", 0, 1e9, 1, 0), NULL, NULL,
+     "simulated seconds a drop may take before it ends\n"
+     "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
+     "(default): 100 (sqrt(L/g) + sqrt(2h/g)) for a part of size\n"
+     "L dropped from h, 19.8 s for a 1 cm cube from 0.12 m"},
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},
@@ -385,6 +433,9 @@ static const cli_option options[] = {
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
      "5e-4 s for a 1 cm cube, in proportion to the part's size;\n"
      "0: rigid, the paper's model"},
+    {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
+     "angular speed at release, rad/s, about an axis drawn\n"
+     "uniformly for each drop, 0..10000 (0)"},
     {OPT_INITIAL, "initial", ARG_SCENE, "I", NO_RULE, NULL, "initial",
      "uniform (default): orientations uniform at random;\n"
      "bootstrap: the paper's belt, drops resting on poses drawn\n"
@@ -401,13 +452,32 @@ static const cli_option options[] = {
     {OPT_SCENE, "scene", ARG_INPUT, "FILE", NO_RULE, NULL, NULL,
      "'key = value' lines: height, belt_speed, mu, restitution,\n"
      "restitution_law, vibration, initial, gravity,\n"
-     "contact_time, each at most once; options given after it\n"
-     "override it"},
+     "contact_time, tumble, each at most once; options given\n"
+     "after it override it.\n"
+     "Ranges: -h, -v, --mu, --restitution, --vibration,\n"
+     "--contact-time and --tumble (and their keys) take LO:HI\n"
+     "as well as a value: each drop draws its own value,\n"
+     "uniformly, or log uniformly with LO:HI:log (the default\n"
+     "for --contact-time, which also takes multiples of auto,\n"
+     "0.3x:3x); the estimates are then over the ranges\n"
+     "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
-     "(pose 0: unsettled); with --group, pose is the class\n"
+     "(pose 0: unsettled; end: settled, time_limit,\n"
+     "collision_limit or failed:STAGE:STATUS, docs/cli.md);\n"
+     "with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
-     "within it, numbered as without --group"},
+     "within it, numbered as without --group; then one column\n"
+     "per ranged scene parameter, named by its key, the value\n"
+     "the drop drew (vibration in degrees)"},
+    {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
+     "with ranges, what each ranged parameter moves, as CSV:\n"
+     "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
+     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi: the\n"
+     "pose's probability in the lower and upper third of the\n"
+     "range (95% Wilson) and the first-order index, the share\n"
+     "of the pose's variance the parameter explains (95%\n"
+     "bootstrap interval; docs/uncertainty.md)"},
     {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -629,6 +699,13 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
     case OPT_DT: a->sim.dt = x; break;
+    case OPT_TIME_LIMIT: {
+        int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        a->sim.time_limit = strcmp(arg, "auto") == 0 ? PD_TIME_LIMIT_AUTO : x;
+        break;
+    }
     case OPT_SCENE: {
         pd_diag d;
         pd_diag_init(&d);
@@ -644,6 +721,10 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.keep_trials = 1;
         break;
     case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_SENSITIVITY:
+        a->sensitivity = arg;
+        a->sim.keep_trials = 1;
+        break;
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
@@ -794,6 +875,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (stationary && a->sim.ci_halfwidth > 0)
         return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
                           "number of drops over the poses in advance: give -n");
+    if (a->sensitivity && (!a->dynamic || !pd_scene_ranged(&a->scene) || a->sim.nshards))
+        return fail_usage("%s", "--sensitivity needs drops (-n or --ci) of a scene with a range "
+                          "(such as --mu 0.2:0.5), and does not go with --shard");
+    /* The report says what each ranged parameter moves. */
+    if (a->pictures[VIZ_REPORT] && a->dynamic && pd_scene_ranged(&a->scene))
+        a->sim.keep_trials = 1;
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
     if (a->facets && a->group)
@@ -880,14 +967,65 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
             outside ? "" : " (no sign that they differ)");
 }
 
+/* Why the drops that did not settle ended: how many at each limit (the
+ * time limit with its value) and how many failed, with where and how the
+ * first failed; --verbose adds a line per such drop when --trials kept
+ * them. A merged result from shard files has no breakdown, only the count. */
+static void print_unsettled(const cli_args *a, const pd_sim_result *sim)
+{
+    if (sim->time_limited + sim->collision_limited + sim->failed != sim->unsettled) {
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
+                        "a solver failed) and are in no count\n", prog, a->path, sim->unsettled,
+                sim->n);
+        return;
+    }
+    fprintf(stderr, "%s: %s: %ld of %ld drops did not settle and are in no count:", prog,
+            a->path, sim->unsettled, sim->n);
+    const char *sep = "";
+    if (sim->time_limited) {
+        fprintf(stderr, " %ld at the time limit (%.6g s simulated; --time-limit)",
+                sim->time_limited, sim->time_limit);
+        sep = ",";
+    }
+    if (sim->collision_limited) {
+        fprintf(stderr, "%s %ld at the collision limit (%d collisions)", sep,
+                sim->collision_limited, a->sim.max_collisions);
+        sep = ",";
+    }
+    if (sim->failed) {
+        char st[64];
+        status_word(sim->failed_status, st, sizeof st);
+        fprintf(stderr, "%s %ld failed", sep, sim->failed);
+        if (sim->first_failed >= 0) /* not known after posedrop-mpi's sums */
+            fprintf(stderr, " (the first, drop %ld: failed:%s:%s)", sim->first_failed + 1,
+                    pd_drop_stage_name(sim->failed_stage), st);
+    }
+    fputc('\n', stderr);
+    /* Enough lines to see the pattern; the rest are in the --trials file. */
+    enum { VERBOSE_DROPS = 20 };
+    long shown = 0;
+    for (long i = 0; a->verbose && sim->trials && i < sim->n; i++) {
+        const pd_trial *t = &sim->trials[i];
+        if (t->end == PD_END_SETTLED)
+            continue;
+        if (shown++ == VERBOSE_DROPS) {
+            fprintf(stderr, "%s: and %ld more drops that did not settle, in %s\n", a->path,
+                    sim->unsettled - VERBOSE_DROPS, a->trials);
+            break;
+        }
+        char end[96];
+        long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        fprintf(stderr, "%s: drop %ld: %s after %.6g s simulated, %d collisions\n", a->path,
+                drop + 1, end_name(t, end, sizeof end), t->time, t->collisions);
+    }
+}
+
 /* What every dynamic run reports, whether or not --verbose: drops that could
  * not be classified and collisions the law had to correct are never silent. */
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
 {
     if (sim->unsettled)
-        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
-                        "the engine failed) and are in no count\n", prog, a->path, sim->unsettled,
-                sim->n);
+        print_unsettled(a, sim);
     if (sim->energy_gain)
         fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
                         "friction, resolved by the energetic law; or a compliant impact's step, "
@@ -902,8 +1040,10 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
                         "variation) from the distribution it started from%s\n", prog, a->path,
                 sim->bootstrap_rounds, sim->stationarity,
                 sim->stationarity > 0.1 ? " -- not yet stationary, drop more" : "");
-    if (sim->transitions && sim->nshards == 0)
+    if (sim->transitions && sim->nshards == 0) {
         print_stationary_summary(a, sim);
+        fragile_warn(a->path, sim);
+    }
     if (a->verbose && sim->n)
         fprintf(stderr, "%s: %ld drops, %.2f collisions per drop\n", a->path, sim->n,
                 (double)sim->collisions / (double)sim->n);
@@ -938,9 +1078,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
-                 (!a->transitions || out_open(&transitions_out, a->transitions));
+                 (!a->transitions || out_open(&transitions_out, a->transitions)) &&
+                 (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
         opened = !a->pictures[k] || out_open(&pic_out[k], a->pictures[k]);
     /* A measured distribution is read before the work too. */
@@ -953,6 +1094,7 @@ int cli_run(cli_args *a)
     if (!opened) {
         out_abort(&trials_out);
         out_abort(&transitions_out);
+        out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
             out_abort(&pic_out[k]);
         return EXIT_USAGE;
@@ -962,6 +1104,7 @@ int cli_run(cli_args *a)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
+    pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
     if (st != PD_OK) {
@@ -993,9 +1136,14 @@ int cli_run(cli_args *a)
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     }
+    /* The report shows it when the drops' records were kept (not across
+     * MPI ranks); --sensitivity needs them. */
+    if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
+        (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
+        st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured};
+                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
     if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -1007,11 +1155,14 @@ int cli_run(cli_args *a)
     /* The side files before stdout: if one cannot be written in full (a
      * full disk, /dev/full), the run fails with nothing on stdout. */
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of);
+        write_trials(trials_out.f, sim, class_of, &a->scene);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
+    if (sens_out.f)
+        write_sensitivity(sens_out.f, sens);
     if ((trials_out.f && !out_commit(&trials_out)) ||
-        (transitions_out.f && !out_commit(&transitions_out))) {
+        (transitions_out.f && !out_commit(&transitions_out)) ||
+        (sens_out.f && !out_commit(&sens_out))) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -1050,9 +1201,17 @@ int cli_run(cli_args *a)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
     if (code == 0 && sim && sim->partial)
         code = cli_interrupt_code();
+    else if (code == 0 && sim && sim->n > 0 && sim->failed == sim->n) {
+        /* Not one drop ran to an end the model defines: the rows hold the
+         * static estimates only, and a script must not take them for a run. */
+        fprintf(stderr, "%s: %s: every drop failed: no dynamic estimate\n", prog, a->path);
+        code = EXIT_INTERNAL;
+    }
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);
+    out_abort(&sens_out);
+    pd_sensitivity_free(sens);
     for (int k = 0; k < VIZ_KINDS; k++)
         out_abort(&pic_out[k]);
     viz_measured_free(measured);

@@ -31,6 +31,7 @@ typedef struct {
     int dynamic, facets, group, verbose;
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;
+    const char *sensitivity;       /* --sensitivity FILE */
     int json;                      /* --format json */
     int argc;                      /* the command line, for the JSON metadata */
     char **argv;
@@ -109,6 +110,11 @@ void progress_clear(void);
  * output (standard output included when it is a regular file); otherwise 0,
  * with a message naming both and the file. */
 int cli_files_apart(const cli_file *files, int n);
+
+/* fragile.c: the warnings of a stationary run whose long run rests on its
+ * first drops (several closed classes, or near traps), said without
+ * --verbose. */
+void fragile_warn(const char *path, const pd_sim_result *sim);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
  * error. */

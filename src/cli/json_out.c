@@ -90,6 +90,20 @@ static void run_json(FILE *out, const cli_args *a, const pd_part *part, const pd
             "\"contact_time_auto\": %s},\n",
             s->height, s->belt_speed, s->mu, s->restitution, name_of(s->law, laws), s->vibration,
             name_of(s->initial, initials), s->gravity, contact_time, auto_time ? "true" : "false");
+    /* Tumble and ranges only when set, so a run without them prints what it
+     * always printed. */
+    if (s->tumble != 0.0 || pd_scene_ranged(s)) {
+        fprintf(out, "  \"scene_ranges\": {\"tumble_rad_s\": %.17g", s->tumble);
+        static const char *const kinds[] = {"fixed", "uniform", "log_uniform"};
+        for (int k = 0; k < PD_NPARAMS; k++) {
+            const pd_dist *d = &s->range[k];
+            if (d->kind != PD_DIST_FIXED)
+                fprintf(out, ", \"%s\": {\"kind\": \"%s\", \"lo\": %.17g, \"hi\": %.17g, "
+                        "\"multiple_of_auto\": %s}", pd_scene_param_name((pd_scene_param)k),
+                        name_of(d->kind, kinds), d->lo, d->hi, d->auto_multiple ? "true" : "false");
+        }
+        fprintf(out, "},\n");
+    }
     static const char *const topples[] = {"descent", "edge"};
     static const char *const compares[] = {"raw", "qs"};
     static const char *const bands[] = {"rect", "exact"};

@@ -46,6 +46,7 @@ static const char *const band_names[] = {"rect", "exact", NULL};
 static const char *const engine_names[] = {"impulse", "ode", "bullet", NULL};
 static const char *const law_names[] = {"poisson", "energetic", NULL};
 static const char *const initial_names[] = {"uniform", "bootstrap", "stationary", NULL};
+static const char *const dist_names[] = {"fixed", "uniform", "log", NULL};
 
 /* The identity as key=value words, in a fixed order: write_identity prints
  * it, and merge rebuilds the options from it and prints it again to prove
@@ -104,6 +105,7 @@ static void identity_words(const cli_args *a, const char *sha, words *w)
     word(w, "pqs_band", "%s", band_names[a->estimate.band]);
     word(w, "engine", "%s", engine_names[a->sim.engine]);
     word(w, "dt", "%.17g", a->sim.dt);
+    word(w, "time_limit", "%.17g", a->sim.time_limit);
     word(w, "n", "%ld", a->sim.ndrops);
     word(w, "seed", "%" PRIu64, a->sim.seed);
     const pd_scene *s = &a->scene;
@@ -116,6 +118,19 @@ static void identity_words(const cli_args *a, const char *sha, words *w)
     word(w, "initial", "%s", initial_names[s->initial]);
     word(w, "gravity", "%.17g", s->gravity);
     word(w, "contact_time", "%.17g", s->contact_time);
+    /* What a run without them never had is written only when set, so that
+     * such a run's identity is what it always was. */
+    if (s->tumble != 0.0)
+        word(w, "tumble", "%.17g", s->tumble);
+    for (int k = 0; k < PD_NPARAMS; k++) {
+        const pd_dist *d = &s->range[k];
+        if (d->kind == PD_DIST_FIXED)
+            continue;
+        char key[48];
+        snprintf(key, sizeof key, "%s_range", pd_scene_param_name((pd_scene_param)k));
+        word(w, key, "%s:%.17g:%.17g%s", dist_names[d->kind], d->lo, d->hi,
+             d->auto_multiple ? ":auto" : "");
+    }
     word(w, "group", "%d", a->group);
 }
 
@@ -464,6 +479,39 @@ static int read_double(const char *text, double *out)
     return end != text && *end == '\0';
 }
 
+/* The words identity_words writes only when set: tumble and the ranges. */
+static int ranges_from_identity(const char *id, pd_scene *s)
+{
+    char v[1100];
+    if (find_word(id, "tumble", v, sizeof v) && !read_double(v, &s->tumble))
+        return 0;
+    for (int k = 0; k < PD_NPARAMS; k++) {
+        char key[48];
+        snprintf(key, sizeof key, "%s_range", pd_scene_param_name((pd_scene_param)k));
+        if (!find_word(id, key, v, sizeof v))
+            continue;
+        pd_dist *d = &s->range[k];
+        char kind[16], *end;
+        const char *p = v + strcspn(v, ":");
+        if (*p != ':' || (size_t)(p - v) >= sizeof kind)
+            return 0;
+        memcpy(kind, v, (size_t)(p - v));
+        kind[p - v] = '\0';
+        int e;
+        if (!pick(kind, dist_names, &e) || e == PD_DIST_FIXED)
+            return 0;
+        d->kind = (pd_dist_kind)e;
+        d->lo = strtod(p + 1, &end);
+        if (*end != ':')
+            return 0;
+        d->hi = strtod(end + 1, &end);
+        d->auto_multiple = strcmp(end, ":auto") == 0;
+        if (*end && !d->auto_multiple)
+            return 0;
+    }
+    return 1;
+}
+
 /* The options of the run the shards came from, from their identity. */
 static int options_from_identity(const shard_file *s, cli_args *a, char *path, size_t path_size,
                                  char sha[65])
@@ -497,6 +545,7 @@ static int options_from_identity(const shard_file *s, cli_args *a, char *path, s
         a->part.com_given = 1;
         ok = sscanf(v, "%lf,%lf,%lf", &a->part.com.x, &a->part.com.y, &a->part.com.z) == 3;
     }
+    ok = ok && ranges_from_identity(id, &a->scene);
     if (!ok)
         return merge_fail(s->file, 1, "the run's settings are incomplete or unreadable");
     a->read.units = (pd_units)e[0];

@@ -20,19 +20,33 @@ struct pd_compliant_work {
     double *ptx, *pty;      /* tangential impulses, accumulated over sweeps */
     double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
     int hint;
+    const pd_cancel_flag *cancel; /* may be NULL */
 };
+
+void pd_compliant_work_watch(pd_compliant_work *w, const pd_cancel_flag *cancel)
+{
+    w->cancel = cancel;
+}
 
 pd_status pd_compliant_init(double e, double T, const pd_body *b, double tol_scale, pd_compliant *c)
 {
     if (!(tol_scale > 0.0 && tol_scale <= 1.0))
         return PD_ERR_RANGE;
-    pd_status st = pd_compliant_law_init(e, T, &c->law);
+    pd_compliant_law law;
+    pd_status st = pd_compliant_law_init(e, T, &law);
     if (st != PD_OK)
         return st;
+    pd_compliant_from_law(&law, b, tol_scale, c);
+    return PD_OK;
+}
+
+void pd_compliant_from_law(const pd_compliant_law *law, const pd_body *b, double tol_scale,
+                           pd_compliant *c)
+{
+    c->law = *law;
     c->h1 = tol_scale * PD_COMPLIANT_STEP / (c->law.omega * (1.0 + c->law.chi * c->law.s_peak));
     c->band = PD_COMPLIANT_BAND_REL * b->size;
     c->sweep_tol = tol_scale * PD_COMPLIANT_SWEEP_TOL;
-    return PD_OK;
 }
 
 pd_compliant_work *pd_compliant_work_alloc(const pd_body *b)
@@ -205,6 +219,10 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
         }
         if (t >= t_max) {
             r->end = PD_COMPLIANT_TIME;
+            break;
+        }
+        if (w->cancel && atomic_load_explicit(w->cancel, memory_order_relaxed)) {
+            r->end = PD_COMPLIANT_CANCELLED;
             break;
         }
 

@@ -108,3 +108,70 @@ pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law)
     law->omega = tau / T;
     return PD_OK;
 }
+
+/* The table's nodes are even in log e (dense where chi changes fastest,
+ * towards e = 0) and hold chi e / (1 - e), which stays near 1.6 over the
+ * whole range (chi itself goes as 1 / e towards 0 and as 1 - e towards 1),
+ * log tau, and s_peak (an estimate at step ends, which only sets the
+ * step). */
+pd_status pd_compliant_table_init(double e_lo, double e_hi, pd_compliant_table *t)
+{
+    if (!(e_lo >= 0.0 && e_lo <= e_hi && e_hi <= 1.0))
+        return PD_ERR_RANGE;
+    e_lo = fmax(e_lo, PD_COMPLIANT_E_MIN);
+    e_hi = fmax(e_hi, PD_COMPLIANT_E_MIN);
+    t->n = e_hi > e_lo ? PD_COMPLIANT_TABLE_NODES : 1;
+    t->x_lo = log(e_lo);
+    t->dx = t->n > 1 ? (log(e_hi) - t->x_lo) / (t->n - 1) : 0.0;
+    for (int i = 0; i < t->n; i++) {
+        pd_compliant_law law;
+        double e = i == 0 ? e_lo : i + 1 == t->n ? e_hi : exp(t->x_lo + i * t->dx);
+        pd_status st = pd_compliant_law_init(e, 1.0, &law);
+        if (st != PD_OK)
+            return st;
+        t->one = law;
+        t->y[0][i] = law.e < 1.0 ? law.chi * law.e / (1.0 - law.e) : 0.0;
+        t->y[1][i] = log(law.tau);
+        t->y[2][i] = law.s_peak;
+    }
+    /* At e = 1 chi is 0 and the ratio 0 / 0: its limit, extrapolated by
+     * the cubic through the four nodes below. */
+    int last = t->n - 1;
+    if (t->n > 1 && e_hi == 1.0)
+        t->y[0][last] = 4.0 * t->y[0][last - 1] - 6.0 * t->y[0][last - 2] +
+                        4.0 * t->y[0][last - 3] - t->y[0][last - 4];
+    return PD_OK;
+}
+
+void pd_compliant_table_law(const pd_compliant_table *t, double e, double T, pd_compliant_law *law)
+{
+    e = fmax(e, PD_COMPLIANT_E_MIN);
+    if (t->n == 1) {
+        /* One restitution: its exact law, as pd_compliant_law_init gives
+         * it for duration T (chi, tau, s_peak do not depend on T). */
+        *law = t->one;
+        law->T = T;
+        law->omega = law->tau / T;
+        return;
+    }
+    /* Cubic Lagrange interpolation through the four nodes around x, shifted
+     * inwards at the ends: error of order dx^4 everywhere. */
+    double x = (log(e) - t->x_lo) / t->dx, v[3], w[4];
+    int i = (int)floor(x) - 1;
+    i = i < 0 ? 0 : i > t->n - 4 ? t->n - 4 : i;
+    for (int j = 0; j < 4; j++) {
+        w[j] = 1.0;
+        for (int k = 0; k < 4; k++)
+            if (k != j)
+                w[j] *= (x - (i + k)) / (double)(j - k);
+    }
+    for (int q = 0; q < 3; q++)
+        v[q] = w[0] * t->y[q][i] + w[1] * t->y[q][i + 1] + w[2] * t->y[q][i + 2] +
+               w[3] * t->y[q][i + 3];
+    law->e = e;
+    law->T = T;
+    law->chi = e < 1.0 ? v[0] * (1.0 - e) / e : 0.0;
+    law->tau = exp(v[1]);
+    law->s_peak = v[2];
+    law->omega = law->tau / T;
+}

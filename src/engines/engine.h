@@ -28,6 +28,10 @@ typedef struct pd_engine {
     pd_engine_world *(*world_alloc)(const pd_body *body, const pd_hull *hull, const pd_scene *scene,
                                     double dt);
     void (*world_free)(pd_engine_world *w);
+    /* Sets the floor contact's friction, restitution and contact time
+     * (resolved, never PD_CONTACT_TIME_AUTO) from scene, as world_alloc
+     * does: for drops that draw their own (scene ranges). */
+    pd_status (*material)(pd_engine_world *w, const pd_scene *scene);
     /* Puts the body in state s (velocities included), resting contacts
      * cleared. */
     pd_status (*reset)(pd_engine_world *w, const pd_state *s);

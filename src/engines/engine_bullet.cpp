@@ -166,6 +166,7 @@ struct pd_engine_world {
     btRigidBody floor_body;
     btRigidBody body;
     btScalar dt;
+    double step_s;  /* dt in s, as the scene's contact time is compared with it */
     pd_quat q_last; /* keeps the read-back quaternion on one hemisphere */
 
     pd_engine_world(const pd_body *b, double step)
@@ -178,6 +179,7 @@ struct pd_engine_world {
               btScalar(b->mass), nullptr, &hull,
               btVector3(btScalar(b->moment[0]), btScalar(b->moment[1]), btScalar(b->moment[2])))),
           dt(btScalar(step)),
+          step_s(step),
           q_last(quat_identity())
     {
     }
@@ -221,6 +223,27 @@ static double contact_reach(const btConvexHullShape &hull)
     return fmin(0.25 * sqrt(d2), bullet);
 }
 
+/* The contact's material, for world_alloc and for drops that draw their
+ * own. */
+static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
+{
+    contact_law &law = w->hull_floor.law;
+    double dt = w->step_s;
+    law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
+    law.omega = law.zeta = 0.0;
+    if (law.on)
+        pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
+    /* Penetration deeper than the threshold is removed by a position-only
+     * (split) impulse (see world_alloc). With the scene's spring-dashpot
+     * (law.on) the penetration term is the spring's force: it must act on
+     * the velocities, not only on the positions, and the rebound is the
+     * dashpot's alone (no restitution). */
+    w->world.getSolverInfo().m_splitImpulse = law.on ? 0 : 1;
+    w->body.setFriction(btScalar(scene->mu));
+    w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
+    return PD_OK;
+}
+
 static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull,
                                            const pd_scene *scene, double dt)
 {
@@ -245,12 +268,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * intersection and be exact only away from its corners. */
     w->hull.setMargin(btScalar(PD_BULLET_MARGIN_REL * b->size));
 
-    contact_law &law = w->hull_floor.law;
-    law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
-    law.reach = contact_reach(w->hull);
-    law.omega = law.zeta = 0.0;
-    if (law.on)
-        pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
+    w->hull_floor.law.reach = contact_reach(w->hull);
     w->dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, STATIC_PLANE_PROXYTYPE,
                                               &w->hull_floor);
     w->dispatcher.registerCollisionCreateFunc(STATIC_PLANE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE,
@@ -261,13 +279,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     /* Penetration deeper than this is removed by a position-only (split)
      * impulse; Bullet's -0.04 m default sends every penetration of a small
      * part to Baumgarte velocity instead, which feeds energy in. */
-    info.m_splitImpulse = 1;
     info.m_splitImpulsePenetrationThreshold = 0;
-    /* With the scene's spring-dashpot (law.on) the penetration term is the
-     * spring's force: it must act on the velocities, not only on the
-     * positions, and the rebound is the dashpot's alone (no restitution). */
-    if (law.on)
-        info.m_splitImpulse = 0;
     /* Bullet's default friction acts along the sliding direction only; a
      * part resting on a face then creeps sideways at ~1e-4 m/s (measured on
      * a 1 x 2 x 3 cm box), a second, orthogonal direction holds it (2e-6 m
@@ -278,8 +290,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
 
     w->floor_body.setFriction(1);
     w->floor_body.setRestitution(1);
-    w->body.setFriction(btScalar(scene->mu));
-    w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
+    bullet_material(w, scene);
     w->body.setActivationState(DISABLE_DEACTIVATION);
     w->body.setSleepingThresholds(0, 0);
     w->body.setDamping(0, 0);
@@ -422,6 +433,7 @@ extern "C" const pd_engine pd_engine_bullet = {
     "bullet",
     bullet_world_alloc,
     bullet_world_free,
+    bullet_material,
     bullet_reset,
     bullet_step,
 };

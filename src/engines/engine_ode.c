@@ -365,6 +365,21 @@ static double pow2_near(double x)
     return ldexp(1.0, f < M_SQRT1_2 ? e - 1 : e);
 }
 
+/* The contact's material; w->dt * w->time is the step in s exactly (a
+ * power of two apart). */
+static pd_status material(pd_engine_world *w, const pd_scene *scene)
+{
+    w->mu = scene->mu;
+    w->restitution = scene->restitution;
+    double dt = w->dt * w->time;
+    w->compliant = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
+    w->omega = w->zeta = 0.0;
+    if (w->compliant)
+        pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->omega,
+                              &w->zeta);
+    return PD_OK;
+}
+
 static pd_engine_world *world_alloc(const pd_body *body, const pd_hull *hull,
                                     const pd_scene *scene, double dt)
 {
@@ -393,16 +408,10 @@ static pd_engine_world *world_alloc(const pd_body *body, const pd_hull *hull,
     double acc = w->len / (w->time * w->time);
     w->gravity = scene->gravity / acc;
     w->dt = dt / w->time;
-    w->mu = scene->mu;
-    w->restitution = scene->restitution;
     double gs = g / acc, size = body->size / w->len;
     w->bounce_vel = PD_ODE_BOUNCE_VEL_REL * sqrt(gs * size);
     contact_softness(w, gs, size);
-    if (scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time) {
-        w->compliant = 1;
-        pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->omega,
-                              &w->zeta);
-    }
+    material(w, scene);
     if (!build_points(w, body) || ode_guard(w, ODE_BUILD, NULL) != PD_OK) {
         world_free(w);
         return NULL;
@@ -610,4 +619,4 @@ static pd_status step(pd_engine_world *w, pd_state *s)
     return ode_guard(w, ODE_STEP, s);
 }
 
-const pd_engine pd_engine_ode = {"ode", world_alloc, world_free, reset, step};
+const pd_engine pd_engine_ode = {"ode", world_alloc, world_free, material, reset, step};

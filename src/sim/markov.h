@@ -18,6 +18,12 @@
 
 typedef struct pd_markov_work pd_markov_work;
 
+/* Where drop i (of the whole run) of a stationary run starts: -1 for a
+ * uniform orientation, or the pose it rests on. The first (k + 1)
+ * pose_drops drops go round uniform, pose 0, ..., pose k - 1; the rest
+ * (fewer than k + 1) are uniform (montecarlo.c runs them so). */
+int pd_stationary_start(long i, long pose_drops, int k);
+
 /* Scratch for chains of up to k states (O(k^2) doubles); NULL if out of
  * memory. One work area serves any number of calls. */
 pd_markov_work *pd_markov_work_alloc(int k);

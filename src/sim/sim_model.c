@@ -10,6 +10,7 @@
 #include "contact/contact_phase.h"
 #include "base/base_tol.h"
 #include "sim/sim_tol.h"
+#include "sim/scene.h"
 #include "sim/sim_model.h"
 
 void pd_sim_model_free(pd_sim_model *m)
@@ -50,15 +51,47 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->dt = options->dt > 0 ? options->dt : 1e-3;
     else if (options->engine == PD_ENGINE_BULLET)
         m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    m->time_limit = options->time_limit > 0 ? options->time_limit
+                                            : pd_time_limit_auto(part->size, scene);
+    if (m->engine && m->time_limit / m->dt > PD_STEPS_MAX) {
+        double dt = m->dt, limit = m->time_limit;
+        free(m);
+        return pd_fail(diag, PD_ERR_RANGE, "the %s engine would take %.3g steps of %g s per drop "
+                       "to reach the time limit of %.6g s (for a part of size %g m), more than %g: "
+                       "give a longer step (dt) or a shorter time limit",
+                       options->engine == PD_ENGINE_BULLET ? "Bullet" : "ODE", limit / dt, dt,
+                       limit, part->size, PD_STEPS_MAX);
+    }
     m->hull = part->hull;
     m->com = part->com;
     m->poses = poses;
     pd_status st = pd_body_build(part, &m->body, diag);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
+    m->part_size = part->size;
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
                           ? pd_contact_time_auto(part->size)
                           : scene->contact_time;
+    const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
+    m->material_ranged = scene->range[PD_PARAM_MU].kind != PD_DIST_FIXED ||
+                         e->kind != PD_DIST_FIXED || ct->kind != PD_DIST_FIXED;
+    double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
+                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(part->size)
+                                             : ct->hi;
+    /* A drawn duration obeys the value's range; auto itself is the part's
+     * and has none. */
+    if (st == PD_OK && ct->kind != PD_DIST_FIXED && ct_hi > 1.0)
+        st = pd_fail(diag, PD_ERR_RANGE, "scene contact_time: the range reaches %g s for this "
+                     "part: expected at most 1 s", ct_hi);
+    m->compliant_any = !m->engine && ct_hi > 0.0;
+    if (st == PD_OK && m->compliant_any && m->material_ranged) {
+        double e_lo = e->kind == PD_DIST_FIXED ? scene->restitution : e->lo;
+        double e_hi = e->kind == PD_DIST_FIXED ? scene->restitution : e->hi;
+        st = pd_compliant_table_init(e_lo, e_hi, &m->table);
+        if (st != PD_OK)
+            st = pd_fail(diag, st, "the compliant contact law for restitution %g to %g could not "
+                         "be set up", e_lo, e_hi);
+    }
     if (st == PD_OK && !m->engine && m->contact_time > 0.0) {
         m->compliant_on = 1;
         st = pd_compliant_init(scene->restitution, m->contact_time, m->body, tol_scale,
@@ -94,20 +127,44 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
         w->impact = pd_impact_work_alloc_tol(model->tol_scale);
         w->phase = pd_contact_phase_ode_alloc_tol(model->tol_scale);
         w->pivot = pd_contact_pivot_ode_alloc_tol(model->tol_scale);
-        if (model->compliant_on)
-            w->compliant = pd_compliant_work_alloc(model->body);
+        if (model->compliant_any)
+            w->compliant_work = pd_compliant_work_alloc(model->body);
     }
-    if ((!w->impact || !w->phase || !w->pivot || (model->compliant_on && !w->compliant)) &&
+    if ((!w->impact || !w->phase || !w->pivot || (model->compliant_any && !w->compliant_work)) &&
         !w->world) {
         pd_impact_work_free(w->impact);
         pd_ode_free(w->phase);
         pd_ode_free(w->pivot);
-        pd_compliant_work_free(w->compliant);
+        pd_compliant_work_free(w->compliant_work);
         free(w);
         return NULL;
     }
     w->engine = model->engine;
+    w->contact_time = model->contact_time;
+    w->compliant_on = model->compliant_on;
+    w->compliant = model->compliant;
     return w;
+}
+
+pd_status pd_drop_material(const pd_sim_model *m, pd_drop_work *w, const pd_scene *drawn)
+{
+    if (!m->material_ranged)
+        return PD_OK;
+    w->contact_time = drawn->contact_time == PD_CONTACT_TIME_AUTO
+                          ? pd_contact_time_auto(m->part_size)
+                          : drawn->contact_time;
+    if (m->engine) {
+        pd_scene resolved = *drawn;
+        resolved.contact_time = w->contact_time;
+        return m->engine->material(w->world, &resolved);
+    }
+    w->compliant_on = w->contact_time > 0.0;
+    if (w->compliant_on) {
+        pd_compliant_law law;
+        pd_compliant_table_law(&m->table, drawn->restitution, w->contact_time, &law);
+        pd_compliant_from_law(&law, m->body, m->tol_scale, &w->compliant);
+    }
+    return PD_OK;
 }
 
 void pd_drop_work_free(pd_drop_work *w)
@@ -117,7 +174,7 @@ void pd_drop_work_free(pd_drop_work *w)
     pd_impact_work_free(w->impact);
     pd_ode_free(w->phase);
     pd_ode_free(w->pivot);
-    pd_compliant_work_free(w->compliant);
+    pd_compliant_work_free(w->compliant_work);
     if (w->world)
         w->engine->world_free(w->world);
     free(w);
@@ -140,7 +197,8 @@ static pd_quat quat_between(pd_vec3 a, pd_vec3 b)
 }
 
 static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng,
-                          const double *init_cdf, pd_state *s, double q0[4])
+                          uint64_t seed, long index, const double *init_cdf, pd_state *s,
+                          double q0[4])
 {
     const pd_body *b = m->body;
     pd_quat q;
@@ -168,6 +226,13 @@ static void initial_state(const pd_sim_model *m, const pd_scene *sc, pd_rng *rng
     s->x = v3(0, 0, 0);
     s->v = v3(sc->belt_speed, 0, 0);
     s->w = v3(0, 0, 0);
+    if (sc->tumble > 0.0) {
+        /* From the parameters' stream: a run without tumble draws nothing
+         * more from the drop's own. */
+        double a[3];
+        pd_scene_tumble_axis(seed, index, a);
+        s->w = quat_rotate_inv(q, v3_scale(v3(a[0], a[1], a[2]), sc->tumble));
+    }
     /* Lowest point at the drop height. */
     int low = pd_body_support(b, quat_rotate_inv(q, v3(0, 0, 1)), 0);
     s->x.z = sc->height - pd_body_vertex_world(b, s, low).z;
@@ -184,9 +249,11 @@ void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_opt
 {
     pd_rng rng;
     pd_rng_init(&rng, o->seed, (uint64_t)index);
-    initial_state(m, sc, &rng, init_cdf, s, out->q0);
+    initial_state(m, sc, &rng, o->seed, index, init_cdf, s, out->q0);
     out->pose = -1;
     out->collisions = 0;
     out->end = PD_END_FAILED;
+    out->stage = PD_STAGE_NONE;
+    out->status = PD_OK;
     out->time = 0.0;
 }

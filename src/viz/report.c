@@ -165,7 +165,7 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
 static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
                         const pd_scene *scene)
 {
-    char v[256];
+    char v[640];
     vbuf_put(b, "<section id=\"run\"><h2>Scene, engine and timings</h2>\n<table>\n");
     const pd_static_options *o = run->estimate;
     snprintf(v, sizeof v, "topple %s; PQS epsilon %.4g deg, compare %s, band %s",
@@ -174,11 +174,16 @@ static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
     row(b, "static estimators", v);
     if (scene && sim) {
         const pd_scene *s = scene;
-        snprintf(v, sizeof v, "drop height %.4g m, belt %.4g m/s, mu %.4g, restitution %.4g (%s), "
-                 "vibration %.4g deg, gravity %.4g m/s\xc2\xb2, contact time %.4g s, initial %s",
-                 s->height, s->belt_speed, s->mu, s->restitution,
-                 s->law == PD_RESTITUTION_POISSON ? "Poisson" : "energetic",
-                 s->vibration * (180.0 / M_PI), s->gravity, s->contact_time, viz_initial_name(s->initial));
+        char p[PD_NPARAMS][48];
+        for (int k = 0; k < PD_NPARAMS; k++)
+            pd_scene_format(s, (pd_scene_param)k, p[k], sizeof p[k]);
+        snprintf(v, sizeof v, "drop height %s m, belt %s m/s, mu %s, restitution %s (%s), "
+                 "vibration %s deg, gravity %.4g m/s\xc2\xb2, contact time %s s, tumble %s rad/s, "
+                 "initial %s%s", p[PD_PARAM_HEIGHT], p[PD_PARAM_BELT_SPEED], p[PD_PARAM_MU],
+                 p[PD_PARAM_RESTITUTION], s->law == PD_RESTITUTION_POISSON ? "Poisson" : "energetic",
+                 p[PD_PARAM_VIBRATION], s->gravity, p[PD_PARAM_CONTACT_TIME], p[PD_PARAM_TUMBLE],
+                 viz_initial_name(s->initial),
+                 pd_scene_ranged(s) ? "; LO:HI: a range, each drop drawing its own value" : "");
         row(b, "scene", v);
         static const char *const engines[] = {"impulse (posedrop's own)", "ODE", "Bullet"};
         const pd_sim_options *so = run->sim;
@@ -248,6 +253,22 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                     "Every direction gravity can have in the part's frame, coloured by the pose "
                     "that quasi-static motion from it ends in: each colour's share of the sphere "
                     "is that pose's QS probability.", viz_sphere, in, diag);
+    if (st == PD_OK && in->sensitivity && in->sensitivity->nparams > 0) {
+        vbuf_put(b, "<section id=\"sensitivity\"><h2>What each ranged parameter moves</h2>\n"
+                    "<p class=\"note\">The scene's ranges are drawn anew for every drop, so the "
+                    "estimates above are over the ranges. For each pose, the first-order "
+                    "index is the share of its variance that one parameter explains alone "
+                    "(docs/uncertainty.md).");
+        if (in->scene && in->scene->initial == PD_INITIAL_STATIONARY)
+            vbuf_printf(b, " A stationary run's sensitivity is that of its first drops: the "
+                        "%ld settled drops started from uniform orientations.",
+                        in->sensitivity->n);
+        vbuf_put(b, "</p>\n");
+        viz_sensitivity_words(b, in);
+        vbuf_put(b, "<figure>\n");
+        st = viz_sensitivity(in, 0, b, diag);
+        vbuf_put(b, "</figure></section>\n");
+    }
     if (st == PD_OK) {
         table_section(b, in, e, n);
         run_section(b, run, in->sim, in->scene);

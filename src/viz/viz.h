@@ -36,6 +36,7 @@ typedef struct viz_input {
     const char *engine;           /* the dynamic estimator's name for labels */
     const pd_scene *scene;        /* the drops' scene (NULL without drops) */
     const viz_measured *measured; /* or NULL */
+    const pd_sensitivity *sensitivity; /* of a run with ranges, or NULL */
 } viz_input;
 
 /* What the report says about the run besides the results. */

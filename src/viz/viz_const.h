@@ -35,4 +35,12 @@
  * outside. */
 #define VIZ_MEASURED_SUM_TOL 0.01
 
+/* The sensitivity's words call a parameter one that moves a pose when its
+ * lower and upper thirds' intervals are apart, or when the lower end of its
+ * index's 95% interval is above this: a share of the pose's variance clear
+ * of noise. Small, because a pose indicator's variance p (1 - p) is mostly
+ * the drop's own randomness: p going from 0.2 to 0.7 across a range is an
+ * index of 0.08. */
+#define VIZ_SENS_DETECT 0.01
+
 #endif

@@ -97,5 +97,8 @@ pd_status viz_gallery(const viz_input *in, int standalone, vbuf *b, pd_diag *dia
 pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag);
 pd_status viz_sphere(const viz_input *in, int standalone, vbuf *b, pd_diag *diag);
 pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *diag);
+/* in->sensitivity as a chart, and in words (a list) for the report. */
+pd_status viz_sensitivity(const viz_input *in, int standalone, vbuf *b, pd_diag *diag);
+void viz_sensitivity_words(vbuf *b, const viz_input *in);
 
 #endif

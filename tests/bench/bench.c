@@ -455,6 +455,59 @@ static void bench_effects(const dyn_part *d)
     }
 }
 
+/* What ranges cost: every parameter given as a range of zero width runs the
+ * fixed scene's very drops (tested), so its time against the fixed run's is
+ * the cost of drawing the values and setting each drop's contact law; plain
+ * ranges change the drops themselves (their collisions are shown), so their
+ * ratio is the physics of the range, not its overhead. */
+static void bench_ranges(dyn_part *parts, int nparts)
+{
+    printf("\nranges: cost per drop against the same scene with fixed values, one thread, %d "
+           "drops, best of %d\n", DYN_DROPS, DYN_BEST_OF);
+    printf("%-16s %-26s %10s %9s %9s\n", "part", "scene", "mean us", "coll/drop", "ratio");
+    static const char *const zero[][2] = {{"height", "0.12:0.12"}, {"belt_speed", "0.05:0.05"},
+                                          {"mu", "0.3:0.3"}, {"restitution", "0.3:0.3"},
+                                          {"vibration", "1.5:1.5"}, {"contact_time", "1x:1x"},
+                                          {"tumble", "0:0"}};
+    static const char *const wide[][2] = {{"height", "0.08:0.16"}, {"mu", "0.2:0.6"},
+                                          {"restitution", "0.1:0.5"}, {"contact_time", "0.3x:3x"}};
+    for (int k = 0; k < nparts; k++) {
+        pd_scene fixed, z, w;
+        pd_scene_default(&fixed);
+        pd_scene_set(&fixed, "vibration", "1.5", NULL);
+        z = w = fixed;
+        for (int i = 0; i < 7; i++)
+            pd_scene_set(&z, zero[i][0], zero[i][1], NULL);
+        for (int i = 0; i < 4; i++)
+            pd_scene_set(&w, wide[i][0], wide[i][1], NULL);
+        if (k == 0) {
+            /* The draw alone, many times over: what a range adds to a drop
+             * besides its contact law (a few multiplications, table look-ups). */
+            enum { DRAWS = 1000000 };
+            double v[PD_NPARAMS], sink = 0.0, t0 = now();
+            for (long i = 0; i < DRAWS; i++) {
+                pd_scene_draw(&w, 0.017, 1, i, v, NULL);
+                sink += v[PD_PARAM_MU];
+            }
+            printf("drawing one drop's values (pd_scene_draw): %.3f us (mean of %d; mean mu %.3f)\n",
+                   1e6 * (now() - t0) / DRAWS, DRAWS, sink / DRAWS);
+        }
+        const pd_scene *sc[3] = {&fixed, &z, &w};
+        const char *name[3] = {"fixed values (reference)", "every value a 0-width range",
+                               "mu, e, height, contact time"};
+        double t_ref = 0.0;
+        for (int e = 0; e < 3; e++) {
+            pd_sim_result *r = NULL;
+            double t = time_sim(&parts[k], sc[e], DYN_DROPS, 1, 0, &r, NULL);
+            if (e == 0)
+                t_ref = t;
+            printf("%-16s %-26s %10.1f %9.1f %8.3fx\n", e ? "" : parts[k].name, name[e], 1e6 * t,
+                   (double)r->collisions / (double)r->n, t / t_ref);
+            pd_sim_result_free(r);
+        }
+    }
+}
+
 /* Same outcome, drop by drop: counts and every trial record's fields. */
 static int same_result(const pd_sim_result *a, const pd_sim_result *b)
 {
@@ -760,6 +813,13 @@ int main(int argc, char **argv)
         bench_dynamic();
     if (wanted(argc, argv, "engines"))
         bench_engines();
+    if (wanted(argc, argv, "ranges")) {
+        dyn_part parts[NDYN];
+        issue_parts(parts);
+        bench_ranges(parts, NDYN);
+        for (int k = 0; k < NDYN; k++)
+            dyn_part_free(&parts[k]);
+    }
     if (wanted(argc, argv, "batch"))
         bench_batch();
     return 0;

@@ -27,6 +27,8 @@
     PD_SUITE(contact_pivot) \
     PD_SUITE(compliant) \
     PD_SUITE(sim)    \
+    PD_SUITE(ranges) \
+    PD_SUITE(sensitivity) \
     PD_SUITE(markov) \
     PD_SUITE(fit)    \
     PD_SUITE(drop_step) \
@@ -34,6 +36,7 @@
     PD_SUITE(engine_bullet) \
     PD_SUITE(engine_extreme) \
     PD_SUITE(engine_contact) \
+    PD_SUITE(hard_parts) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(batch)  \

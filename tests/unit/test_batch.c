@@ -189,7 +189,9 @@ static void test_merge_same_file(void)
     free(now_box);
     /* posedrop-mpi shares the check. */
     if (access(PD_CLI_MPI_PATH, X_OK) == 0) {
-        snprintf(args, sizeof args, PD_CLI_MPI_PATH " -n 5 --trials %s %s", part, part);
+        /* OpenMPI's own allocations outlive MPI_Finalize, as for MPIRUN_2. */
+        snprintf(args, sizeof args, "ASAN_OPTIONS=detect_leaks=0 " PD_CLI_MPI_PATH
+                 " -n 5 --trials %s %s", part, part);
         CHECK_INT(run_cmd(args, 1, &out, &err), 2);
         CHECK(out[0] == '\0' && strstr(err, "is the same file as PART") != NULL);
         free(out);

@@ -594,7 +594,7 @@ static void test_flat_landings(void)
             s.v = v3(0, 0, -1.53);
             s.w = v3(0, 0, 0);
             pd_compliant_result r;
-            CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant,
+            CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant_work,
                                           &fx.model->settle, &sc, &s, 1.0, &r), PD_OK);
             CHECK_INT(r.end, PD_COMPLIANT_SEPARATED);
             double rebound = s.v.z;
@@ -645,7 +645,7 @@ static void test_housner(void)
         s.v = v3_cross(ww, v3(-hw, 0, hh));
         s.w = quat_rotate_inv(s.q, ww);
         pd_compliant_result r;
-        CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant, &fx.model->settle,
+        CHECK_STATUS(pd_compliant_run(&fx.model->compliant, fx.work->compliant_work, &fx.model->settle,
                                       &sc, &s, 1e-3, &r), PD_OK);
         CHECK(r.end == PD_COMPLIANT_QUIET || r.end == PD_COMPLIANT_SEPARATED);
         double w2 = quat_rotate(s.q, s.w).y, ratio = w2 / w1;

@@ -392,7 +392,7 @@ static void test_placement(void)
         if (!parts[k])
             continue;
         CHECK_STATUS(pd_static_estimate(parts[k], NULL, &res, NULL), PD_OK);
-        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL};
+        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL};
         CHECK_STATUS(viz_gallery(&in, 1, &b[k], NULL), PD_OK);
         CHECK_STATUS(viz_sphere(&in, 1, &b[k], NULL), PD_OK);
         pd_static_result_free(res);
