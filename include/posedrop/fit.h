@@ -30,7 +30,8 @@ extern "C" {
 #define PD_FIT_MAX_PARAMS 7
 
 /* One parameter to fit: a numeric key of pd_scene_set (height, belt_speed,
- * mu, restitution, vibration in degrees, gravity, contact_time in s) and
+ * mu, restitution, vibration in degrees, gravity, contact_time in s, tumble
+ * in rad/s), set to a plain value at every evaluation, and
  * the range searched, in the key's text units, lo < hi within the key's own
  * limits. log 1 searches and weighs log(value) (lo > 0): for a quantity
  * known to within a factor, such as the contact time. */

@@ -42,7 +42,8 @@ static void fit_usage(FILE *out)
         "  --fit SPEC       the parameters to fit and their ranges, comma-separated:\n"
         "                   KEY=LO:HI with KEY one of height (m), belt_speed (m/s),\n"
         "                   mu, restitution, vibration (degrees), gravity (m/s^2),\n"
-        "                   contact_time (s, searched on a log scale); and 'initial'\n"
+        "                   tumble (rad/s), contact_time (s, searched on a log\n"
+        "                   scale); and 'initial'\n"
         "                   alone to fit the initial mode as a discrete choice\n"
         "                   (uniform, bootstrap, stationary: each fitted, the best kept).\n"
         "                   e.g. --fit mu=0.1:0.8,restitution=0.05:0.7,initial\n"
@@ -208,15 +209,16 @@ static void write_scene(FILE *f, const pd_fit_result *r, const pd_fit_param *par
     for (int i = 0; i < r->nparams; i++)
         fprintf(f, " %s %.6g [%.6g, %.6g]%s", params[i].key, r->value[i], r->lo[i], r->hi[i],
                 i + 1 < r->nparams ? ";" : "");
-    fprintf(f, "\nheight = %.17g\nbelt_speed = %.17g\nmu = %.17g\nrestitution = %.17g\n",
-            s->height, s->belt_speed, s->mu, s->restitution);
-    fprintf(f, "restitution_law = %s\nvibration = %.17g\ninitial = %s\ngravity = %.17g\n",
-            s->law == PD_RESTITUTION_ENERGETIC ? "energetic" : "poisson",
-            s->vibration * 180.0 / M_PI, initial_name(s->initial), s->gravity);
-    if (s->contact_time == PD_CONTACT_TIME_AUTO)
-        fprintf(f, "contact_time = auto\n");
-    else
-        fprintf(f, "contact_time = %.17g\n", s->contact_time);
+    fprintf(f, "\n");
+    /* Every parameter as pd_scene_set reads it: a range of the base scene
+     * stays a range. */
+    char buf[128];
+    for (int k = 0; k < PD_NPARAMS; k++)
+        fprintf(f, "%s = %s\n", pd_scene_param_name((pd_scene_param)k),
+                pd_scene_format(s, (pd_scene_param)k, buf, sizeof buf));
+    fprintf(f, "restitution_law = %s\ninitial = %s\ngravity = %.17g\n",
+            s->law == PD_RESTITUTION_ENERGETIC ? "energetic" : "poisson", initial_name(s->initial),
+            s->gravity);
 }
 
 static void write_params(FILE *f, const pd_fit_result *r, const pd_fit_param *params)

@@ -26,7 +26,7 @@ void pd_fit_options_default(pd_fit_options *o)
 
 /* The keys a fit may vary: the numeric ones of pd_scene_set. */
 static const char *const fit_keys[] = {"height", "belt_speed", "mu", "restitution", "vibration",
-                                       "gravity", "contact_time"};
+                                       "gravity", "contact_time", "tumble"};
 
 typedef struct {
     const pd_fit_part *parts;
@@ -150,7 +150,8 @@ static pd_status check_params(const pd_fit_param *params, int d, const pd_scene 
             known |= strcmp(q->key, fit_keys[j]) == 0;
         if (!known)
             return pd_fail(diag, PD_ERR_USAGE, "cannot fit '%s': expected one of height, "
-                           "belt_speed, mu, restitution, vibration, gravity, contact_time",
+                           "belt_speed, mu, restitution, vibration, gravity, contact_time, "
+                           "tumble",
                            q->key ? q->key : "(null)");
         for (int j = 0; j < i; j++)
             if (strcmp(q->key, params[j].key) == 0)

@@ -488,9 +488,13 @@ static void test_command(void)
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s --gof %s", box,
              counts, scene, scene);
     expect_failure(args, 2, "fitted.scene");
+    /* A range of the base scene stays a range in the fitted one. */
+    char base[128];
+    snprintf(base, sizeof base, "%s/base.scene", tmpdir);
+    write_file(base, "tumble = 0:1\n");
     snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7 -n 100 --max-evals 5 --points 2 "
-             "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s", box,
-             counts, scene, params);
+             "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s "
+             "--scene %s", box, counts, scene, params, base);
     char *out = NULL, *err = NULL;
     CHECK_INT(run(args, &out, &err), 0);
     CHECK(out && strncmp(out, "part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n", 53) == 0);
@@ -523,6 +527,10 @@ static void test_command(void)
     CHECK_INT(run(args, &out, &err), 0);
     free(out);
     free(err);
+    char *stext = slurp(scene);
+    CHECK(stext && strstr(stext, "\ntumble = 0:1\n") != NULL);
+    CHECK(stext && strstr(stext, "\nrestitution = ") != NULL);
+    free(stext);
     char *ptext = slurp(params);
     CHECK(ptext && strncmp(ptext, "parameter,value,lo,hi,mean,range_lo,range_hi\nrestitution,", 57) == 0);
     free(ptext);
