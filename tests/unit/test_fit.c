@@ -395,6 +395,47 @@ static void test_recovery(void)
     box_free(&b);
 }
 
+/* The initial mode as a discrete choice: each fitted, the best kept. */
+static void test_initial_choice(void)
+{
+    box_part b;
+    CHECK(box_make(&b));
+    if (!b.class_of) {
+        box_free(&b);
+        return;
+    }
+    long count[8] = {240, 48, 12, 0, 0, 0, 0, 0};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+    pd_fit_options o;
+    pd_fit_options_default(&o);
+    o.ndrops = 100;
+    o.max_evals = 5;
+    o.npoints = 2;
+    o.fit_initial = 1;
+    pd_fit_result *fr = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(pd_fit_run(&fp, 1, &prm, 1, NULL, &o, &fr, &diag), PD_OK);
+    if (fr) {
+        double best = -HUGE_VAL;
+        int arg = -1;
+        for (int i = 0; i < 3; i++) {
+            CHECK(isfinite(fr->loglik_initial[i]));
+            if (fr->loglik_initial[i] > best) {
+                best = fr->loglik_initial[i];
+                arg = i;
+            }
+        }
+        CHECK_INT((int)fr->initial, arg);
+        CHECK_INT((int)fr->scene.initial, arg);
+        /* The maximum is re-evaluated with the same drops: the same value. */
+        CHECK_NEAR(fr->loglik, best, 1e-9 * fabs(best), "the same drops, round-off of sums");
+    }
+    pd_fit_result_free(fr);
+    box_free(&b);
+}
+
 static void test_errors(void)
 {
     box_part b;
@@ -547,6 +588,7 @@ void suite_fit(void)
     test_dispersion();
     test_coverage_crn();
     test_recovery();
+    test_initial_choice();
     test_errors();
     test_command();
 }
