@@ -119,8 +119,9 @@ typedef struct pd_scene {
 /* contact_time's default: the duration a Hertz contact of a plastic part on a
  * rubber belt takes at the drop's speed, 5e-4 s for a 1 cm cube, in
  * proportion to the part's size for geometrically similar parts (Hertz: the
- * duration goes as (m^2 / (R E^2 v))^(1/5), with the mass m ~ L^3 and the
- * corner radius R ~ L: as L). docs/contact.md. */
+ * duration goes as (m^2 / (R E^2 v))^(1/5), with the mass m from the part's
+ * volume and the corner radius R ~ L: as L for similar parts;
+ * pd_contact_time_auto_part). docs/contact.md. */
 #define PD_CONTACT_TIME_AUTO (-1.0)
 
 /* The duration PD_CONTACT_TIME_AUTO stands for, for a part of size L (the
@@ -129,6 +130,20 @@ typedef struct pd_scene {
  * would press a contact 1e-3 of its size into the floor (it binds above
  * L = 1.2 m: 0.1 s for a 10 m part, 1.3 s for a 1000 m cube). */
 PD_API double pd_contact_time_auto(double size);
+
+/* The duration PD_CONTACT_TIME_AUTO stands for, for part: Hertz's
+ * (m^2 / R)^(1/5) with the mass from the part's volume and the corner
+ * radius in proportion to its size, 5e-4 s (V / 1 cm^3)^(2/5) (1.73 cm /
+ * L)^(1/5), with pd_contact_time_auto's cap for its size L;
+ * pd_contact_time_auto(L) for a cube, in proportion to L for geometrically
+ * similar parts below the cap. */
+PD_API double pd_contact_time_auto_part(const pd_part *part);
+
+/* The length whose pd_contact_time_auto is the part's own,
+ * pd_contact_time_auto_part(part) / pd_contact_time_auto(1): what
+ * pd_scene_draw, pd_scene_quantile and pd_sim_sensitivity take as
+ * part_size (the part's size for a cube). */
+PD_API double pd_contact_time_auto_size(const pd_part *part);
 
 PD_API void pd_scene_default(pd_scene *scene);
 
@@ -160,7 +175,8 @@ PD_API int pd_scene_ranged(const pd_scene *scene);
 
 /* The values drop `drop` of a run seeded `seed` uses, one per parameter
  * (values[PD_NPARAMS], stored units; contact_time resolved for a part of
- * size part_size: never PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
+ * auto size part_size, pd_contact_time_auto_size: never
+ * PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
  * the scene with every range replaced by that drop's value (fixed). Fixed
  * parameters keep their field's value. The draw of parameter i depends on
  * (seed, drop, i) only. drawn may be NULL; scene must pass pd_scene_check. */
@@ -170,7 +186,7 @@ PD_API void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed
 /* Where value v of parameter param falls in its distribution: its
  * cumulative probability in [0, 1] (0.5 for a fixed or zero-width one).
  * For a contact_time range in multiples of auto, v is in s and part_size
- * the part's size. */
+ * the part's pd_contact_time_auto_size. */
 PD_API double pd_scene_quantile(const pd_scene *scene, pd_scene_param param, double part_size,
                                 double v);
 

@@ -159,12 +159,13 @@ static int phase_rhs(double tau, const double y[], double dydt[], void *user)
 /* How far s is from the phase's end, in the part's units: per contact its
  * normal force and, sticking, its force's distance inside the friction cone
  * (per unit weight) or, sliding, its slip above slip_min (per sqrt(g L));
- * and the height of the lowest other vertex above the floor, the lowest
- * contact (*floor_v) (per L); into g[NMARGIN], from s's forces F. Each is a
+ * with a drilling contact, the spin about the normal (SPIN, below); and the
+ * height of the lowest other vertex above the floor, the lowest contact
+ * (*floor_v) (per L); into g[NMARGIN], from s's forces F. Each is a
  * smooth function of the state (the height, per vertex), so an event inside
  * a step is found from a smooth model of the one that crossed. Returns the
  * smallest (positive while the phase may go on). */
-enum { HEIGHT = 4, NMARGIN = 5 };
+enum { SPIN = 4, HEIGHT = 5, NMARGIN = 6 };
 
 /* The height of body vertex w above body vertex v at s (up: the world's up
  * in the body frame), per L. */
@@ -194,6 +195,12 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
     }
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     *up_out = up;
+    /* With a drilling contact: the spin about the normal, in the direction
+     * the phase began with, per 1 / sqrt(L/g); the phase ends where it
+     * reaches zero. */
+    double drill = p->drill[0] != 0.0 ? p->drill[0] : p->drill[1];
+    if (drill != 0.0)
+        g[SPIN] = (drill > 0.0 ? 1.0 : -1.0) * v3_dot(s->w, up) * p->T;
     /* The contacts' own height defines the floor. */
     *floor_v = p->v[0];
     if (p->nc == 2 && v3_dot(up, b->verts[p->v[1]]) < v3_dot(up, b->verts[p->v[0]]))
@@ -453,6 +460,18 @@ static void phase_of(pd_phase *p, const pd_settle *st, const pd_scene *sc, const
     const pd_body *b = st->body;
     double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(sc->gravity * b->size);
     pd_phase_modes(p, b, sc->gravity, sc->mu, s, contacts, nc, slip_start);
+    /* A sticking contact of a phase that can spin about the floor's normal
+     * (one contact, or an edge not pivoting): Coulomb friction over its
+     * patch, uniform pressure on a disc of radius a, gives a couple of at
+     * most (2/3) mu N a against the spin (docs/contact.md, "Drilling
+     * friction"). The phase ends where the spin does (margins). A sliding
+     * contact's friction goes to its slip: left out there. */
+    int spins = nc == 1 || p->mode[0] != p->mode[1];
+    double wn = v3_dot(s->w, quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0)));
+    double k = 2.0 / 3.0 * sc->mu * st->patch;
+    for (int i = 0; i < nc && spins && k > 0.0; i++)
+        if (p->mode[i] == PD_PHASE_STICK)
+            p->drill[i] = wn > 0.0 ? k : wn < 0.0 ? -k : 0.0;
 }
 
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,

@@ -129,13 +129,27 @@ static const pd_vec3 body_axes[3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
  * contacts K is singular (the squeeze along the edge moves nothing): the
  * least-norm solution is taken, from the normal equations with the squeeze
  * set to zero by one more row. 0 if singular. */
-static int solve_layout(const pd_phase *p, const layout *L, int m, double B[6][6])
+static int solve_layout(const pd_phase *p, const layout *L, pd_vec3 up, int drilling, int m,
+                        double B[6][6])
 {
     int n = L->n;
     double K[7][6], Ab[6][AUG];
     for (int i = 0; i < n; i++)
         for (int j = 0; j < n; j++)
             K[i][j] = v3_dot(L->row[i], m3_vec(CONST_M3(p->M[L->c[i]][L->c[j]]), L->col[j]));
+    if (drilling) {
+        /* A drilling contact's couple, -drill (up . f) up, turns the part:
+         * contact i's acceleration gains -drill (up . f) (I^-1 up) x r_i,
+         * linear in the unknowns of the drilling contact. */
+        pd_vec3 Iu = pd_body_inv_inertia(p->b, up);
+        for (int i = 0; i < n; i++)
+            for (int j = 0; j < n; j++) {
+                double d = p->drill[L->c[j]];
+                if (d != 0.0)
+                    K[i][j] -= d * v3_dot(up, L->col[j]) *
+                               v3_dot(L->row[i], v3_cross(Iu, p->r[L->c[i]]));
+            }
+    }
     if (!(p->nc == 2 && p->mode[0] == STICK && p->mode[1] == STICK)) {
         for (int i = 0; i < n; i++) {
             for (int j = 0; j < n; j++)
@@ -227,7 +241,7 @@ void pd_phase_map(pd_phase *p)
     for (int i = 0; i < L.n; i++)
         for (int k = 0; k < L.n; k++)
             p->P[i][k] = i == k;
-    p->singular = !solve_layout(p, &L, L.n, p->P);
+    p->singular = !solve_layout(p, &L, v3(0, 0, 1), 0, L.n, p->P);
 }
 
 void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
@@ -316,6 +330,21 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         }
         for (int j = 0; j < p->nc; j++)
             f[j] = v3(x[3 * j], x[3 * j + 1], x[3 * j + 2]);
+        if (p->drill[0] != 0.0) {
+            /* One contact sticking and drilling: the couple -drill fn up
+             * turns the part, so the contact's acceleration is M f + af -
+             * drill (up . f) u with u = (I^-1 up) x r, and holding it at
+             * zero takes (M - drill u up^T) f = -af: P's solution, the
+             * rank-one change added (Sherman and Morrison). */
+            pd_vec3 u = v3_cross(pd_body_inv_inertia(b, up), p->r[0]);
+            pd_vec3 Pu = v3(p->P[0][0] * u.x + p->P[0][1] * u.y + p->P[0][2] * u.z,
+                            p->P[1][0] * u.x + p->P[1][1] * u.y + p->P[1][2] * u.z,
+                            p->P[2][0] * u.x + p->P[2][1] * u.y + p->P[2][2] * u.z);
+            double den = 1.0 - p->drill[0] * v3_dot(up, Pu);
+            if (!(fabs(den) > 0.0))
+                return 1;
+            f[0] = v3_add(f[0], v3_scale(Pu, p->drill[0] * v3_dot(up, f[0]) / den));
+        }
     } else if (!general && p->mode[0] == SLIDE && (p->nc == 1 || p->mode[1] == SLIDE)) {
         /* Every contact slides: one unknown per contact, along its force
          * direction, and one row, its normal. */
@@ -344,13 +373,17 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         double x[6][6];
         for (int i = 0; i < L.n; i++)
             x[i][0] = -v3_dot(L.row[i], af[L.c[i]]);
-        if (!solve_layout(p, &L, 1, x))
+        if (!solve_layout(p, &L, up, 1, 1, x))
             return 1;
         for (int k = 0; k < L.n; k++)
             f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
     }
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
+    for (int j = 0; j < p->nc; j++)
+        if (p->drill[j] != 0.0)
+            out->wdot = v3_add(out->wdot, pd_body_inv_inertia(b, v3_scale(up, -p->drill[j] *
+                                                                             v3_dot(up, f[j]))));
     for (int j = 0; j < p->nc; j++) {
         out->wdot = v3_add(out->wdot, pd_body_inv_inertia(b, v3_cross(p->r[j], f[j])));
         F = v3_add(F, f[j]);
@@ -401,7 +434,7 @@ int pd_phase_project_velocity(const pd_phase *p, pd_state *s)
     pd_vec3 vb = quat_rotate_inv(s->q, s->v);
     for (int i = 0; i < L.n; i++)
         x[i][0] = -v3_dot(L.row[i], v3_add(vb, v3_cross(s->w, p->r[L.c[i]])));
-    if (!solve_layout(p, &L, 1, x))
+    if (!solve_layout(p, &L, up, 0, 1, x))
         return 0;
     for (int k = 0; k < L.n; k++) {
         pd_vec3 P = v3_scale(L.col[k], x[k][0]);

@@ -19,6 +19,11 @@ typedef struct {
     int v[2];          /* contact vertices */
     int mode[2];       /* PD_PHASE_SLIDE or PD_PHASE_STICK */
     double mu, g;      /* SI */
+    double drill[2];   /* a sticking contact of a phase that can spin about
+                          the floor's normal (not a pivot): its drilling
+                          friction's couple per unit normal force,
+                          (2/3) mu a (m), signed as the spin at the phase's
+                          start; 0: none (pd_phase_modes sets none) */
     double L, T;       /* units: length, time */
     pd_vec3 r[2];      /* contact vertices, body frame */
     double M[2][2][3][3]; /* M[i][j] f: acceleration of contact i by force f at j */

@@ -104,4 +104,18 @@
  * genuine search and still stops a runaway (NaN-free but stuck) state fast. */
 #define PD_CONTACT_MAX_STEPS 100000
 
+/* The flight's bound on |w| (flight.c, wmax_bound) leaves out a pair of
+ * principal moments closer than this relative to the larger, and adds
+ * PD_FLIGHT_WMAX_ROUND times 2 E / I_min to the bound's square. Why 1e-6 and
+ * 1e-9: a pair's solution divides by the moments' difference, so its
+ * round-off, ~1e-16 of 2 E / I_min over the relative difference, is at most
+ * 1e-10 of 2 E / I_min for the pairs kept, ten times below the margin
+ * added; the margin widens the bound by at most 1e-9 of the classical
+ * energy bound (a needle of aspect 1000 at 3 rad/s: by 2e-3 rad/s). Closer
+ * pairs are left out, as the set's other vertices then bound it. Larger
+ * margin: looser bounds for parts of extreme inertia ratio; smaller: the
+ * margin no longer covers the round-off. */
+#define PD_FLIGHT_WMAX_PAIR_REL 1e-6
+#define PD_FLIGHT_WMAX_ROUND 1e-9
+
 #endif

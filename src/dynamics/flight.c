@@ -271,6 +271,39 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
     return elliptic_at(F, F->tau0, u0, &F->P0);
 }
 
+/* A bound on |w| over the torque-free motion from body rates w0 (principal
+ * moments I, |L|^2 = L2). Along the motion the squares x_i = w_i^2 keep
+ * sum I_i x_i = 2 E and sum I_i^2 x_i = L2, so |w|^2 = sum x_i is at most
+ * the largest sum over the vertices of that set with x >= 0, each with at
+ * most two x_i nonzero (a linear programme's basic solutions). |L| / I_min,
+ * the classical bound, can be looser by the inertia ratio: a needle 1000
+ * times longer than thick turning end over end at 3 rad/s got a bound of
+ * 1.6e6 rad/s, and the impact search, whose steps shrink with it, ran out
+ * of steps. A pair of moments closer than PD_FLIGHT_WMAX_PAIR_REL is left
+ * out (its solution is round-off; the set is then nearly a segment whose
+ * ends the other pairs give), and the round-off of the others, at most
+ * ~1e-16 (2 E / I_min) / PD_FLIGHT_WMAX_PAIR_REL, is covered by adding
+ * PD_FLIGHT_WMAX_ROUND times 2 E / I_min. Never above the classical bounds. */
+static double wmax_bound(const double *I, pd_vec3 w0, double L2)
+{
+    double w[3] = {w0.x, w0.y, w0.z}, E2 = 0.0, best = 0.0, Imin = fmin(I[0], fmin(I[1], I[2]));
+    for (int i = 0; i < 3; i++) {
+        E2 += I[i] * w[i] * w[i];
+        best += w[i] * w[i];
+    }
+    for (int i = 0; i < 3; i++)
+        for (int j = i + 1; j < 3; j++) {
+            double d = I[i] - I[j];
+            if (fabs(d) <= PD_FLIGHT_WMAX_PAIR_REL * fmax(I[i], I[j]))
+                continue;
+            double xi = (L2 - I[j] * E2) / (I[i] * d), xj = (L2 - I[i] * E2) / (-I[j] * d);
+            if (xi >= 0.0 && xj >= 0.0)
+                best = fmax(best, xi + xj);
+        }
+    double w2 = best + PD_FLIGHT_WMAX_ROUND * E2 / Imin;
+    return fmin(sqrt(fmin(w2, E2 / Imin)), sqrt(L2) / Imin);
+}
+
 pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
 {
     if (!b || !s0 || !f || !(g >= 0.0))
@@ -289,7 +322,7 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
         F->J0[i] = b->inv_moment[i];
     pd_vec3 Lb = body_L(b, s0->w);
     F->lambda = v3_norm(Lb);
-    F->wmax = F->lambda * b->inv_moment[0]; /* |J L| <= max(J) |L| */
+    F->wmax = wmax_bound(b->moment, s0->w, F->lambda * F->lambda);
     if (F->lambda == 0.0) {
         F->kind = PD_FLIGHT_STILL;
         return PD_OK;

@@ -69,6 +69,9 @@ pd_status pd_settle_build(const pd_part *part, const pd_body *body, const pd_sta
      * twice that leaves room for what the part's rotation adds. */
     st->rest_fall = PD_TOL_REST_FALL_REL * body->size;
     st->v_rest = 2.0 * sqrt(2.0 * gravity * st->rest_fall);
+    st->margin = st->rest_fall;
+    st->still = 0.0;
+    st->patch = 0.0;
     return PD_OK;
 }
 
@@ -90,7 +93,7 @@ int pd_settle_decided_at(const pd_settle *st, const pd_state *s, double g, int *
                          int *facet)
 {
     *facet = -1;
-    if (!(energy_height(st->body, s, g) + st->rest_fall < st->barrier_max) &&
+    if (!(energy_height(st->body, s, g) + st->margin < st->barrier_max) &&
         !(s->x.z < st->flat_height))
         return 0;
     pd_vec3 down = gravity_in_part(st, s);
@@ -100,7 +103,7 @@ int pd_settle_decided_at(const pd_settle *st, const pd_state *s, double g, int *
     *facet = f;
     /* A resting vertex may be up to rest_fall below the floor, so the part's
      * potential energy may read that much low: count it. */
-    if (!(energy_height(st->body, s, g) + st->rest_fall < st->barrier[f]))
+    if (!(energy_height(st->body, s, g) + st->margin < st->barrier[f]))
         return 0;
     *pose = st->pose_of[st->descent->facets[f].rest];
     return *pose >= 0 ? 1 : -1;
@@ -111,7 +114,7 @@ int pd_settle_decided(const pd_settle *st, const pd_state *s, double g, int *hin
     /* Above every barrier nothing is decided, whichever basin s is in: the
      * descent, most of the test's cost, is left out (most of a contact
      * phase's tests, which come after every step, are up there). */
-    if (!(energy_height(st->body, s, g) + st->rest_fall < st->barrier_max))
+    if (!(energy_height(st->body, s, g) + st->margin < st->barrier_max))
         return 0;
     int f;
     return pd_settle_decided_at(st, s, g, hint, pose, &f);
@@ -122,9 +125,16 @@ int pd_settle_outcome(const pd_settle *st, const pd_state *s, double g, double m
 {
     int facet, d = pd_settle_decided_at(st, s, g, hint, pose, &facet);
     if (d == 0 && facet >= 0 && st->pose_of[facet] >= 0 &&
-        pd_flat_settled(st->flat, st->body, s, facet, g, mu, st->rest_fall)) {
+        pd_flat_settled(st->flat, st->body, s, facet, g, mu, st->margin)) {
         *pose = st->pose_of[facet];
         return 1;
+    }
+    if (d == 0 && facet >= 0 && st->still > 0.0) {
+        int p = st->pose_of[st->descent->facets[facet].rest];
+        if (p >= 0 && energy_height(st->body, s, g) < st->poses->poses[p].height + st->still) {
+            *pose = p;
+            return 1;
+        }
     }
     return d;
 }

@@ -28,7 +28,20 @@ typedef struct pd_settle {
     pd_descent_map map;         /* the descent, looked up */
     int *pose_of;               /* facet -> pose index in poses, or -1 */
     double rest_fall;           /* m: how far resting contact falls between microcollisions */
+    double margin;              /* m: how low a state's energy may read (the
+                                   engine's resting contact may sink that far):
+                                   the energy test passes below the barrier
+                                   less this */
+    double still;               /* m: with the energy less than this above
+                                   lying on the pose of the basin it is in, the
+                                   part lies still there as far as the engine
+                                   can tell (pd_settle_outcome); 0: no such
+                                   test */
     double v_rest;              /* approach speeds up to this are resting contact (e = 0) */
+    double patch;               /* m: the radius of the contact patch under the
+                                   part's weight, whose friction resists spin
+                                   about the floor's normal (docs/contact.md,
+                                   "Drilling friction"); 0: a point contact */
 } pd_settle;
 
 /* Builds everything the test needs for part (whose rigid body is body) and
@@ -53,8 +66,12 @@ int pd_settle_decided_at(const pd_settle *settle, const pd_state *s, double grav
 
 /* The outcome test of a drop in state s: pd_settle_decided_at, or lying
  * flat on a stable facet that sliding and spinning (friction mu) cannot tip
- * it from (pd_flat_settled). 1 and *pose when decided, 0 if not yet, -1 on
- * failure. */
+ * it from (pd_flat_settled), or its energy within settle->still of lying on
+ * the pose of the basin it is in. The last adds decisions only where that
+ * basin's barrier is below the pose's height plus still plus margin (a
+ * higher one has the energy test pass first): basins the engine cannot tell
+ * apart, such as two stable facets meeting at a ridge of 0.1 degree. 1 and
+ * *pose when decided, 0 if not yet, -1 on failure. */
 int pd_settle_outcome(const pd_settle *settle, const pd_state *s, double gravity, double mu,
                       int *hint, int *pose);
 

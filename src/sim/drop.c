@@ -142,6 +142,17 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
         }
         s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
         ww = v3_add(ww, m3_vec(CONST_M3(J), v3_cross(c, res.p)));
+        if (e == 0.0 && m->settle.patch > 0.0 && J[2][2] > 0.0) {
+            /* Resting contact: drilling friction over its patch
+             * (docs/contact.md), an angular impulse about the normal of at
+             * most (2/3) mu a times the normal impulse, against the spin
+             * and never reversing it, so that it only takes energy. An
+             * impact keeps the rigid law (Poisson's), the compliant law's
+             * limit. */
+            double cap = 2.0 / 3.0 * sc->mu * m->settle.patch * res.p.z;
+            double dl = fmax(-cap, fmin(cap, -ww.z / J[2][2]));
+            ww = v3_add(ww, v3_scale(v3(J[0][2], J[1][2], J[2][2]), dl));
+        }
         s->w = quat_rotate_inv(s->q, ww);
         (*impacts)++;
     }
@@ -184,6 +195,12 @@ static double touching_rise(const pd_body *b, const pd_state *s, const int *cont
         rise = fmin(rise, s->v.z + v3_cross(ww, r).z);
     }
     return rise;
+}
+
+/* Kinetic plus potential energy per unit weight: a height, m. */
+static double energy_height(const pd_body *b, const pd_state *s, double g)
+{
+    return pd_body_kinetic(b, s) / (b->mass * g) + s->x.z;
 }
 
 /* Lifts s by `lift` back onto the floor, paying out of its kinetic energy
@@ -250,7 +267,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             out->end = PD_END_NOT_RUN;
             break;
         }
-        double e_now = pd_body_kinetic(m->body, &s) / (m->body->mass * g) + s.x.z;
+        double e_now = energy_height(m->body, &s, g);
         e_low = fmin(e_low, e_now);
         w->energy_rise = fmax(w->energy_rise, (e_now - e_low) / m->body->size);
         int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
@@ -410,6 +427,15 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         double speed = fabs(s.v.z) + v3_norm(s.w) * m->body->rmax;
         if (speed * dt > PD_REST_SINK_REL * m->body->size)
             dt = PD_REST_SINK_REL * m->body->size / speed;
+        /* Nor long enough for the turn to carry a vertex deeper, beyond the
+         * centre's fall, than the kinetic energy can pay for lifting the part
+         * back (lift_onto_floor), or than the outcome test allows for
+         * (PD_REST_TURN_REL): lifted partly for free, a slowly rocking part
+         * gained height every step and never settled below a low barrier. */
+        double turn = v3_norm(s.w) * m->body->rmax;
+        double payable = fmax(energy_height(m->body, &s, g) - s.x.z, m->settle.margin);
+        if (turn * dt > payable)
+            dt = payable / turn;
         f_at += dt;
         rest_from = s.x.z;
         if ((st = pd_flight_eval(&f, f_at, &s)) != PD_OK) {

@@ -30,17 +30,50 @@ void pd_scene_default(pd_scene *s)
     memset(s->range, 0, sizeof s->range); /* PD_DIST_FIXED */
 }
 
+/* The Hertz estimate for the paper's scene (docs/contact.md) and the part
+ * it was made for, a 1 cm cube: its diagonal and volume. */
+#define CONTACT_T_REF 5e-4
+#define CONTACT_SIZE_REF (0.01 * 1.7320508075688772935)
+#define CONTACT_VOLUME_REF 1e-6
+#define CONTACT_G_REF 9.81
+
+/* The longest automatic duration for a part of size L (below). */
+static double contact_t_sink(double size)
+{
+    return M_PI * sqrt(PD_CONTACT_AUTO_SINK_REL * size / CONTACT_G_REF);
+}
+
 double pd_contact_time_auto(double size)
 {
-    /* The Hertz estimate for the paper's scene (docs/contact.md) and the
-     * size it was made for, a 1 cm cube's diagonal. */
-    const double t_ref = 5e-4, size_ref = 0.01 * sqrt(3.0), g_ref = 9.81;
     /* No longer than a contact that the part's weight, under the estimate's
      * gravity, presses PD_CONTACT_AUTO_SINK_REL of its size into the floor:
      * a contact of duration T is a spring of angular frequency pi / T,
      * which sinks g (T / pi)^2 under the weight. */
-    double t_sink = M_PI * sqrt(PD_CONTACT_AUTO_SINK_REL * size / g_ref);
-    return fmin(t_ref * size / size_ref, t_sink);
+    return fmin(CONTACT_T_REF * size / CONTACT_SIZE_REF, contact_t_sink(size));
+}
+
+double pd_contact_time_auto_part(const pd_part *part)
+{
+    /* A needle's mass is far below L^3: by its length alone a 1 m needle
+     * 1 mm thick got a 29 ms contact, whose static compression (about
+     * g T^2 / 13) sank it deeper than its thickness and kept every drop
+     * from settling. Powers taken apart so that no product of lengths
+     * leaves the doubles over the supported sizes. */
+    double volume = part->mass_known ? part->mass.volume : part->hull->volume;
+    double t = CONTACT_T_REF * pow(volume / CONTACT_VOLUME_REF, 0.4) *
+               pow(CONTACT_SIZE_REF / part->size, 0.2);
+    return fmin(t, contact_t_sink(part->size));
+}
+
+double pd_contact_time_auto_size(const pd_part *part)
+{
+    /* pd_contact_time_auto rises with the size, linear up to its cap, then
+     * as the cap: the length on whichever branch gives this duration. */
+    double t = pd_contact_time_auto_part(part), k = CONTACT_T_REF / CONTACT_SIZE_REF;
+    double cross = M_PI * M_PI * PD_CONTACT_AUTO_SINK_REL / (CONTACT_G_REF * k * k);
+    double linear = t / k;
+    return linear <= cross ? linear
+                           : CONTACT_G_REF * (t / M_PI) * (t / M_PI) / PD_CONTACT_AUTO_SINK_REL;
 }
 
 typedef struct {

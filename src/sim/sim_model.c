@@ -9,6 +9,7 @@
 #include "base/vec3.h"
 #include "contact/contact_phase.h"
 #include "base/base_tol.h"
+#include "posedrop/tolerances.h"
 #include "sim/sim_tol.h"
 #include "sim/scene.h"
 #include "sim/sim_model.h"
@@ -68,15 +69,25 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     pd_status st = pd_body_build(part, &m->body, diag);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
-    m->part_size = part->size;
+    if (st == PD_OK && !m->engine) {
+        /* The impulse engine puts every resting contact back onto the floor
+         * and pays for it (src/sim/drop.c), so its energy reads low by what
+         * an unpaid return may add at most, not by a rest fall; it tells
+         * heights apart to its contact tolerance. */
+        m->settle.margin = PD_REST_TURN_REL * m->body->size;
+        m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
+    }
+    /* Auto, fixed or as a range's multiple, from one length, so that a
+     * zero-width range gives the fixed run's bytes. */
+    m->part_size = pd_contact_time_auto_size(part);
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
-                          ? pd_contact_time_auto(part->size)
+                          ? pd_contact_time_auto(m->part_size)
                           : scene->contact_time;
     const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
     m->material_ranged = scene->range[PD_PARAM_MU].kind != PD_DIST_FIXED ||
                          e->kind != PD_DIST_FIXED || ct->kind != PD_DIST_FIXED;
     double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
-                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(part->size)
+                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(m->part_size)
                                              : ct->hi;
     /* A drawn duration obeys the value's range; auto itself is the part's
      * and has none. */
@@ -99,6 +110,13 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         if (st != PD_OK)
             st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
                          "time %g s could not be set up", scene->restitution, m->contact_time);
+        /* A contact carrying the part's weight at the part's mass sinks
+         * g / omega^2 by the compliant law; a corner of radius R pressed
+         * that deep touches over a patch of radius sqrt(R g) / omega
+         * (Hertz's geometry, a^2 = R d). */
+        else
+            m->settle.patch = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity) /
+                              m->compliant.law.omega;
     }
     if (st != PD_OK) {
         pd_sim_model_free(m);

@@ -35,7 +35,8 @@ typedef struct pd_sim_model {
     int compliant_on;           /* the impulse engine with contact_time > 0 */
     pd_compliant compliant;     /* its impacts with more than one contact */
     double tol_scale;           /* every integration tolerance times this (1) */
-    double part_size;           /* the part's size, for contact_time's auto */
+    double part_size;           /* for contact_time's auto: the part's
+                                   pd_contact_time_auto_size */
     int material_ranged;        /* mu, restitution or contact_time is a range:
                                    each drop sets its own (pd_drop_material) */
     int compliant_any;          /* some drop may be compliant: work areas need it */

@@ -506,8 +506,68 @@ static void test_event_location(void)
     drop_teardown(&fx);
 }
 
+/* A top: a flat square bipyramid (corners 1 cm out, apexes 0.1 mm up and
+ * down) standing upright on its lower apex, spinning about the vertical at
+ * w0. Drilling friction over the patch of radius a (settle.patch, from the
+ * contact time) is a constant couple (2/3) mu m g a against the spin, so
+ * the spin falls linearly and stops at t* = I w0 / ((2/3) mu m g a), I the
+ * moment about the axis; the phase ends there (its spin margin), not
+ * before, to within its event tolerance and the integration's error. The
+ * top is flat so that, slowed below its gyroscopic limit, round-off tips it
+ * by far less than lands a corner before t* (growth about 10 / s). */
+static void test_drilling_top(void)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    drop_fixture fx;
+    const double a = 0.01, c = 1e-4, w0 = 0.1;
+    pd_vec3 p[6] = {{a, 0, 0}, {-a, 0, 0}, {0, a, 0}, {0, -a, 0}, {0, 0, c}, {0, 0, -c}};
+    if (!drop_setup(&fx, convex_mesh(p, 6), &sc))
+        return;
+    const pd_body *b = fx.model->body;
+    const pd_settle *st = &fx.model->settle;
+    /* The axis: the largest moment's; the lower apex, the vertex furthest
+     * along it. */
+    int k = 0;
+    for (int i = 1; i < 3; i++)
+        if (b->moment[i] > b->moment[k])
+            k = i;
+    int apex = 0;
+    double far = -1.0;
+    for (int i = 0; i < b->nverts; i++) {
+        pd_vec3 v = b->verts[i];
+        double d = fabs(k == 0 ? v.x : k == 1 ? v.y : v.z);
+        if (d > far)
+            far = d, apex = i;
+    }
+    pd_state s = {v3(0, 0, 0), quat_onto_down(v3_unit(b->verts[apex])), v3(0, 0, 0), v3(0, 0, 0)};
+    s.x.z = -quat_rotate(s.q, b->verts[apex]).z;
+    s.w = quat_rotate_inv(s.q, v3(0, 0, w0));
+    CHECK(st->patch > 0.0);
+    pd_phase phase;
+    int contacts[1] = {apex};
+    CHECK(pd_contact_phase_start(st, &sc, &s, contacts, 1, &phase));
+    CHECK(phase.drill[0] > 0.0);
+    double t_star = b->moment[k] * w0 / (2.0 / 3.0 * sc.mu * b->mass * sc.gravity * st->patch);
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    double t = 0.0, T = sqrt(b->size / sc.gravity);
+    CHECK_STATUS(pd_contact_phase(st, ode, pivot, &sc, &phase, &s, 4.0 * t_star, &t), PD_OK);
+    /* Early by at most the event tolerance; the spin's decay is linear, which
+     * the integrator follows to round-off. */
+    CHECK(t <= t_star + 1e-9 * T);
+    CHECK(t >= t_star - 2.0 * PD_TOL_PHASE_EVENT_REL * T);
+    double wn = v3_dot(s.w, quat_rotate_inv(s.q, v3(0, 0, 1)));
+    CHECK(wn >= 0.0 && wn <= w0 * 1e-5);
+    printf("     drilling top: stops at %.9g s, predicted %.9g s (patch %.3g m)\n", t, t_star,
+           st->patch);
+    pd_ode_free(ode);
+    pd_ode_free(pivot);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
+    test_drilling_top();
     test_event_location();
     test_specialised_forces();
     test_edge_slide();

@@ -95,24 +95,10 @@ static const struct {
     pd_engine_kind engine;
     int item;
 } expected_failures[] = {
-    {"ridge 0.1 deg", PD_ENGINE_IMPULSE, 1},
-    {"ridge 0.3 deg", PD_ENGINE_IMPULSE, 1},
-    {"ridge 0.9 deg", PD_ENGINE_IMPULSE, 1},
-    {"ridge 2 deg", PD_ENGINE_IMPULSE, 1},
-    {"pyramid h/r 1e-5", PD_ENGINE_IMPULSE, 2},
-    {"pyramid h/r 1e-3", PD_ENGINE_IMPULSE, 2},
-    {"pyramid h/r 1e-1", PD_ENGINE_IMPULSE, 2},
-    {"needle 1 m x 300", PD_ENGINE_IMPULSE, 3},
-    {"needle 1 m x 1000", PD_ENGINE_IMPULSE, 3},
-    {"needle 1 mm x 100", PD_ENGINE_IMPULSE, 3},
-    {"needle 1 mm x 1000", PD_ENGINE_IMPULSE, 3},
     {"cube 0.1 mm", PD_ENGINE_IMPULSE, 5},
     /* The stepping engines' own: not the impulse engine's fixes. */
     {"pyramid h/r 1e-3", PD_ENGINE_ODE, 2},
     {"pyramid h/r 1e-3", PD_ENGINE_BULLET, 2},
-    {"needle 1 m x 300", PD_ENGINE_ODE, 3},
-    {"needle 1 m x 300", PD_ENGINE_BULLET, 3},
-    {"needle 1 m x 1000", PD_ENGINE_BULLET, 3},
     {"needle 1 mm x 1000", PD_ENGINE_BULLET, 3},
     {"cube 1000 m", PD_ENGINE_BULLET, 4},
     {NULL, PD_ENGINE_IMPULSE, 0},

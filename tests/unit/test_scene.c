@@ -6,7 +6,37 @@
 #include <string.h>
 #include "check.h"
 #include "posedrop/sim.h"
+#include "shapes.h"
 #include "suites.h"
+
+/* The automatic contact time of a box a x b x c (m). */
+static double box_contact_time(double a, double b, double c)
+{
+    pd_mesh *m = mesh_box(a, b, c);
+    pd_part *p = NULL;
+    CHECK_STATUS(pd_part_build(m, NULL, &p, NULL), PD_OK);
+    pd_mesh_free(m);
+    double t = p ? pd_contact_time_auto_part(p) : 0.0;
+    pd_part_free(p);
+    return t;
+}
+
+/* Hertz's (m^2 / R)^(1/5), the mass from the volume, R in proportion to the
+ * size: a cube's is the size's; similar parts' in proportion; a needle's from
+ * its volume, not its length (a 1 m needle 1 mm thick: 5e-4 (1.73 cm /
+ * 1 m)^(1/5) = 2.2e-4 s, where its length alone gave 29 ms). */
+static void contact_time_of_parts(void)
+{
+    CHECK_REL(box_contact_time(0.01, 0.01, 0.01), 5e-4, 1e-14, "round-off");
+    CHECK_REL(box_contact_time(3.0, 3.0, 3.0), pd_contact_time_auto(3.0 * sqrt(3.0)), 1e-14,
+              "round-off");
+    /* Below the cap on the static sink (sizes under 1.2 m). */
+    CHECK_REL(box_contact_time(0.1, 0.2, 0.3), 10.0 * box_contact_time(0.01, 0.02, 0.03), 1e-14,
+              "round-off");
+    double L = sqrt(1.0 + 2e-6);
+    CHECK_REL(box_contact_time(1.0, 1e-3, 1e-3), 5e-4 * pow(0.01 * sqrt(3.0) / L, 0.2), 1e-14,
+              "round-off");
+}
 
 /* The Kolmogorov-Smirnov statistic of the n draws of parameter `param`
  * against the range's own distribution (pd_scene_quantile is its cdf). */
@@ -190,6 +220,7 @@ static void test_ranges(void)
 
 void suite_scene(void)
 {
+    contact_time_of_parts();
     test_ranges();
     pd_scene s;
     pd_scene_default(&s);
