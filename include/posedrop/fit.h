@@ -114,8 +114,9 @@ typedef struct pd_fit_result {
 
 /* Fits params (nparams in 1..PD_FIT_MAX_PARAMS, distinct keys) to the parts
  * with counts (at least one) and predicts those without. base holds the
- * values of everything not fitted (NULL: pd_scene_default); options may be
- * NULL. Every part's drops run from the same seed at every evaluation. A
+ * values of everything not fitted (NULL: pd_scene_default); options are
+ * required (pd_fit_options_default fills them), since they set what the fit
+ * costs. Every part's drops run from the same seed at every evaluation. A
  * class the measurements saw and the drops never reached gets the smoothed
  * probability alpha / (nsim + K alpha) instead of 0, so that no value makes
  * the likelihood minus infinity. PD_ERR_USAGE (a bad argument: the message
@@ -131,12 +132,13 @@ PD_API void pd_fit_result_free(pd_fit_result *result);
 /* The smoothed probabilities of k classes from simulated ones: p_sim (k,
  * summing to 1) from nsim drops, each class given alpha more drops, the
  * posterior mean under a Dirichlet(alpha) prior: (nsim p_k + alpha) /
- * (nsim + k alpha), into out (k). */
+ * (nsim + k alpha), into out (k). Does nothing when p_sim or out is NULL. */
 PD_API void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha, double *out);
 
 /* The log-likelihood of counts (k) under the smoothed probabilities of
  * p_sim: sum_k count_k log(pd_fit_smooth's p_k), without the multinomial
- * coefficient (it does not depend on the scene). Finite for alpha > 0. */
+ * coefficient (it does not depend on the scene). Finite for alpha > 0; 0
+ * (no counts) when count or p_sim is NULL. */
 PD_API double pd_fit_loglik(int k, const long *count, const double *p_sim, double nsim,
                             double alpha);
 

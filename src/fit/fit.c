@@ -13,6 +13,8 @@
 
 void pd_fit_options_default(pd_fit_options *o)
 {
+    if (!o)
+        return;
     memset(o, 0, sizeof *o);
     o->ndrops = 1000;
     o->seed = 1;
@@ -140,7 +142,9 @@ static pd_status check_parts(const pd_fit_part *parts, int nparts, pd_diag *diag
 static pd_status check_params(const pd_fit_param *params, int d, const pd_scene *base,
                               pd_diag *diag)
 {
-    if (!params || d < 1 || d > PD_FIT_MAX_PARAMS)
+    if (!params)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: NULL params");
+    if (d < 1 || d > PD_FIT_MAX_PARAMS)
         return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: %d parameters to fit: expected 1 to %d",
                        d, PD_FIT_MAX_PARAMS);
     for (int i = 0; i < d; i++) {
@@ -250,17 +254,13 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
 {
     pd_fit_options o;
     pd_scene sc0;
-    if (options)
-        o = *options;
-    else
-        pd_fit_options_default(&o);
+    if (!options || !result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: NULL %s", options ? "result" : "options");
+    o = *options;
     if (base)
         sc0 = *base;
     else
         pd_scene_default(&sc0);
-    if (!result)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: NULL result");
-    *result = NULL;
     pd_status st = check_options(&o, diag);
     if (st == PD_OK)
         st = check_parts(parts, nparts, diag);

@@ -7,6 +7,8 @@
 
 void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha, double *out)
 {
+    if (!p_sim || !out)
+        return;
     double den = nsim + (double)k * alpha;
     for (int i = 0; i < k; i++)
         out[i] = (nsim * p_sim[i] + alpha) / den;
@@ -15,6 +17,8 @@ void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha, double
 double pd_fit_loglik(int k, const long *count, const double *p_sim, double nsim, double alpha)
 {
     double den = nsim + (double)k * alpha, l = 0.0;
+    if (!count || !p_sim)
+        return 0.0;
     for (int i = 0; i < k; i++)
         if (count[i] > 0)
             l += (double)count[i] * log((nsim * p_sim[i] + alpha) / den);
