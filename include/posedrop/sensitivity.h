@@ -62,8 +62,8 @@ typedef struct pd_sensitivity {
 } pd_sensitivity;
 
 /* The sensitivity of a run made with keep_trials from scene (the scene given
- * to pd_sim_run; part_size the part's, for contact_time in multiples of
- * auto). class_of (result->nposes entries) groups the poses into nclasses
+ * to pd_sim_run; part_size the part's pd_contact_time_auto_size, for
+ * contact_time in multiples of auto). class_of (result->nposes entries) groups the poses into nclasses
  * classes, as pd_pose_classes gives them; NULL for poses. Every ranged
  * parameter of nonzero width gets a row per pose; a scene without one gives
  * nparams 0. PD_ERR_USAGE (NULL, no trial records, a class out of range),

@@ -125,16 +125,25 @@ typedef struct pd_scene {
 #define PD_CONTACT_TIME_AUTO (-1.0)
 
 /* The duration PD_CONTACT_TIME_AUTO stands for, for a part of size L (the
- * bounding-box diagonal, m) shaped like a cube: 5e-4 s times L over a 1 cm
- * cube's diagonal. */
+ * bounding-box diagonal, m): 5e-4 s times L over a 1 cm cube's diagonal, up
+ * to pi sqrt(1e-3 L / 9.81 m/s^2), the duration at which the part's weight
+ * would press a contact 1e-3 of its size into the floor (it binds above
+ * L = 1.2 m: 0.1 s for a 10 m part, 1.3 s for a 1000 m cube). */
 PD_API double pd_contact_time_auto(double size);
 
 /* The duration PD_CONTACT_TIME_AUTO stands for, for part: Hertz's
  * (m^2 / R)^(1/5) with the mass from the part's volume and the corner
  * radius in proportion to its size, 5e-4 s (V / 1 cm^3)^(2/5) (1.73 cm /
- * L)^(1/5); pd_contact_time_auto(L) for a cube, in proportion to L for
- * geometrically similar parts. */
+ * L)^(1/5), with pd_contact_time_auto's cap for its size L;
+ * pd_contact_time_auto(L) for a cube, in proportion to L for geometrically
+ * similar parts below the cap. */
 PD_API double pd_contact_time_auto_part(const pd_part *part);
+
+/* The length whose pd_contact_time_auto is the part's own,
+ * pd_contact_time_auto_part(part) / pd_contact_time_auto(1): what
+ * pd_scene_draw, pd_scene_quantile and pd_sim_sensitivity take as
+ * part_size (the part's size for a cube). */
+PD_API double pd_contact_time_auto_size(const pd_part *part);
 
 PD_API void pd_scene_default(pd_scene *scene);
 
@@ -166,7 +175,8 @@ PD_API int pd_scene_ranged(const pd_scene *scene);
 
 /* The values drop `drop` of a run seeded `seed` uses, one per parameter
  * (values[PD_NPARAMS], stored units; contact_time resolved for a part of
- * size part_size: never PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
+ * auto size part_size, pd_contact_time_auto_size: never
+ * PD_CONTACT_TIME_AUTO when it is ranged), and *drawn,
  * the scene with every range replaced by that drop's value (fixed). Fixed
  * parameters keep their field's value. The draw of parameter i depends on
  * (seed, drop, i) only. drawn may be NULL; scene must pass pd_scene_check. */
@@ -176,7 +186,7 @@ PD_API void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed
 /* Where value v of parameter param falls in its distribution: its
  * cumulative probability in [0, 1] (0.5 for a fixed or zero-width one).
  * For a contact_time range in multiples of auto, v is in s and part_size
- * the part's size. */
+ * the part's pd_contact_time_auto_size. */
 PD_API double pd_scene_quantile(const pd_scene *scene, pd_scene_param param, double part_size,
                                 double v);
 
@@ -202,8 +212,31 @@ typedef enum pd_drop_end {
     PD_END_SETTLED = 0,  /* energy below its basin's barrier: outcome final */
     PD_END_TIME_LIMIT,   /* simulated time ran out: counted, never classified */
     PD_END_COLLISION_LIMIT, /* too many collisions (a Zeno-like cascade) */
-    PD_END_FAILED        /* the collision solver could not finish (counted) */
+    PD_END_FAILED        /* a solver could not go on: which one is the trial's
+                            stage, and how its status (counted) */
 } pd_drop_end;
+
+/* Where a failed drop (PD_END_FAILED) failed; PD_STAGE_NONE for any other
+ * end. The names pd_drop_stage_name gives are stable: the command prints
+ * them in the end column of --trials (docs/cli.md). */
+typedef enum pd_drop_stage {
+    PD_STAGE_NONE = 0,
+    PD_STAGE_SETTLE,        /* "settle": whether the drop is decided (energy
+                               barriers, the descent map) */
+    PD_STAGE_FLIGHT,        /* "flight": the torque-free flight between contacts */
+    PD_STAGE_IMPACT_SEARCH, /* "impact_search": the time of the next impact */
+    PD_STAGE_COLLISION,     /* "collision": the rigid frictional impulse law */
+    PD_STAGE_COMPLIANT,     /* "compliant": a compliant impact */
+    PD_STAGE_CONTACT_PHASE, /* "contact_phase": lasting contact on a vertex or an edge */
+    PD_STAGE_ENGINE_RESET,  /* "engine_reset": the stepping engine refused the release */
+    PD_STAGE_ENGINE_STEP,   /* "engine_step": a step of the stepping engine (ODE's
+                               internal error, a non-finite state) */
+    PD_STAGE_COUNT
+} pd_drop_stage;
+
+/* "settle", "flight", ... as above; "none" for PD_STAGE_NONE, "unknown" out
+ * of range. Never NULL. */
+PD_API const char *pd_drop_stage_name(pd_drop_stage stage);
 
 typedef enum pd_engine_kind {
     PD_ENGINE_IMPULSE = 0, /* posedrop's own: closed-form flight, frictional impulses */
@@ -223,7 +256,9 @@ typedef struct pd_sim_options {
     double ci_halfwidth;    /* in (0, 0.5): keep dropping until every pose's 95%
                                interval is at most this wide on each side; 0 */
     long max_drops;         /* cap for ci_halfwidth runs, >= 0; 10^7 */
-    double time_limit;      /* s of simulated time per drop, > 0; 20 */
+    double time_limit;      /* s of simulated time per drop, > 0, or
+                               PD_TIME_LIMIT_AUTO (0, the default):
+                               pd_time_limit_auto for the part and scene */
     int max_collisions;     /* per drop, >= 1; 100000 */
     int keep_trials;        /* 1: fill result->trials (one record per drop); 0 */
     pd_cancel_flag *cancel; /* may be NULL; see below */
@@ -243,11 +278,31 @@ typedef struct pd_sim_options {
 /* Cancelling a run: point options->cancel at an atomic_int holding 0 and
  * store non-zero into it (atomic_store) from any thread, or from a signal
  * handler (atomic_int is lock-free wherever posedrop builds, which C11 asks
- * of an object a handler touches). The drops under way finish, no new one
- * starts, and pd_sim_run returns PD_OK with result->partial set and the
- * first result->n drops of the run counted (each the drop it would be in a
- * full run, whatever the thread count). The flag is only read, never reset:
- * clear it before the next run. */
+ * of an object a handler touches). The drops under way stop too (each reads
+ * the flag between its steps, whatever the part), no new one starts, and
+ * pd_sim_run returns PD_OK with result->partial set and the first
+ * result->n drops of the run counted, each whole (a drop stopped part way is
+ * not counted, nor any drop after it), each the drop it would be in a full
+ * run, whatever the thread count. The flag is only read, never reset: clear
+ * it before the next run. */
+
+/* time_limit's default: each drop's limit is pd_time_limit_auto's. */
+#define PD_TIME_LIMIT_AUTO 0.0
+
+/* The automatic limit, in units of the drop's own times: the part's natural
+ * time sqrt(L/g) (how long it takes to topple over its own size) plus the
+ * fall from the drop height, sqrt(2 h / g). The slowest drops measured to
+ * rest on ordinary parts (cubes, boxes and coins from 1 mm to 10 m, the
+ * shipped caps, on all three engines) took 37 of these units; 100 leaves
+ * them a margin of more than 2.5 (docs/limits.md). For a 1 cm cube dropped
+ * 0.12 m it is 19.8 s; for a 1000 m cube, 1345 s. */
+#define PD_TIME_LIMIT_UNITS 100.0
+
+/* PD_TIME_LIMIT_UNITS (sqrt(size / g) + sqrt(2 height / g)) in s, for a part
+ * of that size (m, the bounding-box diagonal, pd_part.size) dropped in that
+ * scene (its height, the top of its range if it has one, and gravity);
+ * scene NULL: the default scene's. */
+PD_API double pd_time_limit_auto(double size, const pd_scene *scene);
 
 PD_API void pd_sim_options_default(pd_sim_options *options);
 
@@ -272,6 +327,8 @@ typedef struct pd_trial {
     int collisions;     /* impulses applied (impulse engine; 0 for stepping engines) */
     double time;        /* simulated s */
     pd_drop_end end;
+    pd_drop_stage stage; /* PD_END_FAILED: where it failed, else PD_STAGE_NONE */
+    pd_status status;    /* PD_END_FAILED: how (e.g. PD_ERR_NO_CONVERGENCE), else PD_OK */
     double param[PD_NPARAMS]; /* the scene values this drop used (pd_scene_draw) */
 } pd_trial;
 
@@ -280,7 +337,17 @@ typedef struct pd_sim_result {
     long n;                 /* drops run */
     long *count;            /* per pose: drops that settled there */
     double *p, *ci_lo, *ci_hi; /* count / n and its 95% Wilson interval */
-    long unsettled;         /* drops that hit a limit or failed (not in any count) */
+    long unsettled;         /* drops that hit a limit or failed (not in any count):
+                               the sum of the next three */
+    long time_limited;      /* drops that ended at the time limit */
+    long collision_limited; /* drops that ended at the collision limit */
+    long failed;            /* drops that failed (PD_END_FAILED) */
+    long first_failed;      /* the first failed drop's number in the run (from 0),
+                               -1 if none */
+    pd_drop_stage failed_stage; /* where it failed */
+    pd_status failed_status;    /* and how */
+    double time_limit;      /* s: the limit the drops ran with (options->time_limit,
+                               or pd_time_limit_auto's) */
     long energy_gain;       /* collisions that would have added energy: under
                                Poisson's law with friction (resolved with the
                                energetic law instead), or by a compliant impact's

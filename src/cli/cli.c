@@ -117,13 +117,31 @@ static void print_facets(const pd_part *part, const pd_static_result *res)
     free(pose_of);
 }
 
-static const char *end_name(pd_drop_end e)
+/* A status as one word of the end column: its fixed name with blanks as
+ * underscores ("no convergence": no_convergence). */
+static void status_word(pd_status st, char *buf, size_t size)
 {
-    switch (e) {
+    snprintf(buf, size, "%s", pd_status_str(st));
+    for (char *c = buf; *c; c++)
+        if (*c == ' ' || *c == '-' || *c == '/')
+            *c = '_';
+}
+
+/* How a drop ended, as the end column of --trials and --verbose write it:
+ * settled, time_limit, collision_limit, or failed:STAGE:STATUS (where a
+ * solver failed and how, docs/cli.md). */
+static const char *end_name(const pd_trial *t, char *buf, size_t size)
+{
+    switch (t->end) {
     case PD_END_SETTLED: return "settled";
     case PD_END_TIME_LIMIT: return "time_limit";
     case PD_END_COLLISION_LIMIT: return "collision_limit";
-    default: return "failed";
+    default: {
+        char st[64];
+        status_word(t->status, st, sizeof st);
+        snprintf(buf, size, "failed:%s:%s", pd_drop_stage_name(t->stage), st);
+        return buf;
+    }
     }
 }
 
@@ -258,8 +276,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
         long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        char end[96];
         fprintf(f, "%ld,%.17g,%.17g,%.17g,%.17g,%d,%d,%.10g,%s", drop + 1, t->q0[0], t->q0[1],
-                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t->end));
+                t->q0[2], t->q0[3], pose, t->collisions, t->time, end_name(t, end, sizeof end));
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
         for (int k = 0; k < PD_NPARAMS; k++)
@@ -312,7 +331,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -385,6 +404,11 @@ static const cli_option options[] = {
     {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
      "time step of ode (default 0.001) or bullet (1/960),\n"
      "above 0 and at most 0.01"},
+    {OPT_TIME_LIMIT, "time-limit", ARG_TEXT, "S", REAL("auto or a time in s", 0, 1e9, 1, 0), NULL, NULL,
+     "simulated seconds a drop may take before it ends\n"
+     "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
+     "(default): 100 (sqrt(L/g) + sqrt(2h/g)) for a part of size\n"
+     "L dropped from h, 19.8 s for a 1 cm cube from 0.12 m"},
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},
@@ -445,7 +469,9 @@ static const cli_option options[] = {
      "(docs/uncertainty.md)"},
     {OPT_TRIALS, "trials", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "one CSV row per drop: drop,qw,qx,qy,qz,pose,collisions,time,end\n"
-     "(pose 0: unsettled); with --group, pose is the class\n"
+     "(pose 0: unsettled; end: settled, time_limit,\n"
+     "collision_limit or failed:STAGE:STATUS, docs/cli.md);\n"
+     "with --group, pose is the class\n"
      "number of the output and a last column member the pose\n"
      "within it, numbered as without --group; then one column\n"
      "per ranged scene parameter, named by its key, the value\n"
@@ -677,6 +703,13 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
     case OPT_DT: a->sim.dt = x; break;
+    case OPT_TIME_LIMIT: {
+        int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        a->sim.time_limit = strcmp(arg, "auto") == 0 ? PD_TIME_LIMIT_AUTO : x;
+        break;
+    }
     case OPT_SCENE: {
         pd_diag d;
         pd_diag_init(&d);
@@ -938,14 +971,65 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
             outside ? "" : " (no sign that they differ)");
 }
 
+/* Why the drops that did not settle ended: how many at each limit (the
+ * time limit with its value) and how many failed, with where and how the
+ * first failed; --verbose adds a line per such drop when --trials kept
+ * them. A merged result from shard files has no breakdown, only the count. */
+static void print_unsettled(const cli_args *a, const pd_sim_result *sim)
+{
+    if (sim->time_limited + sim->collision_limited + sim->failed != sim->unsettled) {
+        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
+                        "a solver failed) and are in no count\n", prog, a->path, sim->unsettled,
+                sim->n);
+        return;
+    }
+    fprintf(stderr, "%s: %s: %ld of %ld drops did not settle and are in no count:", prog,
+            a->path, sim->unsettled, sim->n);
+    const char *sep = "";
+    if (sim->time_limited) {
+        fprintf(stderr, " %ld at the time limit (%.6g s simulated; --time-limit)",
+                sim->time_limited, sim->time_limit);
+        sep = ",";
+    }
+    if (sim->collision_limited) {
+        fprintf(stderr, "%s %ld at the collision limit (%d collisions)", sep,
+                sim->collision_limited, a->sim.max_collisions);
+        sep = ",";
+    }
+    if (sim->failed) {
+        char st[64];
+        status_word(sim->failed_status, st, sizeof st);
+        fprintf(stderr, "%s %ld failed", sep, sim->failed);
+        if (sim->first_failed >= 0) /* not known after posedrop-mpi's sums */
+            fprintf(stderr, " (the first, drop %ld: failed:%s:%s)", sim->first_failed + 1,
+                    pd_drop_stage_name(sim->failed_stage), st);
+    }
+    fputc('\n', stderr);
+    /* Enough lines to see the pattern; the rest are in the --trials file. */
+    enum { VERBOSE_DROPS = 20 };
+    long shown = 0;
+    for (long i = 0; a->verbose && sim->trials && i < sim->n; i++) {
+        const pd_trial *t = &sim->trials[i];
+        if (t->end == PD_END_SETTLED)
+            continue;
+        if (shown++ == VERBOSE_DROPS) {
+            fprintf(stderr, "%s: and %ld more drops that did not settle, in %s\n", a->path,
+                    sim->unsettled - VERBOSE_DROPS, a->trials);
+            break;
+        }
+        char end[96];
+        long drop = sim->nshards > 0 ? sim->shard + i * sim->nshards : i;
+        fprintf(stderr, "%s: drop %ld: %s after %.6g s simulated, %d collisions\n", a->path,
+                drop + 1, end_name(t, end, sizeof end), t->time, t->collisions);
+    }
+}
+
 /* What every dynamic run reports, whether or not --verbose: drops that could
  * not be classified and collisions the law had to correct are never silent. */
 static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
 {
     if (sim->unsettled)
-        fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
-                        "the engine failed) and are in no count\n", prog, a->path, sim->unsettled,
-                sim->n);
+        print_unsettled(a, sim);
     if (sim->energy_gain)
         fprintf(stderr, "%s: %s: %ld collisions would have added energy (Poisson's law with "
                         "friction, resolved by the energetic law; or a compliant impact's step, "
@@ -1060,7 +1144,8 @@ int cli_run(cli_args *a)
      * MPI ranks); --sensitivity needs them. */
     if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
         (a->sensitivity || (a->pictures[VIZ_REPORT] && sim->trials)))
-        st = pd_sim_sensitivity(sim, &a->scene, part->size, class_of, nclasses, &sens, &diag);
+        st = pd_sim_sensitivity(sim, &a->scene, pd_contact_time_auto_size(part), class_of,
+                                nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
                     engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
@@ -1121,6 +1206,12 @@ int cli_run(cli_args *a)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
     if (code == 0 && sim && sim->partial)
         code = cli_interrupt_code();
+    else if (code == 0 && sim && sim->n > 0 && sim->failed == sim->n) {
+        /* Not one drop ran to an end the model defines: the rows hold the
+         * static estimates only, and a script must not take them for a run. */
+        fprintf(stderr, "%s: %s: every drop failed: no dynamic estimate\n", prog, a->path);
+        code = EXIT_INTERNAL;
+    }
 done:
     out_abort(&trials_out);
     out_abort(&transitions_out);

@@ -76,7 +76,8 @@ static void run_json(FILE *out, const cli_args *a, const pd_part *part, const pd
     const pd_scene *s = &a->scene;
     /* The duration the drops used: the automatic one is the part's. */
     int auto_time = s->contact_time == PD_CONTACT_TIME_AUTO;
-    double contact_time = auto_time ? pd_contact_time_auto_part(part) : s->contact_time;
+    double contact_time =
+        auto_time ? pd_contact_time_auto(pd_contact_time_auto_size(part)) : s->contact_time;
     fprintf(out, "  \"posedrop\": {\"version\": \"%s\", \"command_line\": [", pd_version());
     for (int i = 0; i < a->argc; i++) {
         fprintf(out, i ? ", " : "");

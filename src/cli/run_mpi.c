@@ -55,13 +55,17 @@ double cli_cpu_seconds(void)
     return cpu_total >= 0 ? cpu_total + own_cpu_seconds() : own_cpu_seconds();
 }
 
-/* The counts as one array of longs: drops, unsettled, corrections,
- * collisions, partial, then per pose count, first and the chain's rows. */
+/* The counts as one array of longs: drops, unsettled (and how: time limit,
+ * collision limit, failed), corrections, collisions, partial, then per pose
+ * count, first and the chain's rows. */
 static size_t pack(const pd_sim_result *r, long *v)
 {
     size_t k = (size_t)r->nposes, n = 0;
     v[n++] = r->n;
     v[n++] = r->unsettled;
+    v[n++] = r->time_limited;
+    v[n++] = r->collision_limited;
+    v[n++] = r->failed;
     v[n++] = r->energy_gain;
     v[n++] = r->fallbacks;
     v[n++] = r->collisions;
@@ -80,6 +84,9 @@ static void unpack(pd_sim_result *r, const long *v)
     size_t k = (size_t)r->nposes, n = 0;
     r->n = v[n++];
     r->unsettled = v[n++];
+    r->time_limited = v[n++];
+    r->collision_limited = v[n++];
+    r->failed = v[n++];
     r->energy_gain = v[n++];
     r->fallbacks = v[n++];
     r->collisions = v[n++];
@@ -137,7 +144,7 @@ pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_arg
         *sim = mine;
         return PD_OK;
     }
-    size_t k = (size_t)res->nposes, len = 6 + k + (mine->transitions ? k + k * k : 0);
+    size_t k = (size_t)res->nposes, len = 9 + k + (mine->transitions ? k + k * k : 0);
     long *mine_v = malloc(sizeof *mine_v * len), *sum_v = malloc(sizeof *sum_v * len);
     int ok = mine_v && sum_v;
     MPI_Allreduce(MPI_IN_PLACE, &ok, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
@@ -157,6 +164,7 @@ pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_arg
     } else if (rank == 0 && (st = pd_sim_result_new(res->nposes, &a->scene, &whole, &sum, diag)) ==
                                 PD_OK) {
         unpack(sum, sum_v);
+        sum->time_limit = mine->time_limit;
         st = pd_sim_result_finish(sum, diag);
     }
     free(mine_v);

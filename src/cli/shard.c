@@ -105,6 +105,7 @@ static void identity_words(const cli_args *a, const char *sha, words *w)
     word(w, "pqs_band", "%s", band_names[a->estimate.band]);
     word(w, "engine", "%s", engine_names[a->sim.engine]);
     word(w, "dt", "%.17g", a->sim.dt);
+    word(w, "time_limit", "%.17g", a->sim.time_limit);
     word(w, "n", "%ld", a->sim.ndrops);
     word(w, "seed", "%" PRIu64, a->sim.seed);
     const pd_scene *s = &a->scene;

@@ -20,7 +20,13 @@ struct pd_compliant_work {
     double *ptx, *pty;      /* tangential impulses, accumulated over sweeps */
     double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
     int hint;
+    const pd_cancel_flag *cancel; /* may be NULL */
 };
+
+void pd_compliant_work_watch(pd_compliant_work *w, const pd_cancel_flag *cancel)
+{
+    w->cancel = cancel;
+}
 
 pd_status pd_compliant_init(double e, double T, const pd_body *b, double tol_scale, pd_compliant *c)
 {
@@ -213,6 +219,10 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
         }
         if (t >= t_max) {
             r->end = PD_COMPLIANT_TIME;
+            break;
+        }
+        if (w->cancel && atomic_load_explicit(w->cancel, memory_order_relaxed)) {
+            r->end = PD_COMPLIANT_CANCELLED;
             break;
         }
 

@@ -26,7 +26,7 @@
  *     floor, by its static compression, about g / omega^2);
  *   - the outcome is decided (pd_settle_outcome on the state with its
  *     elastic energy counted as height) (DECIDED);
- *   - the time runs out (TIME). */
+ *   - the time runs out (TIME), or the run is cancelled (CANCELLED). */
 #ifndef PD_COMPLIANT_H
 #define PD_COMPLIANT_H
 
@@ -47,7 +47,8 @@ typedef enum pd_compliant_end {
     PD_COMPLIANT_SEPARATED,
     PD_COMPLIANT_QUIET,
     PD_COMPLIANT_DECIDED,
-    PD_COMPLIANT_TIME
+    PD_COMPLIANT_TIME,
+    PD_COMPLIANT_CANCELLED  /* the flag given to pd_compliant_work_watch was set */
 } pd_compliant_end;
 
 typedef struct pd_compliant_result {
@@ -76,6 +77,11 @@ void pd_compliant_from_law(const pd_compliant_law *law, const pd_body *b, double
 
 pd_compliant_work *pd_compliant_work_alloc(const pd_body *b);
 void pd_compliant_work_free(pd_compliant_work *w);
+
+/* The run's cancel flag (may be NULL): pd_compliant_run reads it at every
+ * step and stops (CANCELLED) once it is set, so that a long run does not
+ * hold up a cancelled batch of drops. */
+void pd_compliant_work_watch(pd_compliant_work *w, const pd_cancel_flag *cancel);
 
 /* Runs the impact of the part in state s (a vertex on the floor, within the
  * contact tolerance, at least one approaching) for at most t_max seconds;

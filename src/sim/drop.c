@@ -228,12 +228,20 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
 {
+    /* The options as the drop runs them: an automatic time limit resolved
+     * (the model's, for its part and scene). */
+    pd_sim_options run = *o;
+    if (!(run.time_limit > 0))
+        run.time_limit = m->time_limit;
+    o = &run;
     if (m->engine) {
         pd_drop_run_stepping(m, w, sc, o, index, init_cdf, out);
         return;
     }
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
+    if (w->compliant_work)
+        pd_compliant_work_watch(w->compliant_work, o->cancel);
     w->rest_depth = 0.0;
     double t = 0.0, g = sc->gravity;
     /* Resting contact advances by the time to fall rest_fall, so that a
@@ -253,13 +261,20 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     double e_low = HUGE_VAL;
     double rest_from = -HUGE_VAL; /* the centre's height before the rest step just taken */
     w->energy_rise = 0.0;
+    pd_status st;
     for (;;) {
+        if (pd_drop_cancelled(o)) {
+            out->end = PD_END_NOT_RUN;
+            break;
+        }
         double e_now = energy_height(m->body, &s, g);
         e_low = fmin(e_low, e_now);
         w->energy_rise = fmax(w->energy_rise, (e_now - e_low) / m->body->size);
         int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
-        if (d < 0)
+        if (d < 0) {
+            pd_drop_failed(out, PD_STAGE_SETTLE, PD_ERR_INTERNAL);
             break;
+        }
         if (d > 0) {
             out->pose = pose;
             out->end = PD_END_SETTLED;
@@ -272,8 +287,10 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         /* The flight from s: planned afresh after anything that changed the
          * motion, else the one s already lies on, at its time f_at. */
         if (f_at < 0.0) {
-            if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
+            if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
+                pd_drop_failed(out, PD_STAGE_FLIGHT, st);
                 break;
+            }
             f_at = 0.0;
         }
         if (!resolved) {
@@ -281,9 +298,12 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             /* hint: the lowest vertex of s where decided_at looked the
              * descent up, else of an earlier state; a start for the search's
              * hill-climb either way. */
-            if (pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
-                                      w->contact_time, w->contacts, PD_MAX_CONTACTS, &imp) != PD_OK)
+            if ((st = pd_flight_impact_from(m->body, &f, f_at, &s, hint, f_at + (o->time_limit - t),
+                                            w->contact_time, w->contacts, PD_MAX_CONTACTS,
+                                            &imp)) != PD_OK) {
+                pd_drop_failed(out, PD_STAGE_IMPACT_SEARCH, st);
                 break;
+            }
             if (imp.kind == PD_IMPACT_NONE) {
                 t = o->time_limit;
                 out->end = PD_END_TIME_LIMIT;
@@ -295,13 +315,17 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  * part step by step, paid for out of the motion. */
                 w->rest_depth = fmax(w->rest_depth, -imp.height);
                 lift_onto_floor(m->body, &s, g, -imp.height, rest_from - s.x.z);
-                if (pd_flight_plan(m->body, &s, g, &f) != PD_OK)
+                if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
+                    pd_drop_failed(out, PD_STAGE_FLIGHT, st);
                     break;
+                }
                 f_at = 0.0;
             }
             if (imp.kind == PD_IMPACT_AT) {
-                if (pd_flight_eval(&f, imp.t, &s) != PD_OK)
+                if ((st = pd_flight_eval(&f, imp.t, &s)) != PD_OK) {
+                    pd_drop_failed(out, PD_STAGE_FLIGHT, st);
                     break;
+                }
                 t += imp.t - f_at;
                 f_at = imp.t;
             }
@@ -319,16 +343,22 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
                 if (nc >= 2 && approach > m->settle.v_rest) {
                     pd_compliant_result cr;
-                    pd_status cs = pd_compliant_run(&w->compliant, w->compliant_work, &m->settle, sc,
-                                                    &s, o->time_limit - t, &cr);
-                    if (cs != PD_OK)
+                    st = pd_compliant_run(&w->compliant, w->compliant_work, &m->settle, sc, &s,
+                                          o->time_limit - t, &cr);
+                    if (st != PD_OK) {
+                        pd_drop_failed(out, PD_STAGE_COMPLIANT, st);
                         break;
+                    }
                     out->collisions++;
                     *energy_gain += cr.energy_gain;
                     w->rest_depth = fmax(w->rest_depth, cr.rest_depth);
                     t += cr.time;
                     f_at = -1.0;
                     phase_ok = 1;
+                    if (cr.end == PD_COMPLIANT_CANCELLED) {
+                        out->end = PD_END_NOT_RUN;
+                        break;
+                    }
                     if (cr.end == PD_COMPLIANT_DECIDED) {
                         out->pose = cr.pose;
                         out->end = PD_END_SETTLED;
@@ -345,9 +375,11 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 nc = ntouch;
             }
             int before = out->collisions;
-            if (pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
-                                fallbacks) != PD_OK)
+            if ((st = pd_drop_collide(m, w, sc, &s, w->contacts, nc, &out->collisions, energy_gain,
+                                      fallbacks)) != PD_OK) {
+                pd_drop_failed(out, PD_STAGE_COLLISION, st);
                 break;
+            }
             if (out->collisions != before) {
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
@@ -365,8 +397,11 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if (pd_contact_phase(&m->settle, w->phase, w->pivot, sc, &phase, &s, o->time_limit - t, &dt) != PD_OK)
+            if ((st = pd_contact_phase(&m->settle, w->phase, w->pivot, sc, &phase, &s,
+                                       o->time_limit - t, &dt)) != PD_OK) {
+                pd_drop_failed(out, PD_STAGE_CONTACT_PHASE, st);
                 break;
+            }
             t += dt;
             phase_ok = 0;
             if (t >= o->time_limit) {
@@ -403,8 +438,10 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             dt = payable / turn;
         f_at += dt;
         rest_from = s.x.z;
-        if (pd_flight_eval(&f, f_at, &s) != PD_OK)
+        if ((st = pd_flight_eval(&f, f_at, &s)) != PD_OK) {
+            pd_drop_failed(out, PD_STAGE_FLIGHT, st);
             break;
+        }
         t += dt;
         if (t >= o->time_limit) {
             out->end = PD_END_TIME_LIMIT;

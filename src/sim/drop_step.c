@@ -19,6 +19,7 @@
  * height plus 3 rest_fall: a higher barrier has the energy test pass first
  * (energy + rest_fall < barrier), so the addition never overrides a basin
  * the engine can resolve. */
+#include <math.h>
 #include "base/fail.h"
 #include "base/vec3.h"
 #include "settle/settle.h"
@@ -60,21 +61,33 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
 {
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
-    if (m->engine->reset(w->world, &s) != PD_OK)
+    pd_status st = m->engine->reset(w->world, &s);
+    if (st != PD_OK) {
+        pd_drop_failed(out, PD_STAGE_ENGINE_RESET, st);
         return;
-    long steps = (long)(o->time_limit / m->dt) + 1;
+    }
+    /* At most PD_STEPS_MAX + 1 (sim_model.c refuses more), so a long holds it. */
+    long steps = (long)fmin(o->time_limit / m->dt, PD_STEPS_MAX) + 1;
     int hint = 0;
     for (long k = 0; k < steps; k++) {
-        int pose, d = at_rest(m, &s, sc->gravity, &hint, &pose);
-        if (d < 0)
+        if (pd_drop_cancelled(o)) {
+            out->end = PD_END_NOT_RUN;
             return;
+        }
+        int pose, d = at_rest(m, &s, sc->gravity, &hint, &pose);
+        if (d < 0) {
+            pd_drop_failed(out, PD_STAGE_SETTLE, PD_ERR_INTERNAL);
+            return;
+        }
         if (d > 0) {
             out->pose = pose;
             out->end = PD_END_SETTLED;
             return;
         }
-        if (m->engine->step(w->world, &s) != PD_OK)
+        if ((st = m->engine->step(w->world, &s)) != PD_OK) {
+            pd_drop_failed(out, PD_STAGE_ENGINE_STEP, st);
             return;
+        }
         out->time = (double)(k + 1) * m->dt;
     }
     out->end = PD_END_TIME_LIMIT;

@@ -47,7 +47,7 @@ void pd_sim_options_default(pd_sim_options *o)
     o->threads = 0;
     o->ci_halfwidth = 0.0;
     o->max_drops = 10000000;
-    o->time_limit = 20.0;
+    o->time_limit = PD_TIME_LIMIT_AUTO;
     o->max_collisions = 100000;
     o->keep_trials = 0;
     o->cancel = NULL;
@@ -55,6 +55,35 @@ void pd_sim_options_default(pd_sim_options *o)
     o->shard = 0;
     o->progress = NULL;
     o->progress_user = NULL;
+}
+
+double pd_time_limit_auto(double size, const pd_scene *scene)
+{
+    pd_scene def;
+    if (!scene) {
+        pd_scene_default(&def);
+        scene = &def;
+    }
+    /* A drop height drawn from a range: its highest, the longest fall. */
+    const pd_dist *h = &scene->range[PD_PARAM_HEIGHT];
+    double g = scene->gravity, height = h->kind == PD_DIST_FIXED ? scene->height : h->hi;
+    return PD_TIME_LIMIT_UNITS * (sqrt(size / g) + sqrt(2.0 * height / g));
+}
+
+const char *pd_drop_stage_name(pd_drop_stage stage)
+{
+    static const char *const names[PD_STAGE_COUNT] = {
+        [PD_STAGE_NONE] = "none",
+        [PD_STAGE_SETTLE] = "settle",
+        [PD_STAGE_FLIGHT] = "flight",
+        [PD_STAGE_IMPACT_SEARCH] = "impact_search",
+        [PD_STAGE_COLLISION] = "collision",
+        [PD_STAGE_COMPLIANT] = "compliant",
+        [PD_STAGE_CONTACT_PHASE] = "contact_phase",
+        [PD_STAGE_ENGINE_RESET] = "engine_reset",
+        [PD_STAGE_ENGINE_STEP] = "engine_step",
+    };
+    return (unsigned)stage < PD_STAGE_COUNT ? names[stage] : "unknown";
 }
 
 int pd_shard_of(long drop, int nshards)
@@ -116,13 +145,6 @@ typedef struct batch {
  * and the CLI sets the flag from its SIGINT handler. */
 _Static_assert(ATOMIC_INT_LOCK_FREE == 2, "the cancel flag must be a lock-free atomic_int");
 
-/* Relaxed: the flag only asks the workers to stop; no data is published
- * through it (the records are joined with the threads). */
-static int cancelled(const pd_sim_options *o)
-{
-    return o->cancel && atomic_load_explicit(o->cancel, memory_order_relaxed) != 0;
-}
-
 /* --initial stationary: where drop i starts, -1 for a uniform orientation or
  * the pose it rests on. The first (k+1) pose_drops drops go round uniform,
  * pose 0, ..., pose k-1; the rest (fewer than k+1) are uniform. Interleaved
@@ -146,7 +168,7 @@ static void *worker(void *arg)
     long gain = 0, fallbacks = 0;
     for (;;) {
         long i = atomic_fetch_add(&b->next, 1);
-        if (i >= b->last || cancelled(b->opt))
+        if (i >= b->last || pd_drop_cancelled(b->opt))
             break;
         long drop = run_index(b->r, i);
         const double *cdf = b->init_cdf;
@@ -187,7 +209,7 @@ static long run_batch(batch *b, int nthreads, pd_sim_result *r)
     /* Zeroed first, padding included, so records compare byte for byte. */
     memset(b->out, 0, sizeof *b->out * (size_t)(b->last - b->first));
     for (long i = 0; i < b->last - b->first; i++)
-        b->out[i].end = (pd_drop_end)-1; /* not run */
+        b->out[i].end = PD_END_NOT_RUN;
     pthread_t tid[256];
     int started = 0;
     for (int t = 1; t < nthreads; t++)
@@ -199,7 +221,7 @@ static long run_batch(batch *b, int nthreads, pd_sim_result *r)
     r->energy_gain += atomic_load(&b->energy_gain);
     r->fallbacks += atomic_load(&b->fallbacks);
     long done = 0;
-    while (b->first + done < b->last && (int)b->out[done].end >= 0)
+    while (b->first + done < b->last && b->out[done].end != PD_END_NOT_RUN)
         done++;
     return atomic_load(&b->failed) && done < b->last - b->first ? -1 : done;
 }
@@ -213,6 +235,15 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->collisions += t[i].collisions;
         if (t[i].end != PD_END_SETTLED || t[i].pose < 0) {
             r->unsettled++;
+            if (t[i].end == PD_END_TIME_LIMIT)
+                r->time_limited++;
+            else if (t[i].end == PD_END_COLLISION_LIMIT)
+                r->collision_limited++;
+            else if (r->failed++ == 0) {
+                r->first_failed = run_index(r, r->n + i);
+                r->failed_stage = t[i].stage;
+                r->failed_status = t[i].status;
+            }
             continue;
         }
         r->count[t[i].pose]++;
@@ -463,6 +494,8 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
         r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
         r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
         r->seed = o->seed;
+        r->first_failed = -1;
+        r->time_limit = o->time_limit;
         if (stationary) {
             r->first_count = calloc((size_t)k, sizeof *r->first_count);
             r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
@@ -491,6 +524,15 @@ pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag 
     size_t k = (size_t)sum->nposes;
     sum->n += s->n;
     sum->unsettled += s->unsettled;
+    sum->time_limited += s->time_limited;
+    sum->collision_limited += s->collision_limited;
+    sum->failed += s->failed;
+    if (s->first_failed >= 0 && (sum->first_failed < 0 || s->first_failed < sum->first_failed)) {
+        sum->first_failed = s->first_failed;
+        sum->failed_stage = s->failed_stage;
+        sum->failed_status = s->failed_status;
+    }
+    sum->time_limit = fmax(sum->time_limit, s->time_limit);
     sum->energy_gain += s->energy_gain;
     sum->fallbacks += s->fallbacks;
     sum->collisions += s->collisions;
@@ -540,9 +582,9 @@ static pd_status check_options(const pd_sim_options *o, pd_diag *diag)
     if (o->max_drops < 0)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_drops is %ld: expected 0 or "
                        "more", o->max_drops);
-    if (!(o->time_limit > 0))
+    if (!(o->time_limit >= 0))
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option time_limit is %g s: expected a "
-                       "positive time", o->time_limit);
+                       "positive time or PD_TIME_LIMIT_AUTO (0)", o->time_limit);
     if (o->max_collisions < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_collisions is %d: expected 1 "
                        "or more", o->max_collisions);
@@ -590,6 +632,7 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     pd_sim_result *r = NULL;
     st = pd_sim_result_new(poses->nposes, &sc, &o, &r, diag);
     if (st == PD_OK) {
+        r->time_limit = model->time_limit;
         r->nshards = o.nshards;
         r->shard = o.nshards ? o.shard : 0;
         st = stationary ? drive_stationary(model, &sc, &o, r, diag) : drive(model, &sc, &o, r, diag);

@@ -13,6 +13,7 @@
 #include "base/rng.h"
 #include "posedrop/sim.h"
 #include "sim/scene.h"
+#include "sim/sim_tol.h"
 
 void pd_scene_default(pd_scene *s)
 {
@@ -34,10 +35,21 @@ void pd_scene_default(pd_scene *s)
 #define CONTACT_T_REF 5e-4
 #define CONTACT_SIZE_REF (0.01 * 1.7320508075688772935)
 #define CONTACT_VOLUME_REF 1e-6
+#define CONTACT_G_REF 9.81
+
+/* The longest automatic duration for a part of size L (below). */
+static double contact_t_sink(double size)
+{
+    return M_PI * sqrt(PD_CONTACT_AUTO_SINK_REL * size / CONTACT_G_REF);
+}
 
 double pd_contact_time_auto(double size)
 {
-    return CONTACT_T_REF * size / CONTACT_SIZE_REF;
+    /* No longer than a contact that the part's weight, under the estimate's
+     * gravity, presses PD_CONTACT_AUTO_SINK_REL of its size into the floor:
+     * a contact of duration T is a spring of angular frequency pi / T,
+     * which sinks g (T / pi)^2 under the weight. */
+    return fmin(CONTACT_T_REF * size / CONTACT_SIZE_REF, contact_t_sink(size));
 }
 
 double pd_contact_time_auto_part(const pd_part *part)
@@ -48,8 +60,20 @@ double pd_contact_time_auto_part(const pd_part *part)
      * from settling. Powers taken apart so that no product of lengths
      * leaves the doubles over the supported sizes. */
     double volume = part->mass_known ? part->mass.volume : part->hull->volume;
-    return CONTACT_T_REF * pow(volume / CONTACT_VOLUME_REF, 0.4) *
-           pow(CONTACT_SIZE_REF / part->size, 0.2);
+    double t = CONTACT_T_REF * pow(volume / CONTACT_VOLUME_REF, 0.4) *
+               pow(CONTACT_SIZE_REF / part->size, 0.2);
+    return fmin(t, contact_t_sink(part->size));
+}
+
+double pd_contact_time_auto_size(const pd_part *part)
+{
+    /* pd_contact_time_auto rises with the size, linear up to its cap, then
+     * as the cap: the length on whichever branch gives this duration. */
+    double t = pd_contact_time_auto_part(part), k = CONTACT_T_REF / CONTACT_SIZE_REF;
+    double cross = M_PI * M_PI * PD_CONTACT_AUTO_SINK_REL / (CONTACT_G_REF * k * k);
+    double linear = t / k;
+    return linear <= cross ? linear
+                           : CONTACT_G_REF * (t / M_PI) * (t / M_PI) / PD_CONTACT_AUTO_SINK_REL;
 }
 
 typedef struct {

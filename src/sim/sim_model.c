@@ -52,6 +52,17 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->dt = options->dt > 0 ? options->dt : 1e-3;
     else if (options->engine == PD_ENGINE_BULLET)
         m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
+    m->time_limit = options->time_limit > 0 ? options->time_limit
+                                            : pd_time_limit_auto(part->size, scene);
+    if (m->engine && m->time_limit / m->dt > PD_STEPS_MAX) {
+        double dt = m->dt, limit = m->time_limit;
+        free(m);
+        return pd_fail(diag, PD_ERR_RANGE, "the %s engine would take %.3g steps of %g s per drop "
+                       "to reach the time limit of %.6g s (for a part of size %g m), more than %g: "
+                       "give a longer step (dt) or a shorter time limit",
+                       options->engine == PD_ENGINE_BULLET ? "Bullet" : "ODE", limit / dt, dt,
+                       limit, part->size, PD_STEPS_MAX);
+    }
     m->hull = part->hull;
     m->com = part->com;
     m->poses = poses;
@@ -66,15 +77,17 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->settle.margin = PD_REST_TURN_REL * m->body->size;
         m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
     }
-    m->part_size = part->size;
+    /* Auto, fixed or as a range's multiple, from one length, so that a
+     * zero-width range gives the fixed run's bytes. */
+    m->part_size = pd_contact_time_auto_size(part);
     m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
-                          ? pd_contact_time_auto_part(part)
+                          ? pd_contact_time_auto(m->part_size)
                           : scene->contact_time;
     const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
     m->material_ranged = scene->range[PD_PARAM_MU].kind != PD_DIST_FIXED ||
                          e->kind != PD_DIST_FIXED || ct->kind != PD_DIST_FIXED;
     double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
-                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(part->size)
+                   : ct->auto_multiple       ? ct->hi * pd_contact_time_auto(m->part_size)
                                              : ct->hi;
     /* A drawn duration obeys the value's range; auto itself is the part's
      * and has none. */
@@ -258,5 +271,7 @@ void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_opt
     out->pose = -1;
     out->collisions = 0;
     out->end = PD_END_FAILED;
+    out->stage = PD_STAGE_NONE;
+    out->status = PD_OK;
     out->time = 0.0;
 }

@@ -29,12 +29,14 @@ typedef struct pd_sim_model {
     pd_settle settle;           /* when a drop is decided; resting contact */
     const pd_engine *engine;    /* NULL: the impulse simulator */
     double dt;                  /* the stepping engine's fixed step */
+    double time_limit;          /* s: options->time_limit, or pd_time_limit_auto's */
     double v_eps;               /* approach speeds below this are contact, not impact */
     double contact_time;        /* s: the scene's, PD_CONTACT_TIME_AUTO resolved */
     int compliant_on;           /* the impulse engine with contact_time > 0 */
     pd_compliant compliant;     /* its impacts with more than one contact */
     double tol_scale;           /* every integration tolerance times this (1) */
-    double part_size;           /* the part's size, for contact_time's auto */
+    double part_size;           /* for contact_time's auto: the part's
+                                   pd_contact_time_auto_size */
     int material_ranged;        /* mu, restitution or contact_time is a range:
                                    each drop sets its own (pd_drop_material) */
     int compliant_any;          /* some drop may be compliant: work areas need it */
@@ -62,6 +64,19 @@ typedef struct pd_drop_work {
                                    about a rest fall at most, what a
                                    microcollision may turn into motion */
 } pd_drop_work;
+
+/* A drop's record stays marked so while it has not run to its end: never
+ * started, or stopped part way by the cancel flag. Such a drop and every
+ * drop after it are left out of a partial result (montecarlo.c). */
+#define PD_END_NOT_RUN ((pd_drop_end)-1)
+
+/* 1 if the run's cancel flag is set. Relaxed: the flag only asks the drops
+ * to stop; no data is published through it (the records are joined with the
+ * threads). Cheap enough to read at every step of a drop. */
+static inline int pd_drop_cancelled(const pd_sim_options *o)
+{
+    return o->cancel && atomic_load_explicit(o->cancel, memory_order_relaxed) != 0;
+}
 
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
                              const pd_scene *scene, const pd_sim_options *options,
@@ -93,5 +108,13 @@ void pd_drop_work_free(pd_drop_work *work);
 void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
                      const pd_sim_options *options, long index, const double *init_cdf,
                      pd_state *s, pd_trial *out);
+
+/* Marks the drop's record failed at that stage with that status. */
+static inline void pd_drop_failed(pd_trial *out, pd_drop_stage stage, pd_status status)
+{
+    out->end = PD_END_FAILED;
+    out->stage = stage;
+    out->status = status;
+}
 
 #endif

@@ -71,4 +71,24 @@
  * part with sharper corners spins longer. */
 #define PD_CORNER_RADIUS_REL (0.5e-3 / (0.01 * 1.7320508075688772935))
 
+/* The automatic contact time (pd_contact_time_auto) grows with the size L,
+ * so the static compression of a contact under the part's weight, g T^2 /
+ * pi^2, grows as L^2: past 1.2 m it would exceed this share of L (a 10 m
+ * part 1%, a 1000 m cube sinks deeper than its size, with every engine's
+ * drops rocking in the floor until their time limit). The duration is
+ * capped there. Why 1e-3: the depth lasting contact stays within
+ * (docs/contact.md); a 30 m coin with 2.5% left 12 of 30 impulse drops
+ * unsettled, with 0.3% none. Smaller: parts from a few tens of cm would
+ * lose the Hertz duration the scene stands for. */
+#define PD_CONTACT_AUTO_SINK_REL 1e-3
+
+/* The most fixed steps a stepping engine's drop may need to reach its time
+ * limit; a run that would need more is refused (pd_sim_run, PD_ERR_RANGE)
+ * with the step and the limit that make it. Why 1e7: ODE and Bullet take 2
+ * to 5 us a step on a small hull, so a drop that runs to its limit costs up
+ * to a minute of CPU; a 1000 m cube's automatic limit (1345 s) at the
+ * default steps takes 1.4e6. Larger: a run of giants on the default step
+ * would take hours; smaller: the 1000 m cube would need a coarser step. */
+#define PD_STEPS_MAX 1e7
+
 #endif

@@ -215,6 +215,16 @@ int pts_flat_pyramid(int nsides, double height, pd_vec3 *out)
     return nsides + 1;
 }
 
+int pts_parallelogram_prism(pd_vec3 *out)
+{
+    const double xz[4][2] = {{0, 0}, {1, 0}, {2, 1}, {1, 1}};
+    for (int i = 0; i < 4; i++) {
+        out[i] = v3(xz[i][0], 0, xz[i][1]);
+        out[4 + i] = v3(xz[i][0], 1, xz[i][1]);
+    }
+    return 8;
+}
+
 int pts_tetrahedron(pd_vec3 *out)
 {
     out[0] = v3(1, 1, 1);

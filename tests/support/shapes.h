@@ -39,8 +39,13 @@ int convex_facet_count(const pd_vec3 *pts, int n);
 /* Point sets of standard solids, centred at the origin. Each returns the count
  * and writes into out (room for at least 64 points). */
 int pts_box(double ax, double ay, double az, pd_vec3 *out);   /* edge lengths */
-int pts_prism(int nsides, double radius, double height, pd_vec3 *out); /* n <= 32 */
+/* 2 nsides points: n <= 32 in the 64 points above, more given room. */
+int pts_prism(int nsides, double radius, double height, pd_vec3 *out);
 int pts_tetrahedron(pd_vec3 *out);
+/* A prism over the parallelogram (0,0) (1,0) (2,1) (1,1) in the x-z plane,
+ * depth 1 in y (8 points): its centroid (1, 0.5, 0.5) projects exactly onto
+ * the edge x = 1 of its bottom and of its top, two knife edges. */
+int pts_parallelogram_prism(pd_vec3 *out);
 /* A regular pyramid, flat when height << 1: nsides (<= 64) corners of
  * circumradius 1 on z = 0 (the first on +x) and the apex at (0, 0, height). */
 int pts_flat_pyramid(int nsides, double height, pd_vec3 *out);

@@ -35,6 +35,7 @@
     PD_SUITE(engine_bullet) \
     PD_SUITE(engine_extreme) \
     PD_SUITE(engine_contact) \
+    PD_SUITE(hard_parts) \
     PD_SUITE(symmetry) \
     PD_SUITE(cli)    \
     PD_SUITE(batch)  \

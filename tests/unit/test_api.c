@@ -185,7 +185,7 @@ static void test_impossible_options(const fixture *f)
     REFUSE(o.ci_halfwidth = -0.01, PD_ERR_USAGE, "ci_halfwidth");
     REFUSE(o.ci_halfwidth = NAN, PD_ERR_NONFINITE, "ci_halfwidth");
     REFUSE(o.max_drops = -1, PD_ERR_USAGE, "max_drops");
-    REFUSE(o.time_limit = 0, PD_ERR_USAGE, "time_limit");
+    REFUSE(o.time_limit = -1, PD_ERR_USAGE, "time_limit");
     REFUSE(o.time_limit = INFINITY, PD_ERR_NONFINITE, "time_limit");
     REFUSE(o.max_collisions = 0, PD_ERR_USAGE, "max_collisions");
     REFUSE(o.keep_trials = 2, PD_ERR_USAGE, "keep_trials");

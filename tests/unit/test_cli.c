@@ -911,6 +911,49 @@ static void test_stationary(void)
     expect_failure("--initial stationary -n 300 parts/cap.off", 2, "at least 350 drops");
 }
 
+/* Lines of text that end with `tail` (a trials file's end column). */
+static int rows_ending(const char *text, const char *tail)
+{
+    int n = 0;
+    size_t len = strlen(tail);
+    for (const char *c = text; c && (c = strstr(c, tail)) != NULL; c += len)
+        n += c[len] == '\n';
+    return n;
+}
+
+/* --time-limit: the drops run with it, stderr says how many it ended and
+ * at what time, and each such drop says so in the trials' end column (exit
+ * 0: a limit is an answer about the part, not a failure). A bad value is
+ * refused, and so is a run whose limit a stepping engine could only reach
+ * in more steps than it may take (a 1e29 m cube's automatic limit). */
+static void test_time_limit(void)
+{
+    expect_failure("--time-limit 0 -n 3 parts/cap.off", 2, "--time-limit");
+    expect_failure("--time-limit soon -n 3 parts/cap.off", 2, "expected auto or a time in s");
+    expect_failure("--time-limit inf -n 3 parts/cap.off", 2, "--time-limit");
+    char args[256], trials[160], path[160], *out, *err;
+    snprintf(trials, sizeof trials, "%s/limited.csv", tmpdir);
+    snprintf(args, sizeof args, "--time-limit 0.05 -n 4 --trials %s parts/cap.off", trials);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(err && strstr(err, "4 of 4 drops did not settle") &&
+          strstr(err, "4 at the time limit (0.05 s simulated"));
+    char *t = slurp(trials);
+    CHECK_INT(rows_ending(t, ",time_limit"), 4);
+    free(t);
+    free(out);
+    free(err);
+    CHECK_INT(run("--time-limit auto -n 4 parts/cap.off", &out, &err), 0);
+    CHECK(out && strstr(out, ",4,") != NULL);
+    free(out);
+    free(err);
+    snprintf(path, sizeof path, "%s/giant.off", tmpdir);
+    write_file(path, "OFF\n8 6 0\n0 0 0\n1e29 0 0\n1e29 1e29 0\n0 1e29 0\n0 0 1e29\n"
+                     "1e29 0 1e29\n1e29 1e29 1e29\n0 1e29 1e29\n4 0 3 2 1\n4 4 5 6 7\n"
+                     "4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
+    snprintf(args, sizeof args, "--engine ode -n 2 %s", path);
+    expect_failure(args, 2, "steps of 0.001 s per drop");
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -935,6 +978,7 @@ void suite_cli(void)
     test_group();
     test_group_trials();
     test_stationary();
+    test_time_limit();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

@@ -1,8 +1,9 @@
 /* test_drop_step.c: the stepping engines (ODE, Bullet) through the shared
  * drop loop: symmetric solids land uniformly, same seed gives the same
- * records whatever the thread count, and the drops settle (shallow ridges and
- * needles on the impulse engine too). */
+ * records whatever the thread count, and the drops settle (shallow ridges,
+ * needles and flat pyramids on the impulse engine too). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -164,6 +165,20 @@ static void small_parts_ode(void)
     }
 }
 
+/* Checks that none of r's drops failed and at most max_unsettled ended at a
+ * limit, saying which part (what) when any did not settle. */
+static void check_ends(const pd_sim_result *r, long max_unsettled, const char *what)
+{
+    long failed = 0;
+    for (long i = 0; i < r->n; i++)
+        failed += r->trials[i].end == PD_END_FAILED;
+    if (r->unsettled)
+        printf("     %s: %ld of %ld drops unsettled, %ld failed\n", what, r->unsettled, r->n,
+               failed);
+    CHECK_INT(failed, 0);
+    CHECK(r->unsettled <= max_unsettled);
+}
+
 /* A part whose two stable facets meet at a shallow ridge of `deg` degrees (a
  * 2 x 1 x 1 cm box with a roof for a bottom, mesh_roof_box): the energy
  * barrier between the two poses is c (1 - cos(deg / 2)) for the centre of
@@ -190,14 +205,9 @@ static void ridge_settles(pd_engine_kind engine, double deg, long drops)
     o.keep_trials = 1;
     pd_sim_result *r = run_drops(ok && nroof == 2, part, poses, &o);
     if (r) {
-        long failed = 0;
-        for (long i = 0; i < r->n; i++)
-            failed += r->trials[i].end == PD_END_FAILED;
-        if (r->unsettled)
-            printf("     engine %d, ridge %g deg: %ld of %ld drops unsettled, %ld failed\n",
-                   (int)engine, deg, r->unsettled, r->n, failed);
-        CHECK_INT(failed, 0);
-        CHECK(r->unsettled <= drops / 200);
+        char what[64];
+        snprintf(what, sizeof what, "engine %d, ridge %g deg", (int)engine, deg);
+        check_ends(r, drops / 200, what);
         long a = r->count[roof[0]], b = r->count[roof[1]];
         /* |a - b| against 3.29 sigma of a fair split of a + b. */
         CHECK(fabs((double)(a - b)) <= 3.29 * sqrt((double)(a + b)) + 1.0);
@@ -222,16 +232,49 @@ static void needles_settle(double length, double aspect, long drops)
     o.keep_trials = 1;
     pd_sim_result *r = run_drops(ok, part, poses, &o);
     if (r) {
-        long failed = 0;
-        for (long i = 0; i < r->n; i++)
-            failed += r->trials[i].end == PD_END_FAILED;
-        if (r->unsettled)
-            printf("     needle %g m, aspect %g: %ld of %ld drops unsettled, %ld failed\n", length,
-                   aspect, r->unsettled, r->n, failed);
-        CHECK_INT(failed, 0);
-        CHECK(r->unsettled <= drops / 200);
+        char what[64];
+        snprintf(what, sizeof what, "needle %g m, aspect %g", length, aspect);
+        check_ends(r, drops / 200, what);
     }
     release(r, poses, part);
+}
+
+/* Flat regular pyramids (circumradius 1 cm, 3 to 16 sides, height over
+ * radius 1e-5 to 1e-1) on the impulse engine: none fails, and over all of
+ * them at most 0.5% at a limit (each at most 3%: the 3-sided one at 1e-4
+ * can end spinning upside down on its apex, which its small patch stops in
+ * about 70 s, docs/limits.md). Until 2026-11-27 14 to 26 of 50 drops of
+ * most of them rocked until the time limit (the rest step's unpaid turn). */
+static void pyramids_settle(long drops)
+{
+    const int sides[] = {3, 4, 6, 16};
+    const double ratios[] = {1e-5, 1e-4, 1e-3, 1e-2, 1e-1};
+    long unsettled = 0, total = 0;
+    for (int i = 0; i < 4; i++)
+        for (int j = 0; j < 5; j++) {
+            pd_vec3 p[65];
+            int n = pts_flat_pyramid(sides[i], ratios[j], p);
+            pd_mesh *m = convex_mesh(p, n);
+            double I[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
+            if (m)
+                mesh_transform(m, CR(I), 0.01, v3(0, 0, 0));
+            pd_part *part;
+            pd_static_result *poses;
+            int ok = mesh_part(m, &part, &poses);
+            pd_sim_options o = drop_options(PD_ENGINE_IMPULSE, drops);
+            o.threads = 2;
+            o.keep_trials = 1;
+            pd_sim_result *r = run_drops(ok, part, poses, &o);
+            if (r) {
+                char what[64];
+                snprintf(what, sizeof what, "pyramid %d sides, h/r %g", sides[i], ratios[j]);
+                check_ends(r, (3 * drops + 99) / 100, what);
+                unsettled += r->unsettled;
+                total += r->n;
+            }
+            release(r, poses, part);
+        }
+    CHECK(unsettled <= total / 200);
 }
 
 void suite_drop_step(void)
@@ -257,5 +300,6 @@ void suite_drop_step(void)
         needles_settle(1.0, aspects[k], 200 / DROPS_SCALE);
         needles_settle(1e-3, aspects[k], 200 / DROPS_SCALE);
     }
+    pyramids_settle(100 / DROPS_SCALE);
     small_parts_ode();
 }

@@ -50,8 +50,9 @@ static void run_extreme(const char *part_name, const pd_part *part, const pd_sta
      * step may end past it by less than a step); the impulse simulator's
      * events by the time limit and the collision cap, its compliant impacts
      * ending on their own steps, each shorter than a contact duration. */
-    double T = sc.contact_time == PD_CONTACT_TIME_AUTO ? pd_contact_time_auto_part(part)
-                                                       : sc.contact_time;
+    double T = sc.contact_time == PD_CONTACT_TIME_AUTO
+                   ? pd_contact_time_auto(pd_contact_time_auto_size(part))
+                   : sc.contact_time;
     double dt = engine == PD_ENGINE_IMPULSE ? T
                 : engine == PD_ENGINE_ODE   ? 1e-3
                                             : 1.0 / 960.0;

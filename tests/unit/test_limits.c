@@ -450,12 +450,7 @@ static void test_weld_collapse(void)
 static void test_knife_warned_once(void)
 {
     pd_vec3 p[8];
-    const double xz[4][2] = {{0, 0}, {1, 0}, {2, 1}, {1, 1}};
-    for (int i = 0; i < 4; i++) {
-        p[i] = v3(xz[i][0], 0, xz[i][1]);
-        p[4 + i] = v3(xz[i][0], 1, xz[i][1]);
-    }
-    pd_part *part = part_of(convex_mesh(p, 8), NULL, NULL);
+    pd_part *part = part_of(convex_mesh(p, pts_parallelogram_prism(p)), NULL, NULL);
     pd_static_result *r = NULL;
     pd_diag d;
     pd_diag_init(&d);

@@ -30,7 +30,8 @@ static void contact_time_of_parts(void)
     CHECK_REL(box_contact_time(0.01, 0.01, 0.01), 5e-4, 1e-14, "round-off");
     CHECK_REL(box_contact_time(3.0, 3.0, 3.0), pd_contact_time_auto(3.0 * sqrt(3.0)), 1e-14,
               "round-off");
-    CHECK_REL(box_contact_time(10.0, 20.0, 30.0), 1e3 * box_contact_time(0.01, 0.02, 0.03), 1e-14,
+    /* Below the cap on the static sink (sizes under 1.2 m). */
+    CHECK_REL(box_contact_time(0.1, 0.2, 0.3), 10.0 * box_contact_time(0.01, 0.02, 0.03), 1e-14,
               "round-off");
     double L = sqrt(1.0 + 2e-6);
     CHECK_REL(box_contact_time(1.0, 1e-3, 1e-3), 5e-4 * pow(0.01 * sqrt(3.0) / L, 0.2), 1e-14,
@@ -231,6 +232,14 @@ void suite_scene(void)
     /* 5e-4 s for a 1 cm cube (diagonal sqrt(3) cm), in proportion to size. */
     CHECK_REL(pd_contact_time_auto(0.01 * sqrt(3.0)), 5e-4, 1e-15, "round-off");
     CHECK_REL(pd_contact_time_auto(1.0), 1e2 * pd_contact_time_auto(0.01), 1e-15, "linear");
+    /* Above 1.2 m, capped where the weight presses a contact 1e-3 of the
+     * size into the floor: g (T / pi)^2 = 1e-3 L at the estimate's gravity;
+     * just below 1.2 m still the proportional one. */
+    for (double L = 10.0; L <= 1e6; L *= 100.0) {
+        double T = pd_contact_time_auto(L);
+        CHECK_REL(9.81 * (T / M_PI) * (T / M_PI), 1e-3 * L, 1e-14, "the cap, round-off");
+    }
+    CHECK_REL(pd_contact_time_auto(1.19), 119.0 * pd_contact_time_auto(0.01), 1e-15, "linear");
     CHECK_STATUS(pd_scene_check(&s, NULL), PD_OK);
 
     pd_diag d;

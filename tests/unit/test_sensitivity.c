@@ -192,7 +192,8 @@ static void test_frictionless_belt(void)
     pd_sim_result *r = NULL;
     pd_sensitivity *s = NULL;
     if (ok && pd_sim_run(part, poses, &sc, &o, &r, NULL) == PD_OK)
-        CHECK_STATUS(pd_sim_sensitivity(r, &sc, part->size, NULL, 0, &s, NULL), PD_OK);
+        CHECK_STATUS(pd_sim_sensitivity(r, &sc, pd_contact_time_auto_size(part), NULL, 0, &s, NULL),
+                     PD_OK);
     CHECK(s != NULL);
     for (int k = 0; s && k < s->nposes; k++) {
         const pd_sensitivity_row *belt = &s->rows[k * s->nparams];

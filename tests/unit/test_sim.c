@@ -1,10 +1,14 @@
 /* test_sim.c: the Monte Carlo dynamic estimator: statistics of symmetric
  * parts, determinism whatever the thread count, scale, the run's contracts
- * (cancellation, bootstrap, --ci, trial records), shards summed. */
+ * (cancellation, bootstrap, --ci, trial records), shards summed; drops
+ * cancelled in flight, the time limit, and why a drop did not settle. */
+#include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "contact/compliant.h"
+#include "sim/drop.h"
 #include "base/gsl_adapter.h"
 #include "posedrop/posedrop.h"
 #include "posedrop/sim.h"
@@ -187,7 +191,7 @@ static void test_contracts(void)
 
     /* Bad options are refused with a message. */
     pd_sim_options_default(&o);
-    o.time_limit = 0;
+    o.time_limit = -1;
     pd_diag d;
     pd_diag_init(&d);
     r = NULL;
@@ -270,10 +274,288 @@ static void test_shards(void)
     free_part(&f);
 }
 
+/* --- cancelling drops in flight ---------------------------------------------- */
+
+/* The model of part f on an engine, for scene sc, and a work area, to run
+ * drops one by one through the loop pd_sim_run's threads call. */
+typedef struct {
+    pd_sim_model *m;
+    pd_drop_work *w;
+} drop_model;
+
+/* 0 (a check counted) on failure, with d freed. */
+static int drop_model_build(drop_model *d, const part_fixture *f, const pd_scene *sc,
+                            pd_engine_kind engine)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.engine = engine;
+    d->m = NULL;
+    CHECK_STATUS(pd_sim_model_build(f->part, f->poses, sc, &o, &d->m, NULL), PD_OK);
+    d->w = d->m ? pd_drop_work_alloc(d->m, sc) : NULL;
+    CHECK(d->w != NULL);
+    if (!d->w)
+        pd_sim_model_free(d->m);
+    return d->w != NULL;
+}
+
+static void drop_model_free(drop_model *d)
+{
+    pd_drop_work_free(d->w);
+    pd_sim_model_free(d->m);
+}
+
+/* Drop i of the default options on that engine, with that cancel flag. */
+static pd_trial drop_one(const drop_model *d, const pd_scene *sc, pd_engine_kind engine, long i,
+                         pd_cancel_flag *cancel)
+{
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.engine = engine;
+    o.cancel = cancel;
+    pd_trial t;
+    long gain = 0, fallbacks = 0;
+    pd_drop_run(d->m, d->w, sc, &o, i, NULL, &t, &gain, &fallbacks);
+    return t;
+}
+
+static void stop_on_progress(void *user, long done, long total)
+{
+    (void)done;
+    (void)total;
+    atomic_store((pd_cancel_flag *)user, 1);
+}
+
+/* Cancelled from the progress callback after the calling thread's first
+ * drop, while the other thread's is in flight (or about to start): the run
+ * is partial and its n drops are the first n of the full run, record for
+ * record, so a drop stopped part way was not counted and no later drop was
+ * either. */
+static void test_cancel_in_flight(pd_engine_kind engine)
+{
+    part_fixture f;
+    if (!make_part(&f, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.engine = engine;
+    o.ndrops = 200;
+    o.keep_trials = 1;
+    o.threads = 1;
+    pd_sim_result *full = run(&f, NULL, &o);
+    pd_cancel_flag stop = 0;
+    o.threads = 2;
+    o.cancel = &stop;
+    o.progress = stop_on_progress;
+    o.progress_user = &stop;
+    pd_sim_result *r = run(&f, NULL, &o);
+    CHECK(full != NULL && r != NULL);
+    if (full && r) {
+        CHECK_INT(r->partial, 1);
+        CHECK(r->n < o.ndrops);
+        CHECK(r->n == 0 || memcmp(r->trials, full->trials, sizeof *r->trials * (size_t)r->n) == 0);
+        long counted = r->unsettled, collisions = 0;
+        for (int k = 0; k < r->nposes; k++)
+            counted += r->count[k];
+        for (long i = 0; i < r->n; i++)
+            collisions += full->trials[i].collisions;
+        CHECK_INT(counted, r->n);
+        CHECK_INT(r->collisions, collisions);
+    }
+    pd_sim_result_free(full);
+    pd_sim_result_free(r);
+    free_part(&f);
+}
+
+/* A drop whose cancel flag is already set returns at once on any engine and
+ * any part: not run (left out of a partial result), no simulated time, no
+ * collision; here on parts whose drops are long (a 0.1 mm cube spins for
+ * seconds on the impulse engine; a 1000 m cube takes ODE and Bullet up to a
+ * million steps). The same drop without the flag runs. */
+static void test_cancel_before_drop(void)
+{
+    const pd_engine_kind engines[] = {PD_ENGINE_IMPULSE, PD_ENGINE_ODE, PD_ENGINE_BULLET};
+    CHECK_STATUS(pd_bullet_register(), PD_OK);
+    for (int e = 0; e < 3; e++) {
+        part_fixture f;
+        double edge = engines[e] == PD_ENGINE_IMPULSE ? 1e-4 : 1e3;
+        if (!make_part(&f, mesh_box(edge, edge, edge)))
+            continue;
+        pd_scene sc;
+        pd_scene_default(&sc);
+        drop_model d;
+        pd_cancel_flag stop = 1;
+        for (long i = 0; i < 3 && drop_model_build(&d, &f, &sc, engines[e]); i++) {
+            pd_trial t = drop_one(&d, &sc, engines[e], i, &stop);
+            CHECK(t.end == PD_END_NOT_RUN);
+            CHECK(t.time == 0.0 && t.collisions == 0);
+            drop_model_free(&d);
+        }
+        free_part(&f);
+    }
+}
+
+/* The compliant impact, the one call of the impulse engine's drop that can
+ * run for most of a drop's simulated time, stops at its first step once the
+ * flag it watches is set, and runs without it: a cube landing on a corner
+ * at the speed of a 0.12 m fall. */
+static void test_cancel_compliant(void)
+{
+    part_fixture f;
+    if (!make_part(&f, mesh_box(0.01, 0.01, 0.01)))
+        return;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    drop_model d;
+    if (!drop_model_build(&d, &f, &sc, PD_ENGINE_IMPULSE)) {
+        free_part(&f);
+        return;
+    }
+    const pd_sim_model *m = d.m;
+    CHECK(m->compliant_on);
+    for (int set = 0; m->compliant_on && set < 2; set++) {
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat(0.9, 0.3, 0.2, 0.1)), v3(0.05, 0, -1.5),
+                      v3(0, 0, 0)};
+        double low = HUGE_VAL;
+        for (int i = 0; i < m->body->nverts; i++)
+            low = fmin(low, pd_body_vertex_world(m->body, &s, i).z);
+        s.x.z = -low;
+        pd_cancel_flag stop = set;
+        pd_compliant_work_watch(d.w->compliant_work, &stop);
+        pd_compliant_result cr;
+        CHECK_STATUS(pd_compliant_run(&m->compliant, d.w->compliant_work, &m->settle, &sc, &s,
+                                      1.0, &cr), PD_OK);
+        CHECK(set ? cr.end == PD_COMPLIANT_CANCELLED && cr.steps == 0 && cr.time == 0.0
+                  : cr.end != PD_COMPLIANT_CANCELLED && cr.steps > 0);
+    }
+    drop_model_free(&d);
+    free_part(&f);
+}
+
+/* --- the time limit and why drops end ------------------------------------- */
+
+/* Every stage has its own name, which the command prints in --trials. */
+static void test_stage_names(void)
+{
+    for (int a = 0; a < PD_STAGE_COUNT; a++) {
+        CHECK(strcmp(pd_drop_stage_name((pd_drop_stage)a), "unknown") != 0);
+        for (int b = 0; b < a; b++)
+            CHECK(strcmp(pd_drop_stage_name((pd_drop_stage)a),
+                         pd_drop_stage_name((pd_drop_stage)b)) != 0);
+    }
+    CHECK(strcmp(pd_drop_stage_name(PD_STAGE_COUNT), "unknown") == 0);
+}
+
+/* A drop that cannot go on says where and how: released from a height that
+ * is not a number (pd_sim_run refuses it; the drop loop is called directly),
+ * the impulse engine's flight and the stepping engines' reset meet a
+ * non-finite state. */
+static void test_failure_reason(void)
+{
+    part_fixture f;
+    if (!make_part(&f, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    const pd_engine_kind engines[] = {PD_ENGINE_IMPULSE, PD_ENGINE_ODE, PD_ENGINE_BULLET};
+    const pd_drop_stage stages[] = {PD_STAGE_FLIGHT, PD_STAGE_ENGINE_RESET,
+                                    PD_STAGE_ENGINE_RESET};
+    CHECK_STATUS(pd_bullet_register(), PD_OK);
+    for (int e = 0; e < 3; e++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        drop_model d;
+        if (!drop_model_build(&d, &f, &sc, engines[e]))
+            continue;
+        sc.height = NAN;
+        pd_trial t = drop_one(&d, &sc, engines[e], 0, NULL);
+        CHECK(t.end == PD_END_FAILED && t.pose < 0);
+        CHECK_INT(t.stage, stages[e]);
+        CHECK_STATUS(t.status, PD_ERR_NONFINITE);
+        drop_model_free(&d);
+    }
+    free_part(&f);
+}
+
+/* The run's counts say how its drops ended: with a limit too short for any
+ * drop to settle, every drop ends at it, none failed. */
+static void test_end_counts(void)
+{
+    part_fixture f;
+    if (!make_part(&f, mesh_box(0.01, 0.02, 0.03)))
+        return;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 20;
+    o.keep_trials = 1;
+    o.time_limit = 0.05; /* the fall from 0.12 m takes 0.156 s */
+    pd_sim_result *r = run(&f, NULL, &o);
+    CHECK(r != NULL);
+    if (r) {
+        CHECK_INT(r->unsettled, 20);
+        CHECK_INT(r->time_limited, 20);
+        CHECK_INT(r->collision_limited + r->failed, 0);
+        CHECK_INT(r->first_failed, -1);
+        CHECK(r->time_limit == 0.05);
+        for (long i = 0; i < r->n; i++)
+            CHECK(r->trials[i].end == PD_END_TIME_LIMIT && r->trials[i].stage == PD_STAGE_NONE &&
+                  r->trials[i].status == PD_OK);
+    }
+    pd_sim_result_free(r);
+    free_part(&f);
+}
+
+/* The automatic time limit is the one the drops run with, for the part and
+ * scene at hand: elastic frictionless rigid drops never settle, and each
+ * that ends at the limit ends within a step of it (a step is far below 1e-3
+ * of the limit: rest steps take a rest fall, phases end at the limit), for a
+ * 1 cm box and a 10 m one, whose limits differ by the closed form's ratio. */
+static void test_time_limit_auto(void)
+{
+    const double sizes[] = {0.01, 10.0};
+    CHECK_NEAR(pd_time_limit_auto(0.01 * sqrt(3.0), NULL), 19.84, 0.005,
+               "the figure sim.h and docs/cli.md quote, rounded");
+    for (int k = 0; k < 2; k++) {
+        part_fixture f;
+        if (!make_part(&f, scaled(mesh_box(1, 2, 3), sizes[k])))
+            continue;
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.mu = 0.0;
+        sc.restitution = 1.0;
+        sc.contact_time = 0.0;
+        double limit = pd_time_limit_auto(f.part->size, &sc);
+        CHECK_REL(limit, PD_TIME_LIMIT_UNITS * (sqrt(f.part->size / sc.gravity) +
+                                                sqrt(2.0 * sc.height / sc.gravity)),
+                  1e-15, "closed form, round-off");
+        pd_sim_options o;
+        pd_sim_options_default(&o);
+        o.ndrops = 3;
+        o.keep_trials = 1;
+        pd_sim_result *r = run(&f, &sc, &o);
+        CHECK(r != NULL);
+        if (r) {
+            CHECK(r->time_limit == limit);
+            CHECK(r->time_limited > 0);
+            for (long i = 0; i < r->n; i++)
+                if (r->trials[i].end == PD_END_TIME_LIMIT)
+                    CHECK(r->trials[i].time >= limit && r->trials[i].time < limit * (1 + 1e-3));
+        }
+        pd_sim_result_free(r);
+        free_part(&f);
+    }
+}
+
 void suite_sim(void)
 {
     test_shards();
     test_platonic_uniform();
     test_determinism_and_scale();
     test_contracts();
+    test_cancel_in_flight(PD_ENGINE_IMPULSE);
+    test_cancel_in_flight(PD_ENGINE_ODE);
+    test_cancel_before_drop();
+    test_cancel_compliant();
+    test_stage_names();
+    test_failure_reason();
+    test_end_counts();
+    test_time_limit_auto();
 }

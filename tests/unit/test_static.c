@@ -310,18 +310,12 @@ static void test_platonic(void)
     }
 }
 
-/* A prism over the parallelogram (0,0) (1,0) (2,1) (1,1) in the x-z plane,
- * depth 1 in y: its centroid (1, 0.5, 0.5) projects exactly onto the edge
- * x = 1 of the bottom face and of the top face. */
+/* pts_parallelogram_prism's mesh: its centroid (1, 0.5, 0.5) projects
+ * exactly onto the edge x = 1 of the bottom face and of the top face. */
 static pd_mesh *parallelogram_prism(void)
 {
     pd_vec3 p[8];
-    const double xz[4][2] = {{0, 0}, {1, 0}, {2, 1}, {1, 1}};
-    for (int i = 0; i < 4; i++) {
-        p[i] = v3(xz[i][0], 0, xz[i][1]);
-        p[4 + i] = v3(xz[i][0], 1, xz[i][1]);
-    }
-    return convex_mesh(p, 8);
+    return convex_mesh(p, pts_parallelogram_prism(p));
 }
 
 static void test_knife_edge(void)
