@@ -104,7 +104,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-install test bench bench-mujoco demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+.PHONY: all check check-full check-install test bench bench-mujoco demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
         check-browser figures mpi
 .DEFAULT_GOAL := all
 
@@ -185,8 +185,13 @@ $(BENCH_BIN): $(BENCH_OBJS) $(LIB_BULLET) $(LIB)
 deps:
 	@scripts/install-deps.sh
 
+# The runner runs TEST_JOBS suites at a time, each in a process of its own,
+# printing them in their table's order (tests/support/main.c); the results
+# do not depend on it. TEST_FULL=1 (make check-full) selects the long
+# variants of the statistical tests.
+TEST_JOBS ?= 2
 test: $(TEST_BIN) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
-	$(TEST_BIN) $(SUITES)
+	$(TEST_BIN) -j$(TEST_JOBS) $(if $(filter 1,$(TEST_FULL)),--full) $(SUITES)
 
 # A file may include only its own layer's headers and those of the layers
 # below it (scripts/lint-layers.sh holds the table).
@@ -199,9 +204,13 @@ lint:
 check-install: all
 	+@MAKE="$(MAKE)" CC="$(CC)" CXX="$(CXX)" EXAMPLE_FLAGS="$(LDFLAGS_SAN)" tests/install/check-install.sh
 
-check: deps lint
+# make check builds on two jobs unless make was given its own -j.
+# make check-full is make check with the statistical tests' long variants
+# (docs/development.md says which); CI runs both.
+check check-full: deps lint
+	@$(MAKE) --no-print-directory $(if $(filter -j%,$(MAKEFLAGS)),,-j2) all $(TEST_BIN)
 	@$(MAKE) --no-print-directory check-install
-	@$(MAKE) --no-print-directory test
+	@$(MAKE) --no-print-directory test $(if $(filter check-full,$@),TEST_FULL=1)
 
 demo: deps
 	@$(MAKE) --no-print-directory all
@@ -313,6 +322,7 @@ help:
 	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
+	@echo "make check-full make check with the long statistical runs (CI runs both)"
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make bench-mujoco  cost per drop against MuJoCo (pip install mujoco; see the script)"

@@ -13,20 +13,27 @@
 # drops, started from identical states, that end in the same pose on both.
 # Options after -- go to posedrop unchanged (e.g. --units mm, --mu 0.5).
 set -u
+. "$(dirname "$0")/args.sh"
 n=500
 outdir=crosscheck-out
 opts=()
 parts=()
 while [ $# -gt 0 ]; do
     case "$1" in
-        -n) n=$2; shift 2 ;;
-        -o) outdir=$2; shift 2 ;;
-        --) shift; while [ $# -gt 0 ] && [ "${1#-}" != "$1" ]; do opts+=("$1" "$2"); shift 2; done ;;
+        -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
+        --) shift
+            while [ $# -gt 0 ] && [ "${1#-}" != "$1" ]; do
+                [ $# -ge 2 ] || args_die "$1 after -- needs a value (posedrop's options there take one each)"
+                opts+=("$1" "$2"); shift 2
+            done ;;
+        -*) args_die "unknown option '$1' (options for posedrop go after --)" ;;
         --help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) parts+=("$1"); shift ;;
     esac
 done
-[ ${#parts[@]} -gt 0 ] || { echo "crosscheck.sh: no part files given" >&2; exit 2; }
+[ ${#parts[@]} -gt 0 ] || args_die "no part files given"
+args_files "${parts[@]}"
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
 [ -n "$bin" ] || { echo "crosscheck.sh: posedrop not built (run make)" >&2; exit 2; }
@@ -34,9 +41,13 @@ mkdir -p "$outdir" || exit 2
 csv="$outdir/crosscheck.csv"
 echo "part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled" > "$csv"
 status=0
+runs=0
+start_s=$SECONDS
 for part in "${parts[@]}"; do
     name=$(basename "${part%.*}")
     for engine in impulse ode bullet; do
+        runs=$((runs + 1))
+        echo "crosscheck.sh: $part on $engine, run $runs of $((3 * ${#parts[@]})), $((SECONDS - start_s)) s so far" >&2
         out="$outdir/$name.$engine.csv"
         start=$(date +%s.%N)
         if ! "$bin" "${opts[@]}" -n "$n" --engine "$engine" --trials "$outdir/$name.$engine.trials.csv" \

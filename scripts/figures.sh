@@ -13,6 +13,7 @@
 # physical frequency: its poses are paired with posedrop's classes by rank of
 # QS on both sides, as scripts/eq16.awk does, to write the measured file.
 set -eu
+. "$(dirname "$0")/args.sh"
 here=$(cd "$(dirname "$0")/.." && pwd)
 out="$here/docs/figures"
 tables=""
@@ -20,9 +21,9 @@ cost_args=""
 while [ $# -gt 0 ]; do
     case "$1" in
         --chart-only) cost_args="--chart-only"; shift ;;
-        -d) tables=$2; shift 2 ;;
+        -d) args_value "$@"; tables=$2; shift 2 ;;
         --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-        *) echo "figures.sh: unknown argument '$1'" >&2; exit 2 ;;
+        *) args_die "unknown argument '$1'" ;;
     esac
 done
 bin=${POSEDROP:-$here/build/opt/posedrop}

@@ -8,8 +8,14 @@
 # TARGET/ so that make check replays it from then on.
 set -eu
 cd "$(dirname "$0")/.."
+die() { echo "fuzz.sh: $1 (usage: scripts/fuzz.sh SECONDS TARGET...)" >&2; exit 2; }
+[ $# -ge 2 ] || die "expected a number of seconds and at least one target"
+case $1 in '' | *[!0-9]* | 0*) die "SECONDS: expected a whole number from 1, got '$1'" ;; esac
 seconds=$1
 shift
+for t in "$@"; do
+    [ -x "build/fuzz/fuzz_$t" ] || die "no target '$t' built in build/fuzz/ (make fuzz-build)"
+done
 status=0
 for t in "$@"; do
     corpus=build/fuzz/corpus/$t

@@ -35,6 +35,9 @@ sys.exit(not os.path.isfile(os.path.join(sysconfig.get_paths()["include"], "Pyth
         ;;
     browser) pkgs="chromium librsvg2-bin libxml2-utils fonts-dejavu-core python3" ;;
     mpi) pkgs="libopenmpi-dev openmpi-bin" ;;
+    *[!a-z0-9+.-]* | [!a-z0-9]*)
+        echo "install-deps.sh: '$arg' is not a Debian package name (nor python, browser or mpi)" >&2
+        exit 2 ;;
     *) pkgs=$arg ;;
     esac
     for pkg in $pkgs; do

@@ -6,6 +6,7 @@
 set -eu
 cd "$(dirname "$0")/.."
 
+[ $# -eq 0 ] || { echo "lint-layers.sh: takes no arguments (it checks every file under src/)" >&2; exit 2; }
 lower() {
     case "$1" in
     base)      echo "" ;;

@@ -83,6 +83,10 @@ def platonic():
 
 
 def main():
+    if len(sys.argv) > 2 or (len(sys.argv) == 2 and sys.argv[1].startswith("-")):
+        print("make-canonical.py: expected at most one argument, the output directory "
+              "(default parts/canonical), got " + " ".join(sys.argv[1:]), file=sys.stderr)
+        sys.exit(2)
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "..", "parts", "canonical")
     os.makedirs(out, exist_ok=True)
     cm = 0.01

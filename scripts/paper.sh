@@ -13,7 +13,7 @@
 # CONTACT_TIME, s, the duration of one contact (posedrop's default when not
 # given; 0: the rigid model): --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
-# (default results/) and prints each table: the paper's QS, PQS, dynamic and
+# (default results/) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
@@ -22,6 +22,7 @@
 # probability on both sides, the column the parts were fitted on (the paper
 # numbers its poses by physical frequency).
 set -u
+. "$(dirname "$0")/args.sh"
 n=2000
 initial=stationary
 contact_time=
@@ -29,13 +30,13 @@ outdir=results
 tables=""
 while [ $# -gt 0 ]; do
     case "$1" in
-        -n) n=$2; shift 2 ;;
-        -i) initial=$2; shift 2 ;;
-        -t) contact_time=$2; shift 2 ;;
-        -o) outdir=$2; shift 2 ;;
-        -d) tables=$2; shift 2 ;;
+        -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
+        -i) args_value "$@"; initial=$2; shift 2 ;;
+        -t) args_value "$@"; contact_time=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
+        -d) args_value "$@"; tables=$2; shift 2 ;;
         --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-        *) echo "paper.sh: unknown argument '$1'" >&2; exit 2 ;;
+        *) args_die "unknown argument '$1'" ;;
     esac
 done
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -46,14 +47,38 @@ if [ -z "$tables" ]; then
         [ -f "$t" ] && { tables=$t; break; }
     done
 fi
-[ -f "$tables" ] || { echo "paper.sh: the paper's measured tables not found (give -d FILE)" >&2; exit 2; }
+[ -f "$tables" ] || args_die "the paper's measured tables not found (give -d FILE)"
+# -i and -t as posedrop reads them, on a static run of one part (milliseconds),
+# so that a bad value is refused once, before any drop.
+why=$("$bin" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
+    "$here/parts/cap.off" 2>&1 >/dev/null) || args_die "$(printf '%s' "$why" | head -n 1)"
 mkdir -p "$outdir" || exit 2
+# What the tables' blocks and rows are, so that the output reads without
+# docs/validation.md.
+cat <<EOF
+Tables 1-4 of Goldberg, Mirtich et al., "Part Pose Statistics: Estimators and
+Experiments", with posedrop's columns beside the paper's; every figure in percent.
+  left block, the paper's:  QS and PQS estimates, Dyn its dynamic simulation,
+                            Phys the physical tests (the reference)
+  right block, posedrop's:  QS and PQS estimates, and $n drops (initial $initial)
+                            on posedrop's impulse engine, ODE and Bullet
+  pose  numbered as the paper numbers them (by physical frequency); posedrop's
+        pose classes are paired with them by rank of their QS probability
+  e16   the paper's eq. (16) error against the physical tests: the sum over poses
+        of p_phys |p - p_phys| (0: exact; mass on poses never seen costs nothing)
+  TV    total-variation distance from the physical tests: half the sum of
+        |p - p_phys|, mass on poses never seen included
+EOF
 status=0
+runs=0
+start_s=$SECONDS
 for part in insulator_cap white_button rect_black_button square_black_button; do
     file="$here/parts/$part.off"
     [ -f "$file" ] || { echo "paper.sh: $file missing" >&2; status=1; continue; }
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
+        runs=$((runs + 1))
+        echo "paper.sh: $part on $engine, run $runs of 12, $((SECONDS - start_s)) s so far" >&2
         start=$(date +%s.%N)
         "$bin" --group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
             --engine "$engine" "$file" \
@@ -102,6 +127,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 if (paper[prank[j], 1] > paper[prank[i], 1]) { t = prank[i]; prank[i] = prank[j]; prank[j] = t }
             for (r = 1; r <= np; r++) rank_of[prank[r]] = r
             printf "\n%s (%d physical trials; posedrop: %d pose classes, paper: %d; initial %s)\n", part, trials, ks, np, initial
+            printf "%4s | %-27s | %s\n", "", "the paper", "posedrop"
             printf "%4s | %6s %6s %6s %6s | %6s %6s %7s %6s %6s\n", "pose", "QS", "PQS", "Dyn", "Phys",
                    "QS", "PQS", "impulse", "ODE", "Bullet"
             for (p = 1; p <= np; p++) {

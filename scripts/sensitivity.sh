@@ -23,6 +23,7 @@
 #                           key. Unlike a sweep, each curve is averaged over
 #                           the other parameters' ranges.
 set -u
+. "$(dirname "$0")/args.sh"
 n=2000
 initial=uniform
 outdir=results
@@ -30,18 +31,25 @@ opts=()
 part=""
 while [ $# -gt 0 ]; do
     case "$1" in
-        -n) n=$2; shift 2 ;;
-        -i) initial=$2; shift 2 ;;
-        -o) outdir=$2; shift 2 ;;
+        -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
+        -i) args_value "$@"; initial=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
         --) shift; while [ $# -gt 1 ]; do opts+=("$1"); shift; done ;;
         --help) sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
-        *) part=$1; shift ;;
+        -*) args_die "unknown option '$1' (options for posedrop go after --)" ;;
+        *) [ -z "$part" ] || args_die "give one PART file, not '$part' and '$1'"; part=$1; shift ;;
     esac
 done
-[ -n "$part" ] && [ -f "$part" ] || { echo "sensitivity.sh: give one PART file" >&2; exit 2; }
+[ -n "$part" ] || args_die "give one PART file"
+args_files "$part"
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
 [ -n "$bin" ] || { echo "sensitivity.sh: posedrop not built (run make)" >&2; exit 2; }
+# -i and the options after -- as posedrop reads them, on a static run of the
+# part (milliseconds), so that a bad one is refused before the drops and
+# before anything is written.
+why=$("$bin" --initial "$initial" "${opts[@]}" "$part" 2>&1 >/dev/null) ||
+    args_die "$(printf '%s' "$why" | head -n 1)"
 mkdir -p "$outdir" || exit 2
 name=$(basename "${part%.*}")
 sens="$outdir/$name-sensitivity.csv"
@@ -106,6 +114,8 @@ for v in 0 5 10 15 20 30 45; do
         { print "epsilon", value, $c["pose"], "", $c["p_pqs"], $c["p_pqs"], $c["p_pqs"] }' >> "$curves"
 done
 
+command -v gnuplot >/dev/null 2>&1 || echo "sensitivity.sh: gnuplot is missing: installing the" \
+    "Debian package gnuplot-nox with apt-get (scripts/install-deps.sh, through sudo when not root)" >&2
 command -v gnuplot >/dev/null 2>&1 || "$here/scripts/install-deps.sh" gnuplot-nox ||
     { echo "sensitivity.sh: gnuplot missing; $sens and $curves written, no chart" >&2; exit 1; }
 params=$(awk -F, 'NR > 1 && !seen[$1]++ { printf "%s ", $1 }' "$curves")

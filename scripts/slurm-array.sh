@@ -16,6 +16,7 @@
 # Prints the two job ids. Both jobs run in the current directory, so a PART
 # given by a relative path is found by the merge as by the shards.
 set -euo pipefail
+. "$(dirname "$0")/args.sh"
 
 usage() { sed -n '2,17p' "$0" | sed 's/^# \{0,1\}//'; }
 nshards=""
@@ -25,11 +26,11 @@ bin=""
 extra=""
 while [ $# -gt 0 ]; do
     case "$1" in
-        -N) nshards=$2; shift 2 ;;
-        -o) outdir=$2; shift 2 ;;
-        -c) cpus=$2; shift 2 ;;
-        -b) bin=$2; shift 2 ;;
-        -s) extra=$2; shift 2 ;;
+        -N) args_value "$@"; nshards=$2; shift 2 ;;
+        -o) args_value "$@"; outdir=$2; shift 2 ;;
+        -c) args_value "$@"; cpus=$2; shift 2 ;;
+        -b) args_value "$@"; bin=$2; shift 2 ;;
+        -s) [ $# -ge 2 ] || args_die "-s needs a value"; extra=$2; shift 2 ;;
         --help) usage; exit 0 ;;
         --) shift; break ;;
         *) echo "slurm-array.sh: unknown option '$1' (options for posedrop go after --)" >&2; exit 2 ;;

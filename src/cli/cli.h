@@ -1,51 +1,16 @@
-/* cli.h: what the files of the posedrop command share. cli.c parses the
- * options and prints CSV; run.c (or run_mpi.c in posedrop-mpi) runs the
- * drops; shard.c writes and merges shards; json_out.c prints --format json;
- * progress.c draws the progress line; sha256.c hashes the part file. */
+/* cli.h: what the run (command.c) builds on, below it: run.c (or run_mpi.c
+ * in posedrop-mpi) runs the drops; shard.c writes, reads and sums shards;
+ * json_out.c prints --format json; progress.c draws the progress line;
+ * sha256.c hashes the part file; plausible.c warns of a part or drop height
+ * out of scale; fragile.c of a stationary estimate that rests on few drops;
+ * signals.c catches SIGINT and SIGTERM; same_file.c keeps outputs off
+ * inputs. The commands above it: cli.c (posedrop's options), merge.c
+ * (posedrop merge). */
 #ifndef PD_CLI_CLI_H
 #define PD_CLI_CLI_H
 
 #include <stdio.h>
-#include "viz/viz.h"
-#include "posedrop/posedrop.h"
-
-enum { EXIT_USAGE = 2, EXIT_INTERNAL = 1 };
-
-extern const char *prog;
-
-/* A file the run reads (an input) or writes (an output), with what names it
- * in messages: a long option's name (option 1: "trials" is shown "--trials")
- * or a role ("PART", "shard"). */
-typedef struct {
-    const char *what, *path;
-    int output, option;
-} cli_file;
-
-typedef struct {
-    const char *path, *trials, *transitions, *com_text;
-    pd_mesh_read_options read;
-    pd_part_options part;
-    pd_static_options estimate;
-    pd_scene scene;
-    pd_sim_options sim;
-    int dynamic, facets, group, verbose;
-    const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
-    const char *measured;
-    const char *sensitivity;       /* --sensitivity FILE */
-    int json;                      /* --format json */
-    int argc;                      /* the command line, for the JSON metadata */
-    char **argv;
-    char **merge;                  /* posedrop merge: the shard files (NULL ended) */
-    cli_file *files;               /* every file named, for cli_files_apart (owned) */
-    int nfiles;
-} cli_args;
-
-/* The run after its options: read, estimate, drop (or merge), print. */
-int cli_run(cli_args *a);
-
-/* Axis-aligned normals come out with round-off components like 1e-17; print
- * them as 0 (and never as -0). */
-double cli_clean(double x);
+#include "cli/args.h"
 
 /* run.c / run_mpi.c. cli_start and cli_end wrap the whole program (MPI's
  * start and end); cli_simulate runs the drops (or sums the shards of a
@@ -65,10 +30,14 @@ int cli_any(int mine);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;
- * the merge subcommand (parses its own options, then cli_run). */
+ * the shards of a merge read and checked into a->scene, a->sim and the
+ * part's path and SHA-256 (shard_load; shard_unload frees them), and summed
+ * by merge_shards when the run comes to its drops. */
 int shard_parse(const char *text, pd_sim_options *sim);
 int shard_write_identity(FILE *out, const cli_args *a, const pd_sim_result *sim);
-int cli_merge(int argc, char **argv);
+int shard_load(char **files, int nfiles, cli_args *a, char *path, size_t path_size,
+               char sha[65]);
+void shard_unload(void);
 pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result **sum,
                        pd_diag *diag);
 
@@ -88,6 +57,11 @@ int signals_caught(void);
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+
+/* plausible.c: warns on stderr when the part's size, or the drop height
+ * against it, suggests a unit mistaken (a file in millimetres read as
+ * metres). */
+void plausible_warn(const cli_args *a, const pd_part *part);
 
 /* same_file.c: 1 when no output is the same file as an input or as another
  * output (standard output included when it is a regular file); otherwise 0,

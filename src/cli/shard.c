@@ -1,4 +1,4 @@
-/* shard.c: --shard K/N and posedrop merge.
+/* shard.c: --shard K/N, and the shards posedrop merge (merge.c) sums.
  *
  * A shard prints two leading '#' lines before its CSV: the run's identity
  *   # posedrop VERSION shard=K/N part=PATH sha256=HEX units=... group=0|1
@@ -10,7 +10,6 @@
  * one run, reads the part again (its SHA-256 must not have changed), sums
  * the counts and prints through cli_run what the unsharded run prints. */
 #include <errno.h>
-#include <getopt.h>
 #include <inttypes.h>
 #include <stdarg.h>
 #include <stdlib.h>
@@ -611,116 +610,21 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
     return st;
 }
 
-static void merge_usage(FILE *out)
+int shard_load(char **files, int nfiles, cli_args *a, char *path, size_t path_size, char sha[65])
 {
-    fprintf(out,
-        "usage: %s merge [options] SHARD...\n"
-        "\n"
-        "Sums the shards that 'posedrop --shard K/N' printed, K = 1..N of one run,\n"
-        "and prints exactly what the run without --shard prints. The part file\n"
-        "named in the shards must still be there, unchanged (its SHA-256).\n"
-        "\n"
-        "  --format F         csv (default) or json\n"
-        "  --transitions FILE with --initial stationary, the estimated chain as CSV\n"
-        "  --verbose          a summary of the part and of the drops on stderr\n"
-        "  --help             this help\n"
-        "\n"
-        "exit status: 0 success, 2 shards that do not make one whole run (other\n"
-        "parts, scenes, seeds, versions or shard counts, a shard missing, twice or\n"
-        "interrupted) or a bad file, 1 internal failure\n", prog);
-}
-
-int cli_merge(int argc, char **argv)
-{
-    enum { M_FORMAT = 256, M_TRANSITIONS, M_VERBOSE, M_HELP };
-    static const struct option longopts[] = {
-        {"format", required_argument, 0, M_FORMAT},
-        {"transitions", required_argument, 0, M_TRANSITIONS},
-        {"verbose", no_argument, 0, M_VERBOSE},
-        {"help", no_argument, 0, M_HELP},
-        {0, 0, 0, 0},
-    };
-    cli_args a;
-    memset(&a, 0, sizeof a);
-    pd_mesh_read_options_default(&a.read);
-    pd_part_options_default(&a.part);
-    pd_static_options_default(&a.estimate);
-    pd_scene_default(&a.scene);
-    pd_sim_options_default(&a.sim);
-    a.argc = argc;
-    a.argv = argv;
-    opterr = 0;
-    optind = 1;
-    int c;
-    while ((c = getopt_long(argc, argv, ":", longopts, NULL)) != -1) {
-        switch (c) {
-        case M_FORMAT:
-            if (strcmp(optarg, "csv") != 0 && strcmp(optarg, "json") != 0) {
-                fprintf(stderr, "%s: merge: --format: expected csv or json, got '%s'\n", prog,
-                        optarg);
-                return EXIT_USAGE;
-            }
-            a.json = strcmp(optarg, "json") == 0;
-            break;
-        case M_TRANSITIONS: a.transitions = optarg; break;
-        case M_VERBOSE: a.verbose = 1; break;
-        case M_HELP: merge_usage(stdout); return 0;
-        case ':':
-            fprintf(stderr, "%s: merge: option '%s' needs a value\n", prog, argv[optind - 1]);
-            return EXIT_USAGE;
-        default:
-            fprintf(stderr, "%s: merge: unknown option '%s'\n%s: see '%s merge --help'\n", prog,
-                    argv[optind - 1], prog, prog);
-            return EXIT_USAGE;
-        }
-    }
-    if (optind >= argc) {
-        fprintf(stderr, "%s: merge: expected the shard files\n%s: see '%s merge --help'\n", prog,
-                prog, prog);
-        return EXIT_USAGE;
-    }
-    nshard_files = argc - optind;
+    nshard_files = nfiles;
     shards = calloc((size_t)nshard_files, sizeof *shards);
     if (!shards) {
         fprintf(stderr, "%s: out of memory\n", prog);
-        return EXIT_INTERNAL;
+        return 0;
     }
-    static char path[1100];
-    char sha[65], now[65];
     int ok = 1;
     for (int i = 0; ok && i < nshard_files; i++)
-        ok = read_shard(argv[optind + i], &shards[i]);
-    ok = ok && check_shards() && options_from_identity(&shards[0], &a, path, sizeof path, sha);
-    if (ok && a.transitions && a.scene.initial != PD_INITIAL_STATIONARY)
-        ok = merge_fail(shards[0].file, 0, "--transitions needs the shards of a run with "
-                        "--initial stationary");
-    if (ok && !sha256_file(path, now)) {
-        fprintf(stderr, "%s: %s: cannot read the shards' part: %s\n", prog, path, strerror(errno));
-        ok = 0;
-    }
-    if (ok && strcmp(now, sha) != 0) {
-        fprintf(stderr, "%s: %s: the part has changed since the shards ran (SHA-256 %s, the "
-                "shards name %s)\n", prog, path, now, sha);
-        ok = 0;
-    }
-    int code = EXIT_USAGE;
-    /* The shards and their part are inputs; --transitions the one output. */
-    if (ok && !(a.files = calloc((size_t)nshard_files + 2, sizeof *a.files))) {
-        fprintf(stderr, "%s: out of memory\n", prog);
-        code = EXIT_INTERNAL;
-        ok = 0;
-    }
-    if (ok) {
-        for (int i = 0; i < nshard_files; i++)
-            a.files[a.nfiles++] = (cli_file){"shard", argv[optind + i], 0, 0};
-        a.files[a.nfiles++] = (cli_file){"the shards' part", path, 0, 0};
-        if (a.transitions)
-            a.files[a.nfiles++] = (cli_file){"transitions", a.transitions, 1, 1};
-        a.dynamic = 1;
-        a.merge = argv + optind;
-        code = cli_run(&a);
-    }
-    free(a.files);
+        ok = read_shard(files[i], &shards[i]);
+    return ok && check_shards() && options_from_identity(&shards[0], a, path, path_size, sha);
+}
+
+void shard_unload(void)
+{
     free_shards();
-    return code;
 }

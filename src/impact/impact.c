@@ -4,7 +4,7 @@
  *  - the problem is solved in units where |u0| = 1 and K's mean diagonal is
  *    1, so tolerances are relative and the law is homogeneous to round-off;
  *  - the integrated state is (px, py, W, pz), the velocity always recomputed
- *    as u0 + K p (impact_internal.h), and sliding integrated in a rescaled
+ *    as u0 + K p (impact_collision.h), and sliding integrated in a rescaled
  *    parameter in which zero slip is a rest point (impact_slide.c);
  *  - every phase in which p' is constant (no friction, stable sticking,
  *    sliding along the diverging ray or into the origin along an incoming
@@ -15,7 +15,8 @@
  *    so the integrator never steps over the singularity of eq. 14. */
 #include <math.h>
 #include <stdlib.h>
-#include "impact/impact_internal.h"
+#include "impact/impact_collision.h"
+#include "impact/impact_slide.h"
 #include "impact/impact_tol.h"
 
 struct pd_impact_work {

@@ -1,5 +1,5 @@
 /* impact_slide.c: a collision's sliding phase, eq. 14 integrated with GSL's
- * rk8pd (see impact_internal.h).
+ * rk8pd (see impact_collision.h).
  *
  * Eq. 14 gives p and W as functions of pz. The integrator runs in a
  * parameter sigma of our choosing, with dpz/dsigma = g > 0 along the
@@ -7,7 +7,8 @@
  * solutions. The state is (px, py, pz, W) in every form, W integrated only
  * under the energetic law. */
 #include <math.h>
-#include "impact/impact_internal.h"
+#include "impact/impact_collision.h"
+#include "impact/impact_slide.h"
 #include "impact/impact_tol.h"
 
 enum {

@@ -49,6 +49,28 @@ static void whisker(vbuf *b, double xc, double ylo, double yhi)
     vbuf_put(b, "\" fill=\"none\" stroke=\"#111111\" stroke-width=\"1.2\"/>\n");
 }
 
+/* The legend's line for series sr (which: 0 QS, 1 PQS, 2 drops, 3
+ * measured): its name; with a measured distribution, each estimate's eq.
+ * (16) error and total variation against it. */
+static void legend_line(const viz_input *in, const viz_entry *e, int n, const series *sr,
+                        int which, char *line, size_t size)
+{
+    if (e[0].has_meas && which < 3) {
+        double e16, tv;
+        viz_eq16(e, n, which, &e16, &tv);
+        snprintf(line, size, "%s: eq. (16) error %.2f, total variation %.1f%%", sr->name, e16, tv);
+    } else if (which == 3) {
+        if (in->measured->n)
+            snprintf(line, size, "measured: %ld observations (%s)", in->measured->n,
+                     viz_base_name(in->measured->path));
+        else
+            snprintf(line, size, "measured (%s; p without n: no interval)",
+                     viz_base_name(in->measured->path));
+    } else {
+        snprintf(line, size, "%s", sr->name);
+    }
+}
+
 pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
 {
     viz_entry *e;
@@ -69,48 +91,40 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     int which[4] = {0, 1, 2, 3};
     if (!has_dyn)
         which[2] = 3;
-    double group_w = fmax(nser * (BAR_W + BAR_GAP), THUMB) + GROUP_GAP;
-    double plot_w = n * group_w;
     int legend_rows = nser;
     double legend_h = legend_rows * LEGEND_LINE + 8;
-    double w = LEFT + plot_w + RIGHT;
-    if (w < 640)
-        w = 640;
-    double y_top = TOP + legend_h, y0 = y_top + PLOT_H;
-    double h = y0 + 22 + THUMB + 14;
-    char title[512];
+    char title[512], legend[4][256];
     snprintf(title, sizeof title, "Pose probabilities of %s%s", viz_base_name(in->name),
              in->class_of ? ", by class" : "");
+    const char *whiskers = has_dyn || (has_meas && e[0].meas_ci) ? "whiskers: 95% intervals" : "";
+    const char *caption = in->class_of
+                              ? "pose class (as numbered by --group), drawn as in the gallery"
+                              : "pose (as numbered in the output), drawn as in the gallery";
+    for (int k = 0; k < nser; k++)
+        legend_line(in, e, n, &s[which[k]], which[k], legend[k], sizeof legend[k]);
+    /* As wide as the bars need, or as the title and the whiskers' note, the
+     * legend or the caption (centred under the plot), whichever is widest;
+     * the groups then share the plot's width. */
+    double w = fmax(LEFT + n * (fmax(nser * (BAR_W + BAR_GAP), THUMB) + GROUP_GAP) + RIGHT, 640);
+    w = fmax(w, 10 + viz_text_width(title, 16, 1) + 20 + viz_text_width(whiskers, 11, 0) + RIGHT);
+    for (int k = 0; k < nser; k++)
+        w = fmax(w, LEFT + 18 + viz_text_width(legend[k], 12, 0) + RIGHT);
+    w = ceil(fmax(w, LEFT + viz_text_width(caption, 11, 0) + LEFT));
+    double plot_w = w - LEFT - RIGHT, group_w = plot_w / n;
+    double y_top = TOP + legend_h, y0 = y_top + PLOT_H;
+    double h = y0 + 22 + THUMB + 14;
     viz_svg_open(b, standalone, w, h, title);
     vbuf_put(b, "<g class=\"chart\">\n");
     viz_text(b, 10, 22, 16, "start", 1, "#111111", title);
-    /* Legend: a swatch and name per estimator; with a measured distribution,
-     * each estimate's eq. (16) error and total variation against it. */
     for (int k = 0; k < nser; k++) {
-        const series *sr = &s[which[k]];
         double y = TOP + k * LEGEND_LINE;
-        char line[256];
-        snprintf(line, sizeof line, "fill=\"%s\"", sr->colour);
-        viz_rect(b, LEFT, y, 12, 12, line);
-        if (has_meas && which[k] < 3) {
-            double e16, tv;
-            viz_eq16(e, n, which[k], &e16, &tv);
-            snprintf(line, sizeof line, "%s: eq. (16) error %.2f, total variation %.1f%%",
-                     sr->name, e16, tv);
-        } else if (which[k] == 3) {
-            if (in->measured->n)
-                snprintf(line, sizeof line, "measured: %ld observations (%s)", in->measured->n,
-                         viz_base_name(in->measured->path));
-            else
-                snprintf(line, sizeof line, "measured (%s; p without n: no interval)",
-                         viz_base_name(in->measured->path));
-        } else {
-            snprintf(line, sizeof line, "%s", sr->name);
-        }
-        viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", line);
+        char attrs[32];
+        snprintf(attrs, sizeof attrs, "fill=\"%s\"", s[which[k]].colour);
+        viz_rect(b, LEFT, y, 12, 12, attrs);
+        viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", legend[k]);
     }
-    if (has_dyn || (has_meas && e[0].meas_ci))
-        viz_text(b, w - RIGHT, 22, 11, "end", 0, "#555555", "whiskers: 95% intervals");
+    if (whiskers[0])
+        viz_text(b, w - RIGHT, 22, 11, "end", 0, "#555555", whiskers);
     /* Axis and grid. */
     double step, top = axis_top(e, n, &step);
     double ppu = PLOT_H / top;
@@ -157,9 +171,7 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
             viz_pic_draw(b, in->part, &pics[i], &view, tscale, cx, y0 + 22 + THUMB / 2.0, 0);
         vbuf_put(b, "</g>\n");
     }
-    viz_text(b, LEFT + plot_w / 2.0, h - 2, 11, "middle", 0, "#555555",
-             in->class_of ? "pose class (as numbered by --group), drawn as in the gallery"
-                          : "pose (as numbered in the output), drawn as in the gallery");
+    viz_text(b, LEFT + plot_w / 2.0, h - 4, 11, "middle", 0, "#555555", caption);
     vbuf_put(b, "</g>\n");
     viz_svg_close(b);
     int complete = pics != NULL;

@@ -22,43 +22,63 @@ static int label_lines(const viz_entry *e)
     return 2 + e->has_dyn + e->has_meas;
 }
 
-static void labels(vbuf *b, const viz_input *in, const viz_entry *e, double x, double y)
+/* Line k of an entry's label: its name (bold, 14 px, after its swatch), the
+ * static estimates, the drops', the measured (12.5 px). */
+static void label_line(const viz_input *in, const viz_entry *e, int k, char *line, size_t size)
 {
-    char line[160], a[32], c[32], d[32];
-    char colour[8];
-    viz_entry_colour(e->number - 1, colour);
-    char attrs[80];
-    snprintf(attrs, sizeof attrs, "fill=\"%s\" stroke=\"#333333\" stroke-width=\"0.5\"", colour);
-    viz_rect(b, x, y - 11, 12, 12, attrs);
-    if (e->members > 1)
-        snprintf(line, sizeof line, "Pose %d (%d symmetric)", e->number, e->members);
-    else
-        snprintf(line, sizeof line, "Pose %d", e->number);
-    viz_text(b, x + 17, y, 14, "start", 1, "#111111", line);
-    y += LINE_H;
-    percent(a, sizeof a, e->p_qs);
-    percent(c, sizeof c, e->p_pqs);
-    snprintf(line, sizeof line, "QS %s, PQS %s", a, c);
-    viz_text(b, x, y, 12.5, "start", 0, "#222222", line);
-    if (e->has_dyn) {
-        y += LINE_H;
+    char a[32], c[32], d[32];
+    if (k == 0) {
+        if (e->members > 1)
+            snprintf(line, size, "Pose %d (%d symmetric)", e->number, e->members);
+        else
+            snprintf(line, size, "Pose %d", e->number);
+    } else if (k == 1) {
+        percent(a, sizeof a, e->p_qs);
+        percent(c, sizeof c, e->p_pqs);
+        snprintf(line, size, "QS %s, PQS %s", a, c);
+    } else if (k == 2 && e->has_dyn) {
         percent(a, sizeof a, e->p);
         percent(c, sizeof c, e->lo);
         percent(d, sizeof d, e->hi);
-        snprintf(line, sizeof line, "%s %s [%s, %s]", in->engine ? in->engine : "drops", a, c, d);
-        viz_text(b, x, y, 12.5, "start", 0, "#222222", line);
-    }
-    if (e->has_meas) {
-        y += LINE_H;
+        snprintf(line, size, "%s %s [%s, %s]", in->engine ? in->engine : "drops", a, c, d);
+    } else {
         percent(a, sizeof a, e->mp);
         if (e->meas_ci) {
             percent(c, sizeof c, e->mlo);
             percent(d, sizeof d, e->mhi);
-            snprintf(line, sizeof line, "measured %s [%s, %s]", a, c, d);
+            snprintf(line, size, "measured %s [%s, %s]", a, c, d);
         } else {
-            snprintf(line, sizeof line, "measured %s", a);
+            snprintf(line, size, "measured %s", a);
         }
-        viz_text(b, x, y, 12.5, "start", 0, "#222222", line);
+    }
+}
+
+enum { SWATCH = 17 }; /* the name's indent: its colour swatch and a gap */
+
+/* The widest label line, from the label's left edge. */
+static double label_width(const viz_input *in, const viz_entry *e)
+{
+    char line[160];
+    double w = 0.0;
+    for (int k = 0; k < label_lines(e); k++) {
+        label_line(in, e, k, line, sizeof line);
+        w = fmax(w, k == 0 ? SWATCH + viz_text_width(line, 14, 1) : viz_text_width(line, 12.5, 0));
+    }
+    return w;
+}
+
+static void labels(vbuf *b, const viz_input *in, const viz_entry *e, double x, double y)
+{
+    char line[160], colour[8], attrs[80];
+    viz_entry_colour(e->number - 1, colour);
+    snprintf(attrs, sizeof attrs, "fill=\"%s\" stroke=\"#333333\" stroke-width=\"0.5\"", colour);
+    viz_rect(b, x, y - 11, 12, 12, attrs);
+    for (int k = 0; k < label_lines(e); k++) {
+        label_line(in, e, k, line, sizeof line);
+        if (k == 0)
+            viz_text(b, x + SWATCH, y, 14, "start", 1, "#111111", line);
+        else
+            viz_text(b, x, y + k * LINE_H, 12.5, "start", 0, "#222222", line);
     }
 }
 
@@ -83,34 +103,45 @@ pd_status viz_gallery(const viz_input *in, int standalone, vbuf *b, pd_diag *dia
     int cols = n < 5 ? n : n <= 9 ? 3 + (n > 6) : 5;
     int rows = (n + cols - 1) / cols;
     double panel_h = draw_h + label_h;
-    /* At least two panels wide, so that the title and scale bar fit. */
-    double w = (cols < 2 ? 2 : cols) * PANEL_W + 2 * GAP, h = TITLE_H + rows * panel_h + GAP;
-    char title[512];
+    /* Panels wide enough for the widest label, with a gap to the next. */
+    double panel_w = PANEL_W;
+    for (int i = 0; i < n; i++)
+        panel_w = fmax(panel_w, ceil(label_width(in, &e[i])) + 2 * GAP);
+    char title[512], len_label[32];
+    static const char *const subtitle = "Same scale in every panel. Red dashes: the resting "
+                                        "facet; circle: the centre of mass.";
     snprintf(title, sizeof title, "Stable poses of %s%s", viz_base_name(in->name),
              in->class_of ? ", one panel per class" : "");
+    /* The scale bar, a round length about a quarter of the part's size,
+     * on the title's line at the right; the subtitle on a line of its own.
+     * The picture is as wide as the panels, or as the title and bar, or
+     * the subtitle, whichever is widest. */
+    double len = viz_nice_length(0.25 * in->part->size, len_label, sizeof len_label);
+    double bar = scale * len;
+    double w = fmax(cols * panel_w + 2 * GAP,
+                    fmax(GAP + viz_text_width(title, 16, 1) + 3 * GAP +
+                             viz_text_width(len_label, 12, 0) + 6 + bar + GAP,
+                         GAP + viz_text_width(subtitle, 11, 0) + GAP));
+    w = ceil(w);
+    double h = TITLE_H + rows * panel_h + GAP;
     viz_svg_open(b, standalone, w, h, title);
     vbuf_put(b, "<g class=\"gallery\">\n");
     viz_text(b, GAP, 22, 16, "start", 1, "#111111", title);
-    /* The scale bar: a round length about a quarter of the part's size. */
-    char len_label[32];
-    double len = viz_nice_length(0.25 * in->part->size, len_label, sizeof len_label);
-    double bx = w - GAP - scale * len;
-    viz_xy(b, "<path d=\"M", bx, 36);
-    viz_xy(b, " L", w - GAP, 36);
-    viz_xy(b, " M", bx, 32);
-    viz_xy(b, " L", bx, 40);
-    viz_xy(b, " M", w - GAP, 32);
-    viz_xy(b, " L", w - GAP, 40);
+    double bx = w - GAP - bar;
+    viz_xy(b, "<path class=\"scale-bar\" d=\"M", bx, 17);
+    viz_xy(b, " L", w - GAP, 17);
+    viz_xy(b, " M", bx, 13);
+    viz_xy(b, " L", bx, 21);
+    viz_xy(b, " M", w - GAP, 13);
+    viz_xy(b, " L", w - GAP, 21);
     vbuf_put(b, "\" fill=\"none\" stroke=\"#111111\" stroke-width=\"1.5\"/>\n");
-    viz_text(b, bx - 6, 40, 12, "end", 0, "#111111", len_label);
-    viz_text(b, GAP, 40, 11, "start", 0, "#555555",
-             "Same scale in every panel. Red dashes: the resting facet; "
-             "circle: the centre of mass.");
+    viz_text(b, bx - 6, 21, 12, "end", 0, "#111111", len_label);
+    viz_text(b, GAP, 40, 11, "start", 0, "#555555", subtitle);
     for (int i = 0; i < n; i++) {
-        double x0 = GAP + (i % cols) * PANEL_W, y0 = TITLE_H + (i / cols) * panel_h;
+        double x0 = GAP + (i % cols) * panel_w, y0 = TITLE_H + (i / cols) * panel_h;
         vbuf_printf(b, "<g class=\"panel\" id=\"pose-%d\">\n<title>Pose %d</title>\n", e[i].number,
                     e[i].number);
-        viz_pic_draw(b, in->part, &pics[i], &view, scale, x0 + 0.5 * PANEL_W,
+        viz_pic_draw(b, in->part, &pics[i], &view, scale, x0 + 0.5 * panel_w,
                      y0 + 0.5 * draw_h, 1);
         labels(b, in, &e[i], x0 + GAP, y0 + draw_h + LINE_H - 2);
         vbuf_put(b, "</g>\n");

@@ -12,7 +12,7 @@
 static const char *const style =
     "body{font-family:'DejaVu Sans',Helvetica,Arial,sans-serif;color:#111;margin:0 auto;"
     "max-width:1240px;padding:16px 20px;line-height:1.4}\n"
-    "h1{font-size:1.5em;margin:0.2em 0}h2{font-size:1.2em;border-bottom:1px solid #ccc;"
+    "h1{font-size:1.5em;margin:0.2em 0}.size{font-size:1.15em;margin:0.3em 0}h2{font-size:1.2em;border-bottom:1px solid #ccc;"
     "padding-bottom:2px;margin-top:1.4em}\n"
     "table{border-collapse:collapse;margin:0.4em 0}td,th{border:1px solid #ccc;padding:2px 8px;"
     "text-align:right;font-variant-numeric:tabular-nums}th{background:#f2f2f2}\n"
@@ -162,10 +162,10 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
     vbuf_put(b, "</section>\n");
 }
 
-static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
-                        const pd_scene *scene)
+static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
+                        const pd_sim_result *sim, const pd_scene *scene)
 {
-    char v[640];
+    char v[640], contact[128];
     vbuf_put(b, "<section id=\"run\"><h2>Scene, engine and timings</h2>\n<table>\n");
     const pd_static_options *o = run->estimate;
     snprintf(v, sizeof v, "topple %s; PQS epsilon %.4g deg, compare %s, band %s",
@@ -177,11 +177,23 @@ static void run_section(vbuf *b, const viz_run *run, const pd_sim_result *sim,
         char p[PD_NPARAMS][48];
         for (int k = 0; k < PD_NPARAMS; k++)
             pd_scene_format(s, (pd_scene_param)k, p[k], sizeof p[k]);
+        /* The automatic contact time by name and with the value it stands
+         * for here (the scene holds a code for it, not a duration). */
+        const pd_dist *ct = &s->range[PD_PARAM_CONTACT_TIME];
+        double auto_s = pd_contact_time_auto(part->size);
+        if (ct->kind == PD_DIST_FIXED && s->contact_time == PD_CONTACT_TIME_AUTO)
+            snprintf(contact, sizeof contact, "auto (%.4g s for this part's size)", auto_s);
+        else if (ct->auto_multiple)
+            snprintf(contact, sizeof contact, "%s times auto (%.4g s for this part's size)",
+                     p[PD_PARAM_CONTACT_TIME], auto_s);
+        else
+            snprintf(contact, sizeof contact, "%s s%s", p[PD_PARAM_CONTACT_TIME],
+                     ct->kind == PD_DIST_FIXED && s->contact_time == 0.0 ? " (rigid)" : "");
         snprintf(v, sizeof v, "drop height %s m, belt %s m/s, mu %s, restitution %s (%s), "
-                 "vibration %s deg, gravity %.4g m/s\xc2\xb2, contact time %s s, tumble %s rad/s, "
+                 "vibration %s deg, gravity %.4g m/s\xc2\xb2, contact time %s, tumble %s rad/s, "
                  "initial %s%s", p[PD_PARAM_HEIGHT], p[PD_PARAM_BELT_SPEED], p[PD_PARAM_MU],
                  p[PD_PARAM_RESTITUTION], s->law == PD_RESTITUTION_POISSON ? "Poisson" : "energetic",
-                 p[PD_PARAM_VIBRATION], s->gravity, p[PD_PARAM_CONTACT_TIME], p[PD_PARAM_TUMBLE],
+                 p[PD_PARAM_VIBRATION], s->gravity, contact, p[PD_PARAM_TUMBLE],
                  viz_initial_name(s->initial),
                  pd_scene_ranged(s) ? "; LO:HI: a range, each drop drawing its own value" : "");
         row(b, "scene", v);
@@ -243,6 +255,15 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
                 "stable pose of the part dropped on a flat floor, by the quasi-static (QS) and "
                 "perturbed quasi-static (PQS) estimators%s.</p>\n", PD_VERSION_STRING,
                 in->sim ? " and simulated drops" : "");
+    /* The size up front: a file in millimetres read as metres shows here as
+     * a part of tens of metres. */
+    char size[64];
+    static const char *const unit_names[] = {"metres", "centimetres", "millimetres", "inches"};
+    length(size, sizeof size, in->part->size);
+    vbuf_put(b, "<p class=\"size\">The part is <strong>");
+    vbuf_escape(b, size);
+    vbuf_printf(b, "</strong> across (its bounding box's diagonal), the file's numbers read as "
+                   "%s.</p>\n", unit_names[run->units]);
     part_section(b, in, run);
     st = figure(b, "gallery", "Stable poses", NULL, viz_gallery, in, diag);
     if (st == PD_OK)
@@ -271,7 +292,7 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
     }
     if (st == PD_OK) {
         table_section(b, in, e, n);
-        run_section(b, run, in->sim, in->scene);
+        run_section(b, run, in->part, in->sim, in->scene);
         vbuf_put(b, "</body></html>\n");
     }
     free(e);

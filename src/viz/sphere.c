@@ -198,12 +198,15 @@ pd_status viz_sphere(const viz_input *in, int standalone, vbuf *b, pd_diag *diag
     char title[512];
     snprintf(title, sizeof title, "Gauss-sphere map of %s: where quasi-static descent ends",
              viz_base_name(in->name));
+    static const char *const subtitle =
+        "Gravity's directions in the part's frame, coloured by the pose reached; dark lines: "
+        "basin borders; thin: hull facets; dots: the poses.";
+    /* Wider than the discs and legend when a long file name needs it. */
+    w = ceil(fmax(w, 10 + fmax(viz_text_width(title, 16, 1), viz_text_width(subtitle, 11, 0)) + 10));
     viz_svg_open(b, standalone, w, h, title);
     vbuf_put(b, "<g class=\"sphere\">\n");
     viz_text(b, 10, 22, 16, "start", 1, "#111111", title);
-    viz_text(b, 10, 38, 11, "start", 0, "#555555",
-             "Gravity's directions in the part's frame, coloured by the pose reached; dark lines: "
-             "basin borders; thin: hull facets; dots: the poses.");
+    viz_text(b, 10, 38, 11, "start", 0, "#555555", subtitle);
     for (int hemi = 0; hemi < 2 && !b->failed; hemi++) {
         int side = hemi == 0 ? 1 : -1;
         double cx = MARGIN + RADIUS + hemi * (2 * RADIUS + 2 * MARGIN), cy = TOP + MARGIN + RADIUS;

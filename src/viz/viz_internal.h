@@ -74,6 +74,15 @@ void viz_pics_free(viz_pic *pics, int n);
  * XML declaration first. */
 void viz_svg_open(vbuf *b, int standalone, double w, double h, const char *title);
 void viz_svg_close(vbuf *b);
+/* The width in px of text (UTF-8) set at size px in DejaVu Sans (bold when
+ * bold): the sum of its characters' advances (text_width.c). */
+double viz_text_width(const char *text, double size, int bold);
+/* The vertical extent of a line of that font's ASCII text about its
+ * baseline, in em: every printable ASCII glyph of both weights lies within
+ * 0.80 above ('`' the highest) and 0.236 below ('_', 'g', 'p') by the fonts'
+ * glyph bounding boxes. */
+#define VIZ_TEXT_ASCENT 0.80
+#define VIZ_TEXT_DESCENT 0.24
 /* <text> at (x, y) with the given size, anchor and weight, text escaped. */
 void viz_text(vbuf *b, double x, double y, double size, const char *anchor, int bold,
               const char *fill, const char *text);

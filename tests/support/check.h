@@ -25,6 +25,10 @@ void pd_note(const char *fmt, ...)
 #endif
     ;
 
+/* 1 under make check-full (the runner's --full): the statistical tests that
+ * allow it run their long variants, more trials at the same level. */
+int pd_test_full(void);
+
 /* A boolean property. */
 #define CHECK(cond) pd_check_report(!!(cond), __FILE__, __LINE__, #cond)
 

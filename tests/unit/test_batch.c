@@ -409,6 +409,65 @@ static void test_sha256(void)
     free(err);
 }
 
+/* Every script under scripts/ refuses a bad argument with one line on stderr
+ * that names the script and what was wrong, exit status 2, nothing on
+ * stdout, and nothing left in the directory it ran in (the issue's case:
+ * posedrop-batch given options after --, which printed shell errors and left
+ * all.csv.tmp and 1000.err behind). */
+static void test_script_refusals(void)
+{
+    static const struct {
+        const char *args, *mention;
+    } cases[] = {
+        {"posedrop-batch -j 2 -o results --units mm -- -n 1000 -- a.stl",
+         "posedrop-batch: '-n' after --: options for posedrop go before --"},
+        {"posedrop-batch -j x -- $R/parts/cap.off", "posedrop-batch: -j: expected a whole number"},
+        {"posedrop-batch -o", "posedrop-batch: -o needs a value"},
+        {"posedrop-batch -o results -- a.stl", "posedrop-batch: a.stl: no such readable file"},
+        {"posedrop-batch -o results -- $R/parts/cap.off $R/parts/cap.off", "two parts named 'cap'"},
+        {"collect-csv nofile.csv", "collect-csv: nofile.csv: no such readable file"},
+        {"collect-csv", "collect-csv: no CSV files given"},
+        {"cost-accuracy.sh -s 0", "cost-accuracy.sh: -s: expected a whole number"},
+        {"cost-accuracy.sh -o", "cost-accuracy.sh: -o needs a value"},
+        {"crosscheck.sh -n x $R/parts/cap.off", "crosscheck.sh: -n: expected a whole number"},
+        {"crosscheck.sh -- --units", "crosscheck.sh: --units after -- needs a value"},
+        {"crosscheck.sh -o out nofile.stl", "crosscheck.sh: nofile.stl: no such readable file"},
+        {"figures.sh --x", "figures.sh: unknown argument '--x'"},
+        {"paper.sh -i foo", "paper.sh: posedrop: --initial: initial: expected uniform, bootstrap"},
+        {"paper.sh -n 0", "paper.sh: -n: expected a whole number"},
+        {"slurm-array.sh -N", "slurm-array.sh: -N needs a value"},
+        {"sensitivity.sh -n", "sensitivity.sh: -n needs a value"},
+        {"sensitivity.sh -i foo $R/parts/cap.off", "sensitivity.sh: posedrop: --initial: initial"},
+        {"fuzz.sh x off", "fuzz.sh: SECONDS: expected a whole number"},
+        {"fuzz.sh 5 nosuch", "fuzz.sh: no target 'nosuch' built"},
+        {"lint-layers.sh --x", "lint-layers.sh: takes no arguments"},
+        {"install-deps.sh 'bad name'", "install-deps.sh: 'bad name' is not a Debian package name"},
+        {"make-canonical.py a b", "make-canonical.py: expected at most one argument"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        char cmd[2048], *out, *err;
+        /* An empty directory of its own; R is the repository. */
+        snprintf(cmd, sizeof cmd,
+                 "R=$PWD; d=%s/refuse%zu; mkdir $d && cd $d && $R/scripts/%s", tmpdir, k,
+                 cases[k].args);
+        int rc = run_cmd(cmd, 1, &out, &err);
+        CHECK_INT(rc, 2);
+        CHECK_INT((int)strlen(out), 0);
+        const char *nl = strchr(err, '\n');
+        int one_line = nl && nl[1] == '\0';
+        if (!strstr(err, cases[k].mention) || !one_line)
+            printf("     stderr of '%s' should be one line saying '%s':\n     %s", cases[k].args,
+                   cases[k].mention, err);
+        CHECK(strstr(err, cases[k].mention) && one_line);
+        free(out);
+        free(err);
+        snprintf(cmd, sizeof cmd, "test -z \"$(ls -A %s/refuse%zu)\"", tmpdir, k);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        free(out);
+        free(err);
+    }
+}
+
 void suite_batch(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-batch-XXXXXX");
@@ -426,6 +485,7 @@ void suite_batch(void)
     test_sha256();
     test_slurm();
     test_mpi();
+    test_script_refusals();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

@@ -911,6 +911,103 @@ static void test_stationary(void)
     expect_failure("--initial stationary -n 300 parts/cap.off", 2, "at least 350 drops");
 }
 
+/* posedrop ARGS (through the shell: a pipe may follow) must exit 0 and warn
+ * on stderr with warning (NULL: stay silent there); stdout is a result, with
+ * no warning in it. Returns stdout (caller frees). */
+static char *expect_warning(const char *args, const char *warning)
+{
+    char cmd[1024], *out, *err;
+    snprintf(cmd, sizeof cmd, "{ %s %s; }", PD_CLI_PATH, args); /* stderr of the whole pipe */
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    int ok = warning ? strstr(err, warning) != NULL : err[0] == '\0';
+    if (!ok)
+        printf("     stderr of '%s' should %s%s:\n     %s\n", args, warning ? "say " : "be empty",
+               warning ? warning : "", err);
+    CHECK(ok);
+    CHECK(strncmp(out, "pose,", 5) == 0 && strstr(out, "warning") == NULL);
+    free(err);
+    return out;
+}
+
+/* A cube of side a metres (a sqrt 3 across) in tmpdir/name. */
+static const char *cube_file(const char *name, double a)
+{
+    static char path[256];
+    char text[512];
+    snprintf(path, sizeof path, "%s/%s", tmpdir, name);
+    snprintf(text, sizeof text,
+             "OFF\n8 6 0\n0 0 0\n%.17g 0 0\n%.17g %.17g 0\n0 %.17g 0\n0 0 %.17g\n"
+             "%.17g 0 %.17g\n%.17g %.17g %.17g\n0 %.17g %.17g\n"
+             "4 0 3 2 1\n4 4 5 6 7\n4 0 1 5 4\n4 2 3 7 6\n4 1 2 6 5\n4 0 4 7 3\n",
+             a, a, a, a, a, a, a, a, a, a, a, a);
+    CHECK(write_file(path, text));
+    return path;
+}
+
+/* A part outside the sizes a dropped part has (0.5 mm to 2 m across) or a
+ * drop height out of proportion to it (over 100 or under 0.1 part sizes)
+ * warns on stderr without --verbose, naming the unit to try, and the run
+ * goes on: stdout is what it would be without the warning. The poses'
+ * normals and probabilities do not depend on the unit, so a file read in
+ * the wrong unit prints those columns exactly as in the right one (the
+ * lengths' columns, area and height, are cut). */
+static void test_scale_warnings(void)
+{
+    /* hexnut.obj is in millimetres (20.9 mm across), cap.off in metres. */
+    static const struct {
+        const char *wrong, *right, *warning;
+    } units[] = {
+        {"parts/hexnut.obj", "--units mm parts/hexnut.obj",
+         "posedrop: warning: parts/hexnut.obj: the part is 20.9 m across; if the file is in "
+         "millimetres, add --units mm"},
+        {"--units mm parts/cap.off", "parts/cap.off",
+         "the part is 0.0354 mm across; if the file is in metres, give --units m, not --units mm"},
+    };
+    for (int k = 0; k < 2; k++) {
+        char wrong[256], right[256];
+        snprintf(wrong, sizeof wrong, "%s | cut -d, -f1-4,7-", units[k].wrong);
+        snprintf(right, sizeof right, "%s | cut -d, -f1-4,7-", units[k].right);
+        char *a = expect_warning(wrong, units[k].warning), *b = expect_warning(right, NULL);
+        CHECK(strcmp(a, b) == 0);
+        free(a);
+        free(b);
+    }
+    /* No unit makes a 0.17 mm cube in metres larger: the warning asks. */
+    char args[512];
+    snprintf(args, sizeof args, "%s", cube_file("tiny.off", 1e-4));
+    free(expect_warning(args, "the part is 0.173 mm across; is that what you meant?"));
+    /* The thresholds: 1.905 and 2.165 m across; 0.520 and 0.485 mm. */
+    free(expect_warning(cube_file("c1.off", 1.1), NULL));
+    free(expect_warning(cube_file("c2.off", 1.25), "the part is 2.17 m across; if the file is in "
+                                                   "millimetres, add --units mm"));
+    free(expect_warning(cube_file("c3.off", 3e-4), NULL));
+    free(expect_warning(cube_file("c4.off", 2.8e-4), "the part is 0.485 mm across"));
+    /* Heights against the 20.9 mm nut: 95.7 and 105 sizes, 0.105 and 0.0957;
+     * 0 (set down on purpose) is not warned about, nor a height when the
+     * part's size already is (the likelier cause of both). */
+    static const struct {
+        const char *h, *warning;
+    } heights[] = {
+        {"2.0", NULL},
+        {"2.2", "the drop height, 2.2 m, is 105 times the part's size (20.9 mm across): more a "
+                "throw than a drop; -h is in metres, whatever --units says"},
+        {"120", "the drop height, 120 m, is 5743 times the part's size"},
+        {"0.0022", NULL},
+        {"0.002", "the drop height, 2 mm, is 0.0957 times the part's size (20.9 mm across): the "
+                  "part is set down more than dropped"},
+        {"0", NULL},
+    };
+    for (size_t k = 0; k < sizeof heights / sizeof *heights; k++) {
+        snprintf(args, sizeof args, "--units mm -n 20 -h %s parts/hexnut.obj", heights[k].h);
+        free(expect_warning(args, heights[k].warning));
+    }
+    char *out, *err;
+    CHECK_INT(run("-n 20 parts/hexnut.obj", &out, &err), 0);
+    CHECK(strstr(err, "the part is 20.9 m across") && !strstr(err, "drop height"));
+    free(out);
+    free(err);
+}
+
 /* Lines of text that end with `tail` (a trials file's end column). */
 static int rows_ending(const char *text, const char *tail)
 {
@@ -978,6 +1075,7 @@ void suite_cli(void)
     test_group();
     test_group_trials();
     test_stationary();
+    test_scale_warnings();
     test_time_limit();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);

@@ -557,6 +557,18 @@ static void test_command(void)
                           "initial uniform", "200 drops", "timings", "posedrop --group -n 200"};
     for (int i = 0; i < 8; i++)
         CHECK(r && strstr(r, said[i]));
+    /* The automatic contact time by name and with the value used (the
+     * scene's -1 is a code, not a duration); the size up front. */
+    char auto_time[64];
+    pd_mesh *mesh;
+    pd_part *part;
+    pd_static_result *res;
+    load("parts/insulator_cap.off", &mesh, &part, &res);
+    snprintf(auto_time, sizeof auto_time, "contact time auto (%.4g s for this part",
+             part ? pd_contact_time_auto(part->size) : -1.0);
+    unload(mesh, part, res);
+    CHECK(r && strstr(r, auto_time) && !strstr(r, "contact time -"));
+    CHECK(r && strstr(r, "<p class=\"size\">The part is <strong>"));
     /* Same pictures with one thread. */
     snprintf(cmd, sizeof cmd, PD_CLI_PATH " --group -n 200 -j 1 --svg build/viz-test-g1.svg "
              "--measured %s parts/insulator_cap.off > /dev/null 2>&1", meas);
@@ -585,6 +597,238 @@ static void test_command(void)
     free(out);
 }
 
+/* --- layout: no text over text, nothing cut at the edges ------------------ */
+
+typedef struct {
+    double x0, y0, x1, y1;
+    char text[160];
+} layout_box;
+
+/* The value of attribute name in the tag [tag, end), or NULL. */
+static const char *attr(const char *tag, const char *end, const char *name, char *out, size_t size)
+{
+    char key[48];
+    snprintf(key, sizeof key, " %s=\"", name);
+    const char *p = strstr(tag, key);
+    if (!p || p >= end)
+        return NULL;
+    p += strlen(key);
+    const char *q = strchr(p, '"');
+    if (!q || q >= end)
+        return NULL;
+    snprintf(out, size, "%.*s", (int)(q - p), p);
+    return out;
+}
+
+/* The text of an element with its five XML escapes undone. */
+static void unescape(const char *p, const char *end, char *out, size_t size)
+{
+    static const char *const esc[][2] = {
+        {"&amp;", "&"}, {"&lt;", "<"}, {"&gt;", ">"}, {"&quot;", "\""}, {"&#39;", "'"}};
+    size_t n = 0;
+    while (p < end && n + 1 < size) {
+        size_t k = 0;
+        while (k < 5 && strncmp(p, esc[k][0], strlen(esc[k][0])) != 0)
+            k++;
+        out[n++] = k < 5 ? esc[k][1][0] : *p;
+        p += k < 5 ? strlen(esc[k][0]) : 1;
+    }
+    out[n] = '\0';
+}
+
+/* The boxes of an SVG's text (its advance width in DejaVu Sans by
+ * viz_text_width, its height from VIZ_TEXT_ASCENT above the baseline to
+ * VIZ_TEXT_DESCENT below; a text turned by rotate(-90 cx cy) turned with
+ * it) and of the gallery's scale bar (its path's points, and half its
+ * stroke). Returns the count (at most max); the SVG's size in *w, *h. */
+static int layout_boxes(const char *svg, layout_box *box, int max, double *w, double *h)
+{
+    char v[160];
+    *w = *h = 0.0;
+    const char *root = strstr(svg, "<svg ");
+    if (root) {
+        const char *end = strchr(root, '>');
+        *w = attr(root, end, "width", v, sizeof v) ? atof(v) : 0.0;
+        *h = attr(root, end, "height", v, sizeof v) ? atof(v) : 0.0;
+    }
+    int n = 0;
+    for (const char *p = svg; n < max && (p = strstr(p, "<text ")); p++) {
+        const char *end = strchr(p, '>'), *close = end ? strstr(end, "</text>") : NULL;
+        if (!close)
+            break;
+        double x = attr(p, end, "x", v, sizeof v) ? atof(v) : 0.0;
+        double y = attr(p, end, "y", v, sizeof v) ? atof(v) : 0.0;
+        double size = attr(p, end, "font-size", v, sizeof v) ? atof(v) : 16.0;
+        int bold = attr(p, end, "font-weight", v, sizeof v) && strcmp(v, "bold") == 0;
+        const char *anchor = attr(p, end, "text-anchor", v, sizeof v) ? v : "start";
+        double shift = strcmp(anchor, "middle") == 0 ? 0.5 : strcmp(anchor, "end") == 0 ? 1.0 : 0.0;
+        layout_box *b = &box[n++];
+        unescape(end + 1, close, b->text, sizeof b->text);
+        double tw = viz_text_width(b->text, size, bold);
+        /* Along the line from x, across it from the baseline y. */
+        double a0 = x - shift * tw, a1 = a0 + tw;
+        double c0 = y - VIZ_TEXT_ASCENT * size, c1 = y + VIZ_TEXT_DESCENT * size;
+        double cx, cy;
+        if (attr(p, end, "transform", v, sizeof v) && sscanf(v, "rotate(-90 %lf %lf)", &cx, &cy) == 2) {
+            /* Turned a quarter left about (cx, cy): (x, y) -> (cx + (y - cy), cy - (x - cx)). */
+            b->x0 = cx + (c0 - cy);
+            b->x1 = cx + (c1 - cy);
+            b->y0 = cy - (a1 - cx);
+            b->y1 = cy - (a0 - cx);
+        } else {
+            b->x0 = a0, b->x1 = a1, b->y0 = c0, b->y1 = c1;
+        }
+    }
+    const char *bar = strstr(svg, "<path class=\"scale-bar\" d=\"");
+    if (bar && n < max) {
+        layout_box *b = &box[n++];
+        snprintf(b->text, sizeof b->text, "(the scale bar)");
+        b->x0 = b->y0 = HUGE_VAL;
+        b->x1 = b->y1 = -HUGE_VAL;
+        const char *p = bar + strlen("<path class=\"scale-bar\" d=\"");
+        double px, py;
+        int used;
+        while (*p == 'M' || *p == 'L' || *p == ' ') {
+            if (*p == ' ') {
+                p++;
+                continue;
+            }
+            if (sscanf(p + 1, "%lf,%lf%n", &px, &py, &used) != 2)
+                break;
+            b->x0 = fmin(b->x0, px - 0.75), b->x1 = fmax(b->x1, px + 0.75);
+            b->y0 = fmin(b->y0, py - 0.75), b->y1 = fmax(b->y1, py + 0.75);
+            p += 1 + used;
+        }
+    }
+    return n;
+}
+
+/* Every box inside the picture and no two boxes overlapping; reports the
+ * first offence (unless what is NULL: the checker's own controls). Returns 1
+ * when clean. */
+static int layout_clean(const char *what, const char *svg)
+{
+    enum { MAX_BOXES = 1024 };
+    layout_box *box = malloc(sizeof *box * MAX_BOXES);
+    double w, h;
+    int n = box ? layout_boxes(svg, box, MAX_BOXES, &w, &h) : 0, ok = box && n > 0 && w > 0;
+    for (int i = 0; i < n && ok; i++) {
+        const layout_box *a = &box[i];
+        if (a->x0 < 0.0 || a->y0 < 0.0 || a->x1 > w || a->y1 > h) {
+            if (what)
+                printf("     %s: '%s' at [%.1f, %.1f] x [%.1f, %.1f] is cut by the edge of "
+                       "%.0f x %.0f\n", what, a->text, a->x0, a->x1, a->y0, a->y1, w, h);
+            ok = 0;
+        }
+        for (int j = i + 1; j < n && ok; j++) {
+            const layout_box *c = &box[j];
+            if (a->x0 < c->x1 && c->x0 < a->x1 && a->y0 < c->y1 && c->y0 < a->y1) {
+                if (what)
+                    printf("     %s: '%s' [%.1f, %.1f] x [%.1f, %.1f] overlaps '%s' [%.1f, %.1f] x "
+                           "[%.1f, %.1f]\n", what, a->text, a->x0, a->x1, a->y0, a->y1, c->text,
+                           c->x0, c->x1, c->y0, c->y1);
+                ok = 0;
+            }
+        }
+    }
+    free(box);
+    return ok;
+}
+
+/* The checker sees what it should: text over text, text past an edge, the
+ * scale bar over a line, and a text turned a quarter. */
+static void test_layout_checker(void)
+{
+    const char *head = "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"200\" height=\"100\">";
+    char svg[1024];
+    snprintf(svg, sizeof svg, "%s<text x=\"10\" y=\"20\" font-size=\"12\">abc</text>"
+             "<text x=\"10\" y=\"40\" font-size=\"12\">abc</text></svg>", head);
+    CHECK(layout_clean("control", svg));
+    snprintf(svg, sizeof svg, "%s<text x=\"10\" y=\"20\" font-size=\"12\">abcdef</text>"
+             "<text x=\"40\" y=\"25\" font-size=\"12\">x</text></svg>", head);
+    CHECK(!layout_clean(NULL, svg));
+    snprintf(svg, sizeof svg, "%s<text x=\"190\" y=\"20\" font-size=\"12\" text-anchor=\"start\">"
+             "abc</text></svg>", head);
+    CHECK(!layout_clean(NULL, svg));
+    snprintf(svg, sizeof svg, "%s<text x=\"100\" y=\"20\" font-size=\"12\" text-anchor=\"middle\">"
+             "&lt;0.1%%</text><path class=\"scale-bar\" d=\"M90,18 L120,18\"/></svg>", head);
+    CHECK(!layout_clean(NULL, svg));
+    /* "probability" turned about (14, 50) spans y from 50 - w/2 to 50 + w/2. */
+    snprintf(svg, sizeof svg, "%s<text x=\"14\" y=\"50\" font-size=\"12\" text-anchor=\"middle\" "
+             "transform=\"rotate(-90 14 50)\">probability</text></svg>", head);
+    layout_box b[2];
+    double w, h;
+    CHECK_INT(layout_boxes(svg, b, 2, &w, &h), 1);
+    double tw = viz_text_width("probability", 12, 0);
+    CHECK_NEAR(b[0].y0, 50 - tw / 2, 1e-9, "rotation about the anchor");
+    CHECK_NEAR(b[0].x0, 14 - VIZ_TEXT_ASCENT * 12, 1e-9, "ascent to the left once turned");
+    /* The width table against sums by hand: "Wi" in DejaVu Sans is 2025 +
+     * 569 units of 2048, in Bold 2259 + 702. */
+    CHECK_NEAR(viz_text_width("Wi", 2048, 0), 2594, 1e-9, "hmtx sum");
+    CHECK_NEAR(viz_text_width("Wi", 2048, 1), 2961, 1e-9, "hmtx sum");
+}
+
+/* The gallery, chart and sphere of 1 to 40 entries, static only under a
+ * short part name, and with drops and a measured distribution whose labels
+ * are as wide as they get (100.0%, <0.1%, long file names): no text over other text or over the scale bar, none cut
+ * by the picture's edge, by DejaVu Sans's advance widths (the font the
+ * pictures name first) with no further tolerance. The entries are classes
+ * of the insulator cap's 98 poses, the last class holding the rest. */
+static void test_layout(void)
+{
+    pd_mesh *mesh;
+    pd_part *part;
+    pd_static_result *res;
+    load("parts/insulator_cap.off", &mesh, &part, &res);
+    if (!res)
+        return;
+    int np = res->nposes, bad = 0, drawn = 0;
+    int *class_of = malloc(sizeof *class_of * (size_t)np);
+    double p[40], lo[40], hi[40];
+    for (int i = 0; i < 40; i++) {
+        p[i] = i % 3 == 0 ? 1.0 : i % 3 == 1 ? 0.3333 : 0.0004;
+        lo[i] = i % 2 ? 0.0004 : 0.9999;
+        hi[i] = 1.0;
+    }
+    pd_sim_result sim = {.n = 100000, .p = p, .ci_lo = lo, .ci_hi = hi};
+    char mpath[] = "parts/a_measured_distribution_of_long_name.csv";
+    viz_measured meas = {.p = p, .lo = lo, .hi = hi, .n = 123456, .path = mpath};
+    pd_scene scene;
+    pd_scene_default(&scene);
+    scene.initial = PD_INITIAL_STATIONARY;
+    static const char *const names[] = {"cap.off", "parts/square_black_button_revision_C_final.stl"};
+    for (int n = 1; n <= 40 && class_of; n++) {
+        for (int i = 0; i < np; i++)
+            class_of[i] = i < n ? i : n - 1;
+        sim.nposes = meas.npose = n;
+        for (int dyn = 0; dyn < 2; dyn++) { /* the long name with the long labels */
+            viz_input in = {.name = names[dyn], .part = part, .res = res,
+                            .sim = dyn ? &sim : NULL, .class_of = class_of, .nclasses = n,
+                            .engine = "impulse", .scene = dyn ? &scene : NULL,
+                            .measured = dyn ? &meas : NULL};
+            pd_status (*const draw[3])(const viz_input *, int, vbuf *, pd_diag *) = {
+                viz_gallery, viz_chart, viz_sphere};
+            static const char *const kind[3] = {"gallery", "chart", "sphere"};
+            for (int k = 0; k < 3; k++) {
+                vbuf b;
+                vbuf_init(&b);
+                CHECK_STATUS(draw[k](&in, 1, &b, NULL), PD_OK);
+                char what[160];
+                snprintf(what, sizeof what, "%s of %d entries, %s%s", kind[k], n, in.name,
+                         dyn ? ", with drops and measured" : "");
+                if (!b.failed && b.data && !layout_clean(what, b.data))
+                    bad++;
+                drawn++;
+                vbuf_free(&b);
+            }
+        }
+    }
+    CHECK_INT(bad, 0);
+    CHECK_INT(drawn, 40 * 2 * 3);
+    free(class_of);
+    unload(mesh, part, res);
+}
+
 void suite_viz(void)
 {
     test_view();
@@ -597,4 +841,6 @@ void suite_viz(void)
     test_xml_checker();
     test_measured();
     test_command();
+    test_layout_checker();
+    test_layout();
 }

@@ -1,8 +1,9 @@
-/* impact_internal.h (private to impact.c and impact_slide.c): the state of
- * one collision while it is solved, in the units of impact.c (|u0| = 1, K's
- * mean diagonal 1). */
-#ifndef PD_IMPACT_INTERNAL_H
-#define PD_IMPACT_INTERNAL_H
+/* impact_collision.h (private to the impact layer): the state of one
+ * collision while it is solved, in the units of impact.c (|u0| = 1, K's
+ * mean diagonal 1), and the steps every phase takes on it. The sliding
+ * phase (impact_slide.h) builds on it; the solver (impact.c) on both. */
+#ifndef PD_IMPACT_COLLISION_H
+#define PD_IMPACT_COLLISION_H
 
 #include <math.h>
 #include "base/gsl_adapter.h"
@@ -77,11 +78,5 @@ static inline double work_step(double A, double B, double dw)
     double den = disc >= 0.0 ? A + sqrt(disc) : 0.0;
     return den > 0.0 ? 2.0 * dw / den : (double)NAN;
 }
-
-/* Sliding (eq. 14) from the current state until the collision ends (done
- * set) or the slip vanishes or joins the diverging ray (the state there,
- * done clear); *nsteps counts integrator steps. PD_OK or a failure status:
- * PD_ERR_NO_CONVERGENCE beyond PD_IMPACT_MAX_STEPS, or the integrator's. */
-pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps);
 
 #endif
