@@ -253,21 +253,24 @@ bench-mujoco: deps
 	$(MUJOCO_PY) scripts/bench-mujoco.py --posedrop $(CLI) $(BENCH_MUJOCO)
 
 # make fuzz: libFuzzer targets built with clang (installed on first use) for
-# the OFF, STL and OBJ readers, scene files and the part build (mesh in, part
-# model and static estimate out), each run for FUZZ_SECONDS from the seeds in
-# parts/ and tests/fuzz/ (scripts/fuzz.sh). Only the layers these reach are
-# built, with address and undefined-behaviour sanitizers.
+# the OFF, STL and OBJ readers, scene files, the part build (mesh in, part
+# model and static estimate out) and programs of library calls (api), each
+# run for FUZZ_SECONDS from the seeds in parts/ and tests/fuzz/
+# (scripts/fuzz.sh). The C library is built with address and
+# undefined-behaviour sanitizers (Bullet, C++, is left out: not registered).
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := off stl obj scene part
+FUZZ_TARGETS := off stl obj scene part api
 FUZZ_BUILD   := build/fuzz
 FUZZ_CC      ?= clang
-FUZZ_CFLAGS  := -std=c11 -g -O1 -fsanitize=fuzzer-no-link,address,undefined \
+FUZZ_CFLAGS  := -std=c11 -g -O1 -pthread -fsanitize=fuzzer-no-link,address,undefined \
                 -fno-sanitize-recover=undefined -fno-omit-frame-pointer -ffp-contract=off \
                 -D_DEFAULT_SOURCE -Iinclude -Isrc -Itests/support \
-                $(shell $(PKG_CONFIG) --cflags gsl 2>/dev/null)
-FUZZ_SRCS    := $(wildcard src/base/*.c src/mesh/*.c src/hull/*.c src/part/*.c src/static/*.c) \
-                src/sim/scene.c tests/support/fuzz_targets.c
+                $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null)
+FUZZ_SRCS    := $(LIB_SRCS) tests/support/fuzz_targets.c
 FUZZ_OBJS    := $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/%.o)
+# Kept between runs: make would otherwise delete them as intermediate files
+# of the pattern rule below and compile them all again next time.
+.SECONDARY: $(FUZZ_OBJS)
 
 fuzz:
 	@scripts/install-deps.sh clang libclang-rt-dev
@@ -282,7 +285,7 @@ $(FUZZ_BUILD)/%.o: %.c Makefile
 
 $(FUZZ_BUILD)/fuzz_%: tests/fuzz/fuzz_main.c $(FUZZ_OBJS) Makefile
 	$(FUZZ_CC) $(FUZZ_CFLAGS) -fsanitize=fuzzer -DPD_FUZZ_TARGET=pd_fuzz_$* -o $@ \
-	    tests/fuzz/fuzz_main.c $(FUZZ_OBJS) $(shell $(PKG_CONFIG) --libs gsl 2>/dev/null) -lm
+	    tests/fuzz/fuzz_main.c $(FUZZ_OBJS) $(LDLIBS_LIB)
 
 # Both libraries, shared (with their soname and development links) and
 # static, the headers, the command and a pkg-config file for each library
@@ -333,7 +336,7 @@ help:
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make MPI=1      also build posedrop-mpi with OpenMPI (scripts/install-deps.sh mpi)"
 	@echo "make golden     re-pin the golden outcomes on purpose, printing what moved"
-	@echo "make fuzz       fuzz the readers and the part build, FUZZ_SECONDS=$(FUZZ_SECONDS) each"
+	@echo "make fuzz       fuzz the readers, the part build and the API, FUZZ_SECONDS=$(FUZZ_SECONDS) each"
 	@echo "make install    install to PREFIX=$(PREFIX) (DESTDIR honoured)"
 	@echo "make clean      remove build/"
 	@echo "switches: WERROR=1  SANITIZE=1 (address,undefined)  DEBUG=1"

@@ -25,7 +25,7 @@ typedef struct pd_diag {
     int nwarnings;                     /* warnings raised so far */
 } pd_diag;
 
-/* Empty message, no callback, zero warnings. */
+/* Empty message, no callback, zero warnings. Does nothing when diag is NULL. */
 PD_API void pd_diag_init(pd_diag *diag);
 
 #ifdef __cplusplus

@@ -42,7 +42,8 @@ PD_API pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_
 /* Validates a hull: unit normals, loops of >= 3 corners, each corner on its
  * facet plane, convexity at every edge, symmetric adjacency, Euler's formula,
  * and (when pts != NULL) every input point inside or on the hull, all within
- * PD_TOL_PLANE_REL. PD_OK or PD_ERR_INTERNAL with the failed check in diag. */
+ * PD_TOL_PLANE_REL. PD_OK or PD_ERR_INTERNAL with the failed check in diag;
+ * PD_ERR_USAGE for a NULL hull or a negative npts. */
 PD_API pd_status pd_hull_check(const pd_hull *hull, const pd_vec3 *pts, int npts, pd_diag *diag);
 
 PD_API void pd_hull_free(pd_hull *hull);

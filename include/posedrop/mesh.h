@@ -25,7 +25,8 @@ typedef enum pd_mesh_format {
 
 typedef enum pd_units { PD_UNITS_M = 0, PD_UNITS_CM, PD_UNITS_MM, PD_UNITS_IN } pd_units;
 
-/* Metres per unit: 1, 0.01, 0.001, 0.0254. */
+/* Metres per unit: 1, 0.01, 0.001, 0.0254; 0 for a value that is none of
+ * pd_units'. */
 PD_API double pd_units_scale(pd_units units);
 /* "m", "cm", "mm", "in" -> units. PD_ERR_USAGE for anything else. */
 PD_API pd_status pd_units_parse(const char *text, pd_units *units);
@@ -45,7 +46,8 @@ typedef struct pd_mesh_read_options {
 
 PD_API void pd_mesh_read_options_default(pd_mesh_read_options *options);
 
-/* Reads a mesh file. options may be NULL (defaults). On success *mesh is a new
+/* Reads a mesh file. options may be NULL (defaults); a format or units that
+ * is none of its enum's values is PD_ERR_USAGE. On success *mesh is a new
  * mesh owned by the caller (pd_mesh_free). Returns PD_ERR_IO, PD_ERR_FORMAT,
  * PD_ERR_PARSE (malformed or truncated content, wrong counts), PD_ERR_NONFINITE,
  * PD_ERR_RANGE (index out of range, count too large), PD_ERR_NOMEM; the diag
@@ -59,14 +61,19 @@ PD_API pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
                                const pd_mesh_read_options *options, pd_mesh **mesh,
                                pd_diag *diag);
 
-/* A deep copy; NULL if out of memory. */
+/* A deep copy; NULL if out of memory, or if mesh is NULL or has a negative
+ * count. */
 PD_API pd_mesh *pd_mesh_clone(const pd_mesh *mesh);
 
 /* Welds vertices closer than tol (metres): bit-identical vertices always, near
- * duplicates by distance. Triangles are re-indexed; triangles that collapse
- * (two corners welded) are removed; unused vertices are dropped. Deterministic:
- * the survivor of a cluster is its first vertex in input order. *nmerged (may be
- * NULL) receives the number of vertices removed. Returns PD_OK, PD_ERR_NOMEM. */
+ * duplicates by distance (tol 0: bit-identical only). Triangles are re-indexed;
+ * triangles that collapse (two corners welded) are removed; unused vertices
+ * are dropped. Deterministic: the survivor of a cluster is its first vertex in
+ * input order. *nmerged (may be NULL) receives the number of vertices removed.
+ * Returns PD_OK; PD_ERR_USAGE for a NULL mesh, a negative count or missing
+ * arrays, or a tol that is negative, NaN or infinite; PD_ERR_RANGE for a
+ * vertex index out of range; PD_ERR_NONFINITE for a non-finite coordinate;
+ * PD_ERR_NOMEM. The mesh is unchanged on failure. */
 PD_API pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged);
 
 /* Makes the faces of a welded mesh consistently oriented with outward normals.

@@ -50,7 +50,17 @@ typedef struct pd_part {
  * PD_TOL_WELD_REL of the size; orient (faces flipped are reported by a warning);
  * mass properties; convex hull; centre of mass strictly inside the hull.
  * A mesh that is not closed is accepted only with options->com_given.
- * options may be NULL. Returns the statuses of pd_mesh_orient, pd_mass_compute
+ * options may be NULL. A mesh with a negative count or missing arrays, or
+ * options with com_given other than 0 or 1, is PD_ERR_USAGE; a vertex index
+ * out of range PD_ERR_RANGE; a non-finite coordinate or given centre of
+ * mass PD_ERR_NONFINITE. A closed mesh whose mass properties are no solid's
+ * (second moments negative, volume or moments beyond the convex hull's: a
+ * surface through itself, shells that overlap or cancel) is
+ * PD_ERR_ORIENTATION, and one too thin for its moments to be resolved (a rod
+ * of radius below 1.3e-5 of its length) PD_ERR_COLLINEAR, unless
+ * options->com_given: then the mesh's mass properties are not used (a
+ * warning; mass_known 0) and the drops take the hull's inertia about the
+ * given centre. Returns the statuses of pd_mesh_orient, pd_mass_compute
  * and pd_hull_build, PD_ERR_COM_OUTSIDE, PD_ERR_NOMEM; PD_ERR_RANGE for a
  * size outside 1e-30 to 1e30 m, where products of the part's lengths would
  * leave the normal doubles (docs/limits.md). */

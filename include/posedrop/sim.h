@@ -136,13 +136,13 @@ PD_API double pd_contact_time_auto(double size);
  * radius in proportion to its size, 5e-4 s (V / 1 cm^3)^(2/5) (1.73 cm /
  * L)^(1/5), with pd_contact_time_auto's cap for its size L;
  * pd_contact_time_auto(L) for a cube, in proportion to L for geometrically
- * similar parts below the cap. */
+ * similar parts below the cap. 0 for a NULL part. */
 PD_API double pd_contact_time_auto_part(const pd_part *part);
 
 /* The length whose pd_contact_time_auto is the part's own,
  * pd_contact_time_auto_part(part) / pd_contact_time_auto(1): what
  * pd_scene_draw, pd_scene_quantile and pd_sim_sensitivity take as
- * part_size (the part's size for a cube). */
+ * part_size (the part's size for a cube). 0 for a NULL part. */
 PD_API double pd_contact_time_auto_size(const pd_part *part);
 
 PD_API void pd_scene_default(pd_scene *scene);
@@ -255,7 +255,9 @@ typedef struct pd_sim_options {
     int threads;            /* 0: all cores; at most 256 are used */
     double ci_halfwidth;    /* in (0, 0.5): keep dropping until every pose's 95%
                                interval is at most this wide on each side; 0 */
-    long max_drops;         /* cap for ci_halfwidth runs, >= 0; 10^7 */
+    long max_drops;         /* cap for ci_halfwidth runs, >= 0 (ndrops run
+                               even when more): the run stops there whether
+                               or not the intervals are that narrow; 10^7 */
     double time_limit;      /* s of simulated time per drop, > 0, or
                                PD_TIME_LIMIT_AUTO (0, the default):
                                pd_time_limit_auto for the part and scene */
@@ -305,6 +307,13 @@ typedef struct pd_sim_options {
 PD_API double pd_time_limit_auto(double size, const pd_scene *scene);
 
 PD_API void pd_sim_options_default(pd_sim_options *options);
+
+/* Whether every field of options is within the range given with it (the
+ * engine one of pd_engine_kind's, shard below nshards, no ci_halfwidth with
+ * shards): PD_ERR_NONFINITE for a NaN or infinity, PD_ERR_USAGE otherwise,
+ * the message naming the field. Whether the engine is linked is
+ * pd_engine_available's question. pd_sim_run calls it first. */
+PD_API pd_status pd_sim_options_check(const pd_sim_options *options, pd_diag *diag);
 
 /* 1 if pd_sim_run can run that engine in this program: the impulse engine and
  * ODE always, Bullet once pd_bullet_register (posedrop/bullet.h) was called. */
@@ -383,14 +392,22 @@ typedef struct pd_sim_result {
                                shard + t * nshards; p is count / n with Wilson
                                intervals even for PD_INITIAL_STATIONARY, whose
                                chain is estimated once the shards are summed */
+    uint64_t run_fingerprint; /* the run it belongs to: a hash of the part and
+                               pose table (the static result's), the scene and
+                               the options that change outcomes (not threads,
+                               keep_trials or the shard); pd_sim_result_add
+                               refuses a shard whose own differs */
 } pd_sim_result;
 
 /* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
  * shard gets the same mix of drops (for PD_INITIAL_STATIONARY, of phases and
- * starting poses), so shards take about as long as each other. */
+ * starting poses), so shards take about as long as each other. 0 when
+ * nshards < 1 (the whole run), -1 for a negative drop. */
 PD_API int pd_shard_of(long drop, int nshards);
 
-/* How many of a run's ndrops drops shard (0-based) of nshards runs. */
+/* How many of a run's ndrops drops shard (0-based) of nshards runs: ndrops
+ * when nshards < 1, 0 for a shard outside 0 .. nshards - 1 or a negative
+ * ndrops. */
 PD_API long pd_shard_drops(long ndrops, int shard, int nshards);
 
 /* Runs the drops. static_result gives the pose table the outcomes map onto
@@ -430,18 +447,21 @@ PD_API pd_status pd_sim_run(const pd_part *part, const pd_static_result *static_
 
 PD_API void pd_sim_result_free(pd_sim_result *result);
 
-/* Summing shards. pd_sim_result_new makes an empty result of nposes poses
- * for the whole run that scene and options describe (its nshards ignored);
+/* Summing shards. pd_sim_result_new makes an empty result for the whole run
+ * of static_result's poses that scene and options describe (its nshards
+ * ignored);
  * pd_sim_result_add adds one shard's counts to it (drops, counts, unsettled,
  * collisions and corrections, the stationary estimator's counts; partial if
  * the shard was); pd_sim_result_finish then computes p and its intervals from
  * the sums exactly as pd_sim_run does, so the shards 0..N-1 of a run summed
  * give the unsharded run's result, byte for byte (trials aside: none are
- * kept). PD_ERR_USAGE when a shard does not fit (pose count, initial
- * distribution, seed), PD_ERR_NOMEM. */
-PD_API pd_status pd_sim_result_new(int nposes, const pd_scene *scene,
-                                   const pd_sim_options *options, pd_sim_result **result,
-                                   pd_diag *diag);
+ * kept). scene and options may be NULL (defaults). PD_ERR_USAGE for a NULL
+ * static_result, result, sum or shard, or a shard of another run (its
+ * run_fingerprint: another part, pose table, scene, seed or drop count),
+ * PD_ERR_NOMEM. */
+PD_API pd_status pd_sim_result_new(const pd_static_result *static_result,
+                                   const pd_scene *scene, const pd_sim_options *options,
+                                   pd_sim_result **result, pd_diag *diag);
 PD_API pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *shard,
                                    pd_diag *diag);
 PD_API pd_status pd_sim_result_finish(pd_sim_result *result, pd_diag *diag);

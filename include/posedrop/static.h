@@ -11,6 +11,7 @@
 #ifndef POSEDROP_STATIC_H
 #define POSEDROP_STATIC_H
 
+#include <stdint.h>
 #include "posedrop/diag.h"
 #include "posedrop/export.h"
 #include "posedrop/part.h"
@@ -52,6 +53,11 @@ typedef struct pd_static_options {
 
 PD_API void pd_static_options_default(pd_static_options *options);
 
+/* Whether every field of options holds one of its values, epsilon from 0 to
+ * pi / 2 (NaN is not): PD_OK or PD_ERR_USAGE naming the field.
+ * pd_static_estimate calls it first. */
+PD_API pd_status pd_static_options_check(const pd_static_options *options, pd_diag *diag);
+
 /* Per hull facet (same index as in part->hull). */
 typedef struct pd_facet_result {
     double solid_angle; /* sr, subtended at the centre of mass */
@@ -83,11 +89,18 @@ typedef struct pd_static_result {
     pd_pose *poses;     /* by descending p_qs; ties (PD_TOL_PROB_TIE_REL) by
                            normal, lexicographically ascending */
     int nknife;         /* facets with a knife edge (each also warned) */
+    uint64_t part_fingerprint; /* the part it was computed from: a hash of its
+                           size, centre of mass, mass properties and hull.
+                           pd_sim_run and pd_pose_classes refuse a part whose
+                           own differs (PD_ERR_USAGE): another part, or one
+                           changed since, whose hull the pose table does not
+                           index */
 } pd_static_result;
 
 /* Runs QS and PQS on a part. options may be NULL (defaults). On success
  * *result is owned by the caller (pd_static_result_free). Returns
- * PD_ERR_USAGE (epsilon not in [0, 90 deg]), PD_ERR_NOMEM, PD_ERR_INTERNAL
+ * PD_ERR_USAGE (a NULL argument, options pd_static_options_check refuses),
+ * PD_ERR_NOMEM, PD_ERR_INTERNAL
  * (a QSG link that would raise the centre of mass: a bug). */
 PD_API pd_status pd_static_estimate(const pd_part *part, const pd_static_options *options,
                                     pd_static_result **result, pd_diag *diag);

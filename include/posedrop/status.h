@@ -27,7 +27,9 @@ typedef enum pd_status {
     PD_ERR_COLLINEAR,      /* all points on one line */
     PD_ERR_COPLANAR,       /* all points on one plane: the part has no volume */
     PD_ERR_NOT_CLOSED,     /* the mesh has boundary or non-manifold edges */
-    PD_ERR_ORIENTATION,    /* faces cannot be oriented consistently (non-orientable) */
+    PD_ERR_ORIENTATION,    /* faces cannot be oriented consistently (non-orientable), or
+                              oriented they bound no solid: the surface passes through
+                              itself or shells overlap (impossible mass properties) */
     PD_ERR_COM_OUTSIDE,    /* centre of mass outside the hull or on its boundary */
     PD_ERR_NO_CONVERGENCE, /* an iteration did not finish within its bound */
     PD_ERR_NOMEM,          /* memory allocation failed */

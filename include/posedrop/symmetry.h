@@ -39,7 +39,8 @@ typedef struct pd_symmetry {
  * exhaustive search's, and a body of revolution of n vertices costs about
  * n^2 cheap distance tests for the candidate pairs (a few ns each; 0.05 s
  * at 4000 vertices) instead of n^2 vertex lookups. On success *symmetry is
- * owned by the caller (pd_symmetry_free). PD_ERR_NOMEM. */
+ * owned by the caller (pd_symmetry_free). PD_ERR_USAGE (a NULL argument),
+ * PD_ERR_NOMEM. */
 PD_API pd_status pd_symmetry_find(const pd_part *part, pd_symmetry **symmetry, pd_diag *diag);
 
 PD_API void pd_symmetry_free(pd_symmetry *symmetry);
@@ -50,8 +51,8 @@ PD_API void pd_symmetry_free(pd_symmetry *symmetry);
  * mass heights agree within PD_TOL_SYMMETRY_REL of the size. class_of (room
  * for res->nposes entries) receives each pose's class; classes are numbered
  * 0.. in order of first appearance in the pose table, so class 0 holds pose
- * 0. *nclasses receives their number. Returns PD_ERR_USAGE (a pose whose
- * facet is not a facet of part's hull), PD_ERR_NOMEM. */
+ * 0. *nclasses receives their number. Returns PD_ERR_USAGE (a NULL argument,
+ * a pose whose facet is not a facet of part's hull), PD_ERR_NOMEM. */
 PD_API pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int *class_of,
                                  int *nclasses, pd_diag *diag);
 
@@ -64,7 +65,8 @@ PD_API pd_status pd_pose_classes(const pd_part *part, const pd_static_result *re
  * interval (the same redraws, summed before the percentiles are taken), and
  * its first_count and transitions summed over classes (row and column);
  * stationary_shift is then measured between the classes. class_of has
- * sim->nposes entries in [0, nclasses).
+ * sim->nposes entries in [0, nclasses), and nclasses is at most
+ * sim->nposes (PD_ERR_USAGE otherwise).
  * Free with pd_sim_result_free. PD_ERR_USAGE, PD_ERR_NOMEM. */
 PD_API pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
                                        pd_sim_result **grouped, pd_diag *diag);

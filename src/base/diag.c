@@ -6,6 +6,8 @@
 
 void pd_diag_init(pd_diag *diag)
 {
+    if (!diag)
+        return;
     memset(diag, 0, sizeof *diag);
 }
 

@@ -16,4 +16,9 @@ static inline pd_vec3 m3_vec(const double M[3][3], pd_vec3 v)
               M[2][0] * v.x + M[2][1] * v.y + M[2][2] * v.z);
 }
 
+/* Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations:
+ * A = V diag(eval) V^T, eval ascending, the columns of V orthonormal and
+ * right-handed (det V = +1). */
+void pd_sym_eigen3(const double A[3][3], double eval[3], double V[3][3]);
+
 #endif

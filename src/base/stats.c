@@ -1,4 +1,5 @@
 /* stats.c: Wilson intervals and sample sizes (see stats.h). */
+#include <limits.h>
 #include <math.h>
 #include "base/gsl_adapter.h"
 #include "base/stats.h"
@@ -23,5 +24,8 @@ void pd_wilson(long k, long n, double z, double *lo, double *hi)
 long pd_sample_size(double delta, double alpha, int k)
 {
     double z = pd_gsl_normal_quantile(1.0 - alpha / (2.0 * (k > 0 ? k : 1)));
-    return (long)ceil(z * z / (4.0 * delta * delta));
+    /* A half-width of 1e-20 asks for more drops than a long counts:
+     * converting that double would be undefined. */
+    double n = ceil(z * z / (4.0 * delta * delta));
+    return n < (double)LONG_MAX ? (long)n : LONG_MAX;
 }

@@ -601,6 +601,13 @@ static int parse_args(int argc, char **argv, cli_args *a)
                           "with --ci or --initial bootstrap (later drops depend on earlier "
                           "outcomes), nor with --format json, --transitions (give those to "
                           "'posedrop merge') or the pictures");
+    /* The library's own checks of what the options set, so that the command
+     * accepts nothing the library would refuse later. */
+    pd_diag d;
+    pd_diag_init(&d);
+    if (pd_static_options_check(&a->estimate, &d) != PD_OK ||
+        pd_sim_options_check(&a->sim, &d) != PD_OK)
+        return fail_usage("%s", d.message);
     a->path = argv[optind];
     /* --com is in the file's units, like the mesh. */
     double s = pd_units_scale(a->read.units);

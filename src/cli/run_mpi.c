@@ -161,7 +161,7 @@ pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_arg
     if (!ok) {
         snprintf(diag->message, sizeof diag->message, "out of memory for the counts");
         st = PD_ERR_NOMEM;
-    } else if (rank == 0 && (st = pd_sim_result_new(res->nposes, &a->scene, &whole, &sum, diag)) ==
+    } else if (rank == 0 && (st = pd_sim_result_new(res, &a->scene, &whole, &sum, diag)) ==
                                 PD_OK) {
         unpack(sum, sum_v);
         sum->time_limit = mine->time_limit;

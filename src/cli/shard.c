@@ -572,7 +572,7 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
 {
     pd_sim_options o = a->sim;
     o.nshards = 0;
-    pd_status st = pd_sim_result_new(res->nposes, &a->scene, &o, sum, diag);
+    pd_status st = pd_sim_result_new(res, &a->scene, &o, sum, diag);
     for (int i = 0; st == PD_OK && i < nshard_files; i++) {
         const shard_file *f = &shards[i];
         if (f->nposes != res->nposes || !f->to != !(*sum)->transitions) {

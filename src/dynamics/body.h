@@ -63,11 +63,6 @@ pd_status pd_body_build(const pd_part *part, pd_body **body, pd_diag *diag);
 
 void pd_body_free(pd_body *body);
 
-/* Eigen-decomposition of a symmetric 3x3 matrix by cyclic Jacobi rotations:
- * A = V diag(eval) V^T, eval ascending, the columns of V orthonormal and
- * right-handed (det V = +1). */
-void pd_sym_eigen3(const double A[3][3], double eval[3], double V[3][3]);
-
 /* The hull vertex minimising dot(dir, vertex) (dir in the body frame): for
  * dir = world up expressed in the body frame, the lowest vertex. Hill-climbs
  * the vertex graph from vertex start (any valid index; pass the last answer

@@ -95,7 +95,9 @@ static unsigned long direction_key(pd_vec3 u)
 
 pd_status pd_hull_check(const pd_hull *h, const pd_vec3 *pts, int npts, pd_diag *diag)
 {
-    if (!h || h->nfacets < 4 || h->nverts < 4 || !h->verts || !h->normal || !h->offset || !h->facet_start ||
+    if (!h || npts < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_hull_check: %s", h ? "negative point count" : "NULL hull");
+    if (h->nfacets < 4 || h->nverts < 4 || !h->verts || !h->normal || !h->offset || !h->facet_start ||
         !h->facet_vert || !h->facet_adj || !(h->size > 0.0))
         return pd_fail(diag, PD_ERR_INTERNAL, "hull check: missing arrays or fewer than 4 facets/vertices");
     double tol = PD_TOL_PLANE_REL * h->size;

@@ -24,8 +24,9 @@ double pd_units_scale(pd_units units)
     case PD_UNITS_IN:
         return 0.0254;
     case PD_UNITS_M:
-    default:
         return 1.0;
+    default:
+        return 0.0;
     }
 }
 
@@ -47,6 +48,8 @@ pd_status pd_units_parse(const char *text, pd_units *units)
 
 void pd_mesh_read_options_default(pd_mesh_read_options *options)
 {
+    if (!options)
+        return;
     options->format = PD_FORMAT_AUTO;
     options->units = PD_UNITS_M;
 }
@@ -160,6 +163,12 @@ pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
     }
     if (!name)
         name = "<memory>";
+    if ((unsigned)options->format > (unsigned)PD_FORMAT_OBJ)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: read option format is %d: expected one of "
+                       "PD_FORMAT_AUTO, _OFF, _STL, _OBJ", name, (int)options->format);
+    if ((unsigned)options->units > (unsigned)PD_UNITS_IN)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: read option units is %d: expected one of "
+                       "PD_UNITS_M, _CM, _MM, _IN", name, (int)options->units);
     double scale = pd_units_scale(options->units);
     const unsigned char *d = data;
     pd_mesh_format f = options->format;
@@ -314,7 +323,7 @@ pd_mesh *pd_mesh_clone(const pd_mesh *mesh)
 
 double pd_mesh_size(const pd_mesh *mesh)
 {
-    if (!mesh || mesh->nverts <= 0)
+    if (!mesh || mesh->nverts <= 0 || !mesh->verts)
         return 0.0;
     pd_vec3 lo = mesh->verts[0], hi = lo;
     for (int i = 1; i < mesh->nverts; i++) {

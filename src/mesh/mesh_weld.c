@@ -9,6 +9,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "mesh/mesh_internal.h"
 #include "mesh/mesh_reader.h"
 #include "base/vec3.h"
 
@@ -137,12 +138,11 @@ static pd_status exact_reps(const pd_mesh *m, int *rep)
 
 pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged)
 {
-    if (!mesh || mesh->nverts < 0 || mesh->ntris < 0)
+    pd_status st = pd_mesh_validate(mesh, "weld", NULL);
+    if (st != PD_OK)
+        return st;
+    if (!(tol >= 0.0 && isfinite(tol)))
         return PD_ERR_USAGE;
-    for (int t = 0; t < mesh->ntris; t++)
-        for (int k = 0; k < 3; k++)
-            if (mesh->tris[t][k] < 0 || mesh->tris[t][k] >= mesh->nverts)
-                return PD_ERR_USAGE;
     size_t nv = (size_t)mesh->nverts, nt = (size_t)mesh->ntris;
     /* Everything is built aside and swapped in at the end, so a failure
      * leaves the mesh as it was. */
@@ -154,9 +154,8 @@ pd_status pd_mesh_weld(pd_mesh *mesh, double tol, int *nmerged)
         return PD_ERR_NOMEM;
     }
     int usable = 0;
-    pd_status st = PD_OK;
-    /* tol == 0 (or negative, or NaN) asks for bit-identical merging only. */
-    if (tol > 0.0 && isfinite(tol))
+    /* tol == 0 asks for bit-identical merging only. */
+    if (tol > 0.0)
         st = grid_reps(mesh, tol, rep, &usable);
     if (st == PD_OK && !usable)
         st = exact_reps(mesh, rep);

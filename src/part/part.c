@@ -10,14 +10,21 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include "base/fail.h"
+#include "base/hash.h"
+#include "base/mat3.h"
 #include "base/size_range.h"
+#include "hull/hull_mass.h"
+#include "mesh/mesh_internal.h"
 #include "posedrop/part.h"
 #include "posedrop/tolerances.h"
+#include "part/part_check.h"
 #include "part/part_tol.h"
 #include "base/vec3.h"
 
 void pd_part_options_default(pd_part_options *options)
 {
+    if (!options)
+        return;
     options->com_given = 0;
     options->com = v3(0.0, 0.0, 0.0);
 }
@@ -61,6 +68,87 @@ static pd_status check_com_inside(const pd_part *p, pd_diag *diag)
                    c.x, c.y, c.z, -worst_gap, n.x, n.y, n.z);
 }
 
+/* The smallest eigenvalue of a symmetric matrix, and its largest in *top. */
+static double eig_min(const double A[3][3], double *top)
+{
+    double e[3], V[3][3];
+    pd_sym_eigen3(A, e, V);
+    *top = e[2];
+    return e[0];
+}
+
+/* What the drops need of a closed mesh's mass properties, checked once here
+ * so that a part the static estimate accepts is one the drops accept: a
+ * positive volume no larger than the hull's, principal moments positive,
+ * second moments positive along every direction and within the hull's
+ * (PD_TOL_INERTIA_REL, PD_TOL_SOLID_SHELL_REL). A surface that passes through
+ * itself counts the volume on the far side of the fold negatively (or twice),
+ * which no solid does. st is pd_mass_compute's status: no volume, when the
+ * hull has some, is shells cancelling, not a flat part. */
+static pd_status check_solid(const pd_part *p, pd_status st, pd_diag *diag)
+{
+    const char *why = "the mesh does not bound a solid: its surface passes through itself or "
+                      "part of it is inside out";
+    if (st == PD_ERR_COPLANAR) {
+        return pd_fail(diag, PD_ERR_ORIENTATION, "%s, or its shells overlap (one taken as a "
+                       "void inside another it crosses): it encloses no volume, though its "
+                       "convex hull holds %.3g m^3", why, p->hull->volume);
+    }
+    if (st != PD_OK)
+        return st;
+    const pd_mass *m = &p->mass;
+    double I[3][3], S[3][3], H[3][3], D[3][3];
+    double tr = m->inertia[0][0] + m->inertia[1][1] + m->inertia[2][2];
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++) {
+            I[i][j] = m->inertia[i][j];
+            S[i][j] = (i == j ? 0.5 * tr : 0.0) - I[i][j];
+        }
+    double i_top, i_min = eig_min(CONST_M3(I), &i_top);
+    double s_top, s_min = eig_min(CONST_M3(S), &s_top);
+    if (!(s_min >= -PD_TOL_INERTIA_REL * s_top))
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s (second moments from %.3g to %.3g m^5 per unit density, principal "
+                       "moments of inertia from %.3g to %.3g m^5: a solid's are positive)",
+                       why, s_min, s_top, i_min, i_top);
+    if (!(i_min > PD_TOL_INERTIA_REL * i_top))
+        return pd_fail(diag, PD_ERR_COLLINEAR,
+                       "the part is too thin for its mass properties to be resolved: its "
+                       "smallest principal moment of inertia is %.3g of its largest, below %g "
+                       "(a rod of radius below %.2g of its length)", i_min / i_top,
+                       PD_TOL_INERTIA_REL, sqrt(PD_TOL_INERTIA_REL / 6.0));
+    /* The hull's, about the mesh's centre of mass. */
+    double hv, R2 = 0.0, area = 0.0;
+    pd_hull_moments(p->hull, m->com, &hv, H);
+    const pd_hull *h = p->hull;
+    for (int v = 0; v < h->nverts; v++) {
+        pd_vec3 d = v3_sub(h->verts[v], m->com);
+        R2 = fmax(R2, v3_dot(d, d));
+    }
+    for (int f = 0; f < h->nfacets; f++) {
+        int k0 = h->facet_start[f], k1 = h->facet_start[f + 1];
+        pd_vec3 a = h->verts[h->facet_vert[k0]];
+        for (int k = k0 + 1; k + 1 < k1; k++)
+            area += 0.5 * v3_norm(v3_cross(v3_sub(h->verts[h->facet_vert[k]], a),
+                                           v3_sub(h->verts[h->facet_vert[k + 1]], a)));
+    }
+    double shell = PD_TOL_SOLID_SHELL_REL * p->size * area;
+    if (m->volume > hv + shell)
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s, or its shells overlap (it encloses %.6g m^3, more than its convex "
+                       "hull's %.6g m^3)", why, m->volume, hv);
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            D[i][j] = H[i][j] - S[i][j];
+    double d_top, d_min = eig_min(CONST_M3(D), &d_top), h_top;
+    eig_min(CONST_M3(H), &h_top);
+    if (d_min < -(shell * R2 + PD_TOL_INERTIA_REL * h_top))
+        return pd_fail(diag, PD_ERR_ORIENTATION,
+                       "%s, or its shells overlap (its second moment along one direction exceeds "
+                       "its convex hull's by %.3g m^5, of %.3g m^5)", why, -d_min, h_top);
+    return PD_OK;
+}
+
 /* The part's origin: the centre of the bounding box [lo, hi] rounded to a
  * multiple of u, the least power of two above the size L (L < u <= 2 L).
  * Positions relative to it are within 1.5 L per axis, so everything computed
@@ -97,12 +185,10 @@ static pd_status weld_explains(pd_status st, int nbefore, int nafter, double siz
 
 static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
 {
-    /* Every size-relative tolerance below needs a finite size, within the
-     * range where products of the part's lengths stay normal doubles. */
+    /* Every size-relative tolerance below needs a finite size (the
+     * coordinates were checked finite), within the range where products of
+     * the part's lengths stay normal doubles. */
     pd_mesh *m = p->mesh;
-    for (int i = 0; i < m->nverts; i++)
-        if (!v3_isfinite(m->verts[i]))
-            return pd_fail(diag, PD_ERR_NONFINITE, "vertex %d has a non-finite coordinate", i + 1);
     pd_vec3 lo = v3(0.0, 0.0, 0.0), hi = lo;
     for (int i = 0; i < m->nverts; i++) {
         pd_vec3 v = m->verts[i];
@@ -157,13 +243,18 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     }
 
     if (p->closed) {
-        st = pd_mass_compute(p->mesh, &p->mass, diag);
+        st = check_solid(p, pd_mass_compute(p->mesh, &p->mass, diag), diag);
         if (st == PD_OK)
             p->mass_known = 1;
         else if (!opt->com_given)
             return st;
-        else if (diag)
+        else if (diag) {
+            /* As for an open mesh: the hull and the given centre are all
+             * the estimators need, and the drops take the hull's inertia. */
+            pd_warn(diag, "%s; the given centre of mass and the convex hull's inertia are used",
+                    diag->message);
             diag->message[0] = '\0';
+        }
     }
     p->com = opt->com_given ? com_given : p->mass.com;
     if (!v3_isfinite(p->com))
@@ -180,13 +271,24 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     else
         pd_part_options_default(&opt);
     if (!mesh || !part)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL argument");
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL %s", mesh ? "part" : "mesh");
+    /* A mesh made by hand gets an input error, not an out-of-memory from
+     * copying a negative count or a crash from an index off its end. */
+    pd_status st = pd_mesh_validate(mesh, "pd_part_build", diag);
+    if (st != PD_OK)
+        return st;
+    if (opt.com_given != 0 && opt.com_given != 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: option com_given is %d: expected 0 "
+                       "or 1", opt.com_given);
+    if (opt.com_given && !v3_isfinite(opt.com))
+        return pd_fail(diag, PD_ERR_NONFINITE, "pd_part_build: the given centre of mass is not "
+                       "finite");
     pd_part *p = calloc(1, sizeof *p);
     if (!p || !(p->mesh = pd_mesh_clone(mesh))) {
         free(p);
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory copying the mesh");
     }
-    pd_status st = build(p, &opt, diag);
+    st = build(p, &opt, diag);
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
             pd_fail(diag, st, "out of memory building the part");
@@ -195,4 +297,47 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     }
     *part = p;
     return PD_OK;
+}
+
+pd_status pd_part_check(const pd_part *part, const char *who, pd_diag *diag)
+{
+    if (!part)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: NULL part", who);
+    const pd_hull *h = part->hull;
+    if (!part->mesh || !h || h->nfacets < 4 || h->nverts < 4 || !h->verts || !h->normal ||
+        !h->offset || !h->facet_start || !h->facet_vert || !h->facet_adj || !(part->size > 0.0))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: the part is not one pd_part_build made (its "
+                       "mesh or hull is missing)", who);
+    return PD_OK;
+}
+
+static void hash_vec3s(pd_hash *s, const pd_vec3 *v, int n)
+{
+    for (int i = 0; i < n; i++) {
+        double x[3] = {v[i].x, v[i].y, v[i].z};
+        pd_hash_doubles(s, x, 3);
+    }
+}
+
+uint64_t pd_part_fingerprint(const pd_part *p)
+{
+    const pd_hull *h = p->hull;
+    pd_hash s;
+    pd_hash_init(&s, 0x70617274); /* "part" */
+    pd_hash_doubles(&s, &p->size, 1);
+    hash_vec3s(&s, &p->com, 1);
+    int counts[4] = {p->mass_known, h->nverts, h->nfacets, h->facet_start[h->nfacets]};
+    pd_hash_ints(&s, counts, 4);
+    if (p->mass_known) {
+        pd_hash_doubles(&s, &p->mass.volume, 1);
+        hash_vec3s(&s, &p->mass.com, 1);
+        for (int i = 0; i < 3; i++)
+            pd_hash_doubles(&s, p->mass.inertia[i], 3);
+    }
+    hash_vec3s(&s, h->verts, h->nverts);
+    pd_hash_ints(&s, h->facet_start, (long)h->nfacets + 1);
+    pd_hash_ints(&s, h->facet_vert, h->facet_start[h->nfacets]);
+    hash_vec3s(&s, h->normal, h->nfacets);
+    pd_hash_doubles(&s, h->offset, h->nfacets);
+    return s.h;
 }

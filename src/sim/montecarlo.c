@@ -17,11 +17,13 @@
 #include <string.h>
 #include <unistd.h>
 #include "base/fail.h"
+#include "base/hash.h"
 #include "sim/drop.h"
 #include "sim/markov.h"
 #include "sim/scene.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
+#include "static/static_check.h"
 
 /* The paper's bootstrap: 20 uniform drops, then drops resting on poses drawn
  * from the running estimate. Rounds of fixed size keep it deterministic; the
@@ -39,6 +41,8 @@ static const double Z95 = PD_Z95;
 
 void pd_sim_options_default(pd_sim_options *o)
 {
+    if (!o)
+        return;
     memset(o, 0, sizeof *o);
     o->engine = PD_ENGINE_IMPULSE;
     o->dt = 0.0;
@@ -88,14 +92,22 @@ const char *pd_drop_stage_name(pd_drop_stage stage)
 
 int pd_shard_of(long drop, int nshards)
 {
+    if (drop < 0)
+        return -1;
     return nshards > 0 ? (int)(drop % nshards) : 0;
 }
 
 long pd_shard_drops(long ndrops, int shard, int nshards)
 {
+    if (ndrops < 0)
+        return 0;
     if (nshards <= 0)
         return ndrops;
-    return ndrops > shard ? (ndrops - shard + nshards - 1) / nshards : 0;
+    if (shard < 0 || shard >= nshards)
+        return 0;
+    /* The drops shard, shard + nshards, ... below ndrops; no sum that
+     * could pass LONG_MAX. */
+    return ndrops > shard ? (ndrops - shard - 1) / nshards + 1 : 0;
 }
 
 /* The run's index of a shard's drop number local. */
@@ -360,12 +372,15 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     /* --ci starts from the drops that guarantee the half-width for every pose
      * at once in the worst case (p = 1/2, Bonferroni over the poses: the
      * corrected eq. 17), then adds batches while an interval is still wider. */
-    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards);
+    long want = pd_shard_drops(o->ndrops, r->shard, r->nshards), cap = want;
     if (o->ci_halfwidth > 0) {
+        /* max_drops bounds the run whatever the half-width asks (1e-7 asks
+         * for ~1e14 drops); the ndrops asked for run in any case. */
+        cap = o->max_drops > want ? o->max_drops : want;
         long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
         want = bound > want ? bound : want;
+        want = want < cap ? want : cap;
     }
-    long cap = o->ci_halfwidth > 0 ? (o->max_drops > want ? o->max_drops : want) : want;
     pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
     double *cdf = malloc(sizeof *cdf * (size_t)r->nposes);
     long *before = malloc(sizeof *before * (size_t)r->nposes);
@@ -447,10 +462,24 @@ static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
     return PD_OK;
 }
 
+/* Whether r has the arrays its counts promise: per pose counts (and, with
+ * finished, probabilities and intervals), the chain's counts both or
+ * neither. A result the library made always has; a hand-made one is
+ * checked before its arrays are indexed. */
+static int result_arrays(const pd_sim_result *r, int finished)
+{
+    return r->nposes >= 0 && (r->nposes == 0 || r->count) &&
+           (!finished || r->nposes == 0 || (r->p && r->ci_lo && r->ci_hi)) &&
+           !r->first_count == !r->transitions;
+}
+
 pd_status pd_sim_result_finish(pd_sim_result *r, pd_diag *diag)
 {
     if (!r)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_finish: NULL argument");
+    if (!result_arrays(r, 1))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_finish: the result has not the "
+                       "arrays of its %d poses", r->nposes);
     for (int i = 0; i < r->nposes; i++) {
         r->p[i] = r->n ? (double)r->count[i] / (double)r->n : 0.0;
         pd_wilson(r->count[i], r->n, Z95, &r->ci_lo[i], &r->ci_hi[i]);
@@ -479,12 +508,58 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
     return PD_OK;
 }
 
-pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *o,
-                            pd_sim_result **result, pd_diag *diag)
+/* The identity of a run: the part and pose table the drops map onto, and
+ * every setting that changes an outcome (not threads, trials, the shard, a
+ * cancel flag or a progress callback), so that a shard of another run is
+ * refused by pd_sim_result_add however alike its counts look. */
+static uint64_t run_fingerprint(const pd_static_result *poses, const pd_scene *sc,
+                                const pd_sim_options *o)
 {
-    *result = NULL;
-    if (k < 1 || !scene || !o || o->ndrops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: invalid arguments");
+    pd_hash s;
+    pd_hash_init(&s, 0x72756e); /* "run" */
+    pd_hash_u64(&s, poses->part_fingerprint);
+    pd_hash_ints(&s, &poses->nposes, 1);
+    for (int i = 0; i < poses->nposes; i++)
+        pd_hash_ints(&s, &poses->poses[i].facet, 1);
+    double reals[] = {sc->height, sc->belt_speed, sc->mu, sc->restitution, sc->vibration,
+                      sc->gravity, sc->contact_time, sc->tumble, o->dt, o->ci_halfwidth,
+                      o->time_limit};
+    pd_hash_doubles(&s, reals, (long)(sizeof reals / sizeof reals[0]));
+    int ints[] = {(int)sc->law, (int)sc->initial, (int)o->engine, o->max_collisions};
+    pd_hash_ints(&s, ints, (long)(sizeof ints / sizeof ints[0]));
+    for (int i = 0; i < PD_NPARAMS; i++) {
+        const pd_dist *r = &sc->range[i];
+        double ends[] = {r->lo, r->hi};
+        int kind[] = {(int)r->kind, r->auto_multiple};
+        pd_hash_doubles(&s, ends, 2);
+        pd_hash_ints(&s, kind, 2);
+    }
+    pd_hash_u64(&s, (uint64_t)o->ndrops);
+    pd_hash_u64(&s, (uint64_t)o->max_drops);
+    pd_hash_u64(&s, o->seed);
+    return s.h;
+}
+
+pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene,
+                            const pd_sim_options *o, pd_sim_result **result, pd_diag *diag)
+{
+    pd_scene scene_default;
+    pd_sim_options options_default;
+    if (!scene) {
+        pd_scene_default(&scene_default);
+        scene = &scene_default;
+    }
+    if (!o) {
+        pd_sim_options_default(&options_default);
+        o = &options_default;
+    }
+    if (!poses || !result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: NULL %s",
+                       poses ? "result" : "static_result");
+    int k = poses->nposes;
+    if (k < 1 || !poses->poses || o->ndrops < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: %d poses, %ld drops: expected at "
+                       "least one pose and no negative count", k, o->ndrops);
     int stationary = scene->initial == PD_INITIAL_STATIONARY;
     pd_sim_result *r = calloc(1, sizeof *r);
     if (r) {
@@ -494,6 +569,7 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
         r->ci_lo = calloc((size_t)k, sizeof *r->ci_lo);
         r->ci_hi = calloc((size_t)k, sizeof *r->ci_hi);
         r->seed = o->seed;
+        r->run_fingerprint = run_fingerprint(poses, scene, o);
         r->first_failed = -1;
         r->time_limit = o->time_limit;
         if (stationary) {
@@ -515,12 +591,18 @@ pd_status pd_sim_result_new(int k, const pd_scene *scene, const pd_sim_options *
 pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag *diag)
 {
     if (!sum || !s)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: NULL argument");
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: NULL %s", sum ? "shard" : "sum");
+    if (!result_arrays(sum, 1) || !result_arrays(s, 0))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: the %s has not the arrays of "
+                       "its %d poses", result_arrays(sum, 1) ? "shard" : "sum",
+                       result_arrays(sum, 1) ? s->nposes : sum->nposes);
     if (s->nposes != sum->nposes || !s->transitions != !sum->transitions || s->seed != sum->seed ||
-        s->first_drops != sum->first_drops || s->pose_drops != sum->pose_drops)
+        s->first_drops != sum->first_drops || s->pose_drops != sum->pose_drops ||
+        s->run_fingerprint != sum->run_fingerprint)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: the shard is not of this run "
-                       "(%d poses, seed %llu; the run: %d poses, seed %llu)", s->nposes,
-                       (unsigned long long)s->seed, sum->nposes, (unsigned long long)sum->seed);
+                       "(%d poses, seed %llu; the run: %d poses, seed %llu; or another part, "
+                       "scene or drop count)", s->nposes, (unsigned long long)s->seed,
+                       sum->nposes, (unsigned long long)sum->seed);
     size_t k = (size_t)sum->nposes;
     sum->n += s->n;
     sum->unsettled += s->unsettled;
@@ -548,49 +630,52 @@ pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag 
 
 /* Every field of the options, so that a program's mistake is a clear status
  * rather than a run that ends every drop unsettled (or never ends). The
- * limits are the CLI's where it has the option. */
-static pd_status check_options(const pd_sim_options *o, pd_diag *diag)
+ * command calls it on what its options set, so it accepts nothing that this
+ * refuses. */
+pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
 {
+    if (!o)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_options_check: NULL options");
     const struct {
         const char *name;
         double value;
     } reals[] = {{"dt", o->dt}, {"ci_halfwidth", o->ci_halfwidth}, {"time_limit", o->time_limit}};
     for (size_t i = 0; i < sizeof reals / sizeof reals[0]; i++)
         if (!isfinite(reals[i].value))
-            return pd_fail(diag, PD_ERR_NONFINITE, "pd_sim_run: option %s is %g", reals[i].name,
+            return pd_fail(diag, PD_ERR_NONFINITE, "option %s is %g", reals[i].name,
                            reals[i].value);
     if ((unsigned)o->engine > (unsigned)PD_ENGINE_BULLET)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option engine is %d: expected "
-                       "PD_ENGINE_IMPULSE, PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
-    if (!pd_engine_available(o->engine))
-        return pd_fail(diag, PD_ERR_UNAVAILABLE, "pd_sim_run: the Bullet engine is not in this "
-                       "program: link libposedrop-bullet (pkg-config posedrop-bullet) and call "
-                       "pd_bullet_register() first");
+        return pd_fail(diag, PD_ERR_USAGE, "option engine is %d: expected PD_ENGINE_IMPULSE, "
+                       "PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
     if (o->dt < 0 || o->dt > PD_SIM_DT_MAX)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option dt is %g s: expected 0 (the "
-                       "engine's default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
+        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (the engine's "
+                       "default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
     if (o->ndrops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ndrops is %ld: expected 0 or more",
-                       o->ndrops);
+        return pd_fail(diag, PD_ERR_USAGE, "option ndrops is %ld: expected 0 or more", o->ndrops);
     if (o->threads < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option threads is %d: expected 0 (all "
-                       "cores) or more", o->threads);
+        return pd_fail(diag, PD_ERR_USAGE, "option threads is %d: expected 0 (all cores) or "
+                       "more", o->threads);
     if (o->ci_halfwidth < 0 || o->ci_halfwidth >= 0.5)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option ci_halfwidth is %g: expected 0 "
-                       "(a fixed number of drops) or a half-width above 0 and below 0.5",
-                       o->ci_halfwidth);
+        return pd_fail(diag, PD_ERR_USAGE, "option ci_halfwidth is %g: expected 0 (a fixed "
+                       "number of drops) or a half-width above 0 and below 0.5", o->ci_halfwidth);
     if (o->max_drops < 0)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_drops is %ld: expected 0 or "
-                       "more", o->max_drops);
+        return pd_fail(diag, PD_ERR_USAGE, "option max_drops is %ld: expected 0 or more",
+                       o->max_drops);
     if (!(o->time_limit >= 0))
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option time_limit is %g s: expected a "
-                       "positive time or PD_TIME_LIMIT_AUTO (0)", o->time_limit);
+        return pd_fail(diag, PD_ERR_USAGE, "option time_limit is %g s: expected a positive "
+                       "time or PD_TIME_LIMIT_AUTO (0)", o->time_limit);
     if (o->max_collisions < 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option max_collisions is %d: expected 1 "
-                       "or more", o->max_collisions);
+        return pd_fail(diag, PD_ERR_USAGE, "option max_collisions is %d: expected 1 or more",
+                       o->max_collisions);
     if (o->keep_trials != 0 && o->keep_trials != 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: option keep_trials is %d: expected 0 or 1",
+        return pd_fail(diag, PD_ERR_USAGE, "option keep_trials is %d: expected 0 or 1",
                        o->keep_trials);
+    if (o->nshards < 0 || (o->nshards > 0 && (o->shard < 0 || o->shard >= o->nshards)))
+        return pd_fail(diag, PD_ERR_USAGE, "options nshards %d, shard %d: expected nshards 0 "
+                       "(the whole run), or shard from 0 to nshards - 1", o->nshards, o->shard);
+    if (o->nshards > 0 && o->ci_halfwidth > 0)
+        return pd_fail(diag, PD_ERR_USAGE, "option nshards with ci_halfwidth: a run split into "
+                       "shards needs a fixed number of drops");
     return PD_OK;
 }
 
@@ -607,18 +692,23 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         o = *options;
     else
         pd_sim_options_default(&o);
-    if (!part || !poses || !result)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL argument");
-    pd_status st = pd_scene_check(&sc, diag);
-    if (st == PD_OK)
-        st = check_options(&o, diag);
+    pd_status st = pd_static_result_check(part, poses, "pd_sim_run", diag);
     if (st != PD_OK)
         return st;
-    if (poses->nposes < 1 || !poses->poses)
+    if (!result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: NULL result");
+    st = pd_scene_check(&sc, diag);
+    if (st == PD_OK)
+        st = pd_sim_options_check(&o, diag);
+    if (st != PD_OK)
+        return st;
+    if (!pd_engine_available(o.engine))
+        return pd_fail(diag, PD_ERR_UNAVAILABLE, "pd_sim_run: the Bullet engine is not in this "
+                       "program: link libposedrop-bullet (pkg-config posedrop-bullet) and call "
+                       "pd_bullet_register() first");
+    if (poses->nposes < 1)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: the static result has no stable pose");
-    if (o.nshards < 0 || (o.nshards > 0 && (o.shard < 0 || o.shard >= o.nshards)))
-        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_run: shard %d of %d", o.shard + 1, o.nshards);
-    if (o.nshards > 0 && (o.ci_halfwidth > 0 || sc.initial == PD_INITIAL_BOOTSTRAP))
+    if (o.nshards > 0 && sc.initial == PD_INITIAL_BOOTSTRAP)
         return pd_fail(diag, PD_ERR_USAGE, "a run split into shards needs a fixed number of "
                        "drops, each independent of the others' outcomes: not a confidence "
                        "half-width, nor the bootstrap start, which draws from the outcomes so far");
@@ -630,7 +720,7 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
     if (st != PD_OK)
         return st;
     pd_sim_result *r = NULL;
-    st = pd_sim_result_new(poses->nposes, &sc, &o, &r, diag);
+    st = pd_sim_result_new(poses, &sc, &o, &r, diag);
     if (st == PD_OK) {
         r->time_limit = model->time_limit;
         r->nshards = o.nshards;

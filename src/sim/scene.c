@@ -17,6 +17,8 @@
 
 void pd_scene_default(pd_scene *s)
 {
+    if (!s)
+        return;
     s->height = 0.12;
     s->belt_speed = 0.05;
     s->mu = 0.3;
@@ -54,6 +56,8 @@ double pd_contact_time_auto(double size)
 
 double pd_contact_time_auto_part(const pd_part *part)
 {
+    if (!part || !part->hull)
+        return 0.0;
     /* A needle's mass is far below L^3: by its length alone a 1 m needle
      * 1 mm thick got a 29 ms contact, whose static compression (about
      * g T^2 / 13) sank it deeper than its thickness and kept every drop
@@ -280,6 +284,8 @@ static double draw_one(const pd_dist *d, double u)
 void pd_scene_draw(const pd_scene *scene, double part_size, uint64_t seed, long drop,
                    double values[PD_NPARAMS], pd_scene *drawn)
 {
+    if (!scene || !values)
+        return;
     pd_rng r;
     param_stream(&r, seed, drop);
     double u[PD_NPARAMS];

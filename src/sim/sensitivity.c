@@ -324,8 +324,6 @@ pd_status pd_sim_sensitivity(const pd_sim_result *r, const pd_scene *sc, double 
                              const int *class_of, int nclasses, pd_sensitivity **out,
                              pd_diag *diag)
 {
-    if (out)
-        *out = NULL;
     if (!r || !sc || !out)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_sensitivity: NULL argument");
     if (!r->trials && r->n > 0)

@@ -4,6 +4,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/fail.h"
+#include "base/hash.h"
 #include "base/stats.h"
 #include "posedrop/symmetry.h"
 #include "sim/markov.h"
@@ -11,8 +12,15 @@
 pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, int nclasses,
                                 pd_sim_result **grouped, pd_diag *diag)
 {
-    *grouped = NULL;
-    if (nclasses < 0 || (nclasses == 0 && sim->nposes > 0))
+    if (!sim || !class_of || !grouped)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: NULL %s",
+                       !sim ? "sim" : !class_of ? "class_of" : "grouped");
+    if (sim->nposes < 0 || (sim->nposes > 0 && !sim->count) || !sim->first_count != !sim->transitions)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: the result has not the arrays "
+                       "of its %d poses", sim->nposes);
+    /* At most a class per pose: more would only be empty classes, and a
+     * count of the chain's class-to-class transitions for each pair. */
+    if (nclasses < 0 || nclasses > sim->nposes || (nclasses == 0 && sim->nposes > 0))
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: %d classes for %d poses",
                        nclasses, sim->nposes);
     for (int i = 0; i < sim->nposes; i++)
@@ -24,6 +32,11 @@ pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, i
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory");
     *g = *sim;
     g->nposes = nclasses;
+    /* Another table of outcomes: no shard of the ungrouped run adds to it. */
+    pd_hash h;
+    pd_hash_init(&h, sim->run_fingerprint);
+    pd_hash_ints(&h, class_of, sim->nposes);
+    g->run_fingerprint = h.h;
     g->trials = NULL;
     g->first_count = NULL;
     g->transitions = NULL;

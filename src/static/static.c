@@ -4,17 +4,40 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/fail.h"
+#include "part/part_check.h"
 #include "posedrop/tolerances.h"
+#include "static/static_check.h"
 #include "static/static_tol.h"
 #include "static/static_internal.h"
 #include "base/vec3.h"
 
 void pd_static_options_default(pd_static_options *options)
 {
+    if (!options)
+        return;
     options->topple = PD_TOPPLE_DESCENT;
     options->epsilon = 20.0 * M_PI / 180.0;
     options->compare = PD_PQS_COMPARE_RAW;
     options->band = PD_PQS_BAND_RECT;
+}
+
+pd_status pd_static_options_check(const pd_static_options *o, pd_diag *diag)
+{
+    if (!o)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_static_options_check: NULL options");
+    if ((unsigned)o->topple > (unsigned)PD_TOPPLE_EDGE)
+        return pd_fail(diag, PD_ERR_USAGE, "option topple is %d: expected PD_TOPPLE_DESCENT or "
+                       "PD_TOPPLE_EDGE", (int)o->topple);
+    if (!(o->epsilon >= 0.0 && o->epsilon <= 0.5 * M_PI))
+        return pd_fail(diag, PD_ERR_USAGE, "option epsilon is %g degrees: expected a PQS "
+                       "angle from 0 to 90 degrees", o->epsilon * 180.0 / M_PI);
+    if ((unsigned)o->compare > (unsigned)PD_PQS_COMPARE_QS)
+        return pd_fail(diag, PD_ERR_USAGE, "option compare is %d: expected PD_PQS_COMPARE_RAW "
+                       "or PD_PQS_COMPARE_QS", (int)o->compare);
+    if ((unsigned)o->band > (unsigned)PD_PQS_BAND_EXACT)
+        return pd_fail(diag, PD_ERR_USAGE, "option band is %d: expected PD_PQS_BAND_RECT or "
+                       "PD_PQS_BAND_EXACT", (int)o->band);
+    return PD_OK;
 }
 
 void pd_static_result_free(pd_static_result *result)
@@ -131,18 +154,21 @@ pd_status pd_static_estimate(const pd_part *part, const pd_static_options *optio
         opt = *options;
     else
         pd_static_options_default(&opt);
-    if (!part || !result)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_static_estimate: NULL argument");
-    if (!(opt.epsilon >= 0.0 && opt.epsilon <= 0.5 * M_PI))
-        return pd_fail(diag, PD_ERR_USAGE, "PQS epsilon must lie in [0, 90] degrees, got %g",
-                       opt.epsilon * 180.0 / M_PI);
+    pd_status st = pd_part_check(part, "pd_static_estimate", diag);
+    if (st != PD_OK)
+        return st;
+    if (!result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_static_estimate: NULL result");
+    if ((st = pd_static_options_check(&opt, diag)) != PD_OK)
+        return st;
 
     int n = part->hull->nfacets;
     pd_static_result *res = calloc(1, sizeof *res);
     facet_geom *geom = malloc(sizeof *geom * (size_t)n);
     double *pert = malloc(sizeof *pert * (size_t)n);
-    pd_status st = PD_ERR_NOMEM;
+    st = PD_ERR_NOMEM;
     if (res && geom && pert) {
+        res->part_fingerprint = pd_part_fingerprint(part);
         res->nfacets = n;
         res->facets = calloc((size_t)n, sizeof *res->facets);
         if (res->facets)
@@ -157,5 +183,39 @@ pd_status pd_static_estimate(const pd_part *part, const pd_static_options *optio
         return st;
     }
     *result = res;
+    return PD_OK;
+}
+
+pd_status pd_static_result_check(const pd_part *part, const pd_static_result *res,
+                                 const char *who, pd_diag *diag)
+{
+    pd_status st = pd_part_check(part, who, diag);
+    if (st != PD_OK)
+        return st;
+    if (!res)
+        return pd_fail(diag, PD_ERR_USAGE, "%s: NULL static result", who);
+    if (res->part_fingerprint != pd_part_fingerprint(part))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: the static result was computed for another "
+                       "part, or the part changed since", who);
+    const pd_hull *h = part->hull;
+    if (res->nfacets != h->nfacets || !res->facets || res->nposes < 0 ||
+        res->nposes > h->nfacets || (res->nposes > 0 && !res->poses))
+        return pd_fail(diag, PD_ERR_USAGE, "%s: the static result's tables (%d facets, %d "
+                       "poses) do not fit the part's hull of %d facets", who, res->nfacets,
+                       res->nposes, h->nfacets);
+    /* Poses on distinct facets in range: a facet may hold one pose only,
+     * so each pose's facet must not recur among the poses after it; the
+     * facets' rest links record each stable facet as its own. */
+    for (int i = 0; i < res->nposes; i++) {
+        int f = res->poses[i].facet;
+        if (f < 0 || f >= h->nfacets || res->facets[f].rest != f)
+            return pd_fail(diag, PD_ERR_USAGE, "%s: pose %d of the static result rests on "
+                           "facet %d, not a stable facet of the part's hull (%d facets)", who,
+                           i + 1, f, h->nfacets);
+        for (int j = 0; j < i; j++)
+            if (res->poses[j].facet == f)
+                return pd_fail(diag, PD_ERR_USAGE, "%s: poses %d and %d of the static result "
+                               "rest on the same facet %d", who, j + 1, i + 1, f);
+    }
     return PD_OK;
 }

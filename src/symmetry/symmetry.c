@@ -5,8 +5,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/fail.h"
+#include "part/part_check.h"
 #include "posedrop/symmetry.h"
 #include "posedrop/tolerances.h"
+#include "static/static_check.h"
 #include "symmetry/symmetry_search.h"
 #include "base/vec3.h"
 
@@ -41,11 +43,15 @@ static int collect(void *user, const double R[3][3], const int *perm, uint64_t o
 pd_status pd_symmetry_find_by(const pd_part *part, pd_symmetry_method method,
                               pd_symmetry **symmetry, pd_diag *diag)
 {
-    *symmetry = NULL;
+    pd_status st = pd_part_check(part, "pd_symmetry_find", diag);
+    if (st != PD_OK)
+        return st;
+    if (!symmetry)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_symmetry_find: NULL symmetry");
     rot_list l = {0, 0, NULL, NULL};
     int capped = 0;
     pd_symmetry *s = calloc(1, sizeof *s);
-    pd_status st = s ? pd_symmetry_search(part, method, collect, &l, &capped, diag) : PD_ERR_NOMEM;
+    st = s ? pd_symmetry_search(part, method, collect, &l, &capped, diag) : PD_ERR_NOMEM;
     if (st == PD_OK && !pd_symmetry_sort(l.rot, l.order, l.n))
         st = PD_ERR_NOMEM;
     free(l.order);
@@ -181,14 +187,17 @@ pd_status pd_pose_classes_by(const pd_part *part, const pd_static_result *res,
                              pd_symmetry_method method, int *class_of, int *nclasses,
                              pd_diag *diag)
 {
+    pd_status st = pd_static_result_check(part, res, "pd_pose_classes", diag);
+    if (st != PD_OK)
+        return st;
+    if (!class_of || !nclasses)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_pose_classes: NULL %s",
+                       class_of ? "nclasses" : "class_of");
     const pd_hull *h = part->hull;
-    *nclasses = 0;
-    for (int i = 0; i < res->nposes; i++)
-        if (res->poses[i].facet < 0 || res->poses[i].facet >= h->nfacets)
-            return pd_fail(diag, PD_ERR_USAGE, "pose %d rests on facet %d, not a facet of the "
-                           "part's hull (%d facets)", i + 1, res->poses[i].facet, h->nfacets);
-    if (res->nposes == 0)
+    if (res->nposes == 0) {
+        *nclasses = 0;
         return PD_OK;
+    }
 
     class_ctx k;
     memset(&k, 0, sizeof k);
@@ -203,7 +212,7 @@ pd_status pd_pose_classes_by(const pd_part *part, const pd_static_result *res,
     k.vf = malloc(sizeof *k.vf * ncorners);
     k.stamp = calloc(nv, sizeof *k.stamp);
     int *fill = malloc(sizeof *fill * (nv ? nv : 1));
-    pd_status st = k.parent && k.pose_of && k.vf_start && k.vf && k.stamp && fill
+    st = k.parent && k.pose_of && k.vf_start && k.vf && k.stamp && fill
                        ? PD_OK
                        : pd_fail(diag, PD_ERR_NOMEM, "out of memory grouping poses");
     if (st == PD_OK) {

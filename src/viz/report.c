@@ -180,11 +180,11 @@ static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
         /* The automatic contact time by name and with the value it stands
          * for here (the scene holds a code for it, not a duration). */
         const pd_dist *ct = &s->range[PD_PARAM_CONTACT_TIME];
-        double auto_s = pd_contact_time_auto(part->size);
+        double auto_s = pd_contact_time_auto(pd_contact_time_auto_size(part));
         if (ct->kind == PD_DIST_FIXED && s->contact_time == PD_CONTACT_TIME_AUTO)
-            snprintf(contact, sizeof contact, "auto (%.4g s for this part's size)", auto_s);
+            snprintf(contact, sizeof contact, "auto (%.4g s for this part's size and volume)", auto_s);
         else if (ct->auto_multiple)
-            snprintf(contact, sizeof contact, "%s times auto (%.4g s for this part's size)",
+            snprintf(contact, sizeof contact, "%s times auto (%.4g s for this part's size and volume)",
                      p[PD_PARAM_CONTACT_TIME], auto_s);
         else
             snprintf(contact, sizeof contact, "%s s%s", p[PD_PARAM_CONTACT_TIME],

@@ -15,5 +15,7 @@ int pd_fuzz_stl(const uint8_t *data, size_t size);
 int pd_fuzz_obj(const uint8_t *data, size_t size);
 int pd_fuzz_scene(const uint8_t *data, size_t size);
 int pd_fuzz_part(const uint8_t *data, size_t size);
+/* A program of library calls (see fuzz_targets.c). */
+int pd_fuzz_api(const uint8_t *data, size_t size);
 
 #endif

@@ -7,6 +7,7 @@
 #include "posedrop/hull.h"
 #include "posedrop/part.h"
 #include "posedrop/sim.h"
+#include "posedrop/static.h"
 #include "posedrop/tolerances.h"
 #include "shapes.h"
 #include "base/vec3.h"
@@ -440,4 +441,20 @@ pd_part *ring_part(const ring_spec *r, const double R[3][3], double scale, pd_ve
     pd_hull_free(h);
     free(pts);
     return part;
+}
+
+int mesh_part(pd_mesh *m, pd_part **part, pd_static_result **poses)
+{
+    *part = NULL;
+    *poses = NULL;
+    int ok = m && pd_part_build(m, NULL, part, NULL) == PD_OK &&
+             pd_static_estimate(*part, NULL, poses, NULL) == PD_OK;
+    pd_mesh_free(m);
+    if (!ok) {
+        pd_static_result_free(*poses);
+        pd_part_free(*part);
+        *part = NULL;
+        *poses = NULL;
+    }
+    return ok;
 }

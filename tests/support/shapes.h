@@ -108,6 +108,11 @@ pd_status part_of_points(const pd_vec3 *pts, int n, struct pd_part **part, struc
 
 /* Convenience: convex_mesh of the points above. */
 pd_mesh *mesh_box(double ax, double ay, double az);
+
+/* The part of mesh m (consumed) and its static estimate; 0, both NULL, on
+ * failure. */
+struct pd_static_result;
+int mesh_part(pd_mesh *m, struct pd_part **part, struct pd_static_result **poses);
 pd_mesh *mesh_prism(int nsides, double radius, double height);
 
 /* A w x d x h box (x, y, z) whose bottom is a shallow roof: two facets

@@ -5,6 +5,7 @@
 #define PD_SUITES   \
     PD_SUITE(status) \
     PD_SUITE(api)    \
+    PD_SUITE(nullargs) \
     PD_SUITE(mesh)   \
     PD_SUITE(hull)   \
     PD_SUITE(mass)   \

@@ -1,11 +1,14 @@
 /* test_api.c: the library's contracts with a program: its version, the
  * engines a program can ask for (Bullet only once registered), and
  * pd_sim_run refusing impossible scenes and options with a status that names
- * the field, before any drop runs.
+ * the field, before any drop runs, and calls given two objects that do not
+ * belong together (a static result of another part, a shard of another run)
+ * refusing them.
  *
  * Runs before every other suite that uses Bullet (suites.h), so the first
  * checks see an unregistered Bullet, as a C program that never links
  * libposedrop-bullet does. */
+#include <limits.h>
 #include <math.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -192,8 +195,317 @@ static void test_impossible_options(const fixture *f)
     REFUSE(o.engine = (pd_engine_kind)3, PD_ERR_USAGE, "engine");
 }
 
+/* A part and its static estimate from a mesh (consumed), or 0. */
+static int part_and_poses(pd_mesh *m, pd_part **part, pd_static_result **res)
+{
+    int ok = mesh_part(m, part, res);
+    CHECK(ok);
+    return ok;
+}
+
+static pd_mesh *read_part(const char *path)
+{
+    pd_mesh *m = NULL;
+    return pd_mesh_read(path, NULL, &m, NULL) == PD_OK ? m : NULL;
+}
+
+/* call must refuse with PD_ERR_USAGE and a message containing what. */
+#define REFUSED(call, d, what)                                                            \
+    do {                                                                                   \
+        pd_diag_init(&(d));                                                                \
+        CHECK_STATUS(call, PD_ERR_USAGE);                                                  \
+        if (!strstr((d).message, what))                                                    \
+            printf("     expected '%s' in the message: %s\n", what, (d).message);          \
+        CHECK(strstr((d).message, what) != NULL);                                          \
+    } while (0)
+
+/* A static result belongs to the part it was computed from: the cube's
+ * drops with the cap's pose table wrote past the end of a 6-facet array
+ * (issue 22), and the cap with the cube's table read the wrong facets. */
+static void test_result_of_another_part(void)
+{
+    pd_part *cube = NULL, *cap = NULL;
+    pd_static_result *cube_res = NULL, *cap_res = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.01, 0.01), &cube, &cube_res) ||
+        !part_and_poses(read_part("parts/cap.off"), &cap, &cap_res))
+        goto done;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 10;
+    o.threads = 1;
+    pd_diag d;
+    pd_sim_result untouched, *r = &untouched;
+    REFUSED(pd_sim_run(cube, cap_res, NULL, &o, &r, &d), d, "another part");
+    REFUSED(pd_sim_run(cap, cube_res, NULL, &o, &r, &d), d, "another part");
+    CHECK(r == &untouched);
+    int cls[256], n = -1;
+    REFUSED(pd_pose_classes(cube, cap_res, cls, &n, &d), d, "another part");
+    REFUSED(pd_pose_classes(cap, cube_res, cls, &n, &d), d, "another part");
+    CHECK_INT(n, -1);
+
+    /* The same mesh built again is the same part: its estimate fits. */
+    pd_part *again = NULL;
+    pd_mesh *m = mesh_box(0.01, 0.01, 0.01);
+    CHECK_STATUS(pd_part_build(m, NULL, &again, NULL), PD_OK);
+    pd_mesh_free(m);
+    CHECK_STATUS(pd_sim_run(again, cube_res, NULL, &o, &r, NULL), PD_OK);
+    if (r != &untouched)
+        pd_sim_result_free(r);
+    r = &untouched;
+    pd_part_free(again);
+
+    /* A part freed and another built in its place (malloc often gives the
+     * same address back): the fingerprint, not the address, decides. */
+    const pd_part *old_address = cube;
+    pd_part_free(cube);
+    cube = NULL;
+    pd_static_result *other_res = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.02, 0.03), &cube, &other_res))
+        goto done;
+    pd_note("api: the box was built %s the freed cube's address\n",
+            (const void *)cube == (const void *)old_address ? "at" : "away from");
+    REFUSED(pd_sim_run(cube, cube_res, NULL, &o, &r, &d), d, "another part");
+    pd_static_result_free(other_res);
+
+    /* A part changed after its estimate (the struct is the caller's to
+     * write): the centre of mass moved by one ulp is another part. */
+    cap->com.x = nextafter(cap->com.x, 1.0);
+    REFUSED(pd_sim_run(cap, cap_res, NULL, &o, &r, &d), d, "another part");
+    cap->com.x = nextafter(cap->com.x, -1.0);
+    CHECK_STATUS(pd_pose_classes(cap, cap_res, cls, &n, NULL), PD_OK);
+
+    /* A pose table edited by hand: each pose on a distinct stable facet. */
+    int f0 = cap_res->poses[0].facet;
+    cap_res->poses[0].facet = cap_res->nfacets;
+    REFUSED(pd_sim_run(cap, cap_res, NULL, &o, &r, &d), d, "not a stable facet");
+    cap_res->poses[0].facet = cap_res->poses[1].facet;
+    REFUSED(pd_pose_classes(cap, cap_res, cls, &n, &d), d, "same facet");
+    cap_res->poses[0].facet = f0;
+    CHECK(r == &untouched);
+done:
+    pd_static_result_free(cube_res);
+    pd_static_result_free(cap_res);
+    pd_part_free(cube);
+    pd_part_free(cap);
+}
+
+/* Shards add up only within their run: the counts of another part's or
+ * another scene's run of the same pose count and seed used to be summed. */
+static void test_shard_of_another_run(void)
+{
+    pd_part *a = NULL, *b = NULL;
+    pd_static_result *ra = NULL, *rb = NULL;
+    if (!part_and_poses(mesh_box(0.01, 0.02, 0.03), &a, &ra) ||
+        !part_and_poses(mesh_box(0.01, 0.02, 0.035), &b, &rb))
+        goto done;
+    CHECK_INT(ra->nposes, rb->nposes);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = 20;
+    o.threads = 1;
+    o.nshards = 2;
+    pd_scene sc, other_mu;
+    pd_scene_default(&sc);
+    other_mu = sc;
+    other_mu.mu = 0.4;
+    pd_sim_result *sum = NULL, *mine = NULL, *theirs = NULL, *mu = NULL, *threads = NULL;
+    pd_sim_options o2 = o;
+    o2.threads = 2;
+    o2.keep_trials = 1;
+    CHECK_STATUS(pd_sim_result_new(ra, &sc, &o, &sum, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(a, ra, &sc, &o, &mine, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(b, rb, &sc, &o, &theirs, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_run(a, ra, &other_mu, &o, &mu, NULL), PD_OK);
+    o2.shard = 1;
+    CHECK_STATUS(pd_sim_run(a, ra, &sc, &o2, &threads, NULL), PD_OK);
+    if (sum && mine && theirs && mu && threads) {
+        pd_diag d;
+        REFUSED(pd_sim_result_add(sum, theirs, &d), d, "not of this run");
+        REFUSED(pd_sim_result_add(sum, mu, &d), d, "not of this run");
+        CHECK_INT(sum->n, 0);
+        /* Threads and trials do not change outcomes: those shards fit. */
+        CHECK_STATUS(pd_sim_result_add(sum, mine, NULL), PD_OK);
+        CHECK_STATUS(pd_sim_result_add(sum, threads, NULL), PD_OK);
+        CHECK_INT(sum->n, o.ndrops);
+        /* A hand-made shard without its counts. */
+        pd_sim_result bare = *mine;
+        bare.count = NULL;
+        REFUSED(pd_sim_result_add(sum, &bare, &d), d, "arrays");
+        int one_class[16] = {0};
+        pd_sim_result *g = NULL;
+        REFUSED(pd_sim_result_grouped(&bare, one_class, 1, &g, &d), d, "arrays");
+        CHECK(g == NULL);
+        /* More classes than poses: the api fuzz target asked for 2^30
+         * classes, and the chain's class-to-class counts (a stationary
+         * run's) took a 14 GB calloc. */
+        REFUSED(pd_sim_result_grouped(mine, one_class, mine->nposes + 1, &g, &d), d, "classes");
+        CHECK(g == NULL);
+    }
+    pd_sim_result_free(sum);
+    pd_sim_result_free(mine);
+    pd_sim_result_free(theirs);
+    pd_sim_result_free(mu);
+    pd_sim_result_free(threads);
+done:
+    pd_static_result_free(ra);
+    pd_static_result_free(rb);
+    pd_part_free(a);
+    pd_part_free(b);
+}
+
+/* Values a program can put in a struct that no reader or command would:
+ * enum fields outside their enum, a hand-made mesh whose indices or counts
+ * are wrong, a weld tolerance that is not a length. Each is an input error
+ * naming what is wrong, never a run on a guess (topple 9 ran as one of the
+ * rules), "out of memory" (nverts -4) or a crash. */
+static void test_values_checked(const fixture *f)
+{
+    pd_diag d;
+    pd_static_result untouched, *r = &untouched;
+    const struct {
+        size_t at;
+        int value;
+        const char *field;
+    } enums[] = {
+        {offsetof(pd_static_options, topple), 9, "topple"},
+        {offsetof(pd_static_options, topple), -1, "topple"},
+        {offsetof(pd_static_options, band), 9, "band"},
+        {offsetof(pd_static_options, compare), 2, "compare"},
+    };
+    for (size_t i = 0; i < sizeof enums / sizeof enums[0]; i++) {
+        pd_static_options so;
+        pd_static_options_default(&so);
+        *(int *)(void *)((char *)&so + enums[i].at) = enums[i].value;
+        REFUSED(pd_static_estimate(f->part, &so, &r, &d), d, enums[i].field);
+        REFUSED(pd_static_options_check(&so, &d), d, enums[i].field);
+    }
+    pd_static_options so;
+    pd_static_options_default(&so);
+    so.epsilon = NAN;
+    REFUSED(pd_static_estimate(f->part, &so, &r, &d), d, "epsilon");
+    CHECK(r == &untouched);
+    pd_static_options_default(&so);
+    CHECK_STATUS(pd_static_options_check(&so, NULL), PD_OK);
+
+    /* Read options: units 42 used to read as metres, format 9 as "unknown
+     * format". pd_units_scale says 0 for what is no unit. */
+    static const char tet[] = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n"
+                              "3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    ro.units = (pd_units)42;
+    pd_mesh *m = NULL;
+    REFUSED(pd_mesh_parse(tet, sizeof tet - 1, "t.off", &ro, &m, &d), d, "units");
+    pd_mesh_read_options_default(&ro);
+    ro.format = (pd_mesh_format)9;
+    REFUSED(pd_mesh_parse(tet, sizeof tet - 1, "t.off", &ro, &m, &d), d, "format");
+    CHECK(m == NULL);
+    CHECK(pd_units_scale((pd_units)42) == 0.0);
+    CHECK(pd_units_scale(PD_UNITS_IN) == 0.0254);
+
+    /* Part options: a flag is 0 or 1, a given centre is finite. */
+    pd_mesh *box = mesh_box(0.01, 0.02, 0.03);
+    pd_part *p = NULL;
+    pd_part_options po;
+    pd_part_options_default(&po);
+    po.com_given = 7;
+    REFUSED(pd_part_build(box, &po, &p, &d), d, "com_given");
+    po.com_given = 1;
+    po.com.y = NAN;
+    pd_diag_init(&d);
+    CHECK_STATUS(pd_part_build(box, &po, &p, &d), PD_ERR_NONFINITE);
+    CHECK(strstr(d.message, "centre of mass") != NULL);
+    CHECK(p == NULL);
+
+    /* Hand-made meshes: an index past the end or negative is
+     * PD_ERR_RANGE, a negative count PD_ERR_USAGE. */
+    if (box) {
+        const struct {
+            int tri, corner, value;
+            int nverts;
+            pd_status want;
+            const char *what;
+        } bad[] = {
+            {3, 1, 8, 8, PD_ERR_RANGE, "out of range"},
+            {0, 2, -1, 8, PD_ERR_RANGE, "out of range"},
+            {0, 0, 0, -4, PD_ERR_USAGE, "invalid mesh"},
+        };
+        for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+            pd_mesh *c = pd_mesh_clone(box);
+            if (!c)
+                continue;
+            c->tris[bad[i].tri][bad[i].corner] = bad[i].value;
+            if (bad[i].nverts < 0)
+                c->nverts = bad[i].nverts;
+            pd_diag_init(&d);
+            CHECK_STATUS(pd_part_build(c, NULL, &p, &d), bad[i].want);
+            CHECK(strstr(d.message, bad[i].what) != NULL);
+            CHECK(p == NULL);
+            pd_mass mass;
+            CHECK_STATUS(pd_mass_compute(c, &mass, NULL), bad[i].want);
+            CHECK_STATUS(pd_mesh_weld(c, 1e-9, NULL), bad[i].want);
+            c->nverts = 8;
+            pd_mesh_free(c);
+        }
+        /* Weld tolerances: a length, 0 for bit-identical vertices only. */
+        const double tols[] = {NAN, -1e-9, INFINITY};
+        for (size_t i = 0; i < sizeof tols / sizeof tols[0]; i++) {
+            int merged = -1;
+            CHECK_STATUS(pd_mesh_weld(box, tols[i], &merged), PD_ERR_USAGE);
+            CHECK_INT(merged, -1);
+            CHECK_INT(box->nverts, 8);
+        }
+        CHECK_STATUS(pd_mesh_weld(box, 0.0, NULL), PD_OK);
+    }
+    pd_mesh_free(box);
+
+    /* Shards: a shard outside the run, or counts that would overflow. */
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.nshards = 3;
+    o.shard = 3;
+    REFUSED(pd_sim_options_check(&o, &d), d, "shard");
+    o.nshards = -1;
+    o.shard = 0;
+    REFUSED(pd_sim_options_check(&o, &d), d, "nshards");
+    pd_sim_options_default(&o);
+    o.engine = (pd_engine_kind)9;
+    REFUSED(pd_sim_options_check(&o, &d), d, "engine");
+    pd_sim_options_default(&o);
+    CHECK_STATUS(pd_sim_options_check(&o, NULL), PD_OK);
+    CHECK_INT(pd_shard_of(-3, 2), -1);
+    CHECK_INT(pd_shard_drops(LONG_MAX, -5, 1), 0);
+    CHECK_INT(pd_shard_drops(LONG_MAX, 0, 1), LONG_MAX);
+    CHECK_INT(pd_shard_drops(LONG_MAX, 1, 2), LONG_MAX / 2);
+    CHECK_INT(pd_shard_drops(10, 3, 3), 0);
+}
+
+/* max_drops caps a ci_halfwidth run whatever the half-width asks: 1e-7
+ * asks for ~1e14 drops, which ran (found by the api fuzz target as a
+ * timeout) although the header and docs/cli.md promise at most max_drops;
+ * ndrops run even when more. */
+static void test_ci_capped(const fixture *f)
+{
+    const long cases[][3] = {{3, 25, 25}, {30, 5, 30}, {0, 7, 7}};
+    for (int i = 0; i < 3; i++) {
+        pd_sim_options o;
+        pd_sim_options_default(&o);
+        o.threads = 1;
+        /* The last asks for more drops than a long counts. */
+        o.ci_halfwidth = i < 2 ? 1e-7 : 1e-300;
+        o.ndrops = cases[i][0];
+        o.max_drops = cases[i][1];
+        pd_sim_result *r = NULL;
+        CHECK_STATUS(pd_sim_run(f->part, f->poses, NULL, &o, &r, NULL), PD_OK);
+        CHECK(r != NULL && r->n == cases[i][2] && !r->partial);
+        pd_sim_result_free(r);
+    }
+}
+
 void suite_api(void)
 {
+    test_result_of_another_part();
+    test_shard_of_another_run();
     test_version();
     fixture f;
     if (!setup(&f))
@@ -201,6 +513,8 @@ void suite_api(void)
     test_engines(&f);
     test_impossible_scenes(&f);
     test_impossible_options(&f);
+    test_values_checked(&f);
+    test_ci_capped(&f);
     pd_static_result_free(f.poses);
     pd_part_free(f.part);
 }

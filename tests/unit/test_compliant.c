@@ -24,6 +24,7 @@
  * on a quarter of that again (drops_scale.h): every check runs, and the
  * statistical tests keep their level at any count, with less power to see a
  * small effect. */
+
 /* --- a model of any part, at any tolerance scale ---------------------------- */
 
 typedef struct {

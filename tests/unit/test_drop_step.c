@@ -14,15 +14,10 @@
 #include "suites.h"
 #include "base/vec3.h"
 
-/* The part of mesh m (consumed) and its poses; 0 (a check counted) on
- * failure. */
-static int mesh_part(pd_mesh *m, pd_part **part, pd_static_result **poses)
+/* mesh_part, a check counted. */
+static int checked_mesh_part(pd_mesh *m, pd_part **part, pd_static_result **poses)
 {
-    *part = NULL;
-    *poses = NULL;
-    int ok = m && pd_part_build(m, NULL, part, NULL) == PD_OK &&
-             pd_static_estimate(*part, NULL, poses, NULL) == PD_OK;
-    pd_mesh_free(m);
+    int ok = mesh_part(m, part, poses);
     CHECK(ok);
     return ok;
 }
@@ -36,7 +31,7 @@ static int solid_part(int (*solid)(pd_vec3 *), pd_part **part, pd_static_result 
     double I[3][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}};
     if (m)
         mesh_transform(m, CR(I), 0.005, v3(0, 0, 0));
-    return mesh_part(m, part, poses);
+    return checked_mesh_part(m, part, poses);
 }
 
 static pd_sim_options drop_options(pd_engine_kind engine, long drops)
@@ -148,7 +143,7 @@ static void small_parts_ode(void)
     for (int k = 0; k < 3; k++) {
         pd_part *part;
         pd_static_result *poses;
-        int ok = mesh_part(meshes[k], &part, &poses);
+        int ok = checked_mesh_part(meshes[k], &part, &poses);
         pd_sim_options o = drop_options(PD_ENGINE_ODE, 100);
         o.threads = 1;
         o.keep_trials = 1;
@@ -194,7 +189,7 @@ static void ridge_settles(pd_engine_kind engine, double deg, long drops)
 {
     pd_part *part;
     pd_static_result *poses;
-    int ok = mesh_part(mesh_roof_box(0.02, 0.01, 0.01, deg * M_PI / 180.0), &part, &poses);
+    int ok = checked_mesh_part(mesh_roof_box(0.02, 0.01, 0.01, deg * M_PI / 180.0), &part, &poses);
     int roof[2] = {-1, -1}, nroof = 0;
     for (int k = 0; ok && k < poses->nposes; k++)
         if (poses->poses[k].normal.z < -0.99 && nroof < 2)
@@ -226,7 +221,7 @@ static void needles_settle(double length, double aspect, long drops)
 {
     pd_part *part;
     pd_static_result *poses;
-    int ok = mesh_part(mesh_box(length, length / aspect, length / aspect), &part, &poses);
+    int ok = checked_mesh_part(mesh_box(length, length / aspect, length / aspect), &part, &poses);
     pd_sim_options o = drop_options(PD_ENGINE_IMPULSE, drops);
     o.threads = 2;
     o.keep_trials = 1;
@@ -260,7 +255,7 @@ static void pyramids_settle(long drops)
                 mesh_transform(m, CR(I), 0.01, v3(0, 0, 0));
             pd_part *part;
             pd_static_result *poses;
-            int ok = mesh_part(m, &part, &poses);
+            int ok = checked_mesh_part(m, &part, &poses);
             pd_sim_options o = drop_options(PD_ENGINE_IMPULSE, drops);
             o.threads = 2;
             o.keep_trials = 1;

@@ -101,7 +101,7 @@ static void test_deterministic(const fixture *f)
     o.ndrops = n;
     o.seed = 11;
     pd_sim_result *sum = NULL;
-    CHECK_STATUS(pd_sim_result_new(f->poses->nposes, &sc, &o, &sum, NULL), PD_OK);
+    CHECK_STATUS(pd_sim_result_new(f->poses, &sc, &o, &sum, NULL), PD_OK);
     int records = 1;
     for (int k = 0; k < 3 && sum && one; k++) {
         pd_sim_result *s = sim_run(f, &sc, PD_ENGINE_IMPULSE, n, 2, 3, k);

@@ -223,7 +223,7 @@ static void test_shards(void)
         pd_sim_result *whole = run(&f, &sc, &o), *sum = NULL;
         CHECK(whole != NULL);
         for (int n = 1; whole && n <= 5; n += 2) {
-            CHECK_STATUS(pd_sim_result_new(f.poses->nposes, &sc, &o, &sum, NULL), PD_OK);
+            CHECK_STATUS(pd_sim_result_new(f.poses, &sc, &o, &sum, NULL), PD_OK);
             long drops = 0;
             for (int k = 0; sum && k < n; k++) {
                 pd_sim_options os = o;
@@ -255,7 +255,7 @@ static void test_shards(void)
             sum = NULL;
         }
         /* Another seed's shard does not fit. */
-        CHECK_STATUS(pd_sim_result_new(f.poses->nposes, &sc, &o, &sum, NULL), PD_OK);
+        CHECK_STATUS(pd_sim_result_new(f.poses, &sc, &o, &sum, NULL), PD_OK);
         pd_sim_options other = o;
         other.seed = 12;
         other.nshards = 2;

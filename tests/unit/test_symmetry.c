@@ -620,6 +620,7 @@ static void test_grouped_counts(void)
         CHECK(g->trials == NULL);
     }
     pd_sim_result_free(g);
+    g = NULL;
     int bad[4] = {0, 1, 2, 1};
     CHECK_STATUS(pd_sim_result_grouped(&sim, bad, 2, &g, NULL), PD_ERR_USAGE);
     CHECK(g == NULL);

@@ -565,7 +565,7 @@ static void test_command(void)
     pd_static_result *res;
     load("parts/insulator_cap.off", &mesh, &part, &res);
     snprintf(auto_time, sizeof auto_time, "contact time auto (%.4g s for this part",
-             part ? pd_contact_time_auto(part->size) : -1.0);
+             part ? pd_contact_time_auto(pd_contact_time_auto_size(part)) : -1.0);
     unload(mesh, part, res);
     CHECK(r && strstr(r, auto_time) && !strstr(r, "contact time -"));
     CHECK(r && strstr(r, "<p class=\"size\">The part is <strong>"));
