@@ -748,6 +748,8 @@ static PyObject *Poses_classes(PosesObject *self, PyObject *unused)
 typedef struct {
     PyObject_HEAD
     pd_sim_result *sim;
+    pd_scene scene;     /* the scene the drops ran in, for their sensitivity */
+    double part_size;   /* pd_contact_time_auto_size of the part */
 } DropsObject;
 
 static PyTypeObject DropsType;
@@ -758,7 +760,7 @@ static void Drops_dealloc(DropsObject *self)
     Py_TYPE(self)->tp_free((PyObject *)self);
 }
 
-static PyObject *drops_new(pd_sim_result *sim)
+static PyObject *drops_new(pd_sim_result *sim, const pd_scene *scene, double part_size)
 {
     DropsObject *d = PyObject_New(DropsObject, &DropsType);
     if (!d) {
@@ -766,6 +768,8 @@ static PyObject *drops_new(pd_sim_result *sim)
         return NULL;
     }
     d->sim = sim;
+    d->scene = *scene;
+    d->part_size = part_size;
     return (PyObject *)d;
 }
 
@@ -920,6 +924,33 @@ static int opt_double(const char *name, PyObject *value, double *field)
     return value == Py_None ? 0 : finite_double(name, value, field);
 }
 
+/* time_limit: None or "auto" keeps PD_TIME_LIMIT_AUTO; a number must be
+ * above 0, as the command's --time-limit (0 would silently mean auto). */
+static int opt_time_limit(PyObject *value, double *field)
+{
+    if (value == Py_None)
+        return 0;
+    if (PyUnicode_Check(value)) {
+        if (PyUnicode_CompareWithASCIIString(value, "auto") == 0) {
+            *field = PD_TIME_LIMIT_AUTO;
+            return 0;
+        }
+        raise_status(PD_ERR_USAGE, "time_limit: expected a number of seconds or \"auto\"");
+        return -1;
+    }
+    double x;
+    if (finite_double("time_limit", value, &x) < 0)
+        return -1;
+    if (!(x > 0)) {
+        char msg[PD_DIAG_MESSAGE_LEN];
+        snprintf(msg, sizeof msg, "time_limit: expected seconds above 0 or \"auto\", got %g", x);
+        raise_status(PD_ERR_RANGE, msg);
+        return -1;
+    }
+    *field = x;
+    return 0;
+}
+
 /* The scene: the defaults, then the file, then each (key, text) pair, all
  * through the library's own reader, as the command's --scene and options. */
 static int build_scene(PyObject *file, PyObject *items, pd_scene *scene)
@@ -988,7 +1019,7 @@ static PyObject *Poses_drop(PosesObject *self, PyObject *args, PyObject *kw)
         opt_double("ci", ci, &o->ci_halfwidth) < 0 || opt_int(threads, &o->threads) < 0 ||
         choose("engine", engine_names, engine, &eng) < 0 || opt_double("dt", dt, &o->dt) < 0 ||
         opt_long(max_drops, &o->max_drops) < 0 ||
-        opt_double("time_limit", time_limit, &o->time_limit) < 0 ||
+        opt_time_limit(time_limit, &o->time_limit) < 0 ||
         opt_int(max_collisions, &o->max_collisions) < 0) {
         free(c);
         return NULL;
@@ -1020,7 +1051,7 @@ static PyObject *Poses_drop(PosesObject *self, PyObject *args, PyObject *kw)
     } else if (diag_finish(&w) < 0) {
         pd_sim_result_free(c->sim);
     } else {
-        result = drops_new(c->sim);
+        result = drops_new(c->sim, &c->scene, pd_contact_time_auto_size(c->part));
     }
     free(c);
     return result;
@@ -1039,6 +1070,11 @@ static PyObject *Drops_arrays(DropsObject *self, PyObject *unused)
               put_doubles(d, "p", s->p, k) || put_doubles(d, "ci_lo", s->ci_lo, k) ||
               put_doubles(d, "ci_hi", s->ci_hi, k) ||
               put(d, "unsettled", PyLong_FromLong(s->unsettled)) ||
+              put(d, "time_limited", PyLong_FromLong(s->time_limited)) ||
+              put(d, "collision_limited", PyLong_FromLong(s->collision_limited)) ||
+              put(d, "failed", PyLong_FromLong(s->failed)) ||
+              put(d, "first_failed", PyLong_FromLong(s->first_failed)) ||
+              put(d, "time_limit", PyFloat_FromDouble(s->time_limit)) ||
               put(d, "energy_gain", PyLong_FromLong(s->energy_gain)) ||
               put(d, "fallbacks", PyLong_FromLong(s->fallbacks)) ||
               put(d, "collisions", PyLong_FromLong(s->collisions)) ||
@@ -1056,20 +1092,37 @@ static PyObject *Drops_arrays(DropsObject *self, PyObject *unused)
     if (!bad && s->trials) {
         size_t m = (size_t)s->n;
         void *q0 = NULL, *pose = NULL, *coll = NULL, *time = NULL, *end = NULL;
+        void *stage = NULL, *status = NULL, *param = NULL;
         bad = put(d, "trial_q0", new_buffer(4 * m, sizeof(double), &q0)) ||
               put(d, "trial_pose", new_buffer(m, sizeof(int32_t), &pose)) ||
               put(d, "trial_collisions", new_buffer(m, sizeof(int32_t), &coll)) ||
               put(d, "trial_time", new_buffer(m, sizeof(double), &time)) ||
-              put(d, "trial_end", new_buffer(m, sizeof(int32_t), &end));
+              put(d, "trial_end", new_buffer(m, sizeof(int32_t), &end)) ||
+              put(d, "trial_stage", new_buffer(m, sizeof(int32_t), &stage)) ||
+              put(d, "trial_status", new_buffer(m, sizeof(int32_t), &status)) ||
+              put(d, "trial_param", new_buffer(PD_NPARAMS * m, sizeof(double), &param));
         for (size_t i = 0; !bad && i < m; i++) {
             const pd_trial *t = &s->trials[i];
             memcpy((double *)q0 + 4 * i, t->q0, sizeof t->q0);
+            memcpy((double *)param + PD_NPARAMS * i, t->param, sizeof t->param);
             ((int32_t *)pose)[i] = t->pose;
             ((int32_t *)coll)[i] = t->collisions;
             ((double *)time)[i] = t->time;
             ((int32_t *)end)[i] = (int32_t)t->end;
+            ((int32_t *)stage)[i] = (int32_t)t->stage;
+            ((int32_t *)status)[i] = (int32_t)t->status;
         }
     }
+    /* The ranged parameters in pd_scene_param order: the drawn values'
+     * columns, as --trials writes them. */
+    PyObject *ranged = bad ? NULL : PyList_New(0);
+    bad = bad || put(d, "ranged", ranged);
+    for (int k = 0; !bad && k < PD_NPARAMS; k++)
+        if (self->scene.range[k].kind != PD_DIST_FIXED) {
+            PyObject *name = PyUnicode_FromString(pd_scene_param_name((pd_scene_param)k));
+            bad = !name || PyList_Append(ranged, name) < 0;
+            Py_XDECREF(name);
+        }
     if (bad) {
         Py_DECREF(d);
         return NULL;
@@ -1077,37 +1130,46 @@ static PyObject *Drops_arrays(DropsObject *self, PyObject *unused)
     return d;
 }
 
-static PyObject *Drops_grouped(DropsObject *self, PyObject *args)
+/* The class of each pose from a C-contiguous int32 buffer: 0 with the view
+ * held (the caller releases it), -1 with an exception set. */
+static int read_classes(const DropsObject *self, PyObject *obj, int nclasses, Py_buffer *view)
 {
-    PyObject *obj;
-    int nclasses;
-    if (!PyArg_ParseTuple(args, "Oi", &obj, &nclasses))
-        return NULL;
-    Py_buffer view;
-    if (PyObject_GetBuffer(obj, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
-        return NULL;
-    const char *f = view.format ? view.format : "B";
+    if (PyObject_GetBuffer(obj, view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+        return -1;
+    const char *f = view->format ? view->format : "B";
     if (*f == '<' || *f == '=' || *f == '@')
         f++;
     char msg[PD_DIAG_MESSAGE_LEN] = "";
-    if (view.ndim != 1 || view.itemsize != sizeof(int) || strcmp(f, "i") != 0 ||
-        view.shape[0] != self->sim->nposes)
+    if (view->ndim != 1 || view->itemsize != sizeof(int) || strcmp(f, "i") != 0 ||
+        view->shape[0] != self->sim->nposes)
         snprintf(msg, sizeof msg, "classes: expected %d int32 class numbers, one per pose",
                  self->sim->nposes);
-    const int *class_of = view.buf;
+    const int *class_of = view->buf;
     for (int i = 0; !*msg && i < self->sim->nposes; i++)
         if (class_of[i] < 0 || class_of[i] >= nclasses)
             snprintf(msg, sizeof msg, "classes[%d] is %d: expected a class from 0 to %d", i,
                      class_of[i], nclasses - 1);
     if (*msg) {
-        PyBuffer_Release(&view);
-        return raise_status(PD_ERR_USAGE, msg);
+        PyBuffer_Release(view);
+        raise_status(PD_ERR_USAGE, msg);
+        return -1;
     }
+    return 0;
+}
+
+static PyObject *Drops_grouped(DropsObject *self, PyObject *args)
+{
+    PyObject *obj;
+    int nclasses;
+    Py_buffer view;
+    if (!PyArg_ParseTuple(args, "Oi", &obj, &nclasses) ||
+        read_classes(self, obj, nclasses, &view) < 0)
+        return NULL;
     warn_box w;
     pd_diag diag;
     diag_start(&diag, &w);
     pd_sim_result *g = NULL;
-    pd_status st = pd_sim_result_grouped(self->sim, class_of, nclasses, &g, &diag);
+    pd_status st = pd_sim_result_grouped(self->sim, view.buf, nclasses, &g, &diag);
     PyBuffer_Release(&view);
     if (st != PD_OK)
         return fail(st, &diag, &w);
@@ -1115,7 +1177,66 @@ static PyObject *Drops_grouped(DropsObject *self, PyObject *args)
         pd_sim_result_free(g);
         return NULL;
     }
-    return drops_new(g);
+    return drops_new(g, &self->scene, self->part_size);
+}
+
+/* pd_sim_sensitivity of these drops (kept trials) in their scene, per pose
+ * or, given (class_of, nclasses), per class: a dict of buffers, one entry
+ * per row, pose-major, as --sensitivity writes them. */
+static PyObject *Drops_sensitivity(DropsObject *self, PyObject *args)
+{
+    PyObject *obj = Py_None;
+    int nclasses = 0;
+    Py_buffer view = {0};
+    if (!PyArg_ParseTuple(args, "|Oi", &obj, &nclasses) ||
+        (obj != Py_None && read_classes(self, obj, nclasses, &view) < 0))
+        return NULL;
+    warn_box w;
+    pd_diag diag;
+    diag_start(&diag, &w);
+    pd_sensitivity *s = NULL;
+    pd_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = pd_sim_sensitivity(self->sim, &self->scene, self->part_size,
+                            obj != Py_None ? view.buf : NULL, nclasses, &s, &diag);
+    Py_END_ALLOW_THREADS
+    if (obj != Py_None)
+        PyBuffer_Release(&view);
+    if (st != PD_OK)
+        return fail(st, &diag, &w);
+    if (diag_finish(&w) < 0) {
+        pd_sensitivity_free(s);
+        return NULL;
+    }
+    size_t m = (size_t)s->nposes * (size_t)s->nparams;
+    PyObject *d = PyDict_New(), *params = d ? PyList_New(0) : NULL;
+    int bad = !d || put(d, "params", params) || put(d, "n", PyLong_FromLong(s->n)) ||
+              put(d, "nposes", PyLong_FromLong(s->nposes));
+    for (int k = 0; !bad && k < s->nparams; k++) {
+        PyObject *name = PyUnicode_FromString(pd_scene_param_name(s->param[k]));
+        bad = !name || PyList_Append(params, name) < 0;
+        Py_XDECREF(name);
+    }
+    void *pose = NULL, *nlow = NULL, *nhigh = NULL, *v = NULL;
+    bad = bad || put(d, "pose", new_buffer(m, sizeof(int32_t), &pose)) ||
+          put(d, "n_low", new_buffer(m, sizeof(int64_t), &nlow)) ||
+          put(d, "n_high", new_buffer(m, sizeof(int64_t), &nhigh)) ||
+          put(d, "values", new_buffer(9 * m, sizeof(double), &v));
+    for (size_t i = 0; !bad && i < m; i++) {
+        const pd_sensitivity_row *r = &s->rows[i];
+        const double row[9] = {r->p_low,  r->p_low_lo,  r->p_low_hi, r->p_high,  r->p_high_lo,
+                               r->p_high_hi, r->index, r->index_lo, r->index_hi};
+        ((int32_t *)pose)[i] = r->pose;
+        ((int64_t *)nlow)[i] = r->n_low;
+        ((int64_t *)nhigh)[i] = r->n_high;
+        memcpy((double *)v + 9 * i, row, sizeof row);
+    }
+    pd_sensitivity_free(s);
+    if (bad) {
+        Py_XDECREF(d);
+        return NULL;
+    }
+    return d;
 }
 
 /* --- module ------------------------------------------------------------ */
@@ -1152,6 +1273,36 @@ static PyObject *mod_statuses(PyObject *mod, PyObject *unused)
     return d;
 }
 
+/* A tuple of n names, name(i) for i in 0..n-1. */
+static PyObject *name_tuple(int n, const char *(*name)(int))
+{
+    PyObject *t = PyTuple_New(n);
+    for (int i = 0; t && i < n; i++) {
+        PyObject *x = PyUnicode_FromString(name(i));
+        if (!x)
+            Py_CLEAR(t);
+        else
+            PyTuple_SET_ITEM(t, i, x);
+    }
+    return t;
+}
+
+static const char *stage_name(int i) { return pd_drop_stage_name((pd_drop_stage)i); }
+static const char *status_text(int i) { return pd_status_str((pd_status)i); }
+static const char *param_name(int i) { return pd_scene_param_name((pd_scene_param)i); }
+
+/* The library's names by number: drop stages (pd_drop_stage_name),
+ * statuses (pd_status_str) and ranged scene parameters
+ * (pd_scene_param_name). */
+static PyObject *mod_names(PyObject *mod, PyObject *unused)
+{
+    (void)mod;
+    (void)unused;
+    return Py_BuildValue("(NNN)", name_tuple(PD_STAGE_COUNT, stage_name),
+                         name_tuple(PD_STATUS_COUNT, status_text),
+                         name_tuple(PD_NPARAMS, param_name));
+}
+
 static PyObject *mod_engine_available(PyObject *mod, PyObject *arg)
 {
     (void)mod;
@@ -1179,6 +1330,7 @@ static PyMethodDef Poses_methods[] = {
 static PyMethodDef Drops_methods[] = {
     {"arrays", (PyCFunction)Drops_arrays, METH_NOARGS, "the result as a dict of buffers"},
     {"grouped", (PyCFunction)Drops_grouped, METH_VARARGS, "pd_sim_result_grouped"},
+    {"sensitivity", (PyCFunction)Drops_sensitivity, METH_VARARGS, "pd_sim_sensitivity"},
     {NULL, NULL, 0, NULL}};
 
 static PyMemberDef Poses_members[] = {
@@ -1224,6 +1376,7 @@ static PyMethodDef module_methods[] = {
     {"version", mod_version, METH_NOARGS, "pd_version()"},
     {"statuses", mod_statuses, METH_NOARGS, "the pd_status names and values"},
     {"engine_available", mod_engine_available, METH_O, "pd_engine_available"},
+    {"names", mod_names, METH_NOARGS, "(stage names, status strings, parameter names)"},
     {NULL, NULL, 0, NULL}};
 
 static struct PyModuleDef module_def = {PyModuleDef_HEAD_INIT, "posedrop._posedrop",

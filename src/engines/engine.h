@@ -38,6 +38,10 @@ typedef struct pd_engine {
     /* Advances one time step and reads the state back. PD_ERR_NONFINITE if
      * the engine produced a non-finite state. */
     pd_status (*step)(pd_engine_world *w, pd_state *s);
+    /* NULL, or why the engine cannot stand for this part in this scene
+     * (a sentence to follow "the <engine> engine cannot run this part: "),
+     * decided before any drop. NULL itself: the engine takes any part. */
+    const char *(*refuses)(const pd_body *body, const pd_hull *hull, const pd_scene *scene);
 } pd_engine;
 
 extern const pd_engine pd_engine_ode;    /* engine_ode.c */

@@ -26,6 +26,7 @@
  *   absolute 0.2 m/s; penetration recovered by split impulse only, so
  *   pushing a sunk part out adds no kinetic energy that the rest test would
  *   count. */
+#include <cfloat>
 #include <cmath>
 #include <new>
 
@@ -154,6 +155,22 @@ struct hull_floor_create : btCollisionAlgorithmCreateFunc {
     }
 };
 
+/* The unit Bullet is handed masses in: the power of two nearest the part's
+ * mass (so the conversion is exact), which makes the body's mass of order 1.
+ * Nothing of the motion depends on it (gravity is an acceleration, friction
+ * and restitution are ratios, the contact law's springs are per effective
+ * mass, and no mass is read back), but Bullet's solver has absolute limits:
+ * a 300 m cube of 2.7e7 kg met the floor with its contact found and no
+ * impulse applied, and fell through it (a 100 m one of 1e6 kg was held);
+ * handed its mass in units of 2^25 kg (0.8 of one) it rests, and so does a
+ * 1000 m cube. */
+static double mass_unit(double mass)
+{
+    int e;
+    double f = std::frexp(mass, &e); /* mass = f 2^e, 0.5 <= f < 1 */
+    return std::ldexp(1.0, f < M_SQRT1_2 ? e - 1 : e);
+}
+
 struct pd_engine_world {
     btDefaultCollisionConfiguration config;
     hull_floor_create hull_floor;
@@ -167,19 +184,24 @@ struct pd_engine_world {
     btRigidBody body;
     btScalar dt;
     double step_s;  /* dt in s, as the scene's contact time is compared with it */
+    double size_m, width_m; /* the part's size and thickness, m (pd_engine_contact_resolved) */
     pd_quat q_last; /* keeps the read-back quaternion on one hemisphere */
 
-    pd_engine_world(const pd_body *b, double step)
+    pd_engine_world(const pd_body *b, double step, double width, double margin)
         : dispatcher(&config),
           world(&dispatcher, &broadphase, &solver, &config),
           hull(),
-          floor(btVector3(0, 0, 1), btScalar(-PD_BULLET_MARGIN_REL * b->size)),
+          floor(btVector3(0, 0, 1), btScalar(-margin)),
           floor_body(btRigidBody::btRigidBodyConstructionInfo(0, nullptr, &floor)),
           body(btRigidBody::btRigidBodyConstructionInfo(
-              btScalar(b->mass), nullptr, &hull,
-              btVector3(btScalar(b->moment[0]), btScalar(b->moment[1]), btScalar(b->moment[2])))),
+              btScalar(b->mass / mass_unit(b->mass)), nullptr, &hull,
+              btVector3(btScalar(b->moment[0] / mass_unit(b->mass)),
+                        btScalar(b->moment[1] / mass_unit(b->mass)),
+                        btScalar(b->moment[2] / mass_unit(b->mass))))),
           dt(btScalar(step)),
           step_s(step),
+          size_m(b->size),
+          width_m(width),
           q_last(quat_identity())
     {
     }
@@ -228,11 +250,14 @@ static double contact_reach(const btConvexHullShape &hull)
 static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
 {
     contact_law &law = w->hull_floor.law;
-    double dt = w->step_s;
-    law.on = scene->contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= scene->contact_time;
     law.omega = law.zeta = 0.0;
-    if (law.on)
+    law.on = false;
+    if (scene->contact_time > 0.0) {
         pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
+        law.on = pd_engine_contact_resolved(w->step_s, scene->contact_time, law.omega,
+                                            pd_engine_fall_speed(scene, w->size_m),
+                                            w->width_m);
+    }
     /* Penetration deeper than the threshold is removed by a position-only
      * (split) impulse (see world_alloc). With the scene's spring-dashpot
      * (law.on) the penetration term is the spring's force: it must act on
@@ -244,15 +269,41 @@ static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
     return PD_OK;
 }
 
+/* Bullet's coordinates are single precision: a vertex is known to
+ * FLT_EPSILON of its distance from the origin, and a drop's vertices are at
+ * least the drop height plus the part's size from it. A part whose
+ * thickness that round-off does not resolve to PD_BULLET_WIDTH_ULPS_MAX
+ * cannot rest on its faces in Bullet: its contacts are blurred by a sizeable
+ * share of its thickness and its margin (a thousandth of the thickness) is
+ * below the round-off altogether. Measured: a 1 mm x 1 um needle
+ * (round-off 1.4e-2 of its thickness) left 4 of 100 drops balanced on an
+ * edge at the time limit; a flat pyramid 5 um high (3.2e-3) settled every
+ * one of 200. */
+static const char *bullet_refuses(const pd_body *b, const pd_hull *hull, const pd_scene *scene)
+{
+    if (!b || !hull || !scene)
+        return nullptr;
+    const pd_dist *h = &scene->range[PD_PARAM_HEIGHT];
+    double height = h->kind == PD_DIST_FIXED ? scene->height : h->hi;
+    double ulp = double(FLT_EPSILON) * (height + b->size);
+    if (ulp > PD_BULLET_WIDTH_ULPS_MAX * pd_engine_hull_width(hull))
+        return "its thickness is below what Bullet's single-precision coordinates resolve at the "
+               "drop's scale (the drop height plus its size); use the ode or impulse engine";
+    return nullptr;
+}
+
 static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull,
                                            const pd_scene *scene, double dt)
 {
-    (void)hull; /* the body's vertices are already in the principal frame */
-    if (!b || !scene || !(dt > 0.0) || b->nverts < 4 || !(b->mass > 0.0))
+    /* The body's vertices are already in the principal frame; the hull
+     * gives the thickness. */
+    if (!b || !hull || !scene || !(dt > 0.0) || b->nverts < 4 || !(b->mass > 0.0))
         return nullptr;
+    double width = pd_engine_hull_width(hull);
+    double margin = PD_BULLET_MARGIN_REL * fmin(b->size, width);
     pd_engine_world *w;
     try {
-        w = new pd_engine_world(b, dt);
+        w = new pd_engine_world(b, dt, width, margin);
     } catch (const std::bad_alloc &) {
         return nullptr;
     }
@@ -266,7 +317,7 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
      * the orientation, touches that plane exactly when the corner itself
      * reaches z = 0. Shrinking the hull instead would need a half-space
      * intersection and be exact only away from its corners. */
-    w->hull.setMargin(btScalar(PD_BULLET_MARGIN_REL * b->size));
+    w->hull.setMargin(btScalar(margin));
 
     w->hull_floor.law.reach = contact_reach(w->hull);
     w->dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, STATIC_PLANE_PROXYTYPE,
@@ -436,6 +487,7 @@ extern "C" const pd_engine pd_engine_bullet = {
     bullet_material,
     bullet_reset,
     bullet_step,
+    bullet_refuses,
 };
 
 extern "C" pd_status pd_bullet_register(void)

@@ -6,6 +6,8 @@
 #define PD_ENGINE_CONTACT_H
 
 #include <math.h>
+#include "posedrop/hull.h"
+#include "posedrop/sim.h"
 
 /* Restitution below this is taken as this by the contact law below, as by
  * the impulse simulator's compliant law (PD_COMPLIANT_E_MIN, in a layer this
@@ -21,6 +23,64 @@
  * steps 0.18 and 0.10, at Bullet's default 1/960 s for T = 5e-4 s 0.02. A
  * contact that short is rigid as far as such a step can tell. */
 #define PD_ENGINE_CONTACT_STEPS 10.0
+
+/* Depth a contact may reach at the fall speed, times the part's thickness,
+ * for an engine to stand for the scene's contact by that law. The engines
+ * meet the floor at the hull's vertices only, so a penetration of the order
+ * of the thickness puts corners of the far side below the floor, and the
+ * part rests part way through it (measured: a 1 m x 3.3 mm rod at a
+ * contact time of 29 to 30 ms, omega ~ 90 rad/s, resolved by ODE's 1 ms
+ * step, came to rest 2.6 mm deep on an edge in 3 of 100 drops). The
+ * spring-dashpot's deepest point at approach speed v is below v / omega (its
+ * undamped amplitude); with v / omega above this share of the thickness the
+ * engine keeps its own contact, as for a contact the step cannot resolve.
+ * Why 0.1: a corner then stays within a tenth of the thickness of the
+ * floor, so no far corner comes near it whatever the orientation. Parts of
+ * centimetres never meet it at the default steps: their automatic contact
+ * (0.5 ms for a 1 cm cube) is not resolved by a 1 ms step in the first
+ * place. */
+#define PD_ENGINE_CONTACT_DEPTH_REL 0.1
+
+/* The part's thickness: its least width across a facet's plane (m, part
+ * frame or any: a width does not depend on it). A convex body's least width
+ * is across a facet or between two edges; the least facet width is that
+ * or more (equal for boxes, prisms and flat pyramids, the parts whose
+ * thinness matters here). */
+static inline double pd_engine_hull_width(const pd_hull *h)
+{
+    double width = INFINITY;
+    for (int f = 0; f < h->nfacets; f++) {
+        double lo = h->offset[f];
+        for (int i = 0; i < h->nverts; i++) {
+            double d = h->normal[f].x * h->verts[i].x + h->normal[f].y * h->verts[i].y +
+                       h->normal[f].z * h->verts[i].z;
+            lo = fmin(lo, d);
+        }
+        width = fmin(width, h->offset[f] - lo);
+    }
+    return width;
+}
+
+/* The fastest a corner meets the floor (m/s) in a drop of scene for a part
+ * of size L: a fall from the drop height (the top of its range) plus its own
+ * size, as a tumbling part's corner can come down that much further. */
+static inline double pd_engine_fall_speed(const pd_scene *scene, double size)
+{
+    const pd_dist *h = &scene->range[PD_PARAM_HEIGHT];
+    double height = h->kind == PD_DIST_FIXED ? scene->height : h->hi;
+    return sqrt(2.0 * fabs(scene->gravity) * (height + size));
+}
+
+/* Whether an engine stepping dt stands for the scene's contact by the law
+ * below: the contact is soft (contact_time > 0), the step resolves it
+ * (PD_ENGINE_CONTACT_STEPS) and its depth at fall speed v stays within
+ * PD_ENGINE_CONTACT_DEPTH_REL of the thickness (omega from the law). */
+static inline int pd_engine_contact_resolved(double dt, double contact_time, double omega,
+                                             double v, double width)
+{
+    return contact_time > 0.0 && dt * PD_ENGINE_CONTACT_STEPS <= contact_time &&
+           v <= PD_ENGINE_CONTACT_DEPTH_REL * width * omega;
+}
 
 /* Bisection halvings of zeta's bracket: 200 reach round-off of any bracket. */
 enum { PD_ENGINE_CONTACT_HALVINGS = 200 };

@@ -39,12 +39,22 @@
  * 1 cm and a 1 m part. */
 #define PD_ODE_SINK_REL 1e-4
 
+/* The radius of a part's corners, times its size L, for the patch of ODE's
+ * drilling friction (engine_ode.c, drilling_arm). Why 0.0289: the corner
+ * the default contact time assumes (0.5 mm on a 1 cm cube, diagonal
+ * 1.73 cm: Hertz's estimate of 5e-4 s, docs/contact.md), in proportion to
+ * the size as that estimate keeps it. Sharper corners: a smaller patch, a
+ * top that spins longer. */
+#define PD_ODE_CORNER_RADIUS_REL (0.5e-3 / (0.01 * 1.7320508075688772935))
+
 /* Damping ratio of that contact spring: critical, so a contact settles
  * without ringing; the rebound is ODE's bounce (= restitution) alone, not a
  * spring oscillation on top. */
 #define PD_ODE_DAMPING_RATIO 1.0
 
-/* Bullet's collision margin, times L: its convex shapes are the hull inflated
+/* Bullet's collision margin, times the part's size L or its thickness if
+ * that is less (a needle's margin at 1e-3 L was its whole thickness, and it
+ * sank through the floor: 4 of 100 drops of a 1 m x 1 mm rod): its convex shapes are the hull inflated
  * by a sphere of this radius (Bullet's default, 0.04 m absolute, is four times
  * a 1 cm part). The adapter lowers the floor plane by the margin, so heights
  * against the floor are exact whatever its value; what it still moves is the
@@ -55,6 +65,14 @@
  * torques visibly wrong (1e-1 L is a tenth of the arm); smaller than ~1e-5:
  * within a few hundred ulps of float coordinates. */
 #define PD_BULLET_MARGIN_REL 1e-3
+
+/* The most of the part's thickness that the round-off of Bullet's float
+ * coordinates at the drop's scale may be (see bullet_refuses); a part
+ * above it is refused for Bullet. Why 1e-2: the contacts are then known to
+ * a hundredth of the thickness, the resolution at which a face rest is
+ * still told from an edge's; the measured parts at either side (1.4e-2
+ * fails, 3.2e-3 works) are in engine_bullet.cpp. */
+#define PD_BULLET_WIDTH_ULPS_MAX 1e-2
 
 /* Bullet contacts approaching slower than this many steps of gravity (g dt) do
  * not bounce (Bullet's restitution velocity threshold, by default 0.2 m/s

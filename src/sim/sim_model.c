@@ -67,6 +67,12 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     m->com = part->com;
     m->poses = poses;
     pd_status st = pd_body_build(part, &m->body, diag);
+    const char *why = st == PD_OK && m->engine && m->engine->refuses
+                          ? m->engine->refuses(m->body, part->hull, scene)
+                          : NULL;
+    if (why)
+        st = pd_fail(diag, PD_ERR_UNAVAILABLE, "the %s engine cannot run this part: %s",
+                     m->engine->name, why);
     if (st == PD_OK)
         st = pd_settle_build(part, m->body, poses, scene->gravity, &m->settle, diag);
     if (st == PD_OK && !m->engine) {

@@ -17,6 +17,15 @@ _STATUS = _posedrop.statuses()
 #: How each drop ended (``Trials.end``), as the command's --trials names them.
 END_NAMES = ("settled", "time_limit", "collision_limit", "failed")
 
+#: The scene parameters that take ranges, in ``pd_scene_param`` order
+#: (the keys of :attr:`Trials.params`, the rows of a :class:`Sensitivity`).
+_STAGE_NAMES, _STATUS_TEXTS, PARAM_NAMES = _posedrop.names()
+_FAILED = END_NAMES.index("failed")
+# A status as one word of the end column (src/cli/command.c's status_word):
+# its fixed name with blanks, hyphens and slashes as underscores.
+_STATUS_WORDS = tuple(t.replace(" ", "_").replace("-", "_").replace("/", "_")
+                      for t in _STATUS_TEXTS)
+
 
 def _usage(message):
     return InputError(_STATUS["ERR_USAGE"], "invalid argument", message)
@@ -335,12 +344,20 @@ class StablePoses:
             initial="stationary", contact_time="auto"``. Each is handed to
             the library as text (``pd_scene_set``), exactly as in a scene
             file, so every key and value form the library accepts works
-            here too (ranges such as ``mu="0.2:0.5"`` once the scene takes
-            them).
-        max_drops, time_limit, max_collisions : int, float, int
-            The library's run limits (``pd_sim_options``).
+            here too: ranges such as ``mu="0.2:0.5"``,
+            ``contact_time="0.3x:3x"`` (multiples of auto, log uniform) or
+            ``height="0.08:0.16 log"``, each drop drawing its own values
+            from the seed and its index; ``tumble=`` (rad/s, the angular
+            speed at release about a random axis).
+        time_limit : float or "auto"
+            Simulated seconds per drop, above 0 (``--time-limit``); None or
+            "auto": the part's own limit (``pd_time_limit_auto``), which
+            :attr:`Drops.time_limit` reports.
+        max_drops, max_collisions : int
+            The library's other run limits (``pd_sim_options``).
         trials : bool
-            Keep one record per drop (``--trials``): :attr:`Drops.trials`.
+            Keep one record per drop (``--trials``): :attr:`Drops.trials`,
+            which :meth:`Drops.sensitivity` needs.
         cancel : threading.Event, optional
             Anything with ``is_set()``: once set, the drops under way finish
             and the drops done so far are returned with ``partial`` True.
@@ -468,6 +485,20 @@ class Trials:
         Simulated seconds.
     end : (n,)
         How it ended, an index into :data:`posedrop.END_NAMES`.
+    stage, status : (n,)
+        A failed drop's ``pd_drop_stage`` (where it failed) and
+        ``pd_status`` (how); 0 for the others.
+    end_text : (n,) str
+        How it ended as the ``end`` column of ``--trials`` writes it:
+        ``settled``, ``time_limit``, ``collision_limit`` or
+        ``failed:STAGE:STATUS`` (e.g. ``failed:flight:no_convergence``).
+    params : dict of str to (n,) float64
+        The values each drop drew for every ranged scene parameter, keyed by
+        its name in ``pd_scene_param`` order (``mu``, ``contact_time``, ...),
+        in the unit of the scene's text and of ``--trials``' columns:
+        degrees for vibration, SI for the others (s for contact_time,
+        resolved for this part when given in multiples of auto). Empty for a
+        scene without ranges.
     """
 
     def __init__(self, d):
@@ -476,9 +507,79 @@ class Trials:
         self.collisions = _i32(d["trial_collisions"])
         self.time = _f64(d["trial_time"])
         self.end = _i32(d["trial_end"])
+        self.stage = _i32(d["trial_stage"])
+        self.status = _i32(d["trial_status"])
+        text = np.array(END_NAMES, dtype=object)[self.end]
+        for i in np.flatnonzero(self.end == _FAILED):
+            text[i] = "failed:%s:%s" % (_STAGE_NAMES[self.stage[i]], _STATUS_WORDS[self.status[i]])
+        self.end_text = text.astype(str)
+        drawn = _f64(d["trial_param"], len(self.pose), len(PARAM_NAMES))
+        self.params = {}
+        for name in d["ranged"]:
+            k = PARAM_NAMES.index(name)
+            column = drawn[:, k]
+            # As --trials prints it: vibration is stored in radians.
+            column = column / (np.pi / 180.0) if name == "vibration" else column.copy()
+            column.flags.writeable = False
+            self.params[name] = column
 
     def __len__(self):
         return len(self.pose)
+
+
+def _class_array(classes):
+    return np.ascontiguousarray(classes.class_of, dtype=np.intc)
+
+
+class Sensitivity:
+    """What each ranged scene parameter moves, one row per pose (or class)
+    and parameter, pose-major, as the rows of ``--sensitivity FILE``
+    (``reshape(nposes, len(params))`` gives a pose-by-parameter table).
+
+    Attributes
+    ----------
+    n : int
+        Drops used: the settled ones (of a stationary run, only those
+        started uniform).
+    nposes : int
+        Poses (or classes).
+    params : list of str
+        The ranged parameters, in ``pd_scene_param`` order; empty for a
+        scene without a range of nonzero width.
+    pose : (rows,) int32
+        The pose (or class) index, from 0 (the file's ``pose`` less 1).
+    parameter : (rows,) str
+        The parameter's name.
+    n_low, n_high : (rows,) int64
+        Settled drops whose value fell in the lower, upper third of the
+        range (thirds of the logarithm for a log-uniform range).
+    p_low, p_low_lo, p_low_hi, p_high, p_high_lo, p_high_hi : (rows,)
+        The pose's share of those and its 95% Wilson interval.
+    index, index_lo, index_hi : (rows,)
+        The first-order index S_i and its 95% bootstrap interval.
+    """
+
+    _COLUMNS = ("p_low", "p_low_lo", "p_low_hi", "p_high", "p_high_lo", "p_high_hi",
+                "index", "index_lo", "index_hi")
+
+    def __init__(self, d):
+        self.n = d["n"]
+        self.nposes = d["nposes"]
+        self.params = list(d["params"])
+        self.pose = _i32(d["pose"])
+        self.parameter = np.array(self.params * self.nposes, dtype=str)
+        self.n_low = _i64(d["n_low"])
+        self.n_high = _i64(d["n_high"])
+        values = _f64(d["values"], -1, len(self._COLUMNS))
+        for k, name in enumerate(self._COLUMNS):
+            setattr(self, name, values[:, k])
+
+    def __len__(self):
+        return len(self.pose)
+
+    def __repr__(self):
+        return "<posedrop.Sensitivity: %d poses x %s, from %d drops>" % (
+            self.nposes, self.params, self.n)
 
 
 class Drops:
@@ -495,7 +596,17 @@ class Drops:
         ``initial="stationary"``, the long-run probability of the estimated
         pose-to-pose chain and its resampled interval.
     unsettled : int
-        Drops that hit the time or collision limit (in no count).
+        Drops that settled in no pose (in no count): the sum of
+        ``time_limited``, ``collision_limited`` and ``failed``.
+    time_limited, collision_limited, failed : int
+        Drops that ended at the time limit, at the collision limit, or that
+        failed (a solver could not go on; :attr:`Trials.end_text` says
+        where and how).
+    first_failed : int
+        The first failed drop's index in the run, -1 if none.
+    time_limit : float
+        The time limit the drops ran with, s: the ``time_limit`` given, or
+        the part's automatic one.
     partial : bool
         True if the run was cancelled before all drops ran: the result holds
         the first ``n`` drops, each as in a full run.
@@ -521,7 +632,9 @@ class Drops:
         self.p = _f64(d["p"])
         self.ci_lo = _f64(d["ci_lo"])
         self.ci_hi = _f64(d["ci_hi"])
-        for key in ("unsettled", "energy_gain", "fallbacks", "collisions", "partial",
+        self._parent = None
+        for key in ("unsettled", "time_limited", "collision_limited", "failed", "first_failed",
+                    "time_limit", "energy_gain", "fallbacks", "collisions", "partial",
                     "bootstrap_rounds", "stationarity", "seed"):
             setattr(self, key, d[key])
         k = d["nposes"]
@@ -553,9 +666,29 @@ class Drops:
         if self.classes is not None:
             raise _usage("these drops are grouped already")
         classes = self.poses.classes() if classes is None else classes
-        return Drops(self.poses, self._h.grouped(np.ascontiguousarray(classes.class_of,
-                                                                      dtype=np.intc),
-                                                 len(classes)), classes)
+        g = Drops(self.poses, self._h.grouped(_class_array(classes), len(classes)), classes)
+        g._parent = self
+        return g
+
+    def sensitivity(self):
+        """What each ranged scene parameter moves (``--sensitivity FILE``).
+
+        For every pose (or class, on :meth:`grouped` drops) and every ranged
+        parameter of nonzero width: the pose's probability among the
+        settled drops whose value fell in the lower and upper thirds of the
+        range, and the first-order variance-based index of the pose's
+        indicator with respect to the parameter (``pd_sim_sensitivity``;
+        docs/uncertainty.md gives the estimator). The drops must have been
+        run with ``trials=True``.
+
+        Returns
+        -------
+        Sensitivity
+        """
+        if self._parent is not None:
+            c = self.classes
+            return Sensitivity(self._parent._h.sensitivity(_class_array(c), len(c)))
+        return Sensitivity(self._h.sensitivity())
 
     def __len__(self):
         return len(self.count)
