@@ -11,7 +11,8 @@
 # CSVs kept beside it; several minutes). --chart-only redraws that chart from
 # the kept CSV instead of rerunning it. The paper numbers its poses by
 # physical frequency: its poses are paired with posedrop's classes by rank of
-# QS on both sides, as scripts/eq16.awk does, to write the measured file.
+# QS on both sides, as scripts/eq16.awk does, to write the measured file
+# (scripts/measured.awk).
 set -eu
 . "$(dirname "$0")/args.sh"
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -42,26 +43,8 @@ trap 'rm -f "$tmp"' EXIT
 
 # The paper's physical column in posedrop's class numbering.
 "$bin" --group "$part" > "$tmp"
-awk -F, -v part=insulator_cap '
-    FNR == 1 { delete col; for (i = 1; i <= NF; i++) col[$i] = i; next }
-    FILENAME == ARGV[1] {
-        if ($col["part"] == part) {
-            n++; phys[n] = $col["p_physical"] / 100; pqs[n] = $col["p_qs"]; trials = $col["physical_trials"]
-        }
-        next
-    }
-    { k++; qs[k] = $col["p_qs"]; num[k] = $col["pose"] }
-    END {
-        for (i = 1; i <= n; i++) pr[i] = i
-        for (i = 1; i <= n; i++) for (j = i + 1; j <= n; j++)
-            if (pqs[pr[j]] > pqs[pr[i]]) { t = pr[i]; pr[i] = pr[j]; pr[j] = t }
-        for (i = 1; i <= k; i++) ord[i] = i
-        for (i = 1; i <= k; i++) for (j = i + 1; j <= k; j++)
-            if (qs[ord[j]] > qs[ord[i]]) { t = ord[i]; ord[i] = ord[j]; ord[j] = t }
-        if (n > k) { print "figures.sh: the paper has more poses than posedrop classes" > "/dev/stderr"; exit 1 }
-        print "pose,p,n"
-        for (r = 1; r <= n; r++) printf "%d,%.4f,%d\n", num[ord[r]], phys[pr[r]], trials
-    }' "$tables" "$tmp" > "$out/insulator_cap.measured.csv"
+awk -F, -v part=insulator_cap -v tag=figures.sh -f "$here/scripts/measured.awk" \
+    "$tables" "$tmp" > "$out/insulator_cap.measured.csv"
 
 "$bin" --group -n 2000 --initial stationary --seed 1 \
     --svg "$out/cap-gallery.svg" --chart "$out/cap-chart.svg" --sphere "$out/cap-sphere.svg" \

@@ -3,6 +3,7 @@
 # columns beside the paper's.
 #
 #   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV]
+#   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-o DIR]
 #
 # For each of the paper's four parts (parts/<name>.off, rebuilt from the
 # paper's photographs; parts/README.md), runs posedrop's QS and PQS and the
@@ -21,6 +22,20 @@
 # posedrop's classes are matched to the paper's poses by rank of their QS
 # probability on both sides, the column the parts were fitted on (the paper
 # numbers its poses by physical frequency).
+#
+# -L: leave-one-out cross-validation of the calibration (posedrop fit,
+# docs/calibration.md). The paper's physical counts (its percentages times
+# its trials) become pose,count files in posedrop's class numbering (the QS
+# rank pairing above); for each part, the scene parameters SPEC (default
+# mu=0.1:0.8,restitution=0.05:0.7,height=0.06:0.2; 'initial' among them fits
+# the initial mode too) are fitted to the other three parts and the fourth is
+# predicted: at the best fit and averaged over the likelihood-weighted values,
+# with its 95% interval. Prints each held-out part's table (the paper's
+# columns, posedrop's QS and PQS, the two predictions), then e16 and TV per
+# part with the fitted values of each fold. DROPS (default 400) are simulated
+# per part and evaluation, INITIAL (default uniform here) is the initial mode
+# when it is not fitted, EVALS (40) and POINTS (12) bound the search and the
+# weighting.
 set -u
 . "$(dirname "$0")/args.sh"
 n=2000
@@ -28,14 +43,24 @@ initial=stationary
 contact_time=
 outdir=results
 tables=""
+loo=0
+spec=mu=0.1:0.8,restitution=0.05:0.7,height=0.06:0.2
+evals=40
+points=12
+n_given=
+initial_given=
 while [ $# -gt 0 ]; do
     case "$1" in
-        -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
-        -i) args_value "$@"; initial=$2; shift 2 ;;
+        -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
+        -i) args_value "$@"; initial=$2; initial_given=1; shift 2 ;;
+        -L) loo=1; shift ;;
+        -f) args_value "$@"; spec=$2; shift 2 ;;
+        -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
+        -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
         -t) args_value "$@"; contact_time=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,23p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,38p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -53,6 +78,12 @@ fi
 why=$("$bin" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
     "$here/parts/cap.off" 2>&1 >/dev/null) || args_die "$(printf '%s' "$why" | head -n 1)"
 mkdir -p "$outdir" || exit 2
+if [ "$loo" = 1 ]; then
+    [ -n "$n_given" ] || n=400
+    [ -n "$initial_given" ] || initial=uniform
+    exec "$here/scripts/paper-loo.sh" "$bin" "$tables" "$outdir" "$spec" "$n" "$initial" "$evals" \
+        "$points" ${contact_time:+"$contact_time"}
+fi
 # What the tables' blocks and rows are, so that the output reads without
 # docs/validation.md.
 cat <<EOF

@@ -16,6 +16,7 @@
 
 #include "posedrop/bullet.h"
 #include "posedrop/diag.h"
+#include "posedrop/fit.h"
 #include "posedrop/hull.h"
 #include "posedrop/mass.h"
 #include "posedrop/mesh.h"

@@ -2,12 +2,14 @@
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
+#include <gsl/gsl_multimin.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gsl/gsl_poly.h>
 #include <gsl/gsl_randist.h>
 #include <gsl/gsl_rng.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_elljac.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include "base/gsl_adapter.h"
@@ -52,6 +54,77 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
 
 double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }
+
+double pd_gsl_beta_p(double x, double a, double b) { return gsl_cdf_beta_P(x, a, b); }
+
+/* --- minimisation ------------------------------------------------------------ */
+
+typedef struct {
+    pd_min_fn fn;
+    void *user;
+    int evals, stop;
+} min_call;
+
+static double min_trampoline(const gsl_vector *v, void *p)
+{
+    min_call *c = p;
+    c->evals++;
+    /* gsl_vector's data is contiguous for a vector GSL allocated itself. */
+    double f = c->fn(v->data, c->user);
+    if (!isfinite(f)) {
+        c->stop = 1;
+        return GSL_POSINF;
+    }
+    return f;
+}
+
+pd_status pd_gsl_nelder_mead(pd_min_fn fn, void *user, int n, double *x, const double *step,
+                             double size_tol, int max_evals, int *evals, double *fmin)
+{
+    gsl_set_error_handler_off();
+    gsl_multimin_fminimizer *s = gsl_multimin_fminimizer_alloc(gsl_multimin_fminimizer_nmsimplex2,
+                                                               (size_t)n);
+    gsl_vector *x0 = gsl_vector_alloc((size_t)n), *dx = gsl_vector_alloc((size_t)n);
+    pd_status st = PD_OK;
+    min_call call = {fn, user, 0, 0};
+    if (!s || !x0 || !dx)
+        st = PD_ERR_NOMEM;
+    if (st == PD_OK) {
+        for (int i = 0; i < n; i++) {
+            gsl_vector_set(x0, (size_t)i, x[i]);
+            gsl_vector_set(dx, (size_t)i, step[i]);
+        }
+        gsl_multimin_function F = {min_trampoline, (size_t)n, &call};
+        if (gsl_multimin_fminimizer_set(s, &F, x0, dx) != GSL_SUCCESS)
+            st = call.stop ? PD_ERR_INTERNAL : PD_ERR_NO_CONVERGENCE;
+        while (st == PD_OK && !call.stop && call.evals < max_evals) {
+            int rc = gsl_multimin_fminimizer_iterate(s);
+            if (call.stop)
+                break;
+            /* GSL_ENOPROG: the simplex cannot shrink further, a minimum
+             * as good as the function's resolution allows. */
+            if (rc != GSL_SUCCESS)
+                break;
+            if (gsl_multimin_test_size(gsl_multimin_fminimizer_size(s), size_tol) == GSL_SUCCESS)
+                break;
+        }
+        if (st == PD_OK && call.stop)
+            st = PD_ERR_INTERNAL;
+        if (st == PD_OK) {
+            for (int i = 0; i < n; i++)
+                x[i] = gsl_vector_get(s->x, (size_t)i);
+            *fmin = s->fval;
+        }
+    }
+    *evals = call.evals;
+    if (s)
+        gsl_multimin_fminimizer_free(s);
+    if (x0)
+        gsl_vector_free(x0);
+    if (dx)
+        gsl_vector_free(dx);
+    return st;
+}
 
 int pd_gsl_cubic_roots(double a, double b, double c, double x[3])
 {

@@ -21,6 +21,7 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 /* Distribution functions (GSL's cdf module). */
 double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
 double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
+double pd_gsl_beta_p(double x, double a, double b); /* P(X <= x), X ~ Beta(a, b) */
 
 /* The real roots of x^3 + a x^2 + b x + c, ascending, into x[0..n); returns n
  * (1 or 3; a double root is reported twice). GSL's closed form, no iteration. */
@@ -31,6 +32,18 @@ int pd_gsl_cubic_roots(double a, double b, double c, double x[3]);
  * from rng, one of posedrop's own streams, so the draw is as reproducible as
  * a drop. GSL's conditional binomials: O(k) whatever total is. */
 void pd_gsl_multinomial(pd_rng *rng, int k, unsigned total, const double *w, unsigned *out);
+
+/* Minimises fn over R^n by GSL's Nelder-Mead simplex (nmsimplex2), from x
+ * (n values, overwritten by the best point found) with initial steps step
+ * (n values), until the simplex's characteristic size is below size_tol or
+ * max_evals evaluations were spent (*evals receives the count; a step
+ * may overrun max_evals by the n + 1 evaluations of a shrink). *fmin is the
+ * value at x. fn returns a finite value, or a non-finite one to stop the
+ * search: then PD_ERR_INTERNAL, the callee keeping its own reason.
+ * PD_ERR_NO_CONVERGENCE if the first simplex cannot be set, PD_ERR_NOMEM. */
+typedef double (*pd_min_fn)(const double *x, void *user);
+pd_status pd_gsl_nelder_mead(pd_min_fn fn, void *user, int n, double *x, const double *step,
+                             double size_tol, int max_evals, int *evals, double *fmin);
 
 /* ==== Elliptic functions (flight: torque-free rotation) ===============
  * Thin wrappers on GSL's special functions, error handler off, GSL status

@@ -2,7 +2,8 @@
  *
  * It parses the arguments into cli_args (cli/args.h) and hands them to
  * cli_run (command.c), which calls the library and prints: the results as
- * CSV on stdout, diagnostics on stderr; 'posedrop merge' goes to merge.c. Exit codes: 0 success, 2 bad usage or
+ * CSV on stdout, diagnostics on stderr; 'posedrop merge' goes to merge.c,
+ * 'posedrop fit' to fit_cmd.c. Exit codes: 0 success, 2 bad usage or
  * input (nothing is printed on stdout), 1 internal failure, 130 or 143
  * interrupted by SIGINT or SIGTERM (what was done is printed, marked
  * partial). */
@@ -243,6 +244,8 @@ static void usage(FILE *out)
     fprintf(out,
         "usage: %s [options] PART\n"
         "       %s merge [options] SHARD...   (sums shards: see 'posedrop merge --help')\n"
+        "       %s fit [options] --fit SPEC --part PART --measured CSV ...\n"
+        "                             (calibrates the scene: see 'posedrop fit --help')\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
         "flat surface and prints one CSV row per stable pose:\n"
@@ -258,7 +261,7 @@ static void usage(FILE *out)
         "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
-        "\n", prog, prog);
+        "\n", prog, prog, prog);
     for (int i = 0; i < NOPTIONS; i++) {
         const cli_option *o = &options[i];
         if (o->kind == ARG_HEADING) {
@@ -625,6 +628,8 @@ int main(int argc, char **argv)
     cli_start(&argc, &argv);
     if (argc > 1 && strcmp(argv[1], "merge") == 0)
         return cli_end(cli_merge(argc - 1, argv + 1));
+    if (argc > 1 && strcmp(argv[1], "fit") == 0)
+        return cli_end(cli_fit(argc - 1, argv + 1));
     cli_args a;
     int code = parse_args(argc, argv, &a);
     if (code < 0)

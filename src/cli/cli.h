@@ -29,6 +29,23 @@ int cli_interrupt_code(void);
 int cli_any(int mine);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 
+/* A side file written to a temporary beside its path and renamed onto it
+ * once complete (command.c): out_open makes it ready before any work (0 and a
+ * message when it cannot be written), out_commit puts it in place (0 and a
+ * message on a write error), out_abort drops it. */
+typedef struct {
+    const char *path;
+    char *target; /* where the temporary is renamed to (a symbolic link resolved) */
+    char *tmp;    /* NULL when path is written directly */
+    FILE *f;
+} out_file;
+int out_open(out_file *o, const char *path);
+int out_commit(out_file *o);
+void out_abort(out_file *o);
+
+/* fit_cmd.c: the fit subcommand (parses its own options). */
+int cli_fit(int argc, char **argv);
+
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;
  * the shards of a merge read and checked into a->scene, a->sim and the
  * part's path and SHA-256 (shard_load; shard_unload frees them), and summed

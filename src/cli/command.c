@@ -126,7 +126,8 @@ static const char *end_name(const pd_trial *t, char *buf, size_t size)
     }
 }
 
-/* A side file (--trials, --transitions). It is made ready before any work,
+/* A side file (--trials, --transitions; out_file in cli.h, shared with
+ * posedrop fit). It is made ready before any work,
  * so that a path that cannot be written fails at once (exit 2, nothing on
  * stdout). A regular file, or one that does not exist yet, is written to a
  * temporary file in its directory and renamed onto its path only once every
@@ -134,20 +135,13 @@ static const char *end_name(const pd_trial *t, char *buf, size_t size)
  * that looks like a result, nor destroys the one it would replace. Anything
  * else (a device such as /dev/stdout, a pipe) is opened and written as it
  * is; a write error there (/dev/full) is caught when it is closed. */
-typedef struct {
-    const char *path;
-    char *target; /* where the temporary is renamed to (a symbolic link resolved) */
-    char *tmp;    /* NULL when path is written directly */
-    FILE *f;
-} out_file;
-
 static int out_fail(const char *path, const char *why)
 {
     fprintf(stderr, "%s: %s: cannot write: %s\n", prog, path, why);
     return 0;
 }
 
-static int out_open(out_file *o, const char *path)
+int out_open(out_file *o, const char *path)
 {
     memset(o, 0, sizeof *o);
     o->path = path;
@@ -209,7 +203,7 @@ static int out_open(out_file *o, const char *path)
 }
 
 /* Drops what was written (on any failure of the run). */
-static void out_abort(out_file *o)
+void out_abort(out_file *o)
 {
     if (o->f)
         fclose(o->f);
@@ -221,7 +215,7 @@ static void out_abort(out_file *o)
 }
 
 /* Closes with every write error caught, then puts the file in place. */
-static int out_commit(out_file *o)
+int out_commit(out_file *o)
 {
     int ok = fflush(o->f) == 0 && !ferror(o->f);
     int err = errno;

@@ -293,7 +293,11 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(r_i, pb)));
                     change = fmax(change, fmax(fabs(ddx), fabs(ddy)));
                 }
-                if (change <= stop)
+                /* One contact: the slip without its own friction, which
+                 * sets its impulse, does not depend on that impulse, so
+                 * one sweep is converged and another would only re-derive
+                 * it to round-off. */
+                if (change <= stop || npush == 1)
                     break;
             }
         }

@@ -22,6 +22,7 @@
 struct pd_impact_work {
     pd_ode *poisson;   /* dimension NSTATE_P: the impulse */
     pd_ode *energetic; /* NSTATE: and the normal work */
+    double tol;        /* the integrators' local error per step, absolute and relative */
 };
 
 pd_impact_work *pd_impact_work_alloc(void)
@@ -35,6 +36,7 @@ pd_impact_work *pd_impact_work_alloc_tol(double tol_scale)
     if (!w)
         return NULL;
     double tol = tol_scale * PD_TOL_IMPACT_ODE_REL;
+    w->tol = tol;
     w->poisson = pd_ode_alloc(NSTATE_P, tol, tol);
     w->energetic = pd_ode_alloc(NSTATE, tol, tol);
     if (!w->poisson || !w->energetic) {
@@ -169,6 +171,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
     c.mu = mu;
     c.e = e;
     c.law = law;
+    c.tol = w ? w->tol : 0.0;
 
     if (mu == 0.0) {
         /* No friction: p' = (0, 0, 1) throughout, closed form, no ODE. */

@@ -25,6 +25,7 @@ typedef struct {
     pd_vec3 u0;
     double mu, e;
     pd_impact_law law;
+    double tol;       /* the integrator's local error per step (absolute and relative) */
     double y[NSTATE]; /* p = (px, py, pz) and W so far */
     int have_ray;     /* sticking is unstable: the diverging ray (rtx, rty) exists */
     double rtx, rty;

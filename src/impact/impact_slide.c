@@ -260,6 +260,63 @@ static int henon_form(const collision *c, double qmin, int ev, pd_vec3 u, double
     return -1;
 }
 
+/* Dormand and Prince's fifth-order pair (its fourth-order partner as the
+ * error estimate): the nodes, the stages' weights, the fifth-order weights
+ * (also the last stage's), and the difference of the two orders' weights. */
+static const double DP_C[7] = {0.0, 1.0 / 5.0, 3.0 / 10.0, 4.0 / 5.0, 8.0 / 9.0, 1.0, 1.0};
+static const double DP_A[6][6] = {
+    {1.0 / 5.0},
+    {3.0 / 40.0, 9.0 / 40.0},
+    {44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0},
+    {19372.0 / 6561.0, -25360.0 / 2187.0, 64448.0 / 6561.0, -212.0 / 729.0},
+    {9017.0 / 3168.0, -355.0 / 33.0, 46732.0 / 5247.0, 49.0 / 176.0, -5103.0 / 18656.0},
+    {35.0 / 384.0, 0.0, 500.0 / 1113.0, 125.0 / 192.0, -2187.0 / 6784.0, 11.0 / 84.0}};
+static const double DP_E[7] = {71.0 / 57600.0, 0.0, -71.0 / 16695.0, 71.0 / 1920.0,
+                               -17253.0 / 339200.0, 22.0 / 525.0, -1.0 / 40.0};
+
+/* One step of that pair across the whole event interval [e0, e1] of a
+ * Henon form, tried before rk8pd's: most events are reached by a step across
+ * which the sliding direction barely turns (a microcollision's slip far
+ * above its approach speed), where the pair meets the integrator's own
+ * tolerance (the same absolute and relative bound on each component) at 7
+ * evaluations, not 13, and less arithmetic than GSL's stepper. The event's
+ * variable is linear in the state with rate 1 in its own form, which a
+ * Runge-Kutta step keeps exactly, so the step lands on the event as rk8pd's
+ * does. Refused (0, state untouched) when the estimate exceeds the
+ * tolerance or a stage is not finite; the caller then steps as before. */
+static int low_order_event_step(collision *c, pd_ode_fn fn, double e0, double e1,
+                                const double k1[])
+{
+    const int n = c->law == PD_IMPACT_ENERGETIC ? NSTATE : NSTATE_P;
+    const double h = e1 - e0;
+    double k[7][NSTATE], y[NSTATE];
+    for (int i = 0; i < NSTATE; i++) {
+        k[0][i] = k1[i];
+        y[i] = c->y[i];
+    }
+    for (int st = 1; st < 7; st++) {
+        for (int i = 0; i < n; i++) {
+            double dy = 0.0;
+            for (int j = 0; j < st; j++)
+                dy += DP_A[st - 1][j] * k[j][i];
+            y[i] = c->y[i] + h * dy;
+        }
+        fn(e0 + DP_C[st] * h, y, k[st], c);
+    }
+    /* y is now the fifth-order solution, the last stage's argument. */
+    for (int i = 0; i < n; i++) {
+        double err = 0.0;
+        for (int j = 0; j < 7; j++)
+            err += DP_E[j] * k[j][i];
+        err *= h;
+        if (!isfinite(y[i]) || !(fabs(err) <= c->tol * (1.0 + fabs(y[i]))))
+            return 0;
+    }
+    for (int i = 0; i < n; i++)
+        c->y[i] = y[i];
+    return 1;
+}
+
 pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
 {
     const double tols = PD_TOL_IMPACT_EVENT_REL; /* |u0| = 1 */
@@ -317,6 +374,10 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
         if (f >= 0 && e1 > e0) {
             double he = h * s * rate, dy[NSTATE];
             form_rhs[f](e0, c->y, dy, c);
+            if (low_order_event_step(c, form_rhs[f], e0, e1, dy)) {
+                ++*nsteps;
+                continue;
+            }
             pd_status st = pd_ode_step_from(ode, form_rhs[f], c, &e0, e1, &he, c->y, dy);
             ++*nsteps;
             if (st == PD_ERR_NO_CONVERGENCE)

@@ -31,6 +31,7 @@
     PD_SUITE(ranges) \
     PD_SUITE(sensitivity) \
     PD_SUITE(markov) \
+    PD_SUITE(fit)    \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \

@@ -558,7 +558,7 @@ static void test_drilling_top(void)
     CHECK(t >= t_star - 2.0 * PD_TOL_PHASE_EVENT_REL * T);
     double wn = v3_dot(s.w, quat_rotate_inv(s.q, v3(0, 0, 1)));
     CHECK(wn >= 0.0 && wn <= w0 * 1e-5);
-    printf("     drilling top: stops at %.9g s, predicted %.9g s (patch %.3g m)\n", t, t_star,
+    pd_note("contact_phase: drilling top stops at %.9g s, predicted %.9g s (patch %.3g m)\n", t, t_star,
            st->patch);
     pd_ode_free(ode);
     pd_ode_free(pivot);

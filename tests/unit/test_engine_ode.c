@@ -520,7 +520,7 @@ static void test_drilling_top(void)
     int half = (int)(0.5 * t_stop / DT);
     CHECK_STATUS(run(w, &s, half), PD_OK);
     double spin = quat_rotate(s.q, s.w).z;
-    printf("     drilling top: spin %.6g rad/s at %.4g s, predicted %.6g (stops at %.4g s)\n",
+    pd_note("engine_ode: drilling top spins at %.6g rad/s at %.4g s, predicted %.6g (stops at %.4g s)\n",
            spin, half * DT, w0 - couple * half * DT / I, t_stop);
     /* The load settles from touching to the weight's sink in a few steps
      * of the critically damped spring (1 / omega = 0.4 ms); 2% of w0 is

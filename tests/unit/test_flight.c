@@ -961,7 +961,7 @@ static void test_wmax(void)
     /* The motion's own |w| is computed to ~1e-12 (the flight's series). */
     CHECK(worst_over <= 1e-9);
     CHECK(needle_ratio >= 1.0 && needle_ratio <= 1.0 + 1e-3);
-    printf("     wmax: |w| / bound - 1 at most %.2g; needle bound / largest |w| %.9g\n", worst_over,
+    pd_note("flight: wmax: |w| / bound - 1 at most %.2g; needle bound / largest |w| %.9g\n", worst_over,
            needle_ratio);
 }
 

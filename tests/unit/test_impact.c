@@ -626,48 +626,92 @@ static rk4_state rk4_until(const double K[3][3], pd_vec3 u0, double mu, rk4_stat
     return a;
 }
 
-static void test_laws_oracle(void)
+/* A random K in the library's units (mean diagonal 1): RK4's step of 1e-4
+ * is then O(1e-4) of a collision. */
+static void random_K_unit(test_rng *rng, double K[3][3])
 {
-    test_rng rng = {18};
+    random_K(rng, K);
+    double ks = (K[0][0] + K[1][1] + K[2][2]) / 3.0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            K[i][j] /= ks;
+}
+
+/* One collision against RK4: 0 if it stuck (the oracle is for slip that
+ * never stops), else 1 with the impulse's error in *err, relative to the
+ * impulse (per_u0 0) or to the library's unit |u0| / K (per_u0 1; K's mean
+ * diagonal is 1). */
+static int oracle_case(pd_impact_work *w, const double K[3][3], pd_vec3 u0, double mu, double e,
+                       pd_impact_law law, int per_u0, double *err)
+{
+    pd_impact_result r;
+    CHECK_STATUS(pd_impact_solve(w, K, u0, mu, e, law, &r), PD_OK);
+    if (r.stuck)
+        return 0;
+    const double h = 1e-4;
+    rk4_state c = rk4_until(K, u0, mu, (rk4_state){v3(0, 0, 0), 0.0}, h, 0, 0.0);
+    rk4_state end;
+    if (law == PD_IMPACT_ENERGETIC) {
+        end = rk4_until(K, u0, mu, c, h, 1, (1.0 - e * e) * c.W);
+    } else {
+        double dpz = e * c.p.z;
+        int m = (int)ceil(dpz / h);
+        end = c;
+        for (int i = 0; i < m; i++)
+            end = rk4_step(K, u0, mu, end, dpz / m);
+    }
+    CHECK_REL(r.pz_c, c.p.z, EV, EV_SRC);
+    *err = v3_norm(v3_sub(r.p, end.p)) / v3_norm(per_u0 ? u0 : end.p);
+    CHECK_NEAR(*err, 0.0, EV, EV_SRC);
+    return 1;
+}
+
+/* Twelve random collisions against RK4, both laws, and the worst error;
+ * *n counts those that did not stick. Sliding (glancing 0): slip 3 times
+ * the approach speed, mu 0.2, e 0.01 and 0.3, errors relative to the
+ * impulse. Glancing (1): slip 10, 100 and 1000 times it, mu 0.3, e 0 (a
+ * microcollision ends at compression) and 0.3, errors relative to |u0| / K. */
+static double oracle_batch(unsigned long seed, int glancing, int *n)
+{
+    test_rng rng = {seed};
     pd_impact_work *w = pd_impact_work_alloc();
     double worst = 0.0;
-    int n = 0;
+    *n = 0;
     for (int t = 0; t < 12; t++) {
-        double K[3][3];
-        random_K(&rng, K);
-        double ks = (K[0][0] + K[1][1] + K[2][2]) / 3.0;
-        for (int i = 0; i < 3; i++)
-            for (int j = 0; j < 3; j++)
-                K[i][j] /= ks; /* units of the library: RK4's step is then O(1e-4) of the collision */
-        double ang = rng_range(&rng, 0.0, 2.0 * M_PI);
-        pd_vec3 u0 = v3(3.0 * cos(ang), 3.0 * sin(ang), -1.0);
-        double mu = 0.2, e = t % 2 ? 0.01 : 0.3;
+        double K[3][3], err = 0.0;
+        random_K_unit(&rng, K);
+        double ang = rng_range(&rng, 0.0, 2.0 * M_PI), slip = glancing ? pow(10.0, 1.0 + t % 3) : 3.0;
+        pd_vec3 u0 = v3(slip * cos(ang), slip * sin(ang), -1.0);
+        double e = t % 2 ? (glancing ? 0.0 : 0.01) : 0.3;
         pd_impact_law law = t % 4 < 2 ? PD_IMPACT_ENERGETIC : PD_IMPACT_POISSON;
-        pd_impact_result r;
-        CHECK_STATUS(pd_impact_solve(w, CR(K), u0, mu, e, law, &r), PD_OK);
-        if (r.stuck)
-            continue; /* the oracle is for slip that never stops */
-        const double h = 1e-4;
-        rk4_state c = rk4_until(CR(K), u0, mu, (rk4_state){v3(0, 0, 0), 0.0}, h, 0, 0.0);
-        rk4_state end;
-        if (law == PD_IMPACT_ENERGETIC) {
-            end = rk4_until(CR(K), u0, mu, c, h, 1, (1.0 - e * e) * c.W);
-        } else {
-            double dpz = e * c.p.z;
-            int m = (int)ceil(dpz / h);
-            end = c;
-            for (int i = 0; i < m; i++)
-                end = rk4_step(CR(K), u0, mu, end, dpz / m);
-        }
-        CHECK_REL(r.pz_c, c.p.z, EV, EV_SRC);
-        double err = v3_norm(v3_sub(r.p, end.p)) / v3_norm(end.p);
-        CHECK_NEAR(err, 0.0, EV, EV_SRC);
+        *n += oracle_case(w, CR(K), u0, glancing ? 0.3 : 0.2, e, law, glancing, &err);
         worst = fmax(worst, err);
-        n++;
     }
+    pd_impact_work_free(w);
+    return worst;
+}
+
+static void test_laws_oracle(void)
+{
+    int n;
+    double worst = oracle_batch(18, 0, &n);
     CHECK(n >= 8);
     pd_note("impact: %d sliding collisions, both laws, e = 0.01 and 0.3: impulse within %.2g of RK4's\n", n, worst);
-    pd_impact_work_free(w);
+}
+
+/* Glancing collisions (a part sliding on the floor meets it with such
+ * microcollisions): the slide reaches each event in one step across which
+ * the direction barely turns, taken by the fifth-order pair where it meets
+ * the integrator's tolerance (impact_slide.c). The impulse within the event
+ * tolerance of the library's unit, none stuck (mu p_z is far below the
+ * slip). */
+static void test_glancing_oracle(void)
+{
+    int n;
+    double worst = oracle_batch(23, 1, &n);
+    CHECK_INT(n, 12);
+    pd_note("impact: %d glancing collisions (slip 10-1000 x approach): impulse within %.2g |u0|/K of "
+            "RK4's\n", n, worst);
 }
 
 /* The tail onto an incoming ray (impact_ray_series.c) against the slide
@@ -849,6 +893,7 @@ void suite_impact(void)
     test_planar_stick();
     test_rk4_oracle();
     test_laws_oracle();
+    test_glancing_oracle();
     test_figure7();
     test_figure7_portrait();
     test_incoming_rays();

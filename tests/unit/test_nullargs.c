@@ -438,6 +438,58 @@ static void c_sim_result_grouped(const fixture *f, int k, outcome *o)
     settle_output(o, g, pd_sim_result_free);
 }
 
+DEFAULTS(fit_options_default, pd_fit_options)
+
+/* A fit of the cube's restitution to ten drops on its one class: a few
+ * evaluations of ten drops. */
+static pd_status cube_fit(const fixture *f, int k, pd_fit_result **r, pd_diag *diag)
+{
+    static const long count[1] = {10};
+    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count};
+    pd_fit_param param = {"restitution", 0.1, 0.5, 0};
+    pd_fit_options fo;
+    pd_fit_options_default(&fo);
+    fo.ndrops = 10;
+    fo.threads = 1;
+    fo.max_evals = 2;
+    fo.npoints = 1;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    return pd_fit_run(P(0, &part), 1, P(1, &param), 1, P(2, &sc), P(3, &fo), P(4, r), P(5, diag));
+}
+
+static void c_fit_run(const fixture *f, int k, outcome *o)
+{
+    pd_fit_result *r = SENTINEL;
+    o->st = cube_fit(f, k, &r, &o->diag);
+    settle_output(o, r, pd_fit_result_free);
+}
+
+static void c_fit_result_free(const fixture *f, int k, outcome *o)
+{
+    pd_fit_result *r = NULL;
+    o->st = cube_fit(f, -1, &r, NULL);
+    free_unless_null(k, r, pd_fit_result_free);
+}
+
+static void c_fit_smooth(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    const double p[2] = {0.5, 0.5};
+    double out[2] = {-7, -7};
+    pd_fit_smooth(2, P(0, p), 10, 0.5, P(1, out));
+    o->st = k < 0 && out[0] != 0.5 ? PD_ERR_INTERNAL : PD_OK;
+}
+
+static void c_fit_loglik(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    const double p[2] = {0.5, 0.5};
+    const long c[2] = {1, 1};
+    double l = pd_fit_loglik(2, P(0, c), P(1, p), 10, 0.5);
+    o->st = (k < 0 ? l < 0 : l == 0) ? PD_OK : PD_ERR_INTERNAL;
+}
+
 static void c_version(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -614,6 +666,11 @@ static const entry table[] = {
     {"pd_pose_classes", "part res class_of nclasses ?diag", c_pose_classes},
     {"pd_sim_result_grouped", "sim class_of grouped ?diag", c_sim_result_grouped},
     {"pd_version", "", c_version},
+    {"pd_fit_options_default", "?options", c_fit_options_default},
+    {"pd_fit_run", "parts params ?base options result ?diag", c_fit_run},
+    {"pd_fit_result_free", "?result", c_fit_result_free},
+    {"pd_fit_smooth", "?p_sim ?out", c_fit_smooth},
+    {"pd_fit_loglik", "?count ?p_sim", c_fit_loglik},
     {"pd_first_order_index", "x y index lo hi ?diag", c_first_order_index},
     {"pd_sim_sensitivity", "result scene ?class_of out ?diag", c_sim_sensitivity},
     {"pd_sensitivity_free", "?sensitivity", c_sensitivity_free},

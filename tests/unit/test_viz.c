@@ -247,7 +247,7 @@ static void test_painter_depth_buffer(void)
     double worst = 0.0;
     for (int i = 0; res && i < res->nposes; i++)
         worst = fmax(worst, painter_error(part, res, i));
-    printf("     painter's order vs depth buffer, insulator cap: worst pose %.2f%% of pixels\n",
+    pd_note("viz: painter's order vs depth buffer, insulator cap: worst pose %.2f%% of pixels\n",
            100.0 * worst);
     /* Bound: a few percent (docs/figures.md has the measured figure); a
      * reversed or broken sort gets most front pixels of the bore wrong. */
@@ -339,7 +339,7 @@ static void test_sphere_map(void)
     }
     /* Directions within a chord's gap (4e-5 of the radius) of a region's
      * side can land in the neighbour: a band of under 2e-3 of the disc. */
-    printf("     sphere map: %d of %d random directions in another facet's region, %d in the "
+    pd_note("viz: sphere map: %d of %d random directions in another facet's region, %d in the "
            "rim's chords\n", mismatch, N, rim);
     CHECK(mismatch <= N * 2e-3);
     for (int i = 0; i < res->nposes; i++) {

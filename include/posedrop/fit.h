@@ -1,0 +1,148 @@
+/* posedrop/fit.h: calibrating the scene to measured drops.
+ *
+ * Given parts with measured counts per pose (or per pose class), pd_fit_run
+ * finds the scene values, shared by all the parts (one feeder), that
+ * maximise the multinomial likelihood of all the counts together, the
+ * model's pose probabilities coming from simulated drops. Every evaluation
+ * runs the same drops (the same seed: common random numbers), so that the
+ * simulated likelihood moves with the parameters and not with the noise of
+ * fresh draws. The search is GSL's Nelder-Mead simplex on the parameters
+ * mapped onto the real line; the intervals and the averaged predictions
+ * weigh points around the optimum by their likelihood (docs/calibration.md
+ * gives the method and its sources). */
+#ifndef POSEDROP_FIT_H
+#define POSEDROP_FIT_H
+
+#include <stdint.h>
+#include "posedrop/diag.h"
+#include "posedrop/export.h"
+#include "posedrop/part.h"
+#include "posedrop/sim.h"
+#include "posedrop/static.h"
+#include "posedrop/status.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* At most this many parameters are fitted at once (the quasi-random points
+ * of the weighting use one prime per parameter). */
+#define PD_FIT_MAX_PARAMS 7
+
+/* One parameter to fit: a numeric key of pd_scene_set (height, belt_speed,
+ * mu, restitution, vibration in degrees, gravity, contact_time in s, tumble
+ * in rad/s), set to a plain value at every evaluation, and
+ * the range searched, in the key's text units, lo < hi within the key's own
+ * limits. log 1 searches and weighs log(value) (lo > 0): for a quantity
+ * known to within a factor, such as the contact time. */
+typedef struct pd_fit_param {
+    const char *key;
+    double lo, hi;
+    int log;
+} pd_fit_param;
+
+/* One part. count NULL: the part is not fitted, only predicted at the
+ * fitted values (and averaged over the values the data allow). */
+typedef struct pd_fit_part {
+    const pd_part *part;
+    const pd_static_result *poses; /* its stable poses (pd_static_estimate) */
+    const int *class_of;  /* poses->nposes classes in [0, nclasses) (pd_pose_classes),
+                             or NULL: every pose its own class */
+    int nclasses;         /* with class_of NULL: poses->nposes */
+    const long *count;    /* nclasses measured counts (>= 0, not all 0), or NULL */
+} pd_fit_part;
+
+typedef struct pd_fit_options {
+    long ndrops;        /* simulated drops per part and evaluation, >= 10; 1000
+                           (raised to what --initial stationary needs) */
+    uint64_t seed;      /* 1: every evaluation's drops use it (common random numbers) */
+    int threads;        /* 0: all cores */
+    pd_engine_kind engine; /* PD_ENGINE_IMPULSE */
+    int fit_initial;    /* 1: the initial mode is fitted too, as a discrete choice:
+                           uniform, bootstrap and stationary are each fitted and the
+                           one of highest maximised likelihood kept; 0 */
+    int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150 */
+    int npoints;        /* likelihood-weighted points per round (3 to 6 rounds),
+                           >= 1; 0: 8 (d + 1) for d parameters */
+    double alpha;       /* pseudo-count added to every class's simulated count
+                           (Dirichlet smoothing), > 0; 0.5 (Jeffreys) */
+} pd_fit_options;
+
+PD_API void pd_fit_options_default(pd_fit_options *options);
+
+/* What the fit says about one part; arrays of nclasses. */
+typedef struct pd_fit_part_result {
+    int nclasses;
+    long n;             /* measured drops (0 for a predicted part) */
+    long nsim;          /* simulated drops per evaluation */
+    double *p_best;     /* the smoothed simulated probabilities at the best fit */
+    double *p, *lo, *hi; /* averaged over the likelihood-weighted points, and the
+                           95% interval of the probability, which carries the
+                           parameters' spread and the simulation's own error */
+    double loglik;      /* sum_k count_k log p_best_k (0 for a predicted part) */
+    double chi2;        /* Pearson's X^2 of the counts against n p_best */
+    int df;             /* nclasses - 1 */
+    double pvalue;      /* P(chi2_df > chi2) */
+} pd_fit_part_result;
+
+typedef struct pd_fit_result {
+    int nparams;
+    double *value;      /* the maximum found (Nelder-Mead), in the key's text units */
+    double *lo, *hi;    /* 95% interval: quantiles of the likelihood-weighted points */
+    double *mean;       /* the weighted mean */
+    pd_scene scene;     /* the base scene with the fitted values (and initial mode) */
+    pd_initial initial; /* the initial mode used (the one chosen with fit_initial) */
+    double loglik_initial[3]; /* maximised log-likelihood per initial mode tried
+                                 (indexed by pd_initial; -HUGE_VAL if not tried) */
+    double loglik;      /* at the maximum, all fitted parts: sum_k count_k log p_k */
+    double chi2;        /* the parts' X^2 summed */
+    int df;             /* sum of (nclasses - 1) over the fitted parts, minus nparams */
+    double pvalue;
+    double temper;      /* the weights' exponent: 1 / (1 + n / nsim) for equal shares
+                           (docs/calibration.md: the simulation's own error) */
+    double dispersion;  /* >= 1: the parts' X^2 at the best fit over what the data's
+                           and the simulation's noise explain; the weights' log-
+                           likelihood is divided by it, widening the intervals by
+                           its square root when no value reproduces the counts */
+    int npoints;        /* weighted points */
+    double ess;         /* their effective sample size (sum w)^2 / sum w^2 */
+    int evaluations;    /* likelihood evaluations, all searches and points */
+    long drops;         /* drops simulated in all */
+    int nparts;
+    pd_fit_part_result *parts; /* in the order given */
+} pd_fit_result;
+
+/* Fits params (nparams in 1..PD_FIT_MAX_PARAMS, distinct keys) to the parts
+ * with counts (at least one) and predicts those without. base holds the
+ * values of everything not fitted (NULL: pd_scene_default); options are
+ * required (pd_fit_options_default fills them), since they set what the fit
+ * costs. Every part's drops run from the same seed at every evaluation. A
+ * class the measurements saw and the drops never reached gets the smoothed
+ * probability alpha / (nsim + K alpha) instead of 0, so that no value makes
+ * the likelihood minus infinity. PD_ERR_USAGE (a bad argument: the message
+ * names it), PD_ERR_RANGE (a range outside its key's limits), PD_ERR_NOMEM,
+ * and what pd_sim_run returns. On success *result is the caller's
+ * (pd_fit_result_free). */
+PD_API pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
+                            int nparams, const pd_scene *base, const pd_fit_options *options,
+                            pd_fit_result **result, pd_diag *diag);
+
+PD_API void pd_fit_result_free(pd_fit_result *result);
+
+/* The smoothed probabilities of k classes from simulated ones: p_sim (k,
+ * summing to 1) from nsim drops, each class given alpha more drops, the
+ * posterior mean under a Dirichlet(alpha) prior: (nsim p_k + alpha) /
+ * (nsim + k alpha), into out (k). Does nothing when p_sim or out is NULL. */
+PD_API void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha, double *out);
+
+/* The log-likelihood of counts (k) under the smoothed probabilities of
+ * p_sim: sum_k count_k log(pd_fit_smooth's p_k), without the multinomial
+ * coefficient (it does not depend on the scene). Finite for alpha > 0; 0
+ * (no counts) when count or p_sim is NULL. */
+PD_API double pd_fit_loglik(int k, const long *count, const double *p_sim, double nsim,
+                            double alpha);
+
+#ifdef __cplusplus
+}
+#endif
+#endif

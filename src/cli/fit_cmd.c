@@ -1,0 +1,519 @@
+/* fit_cmd.c: posedrop fit, the scene calibrated to measured drops
+ * (pd_fit_run; docs/calibration.md). */
+#include <getopt.h>
+#include <limits.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include "base/number.h"
+#include "cli/cli.h"
+
+enum { MAX_PARTS = 64 };
+/* Fewer effective weighted values than this leave the 2.5% and 97.5%
+ * quantiles to one or two points each. */
+static const double FEW_EFFECTIVE = 10.0;
+
+static void fit_usage(FILE *out)
+{
+    fprintf(out,
+        "usage: %s fit [options] --fit SPEC --part PART --measured CSV [--part ...] [--predict PART]\n"
+        "\n"
+        "Finds the scene values that best explain measured drops of one or more parts\n"
+        "(one feeder: the values are shared), by maximum likelihood of all the counts\n"
+        "together, the pose probabilities from simulated drops at each trial value\n"
+        "(the same drops every time: common random numbers); then weighs the values\n"
+        "around the best by their likelihood, for 95%% intervals of the parameters and\n"
+        "predictions averaged over what the data allow (docs/calibration.md).\n"
+        "\n"
+        "Prints one CSV row per part and pose class:\n"
+        "  part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n"
+        "role: fitted (the part had measurements) or predicted (--predict); count,\n"
+        "p_measured: the measurements (empty for predicted parts); p_best: the\n"
+        "simulated probability at the best fit (smoothed: each class given alpha = 1/2\n"
+        "more drops, so that a pose seen but never simulated is not impossible); p:\n"
+        "averaged over the likelihood-weighted values, ci_lo, ci_hi: its 95%% interval,\n"
+        "which carries both the parameters' spread and the simulation's own error.\n"
+        "stderr: the fitted values with their intervals, the initial modes' likelihoods,\n"
+        "goodness of fit per part (Pearson's X^2 and p) and the cost (evaluations,\n"
+        "drops, wall and CPU seconds).\n"
+        "\n"
+        "  --fit SPEC       the parameters to fit and their ranges, comma-separated:\n"
+        "                   KEY=LO:HI with KEY one of height (m), belt_speed (m/s),\n"
+        "                   mu, restitution, vibration (degrees), gravity (m/s^2),\n"
+        "                   tumble (rad/s), contact_time (s, searched on a log\n"
+        "                   scale); and 'initial'\n"
+        "                   alone to fit the initial mode as a discrete choice\n"
+        "                   (uniform, bootstrap, stationary: each fitted, the best kept).\n"
+        "                   e.g. --fit mu=0.1:0.8,restitution=0.05:0.7,initial\n"
+        "  --part PART      a part file (OFF, STL, OBJ), followed by its --measured\n"
+        "  --measured CSV   its measured counts: pose,count (or pose,p,n), the poses\n"
+        "                   numbered as 'posedrop --group PART' numbers its classes\n"
+        "                   (poses never seen may be left out)\n"
+        "  --predict PART   a part without measurements, predicted at the fit\n"
+        "  --no-group       measured poses are posedrop's poses, not classes\n"
+        "  --units U        unit of every part file's coordinates: m (default), cm,\n"
+        "                   mm, in\n"
+        "  --scene FILE     the values not fitted ('key = value' lines, as for\n"
+        "                   'posedrop --scene'; default the paper's scene)\n"
+        "  -n N             simulated drops per part and evaluation, 10..10^7 (default\n"
+        "                   1000; raised to 10 (k+1) for the stationary start of a\n"
+        "                   part of k poses)\n"
+        "  --seed S         the drops' seed, the same at every evaluation (default 1)\n"
+        "  -j THREADS       threads (default: all cores); never changes results\n"
+        "  --engine E       impulse (default), ode or bullet\n"
+        "  --max-evals N    Nelder-Mead evaluations per search (default 150)\n"
+        "  --points M       likelihood-weighted values per round, 3 to 6 rounds\n"
+        "                   (default 8 (d+1) for d parameters)\n"
+        "  --out FILE       the fitted scene, a file --scene reads\n"
+        "  --params FILE    CSV parameter,value,lo,hi,mean,range_lo,range_hi: the best\n"
+        "                   value, the 95%% interval and the weighted mean\n"
+        "  --gof FILE       CSV part,n,classes,loglik,chi2,df,p: goodness of fit\n"
+        "  --help           this help\n",
+        prog);
+}
+
+static int fit_fail(const char *fmt, const char *a, const char *b)
+{
+    fprintf(stderr, "%s: fit: ", prog);
+    fprintf(stderr, fmt, a, b);
+    fprintf(stderr, "\n%s: see '%s fit --help'\n", prog, prog);
+    return EXIT_USAGE;
+}
+
+/* The index of text among names, -1 if none. */
+static int choice(const char *text, const char *const *names, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (strcmp(text, names[i]) == 0)
+            return i;
+    return -1;
+}
+
+static int number(const char *s, size_t n, double *out)
+{
+    return n > 0 && pd_parse_double(s, n, out) == PD_NUM_OK;
+}
+
+/* --fit: KEY=LO:HI items and 'initial'. The keys point into spec (modified). */
+static int parse_spec(char *spec, pd_fit_param *params, int *nparams, int *fit_initial)
+{
+    for (char *item = strtok(spec, ","); item; item = strtok(NULL, ",")) {
+        if (strcmp(item, "initial") == 0) {
+            *fit_initial = 1;
+            continue;
+        }
+        char *eq = strchr(item, '='), *colon = eq ? strchr(eq, ':') : NULL;
+        if (!eq || !colon)
+            return fit_fail("--fit: expected KEY=LO:HI or initial, got '%s'%s", item, "");
+        if (*nparams == PD_FIT_MAX_PARAMS)
+            return fit_fail("--fit: at most %s parameters at once%s", "7", "");
+        *eq = '\0';
+        pd_fit_param *p = &params[(*nparams)++];
+        p->key = item;
+        p->log = strcmp(item, "contact_time") == 0;
+        if (!number(eq + 1, (size_t)(colon - eq - 1), &p->lo) ||
+            !number(colon + 1, strlen(colon + 1), &p->hi))
+            return fit_fail("--fit: %s: expected a range LO:HI of two numbers, got '%s'", item,
+                            eq + 1);
+    }
+    return -1;
+}
+
+/* The measured file of a part, as counts per class (k of them). */
+static int read_counts(const char *path, const char *part, int k, long **count)
+{
+    viz_measured *m = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    pd_status st = viz_measured_read(path, &m, &diag);
+    if (st != PD_OK) {
+        fprintf(stderr, "%s: %s\n", prog, diag.message);
+        return 0;
+    }
+    int ok = 1;
+    if (m->n <= 0) {
+        fprintf(stderr, "%s: %s: the fit needs counts: columns pose,count, or pose,p,n\n", prog,
+                path);
+        ok = 0;
+    } else if (m->npose > k) {
+        fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, m->npose, part, k,
+                k == 1 ? "" : "s");
+        ok = 0;
+    }
+    if (ok && !(*count = calloc((size_t)k, sizeof **count))) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        ok = 0;
+    }
+    for (int i = 0; ok && i < m->npose; i++)
+        (*count)[i] = lround(m->p[i] * (double)m->n);
+    viz_measured_free(m);
+    return ok;
+}
+
+typedef struct {
+    const char *path, *measured;
+    pd_mesh *mesh;
+    pd_part *part;
+    pd_static_result *res;
+    int *class_of, nclasses;
+    long *count;
+} fit_input;
+
+static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
+{
+    pd_diag diag;
+    pd_diag_init(&diag);
+    pd_part_options po;
+    pd_part_options_default(&po);
+    pd_status st = pd_mesh_read(in->path, read, &in->mesh, &diag);
+    if (st == PD_OK)
+        st = pd_part_build(in->mesh, &po, &in->part, &diag);
+    if (st == PD_OK)
+        st = pd_static_estimate(in->part, NULL, &in->res, &diag);
+    if (st == PD_OK && group) {
+        in->class_of = malloc(sizeof *in->class_of * (size_t)in->res->nposes);
+        st = in->class_of ? pd_pose_classes(in->part, in->res, in->class_of, &in->nclasses, &diag)
+                          : PD_ERR_NOMEM;
+    } else if (st == PD_OK) {
+        in->nclasses = in->res->nposes;
+    }
+    if (st != PD_OK) {
+        const char *msg = diag.message[0] ? diag.message : pd_status_str(st);
+        if (strncmp(msg, in->path, strlen(in->path)) == 0)
+            fprintf(stderr, "%s: %s\n", prog, msg);
+        else
+            fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
+        return 0;
+    }
+    return !in->measured || read_counts(in->measured, in->path, in->nclasses, &in->count);
+}
+
+static const char *initial_name(pd_initial i)
+{
+    return i == PD_INITIAL_BOOTSTRAP ? "bootstrap" : i == PD_INITIAL_STATIONARY ? "stationary"
+                                                                              : "uniform";
+}
+
+/* A scene file that pd_scene_read reads back to the same scene. */
+static void write_scene(FILE *f, const pd_fit_result *r, const pd_fit_param *params,
+                        const fit_input *in, int nin)
+{
+    const pd_scene *s = &r->scene;
+    fprintf(f, "# posedrop fit: the scene that best explains the measured drops of");
+    for (int i = 0; i < nin; i++)
+        if (in[i].count)
+            fprintf(f, " %s", in[i].path);
+    fprintf(f, "\n# 95%% intervals:");
+    for (int i = 0; i < r->nparams; i++)
+        fprintf(f, " %s %.6g [%.6g, %.6g]%s", params[i].key, r->value[i], r->lo[i], r->hi[i],
+                i + 1 < r->nparams ? ";" : "");
+    fprintf(f, "\n");
+    /* Every parameter as pd_scene_set reads it: a range of the base scene
+     * stays a range. */
+    char buf[128];
+    for (int k = 0; k < PD_NPARAMS; k++)
+        fprintf(f, "%s = %s\n", pd_scene_param_name((pd_scene_param)k),
+                pd_scene_format(s, (pd_scene_param)k, buf, sizeof buf));
+    fprintf(f, "restitution_law = %s\ninitial = %s\ngravity = %.17g\n",
+            s->law == PD_RESTITUTION_ENERGETIC ? "energetic" : "poisson", initial_name(s->initial),
+            s->gravity);
+}
+
+static void write_params(FILE *f, const pd_fit_result *r, const pd_fit_param *params)
+{
+    fprintf(f, "parameter,value,lo,hi,mean,range_lo,range_hi\n");
+    for (int i = 0; i < r->nparams; i++)
+        fprintf(f, "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", params[i].key, r->value[i],
+                r->lo[i], r->hi[i], r->mean[i], params[i].lo, params[i].hi);
+}
+
+static void write_gof(FILE *f, const pd_fit_result *r, const fit_input *in, int nin)
+{
+    fprintf(f, "part,n,classes,loglik,chi2,df,p\n");
+    for (int i = 0; i < nin; i++) {
+        const pd_fit_part_result *q = &r->parts[i];
+        if (in[i].count)
+            fprintf(f, "%s,%ld,%d,%.10g,%.10g,%d,%.10g\n", in[i].path, q->n, q->nclasses,
+                    q->loglik, q->chi2, q->df, q->pvalue);
+    }
+}
+
+static void print_table(const pd_fit_result *r, const fit_input *in, int nin)
+{
+    printf("part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n");
+    for (int i = 0; i < nin; i++) {
+        const pd_fit_part_result *q = &r->parts[i];
+        for (int c = 0; c < q->nclasses; c++) {
+            printf("%s,%s,%d,", in[i].path, in[i].count ? "fitted" : "predicted", c + 1);
+            if (in[i].count)
+                printf("%ld,%.10g,", in[i].count[c], (double)in[i].count[c] / (double)q->n);
+            else
+                printf(",,");
+            printf("%.10g,%.10g,%.10g,%.10g\n", q->p_best[c], q->p[c], q->lo[c], q->hi[c]);
+        }
+    }
+}
+
+static void print_summary(const pd_fit_result *r, const pd_fit_param *params, const fit_input *in,
+                          int nin, int fit_initial, double wall, double cpu)
+{
+    for (int i = 0; i < r->nparams; i++)
+        fprintf(stderr, "%s: fit: %s = %.4g, 95%% interval [%.4g, %.4g] (weighted mean %.4g; "
+                "range %g:%g)\n", prog, params[i].key, r->value[i], r->lo[i], r->hi[i],
+                r->mean[i], params[i].lo, params[i].hi);
+    if (fit_initial)
+        fprintf(stderr, "%s: fit: initial %s: maximised log-likelihood uniform %.2f, bootstrap "
+                "%.2f, stationary %.2f\n", prog, initial_name(r->initial),
+                r->loglik_initial[PD_INITIAL_UNIFORM], r->loglik_initial[PD_INITIAL_BOOTSTRAP],
+                r->loglik_initial[PD_INITIAL_STATIONARY]);
+    for (int i = 0; i < nin; i++) {
+        const pd_fit_part_result *q = &r->parts[i];
+        if (in[i].count)
+            fprintf(stderr, "%s: fit: %s: %ld measured drops, %d classes: X^2 = %.2f, df %d, "
+                    "p = %.3g%s\n", prog, in[i].path, q->n, q->nclasses, q->chi2, q->df,
+                    q->pvalue, q->pvalue < 0.05 ? " (the model does not fit this part)" : "");
+    }
+    fprintf(stderr, "%s: fit: all parts: X^2 = %.2f, df %d, p = %.3g; log-likelihood %.2f\n",
+            prog, r->chi2, r->df, r->pvalue, r->loglik);
+    if (r->dispersion > 1.0)
+        fprintf(stderr, "%s: fit: X^2 is %.3g times what the noise explains: the intervals are "
+                "widened by its square root for the model's misfit\n", prog, r->dispersion);
+    fprintf(stderr, "%s: fit: %d evaluations, %ld drops simulated, %d weighted values (effective "
+            "%.1f, likelihood tempered by %.3f for the simulation's error); %.1f s wall, "
+            "%.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints, r->ess, r->temper, wall,
+            cpu);
+    if (r->ess < FEW_EFFECTIVE)
+        fprintf(stderr, "%s: fit: warning: the weighting rests on %.1f effective values: the "
+                "intervals and the averaged predictions are coarse (raise --points)\n", prog,
+                r->ess);
+}
+
+static double wall_now(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+int cli_fit(int argc, char **argv)
+{
+    enum { F_FIT = 256, F_PART, F_MEASURED, F_PREDICT, F_NOGROUP, F_UNITS, F_SCENE, F_SEED,
+           F_ENGINE, F_MAXEVALS, F_POINTS, F_OUT, F_PARAMS, F_GOF, F_HELP };
+    static const struct option longopts[] = {
+        {"fit", required_argument, 0, F_FIT},
+        {"part", required_argument, 0, F_PART},
+        {"measured", required_argument, 0, F_MEASURED},
+        {"predict", required_argument, 0, F_PREDICT},
+        {"no-group", no_argument, 0, F_NOGROUP},
+        {"units", required_argument, 0, F_UNITS},
+        {"scene", required_argument, 0, F_SCENE},
+        {"seed", required_argument, 0, F_SEED},
+        {"engine", required_argument, 0, F_ENGINE},
+        {"max-evals", required_argument, 0, F_MAXEVALS},
+        {"points", required_argument, 0, F_POINTS},
+        {"out", required_argument, 0, F_OUT},
+        {"params", required_argument, 0, F_PARAMS},
+        {"gof", required_argument, 0, F_GOF},
+        {"help", no_argument, 0, F_HELP},
+        {0, 0, 0, 0},
+    };
+    if (!cli_writer())
+        return 0; /* posedrop-mpi: one process fits */
+    static fit_input in[MAX_PARTS];
+    memset(in, 0, sizeof in);
+    int nin = 0, group = 1, nparams = 0, fit_initial = 0;
+    pd_fit_param params[PD_FIT_MAX_PARAMS];
+    char *spec = NULL;
+    const char *out_path = NULL, *params_path = NULL, *gof_path = NULL, *scene_path = NULL;
+    pd_mesh_read_options read;
+    pd_mesh_read_options_default(&read);
+    pd_fit_options fo;
+    pd_fit_options_default(&fo);
+    pd_diag diag;
+    pd_diag_init(&diag);
+    opterr = 0;
+    optind = 1;
+    int c, code = -1;
+    static const char *const units[] = {"m", "cm", "mm", "in"};
+    static const char *const engines[] = {"impulse", "ode", "bullet"};
+    while (code < 0 && (c = getopt_long(argc, argv, ":n:j:", longopts, NULL)) != -1) {
+        long long v = 0;
+        switch (c) {
+        case F_FIT:
+            if (spec)
+                code = fit_fail("--fit given twice: list the parameters in one%s%s", "", "");
+            else if (!(spec = strdup(optarg)))
+                code = EXIT_INTERNAL;
+            else
+                code = parse_spec(spec, params, &nparams, &fit_initial);
+            break;
+        case F_PART:
+        case F_PREDICT:
+            if (nin == MAX_PARTS)
+                code = fit_fail("at most %s parts%s", "64", "");
+            else
+                in[nin++].path = optarg;
+            if (code < 0 && c == F_PART)
+                in[nin - 1].measured = ""; /* a --measured must follow */
+            break;
+        case F_MEASURED:
+            if (nin == 0 || !in[nin - 1].measured || in[nin - 1].measured[0])
+                code = fit_fail("--measured %s: expected after its --part%s", optarg, "");
+            else
+                in[nin - 1].measured = optarg;
+            break;
+        case F_NOGROUP: group = 0; break;
+        case F_UNITS:
+            if ((v = choice(optarg, units, 4)) < 0)
+                code = fit_fail("--units: expected m, cm, mm or in, got '%s'%s", optarg, "");
+            else
+                read.units = (pd_units)v;
+            break;
+        case F_ENGINE:
+            if ((v = choice(optarg, engines, 3)) < 0)
+                code = fit_fail("--engine: expected impulse, ode or bullet, got '%s'%s", optarg, "");
+            else
+                fo.engine = (pd_engine_kind)v;
+            break;
+        case F_SCENE: scene_path = optarg; break;
+        case F_OUT: out_path = optarg; break;
+        case F_PARAMS: params_path = optarg; break;
+        case F_GOF: gof_path = optarg; break;
+        case F_HELP: fit_usage(stdout); code = 0; break;
+        case 'n':
+        case 'j':
+        case F_SEED:
+        case F_MAXEVALS:
+        case F_POINTS: {
+            pd_num_rule rule = {c == 'n' ? "a number of drops" : c == 'j' ? "a number of threads"
+                                : c == F_SEED ? "a seed" : "a count",
+                                1, 0, 0, 0, 0, c == 'n' ? 10 : c == F_SEED ? 0 : 1,
+                                c == 'j' ? 256 : c == F_SEED ? LLONG_MAX : c == 'n' ? 10000000
+                                                                                   : 100000};
+            int outcome = pd_num_read(&rule, optarg, NULL, &v);
+            if (outcome != PD_NUM_OK) {
+                char msg[256];
+                code = fit_fail("%s: %s", argv[optind - 1],
+                                pd_num_message(msg, sizeof msg, &rule, optarg, outcome));
+                break;
+            }
+            if (c == 'n')
+                fo.ndrops = (long)v;
+            else if (c == 'j')
+                fo.threads = (int)v;
+            else if (c == F_SEED)
+                fo.seed = (uint64_t)v;
+            else if (c == F_MAXEVALS)
+                fo.max_evals = (int)v;
+            else
+                fo.npoints = (int)v;
+            break;
+        }
+        case ':':
+            code = fit_fail("option '%s' needs a value%s", argv[optind - 1], "");
+            break;
+        default:
+            code = fit_fail("unknown option '%s'%s", argv[optind - 1], "");
+            break;
+        }
+    }
+    pd_scene scene;
+    pd_scene_default(&scene);
+    int nfitted = 0;
+    for (int i = 0; i < nin; i++)
+        nfitted += in[i].measured != NULL;
+    if (code < 0 && optind < argc)
+        code = fit_fail("unexpected argument '%s' (parts are given with --part or --predict)%s",
+                        argv[optind], "");
+    if (code < 0 && !spec)
+        code = fit_fail("nothing to fit: give --fit KEY=LO:HI[,...]%s%s", "", "");
+    if (code < 0 && nparams == 0)
+        code = fit_fail("--fit: give at least one KEY=LO:HI (initial is fitted beside them)%s%s",
+                        "", "");
+    for (int i = 0; code < 0 && i < nin; i++)
+        if (in[i].measured && !in[i].measured[0])
+            code = fit_fail("--part %s: expected its --measured CSV after it%s", in[i].path, "");
+    if (code < 0 && nfitted == 0)
+        code = fit_fail("no part to fit: give --part PART --measured CSV%s%s", "", "");
+    /* The command offers every engine: it links libposedrop-bullet. */
+    if (code < 0 && pd_bullet_register() != PD_OK) {
+        fprintf(stderr, "%s: the Bullet engine could not be registered\n", prog);
+        code = EXIT_INTERNAL;
+    }
+    if (code < 0 && scene_path && pd_scene_read(scene_path, &scene, &diag) != PD_OK) {
+        fprintf(stderr, "%s: %s\n", prog, diag.message);
+        code = EXIT_USAGE;
+    }
+    out_file outs[3] = {{0}};
+    const char *paths[3] = {out_path, params_path, gof_path};
+    /* No output may land on an input or on another output. */
+    static cli_file files[2 * MAX_PARTS + 4];
+    int nfiles = 0;
+    static const char *const out_names[3] = {"out", "params", "gof"};
+    for (int i = 0; i < nin; i++) {
+        files[nfiles++] = (cli_file){in[i].measured ? "part" : "predict", in[i].path, 0, 1};
+        if (in[i].measured)
+            files[nfiles++] = (cli_file){"measured", in[i].measured, 0, 1};
+    }
+    if (scene_path)
+        files[nfiles++] = (cli_file){"scene", scene_path, 0, 1};
+    for (int k = 0; k < 3; k++)
+        if (paths[k])
+            files[nfiles++] = (cli_file){out_names[k], paths[k], 1, 1};
+    if (code < 0 && !cli_files_apart(files, nfiles))
+        code = EXIT_USAGE;
+    for (int k = 0; code < 0 && k < 3; k++)
+        if (paths[k] && !out_open(&outs[k], paths[k]))
+            code = EXIT_USAGE;
+    for (int i = 0; code < 0 && i < nin; i++)
+        if (!load_part(&in[i], &read, group))
+            code = EXIT_USAGE;
+    pd_fit_result *r = NULL;
+    if (code < 0) {
+        pd_fit_part parts[MAX_PARTS];
+        for (int i = 0; i < nin; i++)
+            parts[i] = (pd_fit_part){in[i].part, in[i].res, in[i].class_of, in[i].nclasses,
+                                     in[i].count};
+        fo.fit_initial = fit_initial;
+        double t0 = wall_now(), c0 = cli_cpu_seconds();
+        pd_status st = pd_fit_run(parts, nin, params, nparams, &scene, &fo, &r, &diag);
+        if (st != PD_OK) {
+            fprintf(stderr, "%s: fit: %s\n", prog, diag.message[0] ? diag.message
+                                                                    : pd_status_str(st));
+            code = pd_status_is_input_error(st) || st == PD_ERR_USAGE ? EXIT_USAGE
+                                                                      : EXIT_INTERNAL;
+        } else {
+            double wall = wall_now() - t0, cpu = cli_cpu_seconds() - c0;
+            if (outs[0].f)
+                write_scene(outs[0].f, r, params, in, nin);
+            if (outs[1].f)
+                write_params(outs[1].f, r, params);
+            if (outs[2].f)
+                write_gof(outs[2].f, r, in, nin);
+            code = 0;
+            for (int k = 0; k < 3; k++)
+                if (outs[k].f && !out_commit(&outs[k]))
+                    code = EXIT_INTERNAL;
+            if (code == 0) {
+                print_summary(r, params, in, nin, fit_initial, wall, cpu);
+                print_table(r, in, nin);
+                if (fflush(stdout) != 0 || ferror(stdout))
+                    code = EXIT_INTERNAL;
+            }
+        }
+    }
+    for (int k = 0; k < 3; k++)
+        out_abort(&outs[k]);
+    pd_fit_result_free(r);
+    for (int i = 0; i < nin; i++) {
+        free(in[i].count);
+        free(in[i].class_of);
+        pd_static_result_free(in[i].res);
+        pd_part_free(in[i].part);
+        pd_mesh_free(in[i].mesh);
+    }
+    free(spec);
+    return code < 0 ? 0 : code;
+}

@@ -1,0 +1,405 @@
+/* fit.c: pd_fit_run, the fit of scene parameters to measured drops, with
+ * posedrop's own drops as the model (docs/calibration.md). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/fail.h"
+#include "base/gsl_adapter.h"
+#include "fit/fit_engine.h"
+#include "posedrop/fit.h"
+#include "posedrop/symmetry.h"
+#include "posedrop/tolerances.h"
+
+void pd_fit_options_default(pd_fit_options *o)
+{
+    if (!o)
+        return;
+    memset(o, 0, sizeof *o);
+    o->ndrops = 1000;
+    o->seed = 1;
+    o->threads = 0;
+    o->engine = PD_ENGINE_IMPULSE;
+    o->fit_initial = 0;
+    o->max_evals = 150;
+    o->npoints = 0;
+    o->alpha = 0.5;
+}
+
+/* The keys a fit may vary: the numeric ones of pd_scene_set. */
+static const char *const fit_keys[] = {"height", "belt_speed", "mu", "restitution", "vibration",
+                                       "gravity", "contact_time", "tumble"};
+
+typedef struct {
+    const pd_fit_part *parts;
+    int nparts;
+    const pd_fit_param *params;
+    int d;
+    pd_scene base;
+    pd_sim_options sim;
+    long *ndrops;  /* per part */
+    long drops;    /* simulated so far */
+    double *pose_p; /* scratch, the largest part's poses */
+} model;
+
+/* The scene at theta (in the problem's scale: log for a log parameter). */
+static pd_status scene_at(const model *m, const double *theta, pd_scene *sc, pd_diag *diag)
+{
+    *sc = m->base;
+    for (int i = 0; i < m->d; i++) {
+        char text[64];
+        double v = m->params[i].log ? exp(theta[i]) : theta[i];
+        snprintf(text, sizeof text, "%.17g", v);
+        pd_status st = pd_scene_set(sc, m->params[i].key, text, diag);
+        if (st != PD_OK)
+            return st;
+    }
+    return PD_OK;
+}
+
+static pd_status run_model(void *user, const double *theta, int all, double *const *p,
+                           double *nsim, pd_diag *diag)
+{
+    model *m = user;
+    pd_scene sc;
+    pd_status st = scene_at(m, theta, &sc, diag);
+    for (int i = 0; st == PD_OK && i < m->nparts; i++) {
+        const pd_fit_part *fp = &m->parts[i];
+        if (!all && !fp->count)
+            continue;
+        pd_sim_options o = m->sim;
+        o.ndrops = m->ndrops[i];
+        pd_sim_result *r = NULL;
+        if ((st = pd_sim_run(fp->part, fp->poses, &sc, &o, &r, diag)) != PD_OK)
+            break;
+        m->drops += r->n;
+        long settled = r->n - r->unsettled;
+        int chain = r->transitions && r->closed_classes > 0;
+        for (int j = 0; j < r->nposes; j++)
+            m->pose_p[j] = chain ? r->p[j] : settled ? (double)r->count[j] / (double)settled : 0.0;
+        for (int c = 0; c < fp->nclasses; c++)
+            p[i][c] = 0.0;
+        double sum = 0.0;
+        for (int j = 0; j < r->nposes; j++) {
+            p[i][fp->class_of ? fp->class_of[j] : j] += m->pose_p[j];
+            sum += m->pose_p[j];
+        }
+        /* No drop settled: nothing is known, and the smoothing alone speaks. */
+        for (int c = 0; c < fp->nclasses; c++)
+            p[i][c] = sum > 0 ? p[i][c] / sum : 1.0 / fp->nclasses;
+        nsim[i] = sum > 0 ? (double)settled : 0.0;
+        pd_sim_result_free(r);
+    }
+    return st;
+}
+
+static pd_status check_parts(const pd_fit_part *parts, int nparts, pd_diag *diag)
+{
+    int fitted = 0;
+    if (!parts || nparts < 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: no part given");
+    for (int i = 0; i < nparts; i++) {
+        const pd_fit_part *fp = &parts[i];
+        if (!fp->part || !fp->poses || fp->poses->nposes < 1)
+            return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d has no part or no stable pose",
+                           i + 1);
+        int k = fp->class_of ? fp->nclasses : fp->poses->nposes;
+        if (fp->nclasses != k || k < 1)
+            return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: %d classes given for %d "
+                           "poses%s", i + 1, fp->nclasses, fp->poses->nposes,
+                           fp->class_of ? "" : " without class_of (expected one per pose)");
+        for (int j = 0; fp->class_of && j < fp->poses->nposes; j++)
+            if (fp->class_of[j] < 0 || fp->class_of[j] >= k)
+                return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: pose %d in class %d, "
+                               "outside 1..%d", i + 1, j + 1, fp->class_of[j] + 1, k);
+        for (int c = 0; fp->class_of && c < k; c++) {
+            int members = 0;
+            for (int j = 0; j < fp->poses->nposes; j++)
+                members += fp->class_of[j] == c;
+            if (!members)
+                return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d has no pose",
+                               i + 1, c + 1);
+        }
+        if (!fp->count)
+            continue;
+        long n = 0;
+        for (int c = 0; c < k; c++) {
+            if (fp->count[c] < 0)
+                return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d has a negative "
+                               "count (%ld)", i + 1, c + 1, fp->count[c]);
+            n += fp->count[c];
+        }
+        if (n == 0)
+            return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: its counts add up to 0",
+                           i + 1);
+        fitted++;
+    }
+    if (!fitted)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: no part has measured counts to fit");
+    return PD_OK;
+}
+
+static pd_status check_params(const pd_fit_param *params, int d, const pd_scene *base,
+                              pd_diag *diag)
+{
+    if (!params)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: NULL params");
+    if (d < 1 || d > PD_FIT_MAX_PARAMS)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: %d parameters to fit: expected 1 to %d",
+                       d, PD_FIT_MAX_PARAMS);
+    for (int i = 0; i < d; i++) {
+        const pd_fit_param *q = &params[i];
+        int known = 0;
+        for (size_t j = 0; q->key && j < sizeof fit_keys / sizeof fit_keys[0]; j++)
+            known |= strcmp(q->key, fit_keys[j]) == 0;
+        if (!known)
+            return pd_fail(diag, PD_ERR_USAGE, "cannot fit '%s': expected one of height, "
+                           "belt_speed, mu, restitution, vibration, gravity, contact_time, "
+                           "tumble",
+                           q->key ? q->key : "(null)");
+        for (int j = 0; j < i; j++)
+            if (strcmp(q->key, params[j].key) == 0)
+                return pd_fail(diag, PD_ERR_USAGE, "%s is to be fitted twice", q->key);
+        if (!isfinite(q->lo) || !isfinite(q->hi))
+            return pd_fail(diag, PD_ERR_NONFINITE, "%s: the range %g:%g is not finite", q->key,
+                           q->lo, q->hi);
+        if (!(q->lo < q->hi))
+            return pd_fail(diag, PD_ERR_USAGE, "%s: the range %g:%g is empty: expected LO < HI",
+                           q->key, q->lo, q->hi);
+        if (q->log && !(q->lo > 0))
+            return pd_fail(diag, PD_ERR_USAGE, "%s: a log range needs LO > 0, got %g", q->key,
+                           q->lo);
+        /* Both ends must be values the scene accepts. */
+        pd_scene sc = *base;
+        char text[64];
+        for (int e = 0; e < 2; e++) {
+            snprintf(text, sizeof text, "%.17g", e ? q->hi : q->lo);
+            pd_status st = pd_scene_set(&sc, q->key, text, diag);
+            if (st != PD_OK)
+                return st;
+        }
+    }
+    return PD_OK;
+}
+
+static pd_status check_options(const pd_fit_options *o, pd_diag *diag)
+{
+    if (o->ndrops < 10)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: %ld drops per evaluation: expected at "
+                       "least 10", o->ndrops);
+    if (o->max_evals < 1 || o->npoints < 0 || o->threads < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: max_evals %d, npoints %d, threads %d: "
+                       "expected max_evals >= 1, npoints >= 0, threads >= 0", o->max_evals,
+                       o->npoints, o->threads);
+    if (!(o->alpha > 0) || !isfinite(o->alpha))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: alpha %g: expected a positive pseudo-count",
+                       o->alpha);
+    if (o->fit_initial != 0 && o->fit_initial != 1)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: fit_initial %d: expected 0 or 1",
+                       o->fit_initial);
+    return PD_OK;
+}
+
+void pd_fit_result_free(pd_fit_result *r)
+{
+    if (!r)
+        return;
+    free(r->value);
+    free(r->lo);
+    free(r->hi);
+    free(r->mean);
+    for (int i = 0; r->parts && i < r->nparts; i++) {
+        free(r->parts[i].p_best);
+        free(r->parts[i].p);
+        free(r->parts[i].lo);
+        free(r->parts[i].hi);
+    }
+    free(r->parts);
+    free(r);
+}
+
+static pd_fit_result *result_alloc(int d, const pd_fit_part *parts, int nparts)
+{
+    pd_fit_result *r = calloc(1, sizeof *r);
+    if (!r)
+        return NULL;
+    r->nparams = d;
+    r->nparts = nparts;
+    r->value = calloc((size_t)d, sizeof *r->value);
+    r->lo = calloc((size_t)d, sizeof *r->lo);
+    r->hi = calloc((size_t)d, sizeof *r->hi);
+    r->mean = calloc((size_t)d, sizeof *r->mean);
+    r->parts = calloc((size_t)nparts, sizeof *r->parts);
+    int ok = r->value && r->lo && r->hi && r->mean && r->parts;
+    for (int i = 0; ok && i < nparts; i++) {
+        pd_fit_part_result *q = &r->parts[i];
+        size_t k = (size_t)parts[i].nclasses;
+        q->nclasses = parts[i].nclasses;
+        q->p_best = calloc(k, sizeof *q->p_best);
+        q->p = calloc(k, sizeof *q->p);
+        q->lo = calloc(k, sizeof *q->lo);
+        q->hi = calloc(k, sizeof *q->hi);
+        ok = q->p_best && q->p && q->lo && q->hi;
+    }
+    if (!ok) {
+        pd_fit_result_free(r);
+        return NULL;
+    }
+    return r;
+}
+
+pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
+                     int nparams, const pd_scene *base, const pd_fit_options *options,
+                     pd_fit_result **result, pd_diag *diag)
+{
+    pd_fit_options o;
+    pd_scene sc0;
+    if (!options || !result)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: NULL %s", options ? "result" : "options");
+    o = *options;
+    if (base)
+        sc0 = *base;
+    else
+        pd_scene_default(&sc0);
+    pd_status st = check_options(&o, diag);
+    if (st == PD_OK)
+        st = check_parts(parts, nparts, diag);
+    if (st == PD_OK)
+        st = pd_scene_check(&sc0, diag);
+    if (st == PD_OK)
+        st = check_params(params, nparams, &sc0, diag);
+    if (st != PD_OK)
+        return st;
+    int d = nparams, maxposes = 1;
+    for (int i = 0; i < nparts; i++)
+        maxposes = parts[i].poses->nposes > maxposes ? parts[i].poses->nposes : maxposes;
+    model m = {.parts = parts, .nparts = nparts, .params = params, .d = d, .base = sc0};
+    pd_sim_options_default(&m.sim);
+    m.sim.seed = o.seed;
+    m.sim.threads = o.threads;
+    m.sim.engine = o.engine;
+    m.ndrops = malloc(sizeof *m.ndrops * (size_t)nparts);
+    m.pose_p = malloc(sizeof *m.pose_p * (size_t)maxposes);
+    double lo[PD_FIT_MAX_PARAMS], hi[PD_FIT_MAX_PARAMS];
+    int *kk = malloc(sizeof *kk * (size_t)nparts);
+    const long **count = malloc(sizeof *count * (size_t)nparts);
+    pd_fit_result *r = result_alloc(d, parts, nparts);
+    if (!m.ndrops || !m.pose_p || !kk || !count || !r) {
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
+        goto done;
+    }
+    for (int i = 0; i < d; i++) {
+        lo[i] = params[i].log ? log(params[i].lo) : params[i].lo;
+        hi[i] = params[i].log ? log(params[i].hi) : params[i].hi;
+    }
+    for (int i = 0; i < nparts; i++) {
+        kk[i] = parts[i].nclasses;
+        count[i] = parts[i].count;
+    }
+    fit_problem pb = {d, lo, hi, nparts, kk, count, o.alpha, run_model, &m};
+    fit_settings set = {o.max_evals, o.npoints ? o.npoints : 8 * (d + 1)};
+    double theta[PD_FIT_MAX_PARAMS], best_theta[PD_FIT_MAX_PARAMS], best = -HUGE_VAL;
+    pd_initial modes[3] = {PD_INITIAL_UNIFORM, PD_INITIAL_BOOTSTRAP, PD_INITIAL_STATIONARY};
+    int nmodes = o.fit_initial ? 3 : 1;
+    if (!o.fit_initial)
+        modes[0] = sc0.initial;
+    for (int i = 0; i < 3; i++)
+        r->loglik_initial[i] = -HUGE_VAL;
+    pd_initial chosen = modes[0];
+    for (int mi = 0; st == PD_OK && mi < nmodes; mi++) {
+        m.base.initial = modes[mi];
+        for (int i = 0; i < nparts; i++) {
+            long need = modes[mi] == PD_INITIAL_STATIONARY
+                            ? (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
+                            : 0;
+            m.ndrops[i] = o.ndrops > need ? o.ndrops : need;
+        }
+        double l;
+        st = fit_search(&pb, &set, theta, &l, &r->evaluations, diag);
+        if (st != PD_OK)
+            break;
+        r->loglik_initial[modes[mi]] = l;
+        if (l > best) {
+            best = l;
+            chosen = modes[mi];
+            memcpy(best_theta, theta, sizeof theta[0] * (size_t)d);
+        }
+    }
+    if (st != PD_OK)
+        goto done;
+    m.base.initial = chosen;
+    for (int i = 0; i < nparts; i++) {
+        long need = chosen == PD_INITIAL_STATIONARY
+                        ? (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
+                        : 0;
+        m.ndrops[i] = o.ndrops > need ? o.ndrops : need;
+    }
+    double **pb_best = malloc(sizeof *pb_best * (size_t)nparts);
+    double **pp = malloc(sizeof *pp * (size_t)nparts), **plo = malloc(sizeof *plo * (size_t)nparts);
+    double **phi = malloc(sizeof *phi * (size_t)nparts), *nsim = malloc(sizeof *nsim * (size_t)nparts);
+    if (!pb_best || !pp || !plo || !phi || !nsim)
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
+    for (int i = 0; st == PD_OK && i < nparts; i++) {
+        pb_best[i] = r->parts[i].p_best;
+        pp[i] = r->parts[i].p;
+        plo[i] = r->parts[i].lo;
+        phi[i] = r->parts[i].hi;
+    }
+    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 0.0, 1.0, 0.0, 0};
+    if (st == PD_OK)
+        st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
+    if (st == PD_OK) {
+        for (int i = 0; i < d; i++) {
+            r->value[i] = best_theta[i];
+            if (params[i].log) {
+                r->value[i] = exp(r->value[i]);
+                r->lo[i] = exp(r->lo[i]);
+                r->hi[i] = exp(r->hi[i]);
+                r->mean[i] = exp(r->mean[i]);
+            }
+        }
+        st = scene_at(&m, best_theta, &r->scene, diag);
+        r->initial = chosen;
+        r->temper = w.temper;
+        r->dispersion = w.dispersion;
+        r->ess = w.ess;
+        r->npoints = w.npoints;
+        r->loglik = 0.0;
+        r->chi2 = 0.0;
+        r->df = -d;
+        for (int i = 0; i < nparts; i++) {
+            pd_fit_part_result *q = &r->parts[i];
+            q->nsim = (long)nsim[i];
+            q->df = q->nclasses - 1;
+            if (!parts[i].count)
+                continue;
+            for (int c = 0; c < q->nclasses; c++) {
+                q->n += parts[i].count[c];
+                if (parts[i].count[c] > 0)
+                    q->loglik += (double)parts[i].count[c] * log(q->p_best[c]);
+            }
+            q->chi2 = fit_chi2(q->nclasses, parts[i].count, q->p_best);
+            q->pvalue = q->df > 0 ? pd_gsl_chisq_q(q->chi2, q->df) : 1.0;
+            r->loglik += q->loglik;
+            r->chi2 += q->chi2;
+            r->df += q->df;
+        }
+        r->pvalue = r->df > 0 ? pd_gsl_chisq_q(r->chi2, r->df) : 1.0;
+        r->drops = m.drops;
+    }
+    free(pb_best);
+    free(pp);
+    free(plo);
+    free(phi);
+    free(nsim);
+done:
+    free(m.ndrops);
+    free(m.pose_p);
+    free(kk);
+    free(count);
+    if (st == PD_OK)
+        *result = r;
+    else
+        pd_fit_result_free(r);
+    return st;
+}

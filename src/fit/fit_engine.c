@@ -1,0 +1,383 @@
+/* fit_engine.c: the search for the maximum of the simulated likelihood and
+ * the likelihood weighting around it (docs/calibration.md).
+ *
+ * The parameters live in the unit cube z (z = (theta - lo) / (hi - lo)), the
+ * prior is uniform there, and the simplex searches u = logit(z), so every
+ * point it tries is inside the box and no step is wasted on a bound. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include "base/fail.h"
+#include "base/gsl_adapter.h"
+#include "fit/fit_engine.h"
+#include "posedrop/fit.h"
+
+enum {
+    MIN_ROUNDS = 3,       /* weighting rounds: the whole box, then at least two around the maximum */
+    MAX_ROUNDS = 6,       /* ... and more, each narrower, while the weight sits on fewer
+                             effective points than a round has (a likelihood of thousands
+                             of drops is far narrower than the box) */
+    DESIGN_PER_PARAM = 4, /* the search's starting design: 4 d + 1 points */
+};
+/* The simplex stops when its size in u is below this: 0.02 in u is 0.005 of
+ * the range at the middle of the box, below what a few hundred measured
+ * drops can tell apart. */
+static const double SIMPLEX_TOL = 0.02;
+/* The first simplex's steps in u: a quarter of the range at the middle. */
+static const double SIMPLEX_STEP = 1.0;
+/* A later round's box: the maximum plus or minus this many weighted standard
+ * deviations of the points so far (a normal's mass beyond 3.5 sd is 5e-4),
+ * shrinking at most 4-fold a round so that a round whose points all but
+ * one weigh nothing still leaves the next one room. */
+static const double BOX_SDS = 3.5, BOX_SHRINK = 4.0;
+/* u beyond this is z within 1e-9 of a bound: the box's edge. */
+static const double U_MAX = 20.0;
+
+typedef struct {
+    const fit_problem *pb;
+    double *const *p;
+    double *nsim;
+    double theta[PD_FIT_MAX_PARAMS];
+    pd_status st;
+    pd_diag *diag;
+    int evals;
+} ctx;
+
+static void to_theta(const fit_problem *pb, const double *z, double *theta)
+{
+    for (int i = 0; i < pb->d; i++)
+        theta[i] = pb->lo[i] + (pb->hi[i] - pb->lo[i]) * z[i];
+}
+
+/* The log-likelihood at z of the parts with counts: plain (*plain) and each
+ * part's tempered by 1 / (1 + n_i / nsim_i) (the return value). */
+static pd_status evaluate(ctx *c, const double *z, int all, double *plain, double *tempered)
+{
+    const fit_problem *pb = c->pb;
+    to_theta(pb, z, c->theta);
+    c->evals++;
+    pd_status st = pb->model(pb->user, c->theta, all, c->p, c->nsim, c->diag);
+    if (st != PD_OK)
+        return st;
+    double l = 0.0, lt = 0.0;
+    for (int i = 0; i < pb->nparts; i++) {
+        if (!pb->count[i])
+            continue;
+        long n = 0;
+        for (int j = 0; j < pb->k[i]; j++)
+            n += pb->count[i][j];
+        double li = pd_fit_loglik(pb->k[i], pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+        l += li;
+        lt += li / (1.0 + (double)n / c->nsim[i]);
+    }
+    *plain = l;
+    if (tempered)
+        *tempered = lt;
+    return PD_OK;
+}
+
+static double objective(const double *u, void *user)
+{
+    ctx *c = user;
+    double z[PD_FIT_MAX_PARAMS], l;
+    for (int i = 0; i < c->pb->d; i++) {
+        double v = u[i] > U_MAX ? U_MAX : u[i] < -U_MAX ? -U_MAX : u[i];
+        z[i] = 1.0 / (1.0 + exp(-v));
+    }
+    c->st = evaluate(c, z, 0, &l, NULL);
+    return c->st == PD_OK ? -l : HUGE_VAL;
+}
+
+/* Per-part buffers of the model's output. */
+static double **part_arrays(const fit_problem *pb)
+{
+    double **p = calloc((size_t)pb->nparts, sizeof *p);
+    for (int i = 0; p && i < pb->nparts; i++)
+        if (!(p[i] = malloc(sizeof **p * (size_t)pb->k[i]))) {
+            for (int j = 0; j < i; j++)
+                free(p[j]);
+            free(p);
+            return NULL;
+        }
+    return p;
+}
+
+static void free_arrays(const fit_problem *pb, double **p)
+{
+    for (int i = 0; p && i < pb->nparts; i++)
+        free(p[i]);
+    free(p);
+}
+
+pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta, double *loglik,
+                     int *evals, pd_diag *diag)
+{
+    double **p = part_arrays(pb), *nsim = malloc(sizeof *nsim * (size_t)pb->nparts);
+    if (!p || !nsim) {
+        free_arrays(pb, p);
+        free(nsim);
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
+    }
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag};
+    int d = pb->d;
+    /* The design: the middle of the box and 4 d Halton points; the search
+     * starts from the best, so a maximum away from the middle is not left
+     * for a simplex to crawl to. */
+    double z[PD_FIT_MAX_PARAMS], zbest[PD_FIT_MAX_PARAMS], best = -HUGE_VAL;
+    pd_status st = PD_OK;
+    for (int i = 0; st == PD_OK && i <= DESIGN_PER_PARAM * d; i++) {
+        double l;
+        for (int j = 0; j < d; j++)
+            z[j] = i == 0 ? 0.5 : fit_halton(i, j);
+        st = evaluate(&c, z, 0, &l, NULL);
+        if (st == PD_OK && l > best) {
+            best = l;
+            memcpy(zbest, z, sizeof z[0] * (size_t)d);
+        }
+    }
+    double u[PD_FIT_MAX_PARAMS], step[PD_FIT_MAX_PARAMS], fmin = 0.0;
+    int nm_evals = 0;
+    for (int j = 0; j < d; j++) {
+        u[j] = log(zbest[j] / (1.0 - zbest[j]));
+        step[j] = SIMPLEX_STEP;
+    }
+    if (st == PD_OK) {
+        st = pd_gsl_nelder_mead(objective, &c, d, u, step, SIMPLEX_TOL, s->max_evals, &nm_evals,
+                                &fmin);
+        if (st == PD_ERR_INTERNAL && c.st != PD_OK)
+            st = c.st; /* the model's failure, its message in diag */
+        else if (st != PD_OK)
+            st = pd_fail(diag, st, "the Nelder-Mead search failed: %s", pd_status_str(st));
+    }
+    if (st == PD_OK) {
+        /* The simplex keeps its best vertex, which is never worse than the
+         * design's best it started from. */
+        for (int j = 0; j < d; j++) {
+            double v = u[j] > U_MAX ? U_MAX : u[j] < -U_MAX ? -U_MAX : u[j];
+            z[j] = 1.0 / (1.0 + exp(-v));
+        }
+        to_theta(pb, z, theta);
+        *loglik = -fmin;
+    }
+    *evals += c.evals;
+    free_arrays(pb, p);
+    free(nsim);
+    return st;
+}
+
+/* Weighted q-quantile of x (n values) with weights w (summing to 1). */
+static double weighted_quantile(int n, const double *x, const double *w, double q, int *order)
+{
+    for (int i = 0; i < n; i++)
+        order[i] = i;
+    for (int i = 1; i < n; i++) { /* insertion sort: a few hundred points */
+        int o = order[i], j = i;
+        for (; j > 0 && x[order[j - 1]] > x[o]; j--)
+            order[j] = order[j - 1];
+        order[j] = o;
+    }
+    double acc = 0.0;
+    for (int i = 0; i < n; i++) {
+        acc += w[order[i]];
+        if (acc >= q)
+            return x[order[i]];
+    }
+    return x[order[n - 1]];
+}
+
+typedef struct {
+    double lo[PD_FIT_MAX_PARAMS], hi[PD_FIT_MAX_PARAMS];
+    int npoints;
+} box;
+
+/* The balance heuristic's weights: each point's tempered likelihood over
+ * the mixture density of the rounds' uniform boxes at that point. */
+static void weights(int d, int n, const double *z, const double *lt, const box *b, int nboxes,
+                    double *w)
+{
+    double top = -HUGE_VAL;
+    for (int j = 0; j < n; j++)
+        top = lt[j] > top ? lt[j] : top;
+    double sum = 0.0;
+    for (int j = 0; j < n; j++) {
+        double q = 0.0;
+        for (int r = 0; r < nboxes; r++) {
+            int in = 1;
+            double vol = 1.0;
+            for (int i = 0; i < d; i++) {
+                double x = z[(size_t)j * (size_t)d + (size_t)i];
+                in &= x >= b[r].lo[i] && x <= b[r].hi[i];
+                vol *= b[r].hi[i] - b[r].lo[i];
+            }
+            if (in)
+                q += (double)b[r].npoints / (double)n / vol;
+        }
+        w[j] = q > 0 ? exp(lt[j] - top) / q : 0.0;
+        sum += w[j];
+    }
+    for (int j = 0; j < n; j++)
+        w[j] /= sum;
+}
+
+pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
+                    fit_weighed *out, int *evals, pd_diag *diag)
+{
+    int d = pb->d, np = pb->nparts, total = MAX_ROUNDS * s->npoints;
+    size_t ksum = 0;
+    for (int i = 0; i < np; i++)
+        ksum += (size_t)pb->k[i];
+    double **p = part_arrays(pb), *nsim = malloc(sizeof *nsim * (size_t)np);
+    double *z = malloc(sizeof *z * (size_t)total * (size_t)d);
+    double *lt = malloc(sizeof *lt * (size_t)total), *w = malloc(sizeof *w * (size_t)total);
+    double *store = malloc(sizeof *store * (size_t)total * ksum);
+    double *sims = malloc(sizeof *sims * (size_t)total * (size_t)np);
+    double *x = malloc(sizeof *x * (size_t)total), *a = malloc(sizeof *a * (size_t)total);
+    double *bb = malloc(sizeof *bb * (size_t)total);
+    int *order = malloc(sizeof *order * (size_t)total);
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag};
+    pd_status st = PD_OK;
+    if (!p || !nsim || !z || !lt || !w || !store || !sims || !x || !a || !bb || !order)
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit's weighting");
+    double zhat[PD_FIT_MAX_PARAMS], l, ltb;
+    for (int i = 0; i < d; i++)
+        zhat[i] = (theta[i] - pb->lo[i]) / (pb->hi[i] - pb->lo[i]);
+    if (st == PD_OK)
+        st = evaluate(&c, zhat, 1, &l, &ltb);
+    if (st == PD_OK) {
+        long ntot = 0;
+        double tsum = 0.0;
+        for (int i = 0; i < np; i++) {
+            pd_fit_smooth(pb->k[i], p[i], nsim[i], pb->alpha, out->p_best[i]);
+            out->nsim_best[i] = nsim[i];
+            if (!pb->count[i])
+                continue;
+            long n = 0;
+            for (int j = 0; j < pb->k[i]; j++)
+                n += pb->count[i][j];
+            ntot += n;
+            tsum += (double)n / (1.0 + (double)n / nsim[i]);
+        }
+        out->temper = ntot ? tsum / (double)ntot : 1.0;
+        /* Overdispersion: X^2 beyond what the data's and the simulation's
+         * noise explain is the model's own misfit, and widens the
+         * weights' spread by its square root (quasi-likelihood). */
+        double x2 = 0.0, expect = 0.0;
+        int df = -d;
+        for (int i = 0; i < np; i++) {
+            if (!pb->count[i])
+                continue;
+            long n = 0;
+            for (int j = 0; j < pb->k[i]; j++)
+                n += pb->count[i][j];
+            x2 += fit_chi2(pb->k[i], pb->count[i], out->p_best[i]);
+            expect += (double)(pb->k[i] - 1) * (1.0 + (double)n / nsim[i]);
+            df += pb->k[i] - 1;
+        }
+        /* Without a degree of freedom left, X^2 says nothing of the fit. */
+        expect *= df > 0 ? (double)df / (double)(df + d) : 0.0;
+        out->dispersion = df > 0 && x2 > expect ? x2 / expect : 1.0;
+    }
+    box b[MAX_ROUNDS];
+    double half[PD_FIT_MAX_PARAMS];
+    int n = 0;
+    long index = 1;
+    double ess = 0.0;
+    for (int r = 0; st == PD_OK && r < MAX_ROUNDS; r++) {
+        if (r >= MIN_ROUNDS && ess >= s->npoints)
+            break;
+        for (int i = 0; i < d; i++) {
+            if (r == 0) {
+                half[i] = 0.5;
+                b[r].lo[i] = 0.0;
+                b[r].hi[i] = 1.0;
+                continue;
+            }
+            /* The spread of the points so far decides the next box. */
+            double m = 0.0, v = 0.0;
+            for (int j = 0; j < n; j++)
+                m += w[j] * z[(size_t)j * (size_t)d + (size_t)i];
+            for (int j = 0; j < n; j++) {
+                double e = z[(size_t)j * (size_t)d + (size_t)i] - m;
+                v += w[j] * e * e;
+            }
+            double h = BOX_SDS * sqrt(v);
+            h = h < half[i] / BOX_SHRINK ? half[i] / BOX_SHRINK : h > half[i] ? half[i] : h;
+            half[i] = h;
+            b[r].lo[i] = zhat[i] - h < 0 ? 0.0 : zhat[i] - h;
+            b[r].hi[i] = zhat[i] + h > 1 ? 1.0 : zhat[i] + h;
+        }
+        b[r].npoints = s->npoints;
+        for (int j = 0; st == PD_OK && j < s->npoints; j++, n++, index++) {
+            double *zj = z + (size_t)n * (size_t)d;
+            for (int i = 0; i < d; i++)
+                zj[i] = b[r].lo[i] + (b[r].hi[i] - b[r].lo[i]) * fit_halton(index, i);
+            st = evaluate(&c, zj, 1, &l, &lt[n]);
+            lt[n] /= out->dispersion;
+            double *sj = store + (size_t)n * ksum;
+            for (int i = 0; st == PD_OK && i < np; i++) {
+                memcpy(sj, p[i], sizeof *sj * (size_t)pb->k[i]);
+                sj += pb->k[i];
+                sims[(size_t)n * (size_t)np + (size_t)i] = nsim[i];
+            }
+        }
+        if (st == PD_OK) {
+            weights(d, n, z, lt, b, r + 1, w);
+            double sw2 = 0.0;
+            for (int j = 0; j < n; j++)
+                sw2 += w[j] * w[j];
+            ess = 1.0 / sw2;
+        }
+    }
+    if (st == PD_OK) {
+        out->ess = ess;
+        out->npoints = n;
+        for (int i = 0; i < d; i++) {
+            double m = 0.0;
+            for (int j = 0; j < n; j++) {
+                x[j] = z[(size_t)j * (size_t)d + (size_t)i];
+                m += w[j] * x[j];
+            }
+            double span = pb->hi[i] - pb->lo[i];
+            out->mean[i] = pb->lo[i] + span * m;
+            out->lo[i] = pb->lo[i] + span * weighted_quantile(n, x, w, 0.025, order);
+            out->hi[i] = pb->lo[i] + span * weighted_quantile(n, x, w, 0.975, order);
+        }
+        /* Each point's probability of a class is known to within its own
+         * drops' error: the posterior Beta of that class under the
+         * Dirichlet(alpha) prior. The averaged prediction is the mixture of
+         * those Betas with the likelihood weights. */
+        size_t off = 0;
+        for (int i = 0; i < np; i++) {
+            int k = pb->k[i];
+            for (int cl = 0; cl < k; cl++) {
+                double mean = 0.0;
+                for (int j = 0; j < n; j++) {
+                    double ns = sims[(size_t)j * (size_t)np + (size_t)i];
+                    double pj = store[(size_t)j * ksum + off + (size_t)cl];
+                    a[j] = ns * pj + pb->alpha;
+                    bb[j] = ns * (1.0 - pj) + (double)(k - 1) * pb->alpha;
+                    if (bb[j] < pb->alpha) /* round-off of 1 - pj */
+                        bb[j] = pb->alpha;
+                    mean += w[j] * a[j] / (a[j] + bb[j]);
+                }
+                out->p[i][cl] = mean;
+                out->plo[i][cl] = fit_beta_mixture_quantile(n, w, a, bb, 0.025);
+                out->phi[i][cl] = fit_beta_mixture_quantile(n, w, a, bb, 0.975);
+            }
+            off += (size_t)k;
+        }
+    }
+    *evals += c.evals;
+    free_arrays(pb, p);
+    free(nsim);
+    free(z);
+    free(lt);
+    free(w);
+    free(store);
+    free(sims);
+    free(x);
+    free(a);
+    free(bb);
+    free(order);
+    return st;
+}

@@ -1,0 +1,75 @@
+/* fit_engine.h (private): maximum simulated likelihood and likelihood
+ * weighting over a box of parameters, for any model that turns a parameter
+ * vector into class probabilities per part (fit.c's is posedrop's drops; the
+ * tests give closed forms). docs/calibration.md describes the method. */
+#ifndef PD_FIT_ENGINE_H
+#define PD_FIT_ENGINE_H
+
+#include "posedrop/diag.h"
+#include "posedrop/status.h"
+
+/* Fills p[i][0..k[i]) (summing to 1) and nsim[i] (the simulated drops behind
+ * them) for every part i with counts, and for the others too when all is 1.
+ * theta is in the problem's scale (lo..hi). */
+typedef pd_status (*fit_model_fn)(void *user, const double *theta, int all, double *const *p,
+                                  double *nsim, pd_diag *diag);
+
+typedef struct fit_problem {
+    int d;                    /* parameters, 1..PD_FIT_MAX_PARAMS */
+    const double *lo, *hi;    /* the box, lo < hi */
+    int nparts;
+    const int *k;             /* classes per part */
+    const long *const *count; /* per part; NULL: predicted only */
+    double alpha;             /* the smoothing pseudo-count */
+    fit_model_fn model;
+    void *user;
+} fit_problem;
+
+typedef struct fit_settings {
+    int max_evals; /* per Nelder-Mead search */
+    int npoints;   /* weighted points per round */
+} fit_settings;
+
+/* The search: a quasi-random design over the box, then Nelder-Mead from its
+ * best point. theta (d) receives the best point, *loglik its log-likelihood
+ * (the parts with counts), *evals is increased by the evaluations spent. */
+pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta, double *loglik,
+                     int *evals, pd_diag *diag);
+
+/* What the weighting gives; the caller allocates every array. */
+typedef struct fit_weighed {
+    double *lo, *hi, *mean;   /* d: 95% interval and weighted mean */
+    double *const *p_best;    /* per part, k[i]: smoothed probabilities at theta */
+    double *nsim_best;        /* per part */
+    double *const *p;         /* per part, k[i]: averaged */
+    double *const *plo, *const *phi; /* per part, k[i]: 95% interval */
+    double temper;            /* the count-weighted mean of the parts' exponents */
+    double dispersion;        /* X^2 at theta over what the noise explains
+                                 (sum (k_i - 1)(1 + n_i / nsim_i) - d), at least 1:
+                                 the tempered log-likelihood is divided by it */
+    double ess;
+    int npoints;
+} fit_weighed;
+
+/* Evaluates theta (the search's maximum) with every part (and its
+ * dispersion from there), then rounds of
+ * s->npoints quasi-random points: the whole box, then boxes around theta
+ * shrunk to the weighted spread (at least 3 rounds, at most 6, stopping once
+ * the effective sample size reaches s->npoints), all weighed by their
+ * tempered likelihood over the density they were drawn from (the balance
+ * heuristic). */
+pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
+                    fit_weighed *out, int *evals, pd_diag *diag);
+
+/* The Halton sequence's coordinate j (0..6) of point i >= 1, in (0, 1). */
+double fit_halton(long i, int j);
+
+/* Pearson's X^2 of counts (k) against n p. */
+double fit_chi2(int k, const long *count, const double *p);
+
+/* The q-quantile of a mixture of Beta(a_j, b_j) with weights w_j (n terms,
+ * summing to 1), by bisection to 1e-9. */
+double fit_beta_mixture_quantile(int n, const double *w, const double *a, const double *b,
+                                 double q);
+
+#endif

@@ -1,0 +1,71 @@
+/* fit_lik.c: the smoothed multinomial likelihood and the small statistics
+ * the fit reports with (docs/calibration.md). */
+#include <math.h>
+#include "base/gsl_adapter.h"
+#include "fit/fit_engine.h"
+#include "posedrop/fit.h"
+
+void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha, double *out)
+{
+    if (!p_sim || !out)
+        return;
+    double den = nsim + (double)k * alpha;
+    for (int i = 0; i < k; i++)
+        out[i] = (nsim * p_sim[i] + alpha) / den;
+}
+
+double pd_fit_loglik(int k, const long *count, const double *p_sim, double nsim, double alpha)
+{
+    double den = nsim + (double)k * alpha, l = 0.0;
+    if (!count || !p_sim)
+        return 0.0;
+    for (int i = 0; i < k; i++)
+        if (count[i] > 0)
+            l += (double)count[i] * log((nsim * p_sim[i] + alpha) / den);
+    return l;
+}
+
+double fit_chi2(int k, const long *count, const double *p)
+{
+    long n = 0;
+    for (int i = 0; i < k; i++)
+        n += count[i];
+    double x2 = 0.0;
+    for (int i = 0; i < k; i++) {
+        double e = (double)n * p[i];
+        x2 += ((double)count[i] - e) * ((double)count[i] - e) / e;
+    }
+    return x2;
+}
+
+double fit_halton(long i, int j)
+{
+    static const int prime[] = {2, 3, 5, 7, 11, 13, 17};
+    double f = 1.0, r = 0.0;
+    long b = prime[j];
+    for (long n = i; n > 0; n /= b) {
+        f /= (double)b;
+        r += f * (double)(n % b);
+    }
+    return r;
+}
+
+/* Bisection to this width: far below any probability printed. */
+static const double QUANTILE_TOL = 1e-9;
+
+double fit_beta_mixture_quantile(int n, const double *w, const double *a, const double *b,
+                                 double q)
+{
+    double x0 = 0.0, x1 = 1.0;
+    while (x1 - x0 > QUANTILE_TOL) {
+        double x = 0.5 * (x0 + x1), c = 0.0;
+        for (int j = 0; j < n; j++)
+            if (w[j] > 0)
+                c += w[j] * pd_gsl_beta_p(x, a[j], b[j]);
+        if (c < q)
+            x0 = x;
+        else
+            x1 = x;
+    }
+    return 0.5 * (x0 + x1);
+}

@@ -1,0 +1,598 @@
+/* test_fit.c: the calibration (posedrop/fit.h): the smoothed likelihood on
+ * hand-computed cases, the search and the weighting on models whose answer
+ * is a closed form, the intervals' coverage over repeats of a simulated
+ * model with common random numbers, and the recovery of a scene value from
+ * posedrop's own drops. PD_TEST_FULL=1 adds the coverage of the recovery
+ * over repeats of posedrop's drops (minutes, not for every check). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+#include "check.h"
+#include "cli_run.h"
+#include "base/gsl_adapter.h"
+#include "fit/fit_engine.h"
+#include "posedrop/posedrop.h"
+#include "shapes.h"
+#include "suites.h"
+
+/* Round-off of a few logarithms and divisions of numbers of order 1. */
+static const double ROUND = 1e-13;
+
+static void test_likelihood_hand(void)
+{
+    /* 10 simulated drops, 5 and 5 on classes 1 and 3, none on 2; alpha 1/2:
+     * (5 + 1/2) / (10 + 3/2) = 11/23 and 1/23. */
+    const double p[] = {0.5, 0.0, 0.5};
+    double s[3];
+    pd_fit_smooth(3, p, 10.0, 0.5, s);
+    CHECK_NEAR(s[0], 11.0 / 23.0, ROUND, "hand: 5.5 / 11.5");
+    CHECK_NEAR(s[1], 1.0 / 23.0, ROUND, "hand: 0.5 / 11.5");
+    CHECK_NEAR(s[0] + s[1] + s[2], 1.0, ROUND, "the smoothed probabilities sum to 1");
+    const long c[] = {5, 0, 2};
+    CHECK_NEAR(pd_fit_loglik(3, c, p, 10.0, 0.5), 7.0 * log(11.0 / 23.0), ROUND,
+               "hand: 5 log(11/23) + 2 log(11/23)");
+    /* Measured on the class no drop reached: finite, 3 log(1/23). */
+    const long unreached[] = {0, 3, 0};
+    double l = pd_fit_loglik(3, unreached, p, 10.0, 0.5);
+    CHECK(isfinite(l));
+    CHECK_NEAR(l, 3.0 * log(1.0 / 23.0), ROUND, "hand: an unreached class gets alpha / 11.5");
+    /* Many simulated drops: the plain multinomial log-likelihood. */
+    const double q[] = {0.2, 0.3, 0.5};
+    const long c2[] = {1, 2, 3};
+    CHECK_NEAR(pd_fit_loglik(3, c2, q, 1e12, 0.5), log(0.2) + 2 * log(0.3) + 3 * log(0.5), 1e-11,
+               "alpha / nsim = 5e-13 relative, times 6 counts");
+    /* Pearson's X^2: n = 6, expected 1.2, 1.8, 3: 0.04/1.2 + 0.04/1.8 + 0. */
+    CHECK_NEAR(fit_chi2(3, c2, q), 0.04 / 1.2 + 0.04 / 1.8, ROUND, "hand");
+}
+
+static void test_beta_mixture(void)
+{
+    const double w1[] = {1.0}, a1[] = {2.0}, b1[] = {1.0};
+    /* Beta(2, 1): CDF x^2, so the q-quantile is sqrt(q). */
+    CHECK_NEAR(fit_beta_mixture_quantile(1, w1, a1, b1, 0.25), 0.5, 1e-8, "bisection to 1e-9");
+    /* Beta(1, 1) and Beta(2, 1), half each: CDF (x + x^2) / 2; at 0.3 it is
+     * x = (-1 + sqrt(1 + 2.4)) / 2. */
+    const double w2[] = {0.5, 0.5}, a2[] = {1.0, 2.0}, b2[] = {1.0, 1.0};
+    CHECK_NEAR(fit_beta_mixture_quantile(2, w2, a2, b2, 0.3), (-1.0 + sqrt(3.4)) / 2.0, 1e-8,
+               "bisection to 1e-9");
+}
+
+/* A model of closed form: part i has two classes, p = (theta_i, 1 -
+ * theta_i), known exactly (nsim so large that the smoothing and the
+ * tempering vanish). */
+static pd_status exact_model(void *user, const double *theta, int all, double *const *p,
+                             double *nsim, pd_diag *diag)
+{
+    const int *nparts = user;
+    (void)all;
+    (void)diag;
+    for (int i = 0; i < *nparts; i++) {
+        p[i][0] = theta[i];
+        p[i][1] = 1.0 - theta[i];
+        nsim[i] = 1e15;
+    }
+    return PD_OK;
+}
+
+static void test_search_closed_form(void)
+{
+    /* Binomial counts 40/60 and 25/75: the maximum is (0.4, 0.25). */
+    const long c0[] = {40, 60}, c1[] = {25, 75};
+    const long *count[] = {c0, c1};
+    const int k[] = {2, 2};
+    const double lo[] = {0.05, 0.05}, hi[] = {0.95, 0.95};
+    int nparts = 2, evals = 0;
+    fit_problem pb = {2, lo, hi, 2, k, count, 0.5, exact_model, &nparts};
+    fit_settings s = {200, 32};
+    double theta[2], l;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(fit_search(&pb, &s, theta, &l, &evals, &diag), PD_OK);
+    /* The simplex stops at size 0.02 in logit space: at most 0.25 * 0.9 * 0.02
+     * in theta. */
+    CHECK_NEAR(theta[0], 0.4, 0.0045, "the simplex's size tolerance mapped to theta");
+    CHECK_NEAR(theta[1], 0.25, 0.0045, "the simplex's size tolerance mapped to theta");
+    CHECK_NEAR(l, 40 * log(0.4) + 60 * log(0.6) + 25 * log(0.25) + 75 * log(0.75), 1e-2,
+               "the maximum's value: second order in the 0.0045 position error, n = 100 each");
+    pd_note("closed-form search: (%.5f, %.5f) in %d evaluations\n", theta[0], theta[1], evals);
+
+    /* The weighting: with a flat prior the weights are the posterior,
+     * Beta(41, 61) for theta_0; the interval is its quantiles. */
+    double wlo[2], whi[2], wmean[2], pbest0[2], pbest1[2], p0[2], p1[2], plo0[2], plo1[2],
+        phi0[2], phi1[2], nsb[2];
+    double *pb_best[] = {pbest0, pbest1}, *pp[] = {p0, p1}, *plo[] = {plo0, plo1},
+           *phi[] = {phi0, phi1};
+    fit_weighed w = {wlo, whi, wmean, pb_best, nsb, pp, plo, phi, 0, 1, 0, 0};
+    fit_settings s2 = {200, 64};
+    CHECK_STATUS(fit_weigh(&pb, &s2, theta, &w, &evals, &diag), PD_OK);
+    const double one[] = {1.0}, a[] = {41.0}, b[] = {61.0};
+    double qlo = fit_beta_mixture_quantile(1, one, a, b, 0.025);
+    double qhi = fit_beta_mixture_quantile(1, one, a, b, 0.975);
+    /* The last round's 64 points span about 7 sd (sd 0.048): 0.005 apart. */
+    CHECK_NEAR(wlo[0], qlo, 0.01, "two spacings of the last round's points");
+    CHECK_NEAR(whi[0], qhi, 0.01, "two spacings of the last round's points");
+    CHECK_NEAR(wmean[0], 41.0 / 102.0, 0.005, "the posterior mean; quasi-random integration");
+    CHECK_NEAR(w.temper, 1.0, 1e-12, "nsim 1e15: no simulation error to carry");
+    pd_note("closed-form weighting: [%.4f, %.4f] against Beta's [%.4f, %.4f], ESS %.1f of %d\n",
+            wlo[0], whi[0], qlo, qhi, w.ess, w.npoints);
+}
+
+/* A model that cannot fit: p = (theta, (1 - theta) / 2, (1 - theta) / 2)
+ * against counts 30, 60, 10, known exactly. */
+static pd_status misfit_model(void *user, const double *theta, int all, double *const *p,
+                              double *nsim, pd_diag *diag)
+{
+    (void)user;
+    (void)all;
+    (void)diag;
+    p[0][0] = theta[0];
+    p[0][1] = p[0][2] = 0.5 * (1.0 - theta[0]);
+    nsim[0] = 1e15;
+    return PD_OK;
+}
+
+static void test_dispersion(void)
+{
+    const long c[] = {30, 60, 10};
+    const long *count[] = {c};
+    const int k[] = {3};
+    const double lo[] = {0.05}, hi[] = {0.95};
+    fit_problem pb = {1, lo, hi, 1, k, count, 0.5, misfit_model, NULL};
+    fit_settings s = {200, 32};
+    double theta[1], l, wlo[1], whi[1], wmean[1], pb0[3], p0[3], l0[3], h0[3], nsb[1];
+    double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
+    fit_weighed w = {wlo, whi, wmean, pbb, nsb, pp, pl, ph, 0, 1, 0, 0};
+    int evals = 0;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(fit_search(&pb, &s, theta, &l, &evals, &diag), PD_OK);
+    CHECK_NEAR(theta[0], 0.3, 0.0045, "the simplex's size tolerance mapped to theta");
+    CHECK_STATUS(fit_weigh(&pb, &s, theta, &w, &evals, &diag), PD_OK);
+    /* One degree of freedom of two classes' worth of X^2 after one fitted
+     * parameter: the noise explains 2 * 1/2 = 1, so the dispersion is X^2
+     * itself, about 35.7 at theta = 0.3. */
+    const double pt[] = {theta[0], 0.5 * (1 - theta[0]), 0.5 * (1 - theta[0])};
+    CHECK_NEAR(w.dispersion, fit_chi2(3, c, pt), 1e-6, "alpha / nsim = 5e-16 relative");
+    CHECK(w.dispersion > 30);
+    /* The interval is widened by sqrt(35.7) = 6: the plain one (Beta(31, 71)
+     * again, 0.19 wide) would be at least 3 times narrower. */
+    CHECK(whi[0] - wlo[0] > 3 * 0.19);
+    pd_note("dispersion %.2f: interval [%.3f, %.3f]\n", w.dispersion, wlo[0], whi[0]);
+}
+
+/* A simulated model with common random numbers: S uniforms fixed for the
+ * whole fit, class 0 for those below theta. Its p is a step function of
+ * theta, as posedrop's counts are. */
+typedef struct {
+    int S;
+    double *u;
+} crn_model;
+
+static pd_status crn_sim(void *user, const double *theta, int all, double *const *p, double *nsim,
+                         pd_diag *diag)
+{
+    const crn_model *m = user;
+    (void)all;
+    (void)diag;
+    int below = 0;
+    for (int i = 0; i < m->S; i++)
+        below += m->u[i] < theta[0];
+    p[0][0] = (double)below / m->S;
+    p[0][1] = 1.0 - p[0][0];
+    nsim[0] = m->S;
+    return PD_OK;
+}
+
+/* Fits theta_true's binomial counts of n drops with S simulated ones; the
+ * 95% interval into lo, hi. */
+static void crn_fit(test_rng *rng, double truth, long n, int S, double *lo, double *hi,
+                    double *best)
+{
+    crn_model m = {S, malloc(sizeof(double) * (size_t)S)};
+    for (int i = 0; i < S; i++)
+        m.u[i] = rng_uniform(rng);
+    long c[2] = {0, 0};
+    for (long i = 0; i < n; i++)
+        c[rng_uniform(rng) < truth ? 0 : 1]++;
+    const long *count[] = {c};
+    const int k[] = {2};
+    const double plo_[] = {0.05}, phi_[] = {0.95};
+    fit_problem pb = {1, plo_, phi_, 1, k, count, 0.5, crn_sim, &m};
+    fit_settings s = {150, 16};
+    double theta[1], l, wmean[1], pb0[2], p0[2], l0[2], h0[2], nsb[1];
+    double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
+    fit_weighed w = {lo, hi, wmean, pbb, nsb, pp, pl, ph, 0, 1, 0, 0};
+    int evals = 0;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(fit_search(&pb, &s, theta, &l, &evals, &diag), PD_OK);
+    CHECK_STATUS(fit_weigh(&pb, &s, theta, &w, &evals, &diag), PD_OK);
+    *best = theta[0];
+    free(m.u);
+}
+
+static void test_coverage_crn(void)
+{
+    /* 300 measured drops, 300 simulated: the simulation's error is as large
+     * as the data's, and intervals that ignored it would cover about 83%
+     * (1.96 / sqrt(2) sd). */
+    enum { R = 200 };
+    const double truth = 0.3;
+    test_rng rng = {20261127};
+    int covered = 0;
+    double width = 0.0;
+    for (int r = 0; r < R; r++) {
+        double lo, hi, best;
+        crn_fit(&rng, truth, 300, 300, &lo, &hi, &best);
+        covered += lo <= truth && truth <= hi;
+        width += (hi - lo) / R;
+    }
+    /* At a true rate of 95%, R trials cover at least R 0.95 - 3 sd. */
+    double bound = R * 0.95 - 3.0 * sqrt(R * 0.95 * 0.05);
+    CHECK(covered >= bound);
+    pd_note("CRN coverage: %d of %d (bound %.1f), mean width %.4f\n", covered, R, bound, width);
+
+    /* More data narrows them: 10 times the drops, measured and simulated,
+     * divide the width by sqrt(10). */
+    double w1 = 0.0, w10 = 0.0;
+    enum { RW = 10 };
+    for (int r = 0; r < RW; r++) {
+        double lo, hi, best;
+        crn_fit(&rng, truth, 200, 400, &lo, &hi, &best);
+        w1 += hi - lo;
+        crn_fit(&rng, truth, 2000, 4000, &lo, &hi, &best);
+        w10 += hi - lo;
+    }
+    CHECK_NEAR(w10 / w1, 1.0 / sqrt(10.0), 0.08,
+               "1/sqrt(10); the quantiles' discretisation and 10 repeats' spread");
+    pd_note("CRN widths: %.4f at 200 drops, %.4f at 2000: ratio %.3f\n", w1 / RW, w10 / RW, w10 / w1);
+}
+
+/* The 1 x 2 x 3 cm box, its pose classes, and counts of n of posedrop's
+ * own drops at restitution e (seed 1000 + rep, never the fit's). */
+typedef struct {
+    pd_part *part;
+    pd_static_result *res;
+    int *class_of, nclasses;
+} box_part;
+
+static int box_make(box_part *b)
+{
+    pd_vec3 pts[8];
+    int n = pts_box(0.01, 0.02, 0.03, pts);
+    pd_diag diag;
+    pd_diag_init(&diag);
+    b->part = part_of(convex_mesh(pts, n), NULL, &diag);
+    b->res = NULL;
+    b->class_of = NULL;
+    if (!b->part || pd_static_estimate(b->part, NULL, &b->res, &diag) != PD_OK)
+        return 0;
+    b->class_of = malloc(sizeof(int) * (size_t)b->res->nposes);
+    return b->class_of &&
+           pd_pose_classes(b->part, b->res, b->class_of, &b->nclasses, &diag) == PD_OK;
+}
+
+static void box_free(box_part *b)
+{
+    free(b->class_of);
+    pd_static_result_free(b->res);
+    pd_part_free(b->part);
+}
+
+static int box_counts(const box_part *b, double e, long n, uint64_t seed, long *count)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.restitution = e;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = n;
+    o.seed = seed;
+    pd_sim_result *r = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    if (pd_sim_run(b->part, b->res, &sc, &o, &r, &diag) != PD_OK)
+        return 0;
+    for (int c = 0; c < b->nclasses; c++)
+        count[c] = 0;
+    for (int j = 0; j < r->nposes; j++)
+        count[b->class_of[j]] += r->count[j];
+    pd_sim_result_free(r);
+    return 1;
+}
+
+static pd_status box_fit(const box_part *b, const long *count, long nsim, int npoints,
+                         pd_fit_result **fr)
+{
+    pd_fit_part fp = {b->part, b->res, b->class_of, b->nclasses, count};
+    pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+    pd_fit_options o;
+    pd_fit_options_default(&o);
+    o.ndrops = nsim;
+    o.npoints = npoints;
+    o.max_evals = 40;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    return pd_fit_run(&fp, 1, &prm, 1, NULL, &o, fr, &diag);
+}
+
+static void test_recovery(void)
+{
+    box_part b;
+    CHECK(box_make(&b));
+    if (!b.class_of) {
+        box_free(&b);
+        return;
+    }
+    const double truth = 0.4;
+    long count[8];
+    CHECK(b.nclasses <= 8);
+    CHECK(box_counts(&b, truth, 300, 1000, count));
+    pd_fit_result *fr = NULL;
+    CHECK_STATUS(box_fit(&b, count, 500, 8, &fr), PD_OK);
+    if (fr) {
+        /* A 95% interval holds the truth (one draw: a 95% event, fixed by
+         * the seeds); the best value is within 3 of the interval's sds. */
+        CHECK(fr->lo[0] <= truth && truth <= fr->hi[0]);
+        CHECK_NEAR(fr->value[0], truth, 3.0 * (fr->hi[0] - fr->lo[0]) / (2 * 1.96),
+                   "3 sd of the interval");
+        CHECK(fr->parts[0].pvalue > 0.001);
+        CHECK_NEAR(fr->scene.restitution, fr->value[0], 1e-12, "the scene holds the fit");
+        double s = 0.0;
+        for (int c = 0; c < fr->parts[0].nclasses; c++) {
+            s += fr->parts[0].p[c];
+            CHECK(fr->parts[0].lo[c] <= fr->parts[0].p[c] && fr->parts[0].p[c] <= fr->parts[0].hi[c]);
+        }
+        CHECK_NEAR(s, 1.0, 1e-9, "the averaged probabilities sum to 1 (quantile bisection aside)");
+        pd_note("box recovery: e = %.3f [%.3f, %.3f] (truth %.2f), X^2 %.2f p %.3f, %d evals, "
+                "%ld drops\n", fr->value[0], fr->lo[0], fr->hi[0], truth, fr->parts[0].chi2,
+                fr->parts[0].pvalue, fr->evaluations, fr->drops);
+    }
+    pd_fit_result_free(fr);
+
+    if (getenv("PD_TEST_FULL")) {
+        /* Coverage over repeats of posedrop's own drops, and narrowing. */
+        enum { R = 20 };
+        int covered = 0;
+        double w300 = 0.0, w3000 = 0.0, w300_min = HUGE_VAL;
+        for (int r = 0; r < R; r++) {
+            CHECK(box_counts(&b, truth, 300, 2000 + (uint64_t)r, count));
+            fr = NULL;
+            pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+            pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+            pd_fit_options o;
+            pd_fit_options_default(&o);
+            o.ndrops = 500;
+            o.seed = 3000 + (uint64_t)r;
+            pd_diag diag;
+            pd_diag_init(&diag);
+            CHECK_STATUS(pd_fit_run(&fp, 1, &prm, 1, NULL, &o, &fr, &diag), PD_OK);
+            if (fr) {
+                covered += fr->lo[0] <= truth && truth <= fr->hi[0];
+                w300 += fr->hi[0] - fr->lo[0];
+                if (fr->hi[0] - fr->lo[0] < w300_min)
+                    w300_min = fr->hi[0] - fr->lo[0];
+            }
+            pd_fit_result_free(fr);
+        }
+        double bound = R * 0.95 - 3.0 * sqrt(R * 0.95 * 0.05);
+        CHECK(covered >= bound);
+        CHECK(box_counts(&b, truth, 3000, 5000, count));
+        fr = NULL;
+        CHECK_STATUS(box_fit(&b, count, 5000, 16, &fr), PD_OK);
+        if (fr)
+            w3000 = fr->hi[0] - fr->lo[0];
+        pd_fit_result_free(fr);
+        /* 10 times the data: narrower than every one of the 20 intervals
+         * of 300 drops (were the widths alike, a 1 in 21 chance). Not
+         * sqrt(10) narrower: the box barely feels its restitution, and at
+         * 300 drops the intervals span most of the range, which caps them. */
+        CHECK(w3000 < w300_min);
+        pd_note("box coverage: %d of %d (bound %.1f); widths %.3f (narrowest %.3f) at 300 "
+                "drops, %.3f at 3000\n", covered, R, bound, w300 / R, w300_min, w3000);
+    }
+    box_free(&b);
+}
+
+/* The initial mode as a discrete choice: each fitted, the best kept. */
+static void test_initial_choice(void)
+{
+    box_part b;
+    CHECK(box_make(&b));
+    if (!b.class_of) {
+        box_free(&b);
+        return;
+    }
+    long count[8] = {240, 48, 12, 0, 0, 0, 0, 0};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+    pd_fit_options o;
+    pd_fit_options_default(&o);
+    o.ndrops = 100;
+    o.max_evals = 5;
+    o.npoints = 2;
+    o.fit_initial = 1;
+    pd_fit_result *fr = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(pd_fit_run(&fp, 1, &prm, 1, NULL, &o, &fr, &diag), PD_OK);
+    if (fr) {
+        double best = -HUGE_VAL;
+        int arg = -1;
+        for (int i = 0; i < 3; i++) {
+            CHECK(isfinite(fr->loglik_initial[i]));
+            if (fr->loglik_initial[i] > best) {
+                best = fr->loglik_initial[i];
+                arg = i;
+            }
+        }
+        CHECK_INT((int)fr->initial, arg);
+        CHECK_INT((int)fr->scene.initial, arg);
+        /* The maximum is re-evaluated with the same drops: the same value. */
+        CHECK_NEAR(fr->loglik, best, 1e-9 * fabs(best), "the same drops, round-off of sums");
+    }
+    pd_fit_result_free(fr);
+    box_free(&b);
+}
+
+static void test_errors(void)
+{
+    box_part b;
+    CHECK(box_make(&b));
+    if (!b.class_of) {
+        box_free(&b);
+        return;
+    }
+    long count[8] = {10, 5, 1, 0, 0, 0, 0, 0};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_result *fr = NULL;
+    pd_fit_options fo;
+    pd_fit_options_default(&fo);
+    pd_diag diag;
+    pd_diag_init(&diag);
+    pd_fit_param bad_key = {"colour", 0, 1, 0};
+    CHECK_STATUS(pd_fit_run(&fp, 1, &bad_key, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    CHECK(strstr(diag.message, "colour") != NULL);
+    pd_fit_param empty = {"mu", 0.5, 0.5, 0};
+    CHECK_STATUS(pd_fit_run(&fp, 1, &empty, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    pd_fit_param outside = {"restitution", 0.5, 1.5, 0};
+    CHECK_STATUS(pd_fit_run(&fp, 1, &outside, 1, NULL, &fo, &fr, &diag), PD_ERR_RANGE);
+    pd_fit_param twice[] = {{"mu", 0.1, 0.5, 0}, {"mu", 0.2, 0.6, 0}};
+    CHECK_STATUS(pd_fit_run(&fp, 1, twice, 2, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    pd_fit_param logzero = {"contact_time", 0.0, 1e-3, 1};
+    CHECK_STATUS(pd_fit_run(&fp, 1, &logzero, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    pd_fit_param ok = {"mu", 0.1, 0.5, 0};
+    CHECK_STATUS(pd_fit_run(&fp, 1, &ok, 0, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    pd_fit_part nocount = fp;
+    nocount.count = NULL;
+    CHECK_STATUS(pd_fit_run(&nocount, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    long zero[8] = {0};
+    pd_fit_part zeros = fp;
+    zeros.count = zero;
+    CHECK_STATUS(pd_fit_run(&zeros, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    long negative[8] = {3, -1, 0};
+    pd_fit_part neg = fp;
+    neg.count = negative;
+    CHECK_STATUS(pd_fit_run(&neg, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    pd_fit_part wrongk = fp;
+    wrongk.nclasses = b.nclasses + 1;
+    CHECK_STATUS(pd_fit_run(&wrongk, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    CHECK_STATUS(pd_fit_run(&fp, 1, &ok, 1, NULL, NULL, &fr, &diag), PD_ERR_USAGE);
+    CHECK(strstr(diag.message, "options") != NULL);
+    CHECK(fr == NULL);
+    box_free(&b);
+}
+
+/* posedrop fit as a user runs it: refused input (exit 2, nothing on
+ * stdout, a message naming the problem), and a small fit whose scene file
+ * --scene reads back and whose rows sum to one per part. */
+static void test_command(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-fit-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        CHECK(!"cannot create a temporary directory");
+        return;
+    }
+    char counts[128], scene[128], params[128], args[1024];
+    snprintf(counts, sizeof counts, "%s/box.csv", tmpdir);
+    snprintf(scene, sizeof scene, "%s/fitted.scene", tmpdir);
+    snprintf(params, sizeof params, "%s/params.csv", tmpdir);
+    write_file(counts, "pose,count\n1,240\n2,48\n3,12\n");
+    const char *box = "--part parts/canonical/box_1x2x3.off";
+    snprintf(args, sizeof args, "fit %s --measured %s", box, counts);
+    expect_failure(args, 2, "nothing to fit");
+    snprintf(args, sizeof args, "fit --fit mu %s --measured %s", box, counts);
+    expect_failure(args, 2, "KEY=LO:HI");
+    snprintf(args, sizeof args, "fit --fit mu=0.5:0.2 %s --measured %s", box, counts);
+    expect_failure(args, 2, "LO < HI");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:x %s --measured %s", box, counts);
+    expect_failure(args, 2, "two numbers");
+    snprintf(args, sizeof args, "fit --fit colour=0:1 %s --measured %s", box, counts);
+    expect_failure(args, 2, "colour");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s", box);
+    expect_failure(args, 2, "--measured");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 --predict parts/canonical/box_1x2x3.off");
+    expect_failure(args, 2, "no part to fit");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s/none.csv", box, tmpdir);
+    expect_failure(args, 2, "none.csv");
+    char many[128];
+    snprintf(many, sizeof many, "%s/many.csv", tmpdir);
+    write_file(many, "pose,count\n1,1\n9,2\n");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
+    expect_failure(args, 2, "pose 9");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 -n 5 %s --measured %s", box, counts);
+    expect_failure(args, 2, "number of drops");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s/no/dir/x", box,
+             counts, tmpdir);
+    expect_failure(args, 2, "no/dir");
+
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s", box, counts,
+             counts);
+    expect_failure(args, 2, "box.csv");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s --gof %s", box,
+             counts, scene, scene);
+    expect_failure(args, 2, "fitted.scene");
+    /* A range of the base scene stays a range in the fitted one. */
+    char base[128];
+    snprintf(base, sizeof base, "%s/base.scene", tmpdir);
+    write_file(base, "tumble = 0:1\n");
+    snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7 -n 100 --max-evals 5 --points 2 "
+             "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s "
+             "--scene %s", box, counts, scene, params, base);
+    char *out = NULL, *err = NULL;
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(out && strncmp(out, "part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n", 53) == 0);
+    double sum[2] = {0, 0};
+    int rows = 0;
+    for (const char *line = out ? strchr(out, '\n') : NULL; line && line[1]; line = strchr(line + 1, '\n')) {
+        char role[16];
+        int pose;
+        double p_best, p, lo, hi;
+        const char *c = strchr(line + 1, ',');
+        if (!c || sscanf(c + 1, "%15[a-z],%d,", role, &pose) != 2)
+            break;
+        const char *f = c + 1;
+        for (int i = 0; i < 4 && f; i++) /* role, pose, count, p_measured */
+            f = strchr(f, ',') ? strchr(f, ',') + 1 : NULL;
+        if (!f || sscanf(f, "%lf,%lf,%lf,%lf", &p_best, &p, &lo, &hi) != 4)
+            break;
+        sum[strcmp(role, "fitted") != 0] += p;
+        CHECK(lo <= p && p <= hi);
+        rows++;
+    }
+    CHECK_INT(rows, 3 + 2);
+    CHECK_NEAR(sum[0], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
+    CHECK_NEAR(sum[1], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
+    CHECK(err && strstr(err, "restitution = ") != NULL);
+    free(out);
+    free(err);
+    /* The scene file is one --scene reads. */
+    snprintf(args, sizeof args, "--scene %s -n 10 parts/canonical/box_1x2x3.off", scene);
+    CHECK_INT(run(args, &out, &err), 0);
+    free(out);
+    free(err);
+    char *stext = slurp(scene);
+    CHECK(stext && strstr(stext, "\ntumble = 0:1\n") != NULL);
+    CHECK(stext && strstr(stext, "\nrestitution = ") != NULL);
+    free(stext);
+    char *ptext = slurp(params);
+    CHECK(ptext && strncmp(ptext, "parameter,value,lo,hi,mean,range_lo,range_hi\nrestitution,", 57) == 0);
+    free(ptext);
+    char cmd[256];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    CHECK(system(cmd) == 0);
+}
+
+void suite_fit(void)
+{
+    test_likelihood_hand();
+    test_beta_mixture();
+    test_search_closed_form();
+    test_dispersion();
+    test_coverage_crn();
+    test_recovery();
+    test_initial_choice();
+    test_errors();
+    test_command();
+}
