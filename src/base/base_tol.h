@@ -15,4 +15,13 @@
  * that must stay distinct differ by 1e-7 rad or more (see PD_TOL_PLANE_REL). */
 #define PD_TOL_ANGLE 1e-12
 
+/* The radius of a part's corners, times its size L, behind the contact
+ * patch of drilling friction: the impulse engine's (src/sim/sim_model.c)
+ * and ODE's (src/engines/engine_ode.c); docs/contact.md. Why 0.0289: it is
+ * the corner the default contact time rests on (about 0.5 mm on a 1 cm
+ * cube, diagonal 1.73 cm: Hertz's estimate of 5e-4 s), kept in proportion
+ * to the size as that estimate keeps it. The patch radius goes as its
+ * square root: a part with sharper corners spins longer. */
+#define PD_CORNER_RADIUS_REL (0.5e-3 / (0.01 * 1.7320508075688772935))
+
 #endif

@@ -48,6 +48,7 @@
 #include <ode/ode.h>
 #include "engines/engine.h"
 #include "engines/engine_contact.h"
+#include "base/base_tol.h"
 #include "engines/engines_tol.h"
 #include "base/vec3.h"
 
@@ -378,12 +379,12 @@ static double pow2_near(double x)
  * (23 of 200 drops). The patch is the one a corner of radius R pressed as
  * deep as the contact sinks under the part's weight makes, a = sqrt(R d):
  * d = g / omega^2 with the scene's law, PD_ODE_SINK_REL L with ODE's own;
- * R = PD_ODE_CORNER_RADIUS_REL L. ODE's spinning friction (rhoN, with
+ * R = PD_CORNER_RADIUS_REL L. ODE's spinning friction (rhoN, with
  * dContactApprox1 a multiple of the normal force) is that couple's arm. */
 static void drilling_arm(pd_engine_world *w)
 {
     double d = w->compliant ? w->gscale / (w->omega * w->omega) : PD_ODE_SINK_REL * w->size;
-    w->drill = 2.0 / 3.0 * w->mu * sqrt(PD_ODE_CORNER_RADIUS_REL * w->size * d);
+    w->drill = 2.0 / 3.0 * w->mu * sqrt(PD_CORNER_RADIUS_REL * w->size * d);
 }
 
 /* The contact's material; w->dt * w->time is the step in s exactly (a

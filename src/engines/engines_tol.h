@@ -39,14 +39,6 @@
  * 1 cm and a 1 m part. */
 #define PD_ODE_SINK_REL 1e-4
 
-/* The radius of a part's corners, times its size L, for the patch of ODE's
- * drilling friction (engine_ode.c, drilling_arm). Why 0.0289: the corner
- * the default contact time assumes (0.5 mm on a 1 cm cube, diagonal
- * 1.73 cm: Hertz's estimate of 5e-4 s, docs/contact.md), in proportion to
- * the size as that estimate keeps it. Sharper corners: a smaller patch, a
- * top that spins longer. */
-#define PD_ODE_CORNER_RADIUS_REL (0.5e-3 / (0.01 * 1.7320508075688772935))
-
 /* Damping ratio of that contact spring: critical, so a contact settles
  * without ringing; the rebound is ODE's bounce (= restitution) alone, not a
  * spring oscillation on top. */

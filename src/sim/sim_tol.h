@@ -62,15 +62,6 @@
  * comes to rest. */
 #define PD_REST_TURN_REL 1e-8
 
-/* The radius of a part's corners, times its size L, for the contact patch
- * of drilling friction (src/sim/sim_model.c, docs/contact.md). Why 0.0289:
- * it is the assumption the default contact time rests on (a plastic part's
- * corner of about 0.5 mm on a 1 cm cube, diagonal 1.73 cm: Hertz's
- * estimate of 5e-4 s, docs/contact.md), kept in proportion to the size as
- * that estimate keeps it. It sets the patch radius as its square root: a
- * part with sharper corners spins longer. */
-#define PD_CORNER_RADIUS_REL (0.5e-3 / (0.01 * 1.7320508075688772935))
-
 /* The automatic contact time (pd_contact_time_auto) grows with the size L,
  * so the static compression of a contact under the part's weight, g T^2 /
  * pi^2, grows as L^2: past 1.2 m it would exceed this share of L (a 10 m

@@ -8,6 +8,7 @@
 #include "check.h"
 #include "engines/engine.h"
 #include "posedrop/posedrop.h"
+#include "base/base_tol.h"
 #include "engines/engines_tol.h"
 #include "base/quat.h"
 #include "shapes.h"
@@ -485,7 +486,7 @@ static void test_threads_and_errors(void)
 /* Drilling friction: a regular octahedron balanced on a corner and spun
  * about the vertical. The corner's slip is zero, so sliding friction does
  * not act; only the couple over the contact's patch, (2/3) mu a m g with
- * a = sqrt(R d) (R = PD_ODE_CORNER_RADIUS_REL L, d = PD_ODE_SINK_REL L, the
+ * a = sqrt(R d) (R = PD_CORNER_RADIUS_REL L, d = PD_ODE_SINK_REL L, the
  * sink under the weight), slows it, at a constant rate: w(t) = w0 - C t / I
  * until it stops at t* = I w0 / C, and stays stopped. Without the couple
  * the spin stayed w0. The balance is unstable, but its round-off grows by
@@ -512,7 +513,7 @@ static void test_drilling_top(void)
                   v3(0, 0, 0)};
     double w0 = 1.0;
     s.w = quat_rotate_inv(s.q, v3(0, 0, w0));
-    double a = sqrt(PD_ODE_CORNER_RADIUS_REL * L * PD_ODE_SINK_REL * L);
+    double a = sqrt(PD_CORNER_RADIUS_REL * L * PD_ODE_SINK_REL * L);
     double couple = 2.0 / 3.0 * fx.scene.mu * a * b->mass * g;
     double I = b->moment[2], t_stop = I * w0 / couple;
     CHECK(t_stop > 0.05 && t_stop < 0.25); /* the run below covers it */
