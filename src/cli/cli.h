@@ -28,6 +28,7 @@ int cli_interrupt_code(void);
  * input) stops them all together. */
 int cli_any(int mine);
 double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
+double cli_wall_seconds(void); /* a monotonic clock, s, for timings (command.c) */
 
 /* A side file written to a temporary beside its path and renamed onto it
  * once complete (command.c): out_open makes it ready before any work (0 and a

@@ -439,8 +439,7 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
-/* Seconds on a monotonic clock, for the report's timings. */
-static double now(void)
+double cli_wall_seconds(void)
 {
     struct timespec ts;
     clock_gettime(CLOCK_MONOTONIC, &ts);
@@ -474,7 +473,7 @@ int cli_run(cli_args *a)
         opened = !a->pictures[k] || out_open(&pic_out[k], a->pictures[k]);
     /* A measured distribution is read before the work too. */
     viz_measured *measured = NULL;
-    double t0 = now(), t_static = 0.0, t_sim = 0.0;
+    double t0 = cli_wall_seconds(), t_static = 0.0, t_sim = 0.0;
     if (opened && a->measured && (st = viz_measured_read(a->measured, &measured, &diag)) != PD_OK) {
         fail_status(st, &diag, NULL);
         opened = 0;
@@ -504,7 +503,7 @@ int cli_run(cli_args *a)
         plausible_warn(a, part);
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
-    t_static = now() - t0;
+    t_static = cli_wall_seconds() - t0;
     /* A signal before the drops (or, without drops, before the output)
      * ends the run here, nothing printed. */
     if (st == PD_OK && cli_any(signals_caught())) {
@@ -513,7 +512,7 @@ int cli_run(cli_args *a)
     }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
-        t_sim = now() - t0 - t_static;
+        t_sim = cli_wall_seconds() - t0 - t_static;
     }
     if (st == PD_OK && !cli_writer()) {
         code = 0;
@@ -557,8 +556,8 @@ int cli_run(cli_args *a)
         code = EXIT_INTERNAL;
         goto done;
     }
-    viz_run run = {a->path, a->read.units, &a->estimate, &a->sim, t_static, t_sim, now() - t0,
-                   a->argc, a->argv};
+    viz_run run = {a->path, a->read.units, &a->estimate, &a->sim, t_static, t_sim,
+                   cli_wall_seconds() - t0, a->argc, a->argv};
     for (int k = 0; k < VIZ_KINDS; k++) {
         if (!pic_out[k].f)
             continue;
@@ -580,7 +579,8 @@ int cli_run(cli_args *a)
         goto done;
     }
     if (a->json)
-        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses, now() - t0);
+        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses,
+                   cli_wall_seconds() - t0);
     else if (a->facets)
         print_facets(part, res);
     else if (class_of)

@@ -6,7 +6,6 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 #include "base/number.h"
 #include "cli/cli.h"
 
@@ -290,13 +289,6 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
                 r->ess);
 }
 
-static double wall_now(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 int cli_fit(int argc, char **argv)
 {
     enum { F_FIT = 256, F_PART, F_MEASURED, F_PREDICT, F_NOGROUP, F_UNITS, F_SCENE, F_SEED,
@@ -477,7 +469,7 @@ int cli_fit(int argc, char **argv)
             parts[i] = (pd_fit_part){in[i].part, in[i].res, in[i].class_of, in[i].nclasses,
                                      in[i].count};
         fo.fit_initial = fit_initial;
-        double t0 = wall_now(), c0 = cli_cpu_seconds();
+        double t0 = cli_wall_seconds(), c0 = cli_cpu_seconds();
         pd_status st = pd_fit_run(parts, nin, params, nparams, &scene, &fo, &r, &diag);
         if (st != PD_OK) {
             fprintf(stderr, "%s: fit: %s\n", prog, diag.message[0] ? diag.message
@@ -485,7 +477,7 @@ int cli_fit(int argc, char **argv)
             code = pd_status_is_input_error(st) || st == PD_ERR_USAGE ? EXIT_USAGE
                                                                       : EXIT_INTERNAL;
         } else {
-            double wall = wall_now() - t0, cpu = cli_cpu_seconds() - c0;
+            double wall = cli_wall_seconds() - t0, cpu = cli_cpu_seconds() - c0;
             if (outs[0].f)
                 write_scene(outs[0].f, r, params, in, nin);
             if (outs[1].f)
