@@ -34,11 +34,16 @@ extern "C" {
  * in rad/s), set to a plain value at every evaluation, and
  * the range searched, in the key's text units, lo < hi within the key's own
  * limits. log 1 searches and weighs log(value) (lo > 0): for a quantity
- * known to within a factor, such as the contact time. */
+ * known to within a factor, such as the contact time. multiple 1
+ * (contact_time only): lo, hi and the fitted values are multiples of each
+ * part's own automatic contact time (pd_contact_time_auto_part), 1e-3 to
+ * 1e3, one multiple shared by the parts ("0.3x:3x" of pd_scene_set), so
+ * that parts of one material but different sizes share the value. */
 typedef struct pd_fit_param {
     const char *key;
     double lo, hi;
     int log;
+    int multiple;
 } pd_fit_param;
 
 /* One part. count NULL: the part is not fitted, only predicted at the

@@ -41,8 +41,9 @@ static void fit_usage(FILE *out)
         "  --fit SPEC       the parameters to fit and their ranges, comma-separated:\n"
         "                   KEY=LO:HI with KEY one of height (m), belt_speed (m/s),\n"
         "                   mu, restitution, vibration (degrees), gravity (m/s^2),\n"
-        "                   tumble (rad/s), contact_time (s, searched on a log\n"
-        "                   scale); and 'initial'\n"
+        "                   tumble (rad/s), contact_time (s, or multiples of each\n"
+        "                   part's automatic duration as 0.3x:3x, one multiple\n"
+        "                   shared by the parts; searched on a log scale); and 'initial'\n"
         "                   alone to fit the initial mode as a discrete choice\n"
         "                   (uniform, bootstrap, stationary: each fitted, the best kept).\n"
         "                   e.g. --fit mu=0.1:0.8,restitution=0.05:0.7,initial\n"
@@ -66,8 +67,9 @@ static void fit_usage(FILE *out)
         "  --points M       likelihood-weighted values per round, 3 to 6 rounds\n"
         "                   (default 8 (d+1) for d parameters)\n"
         "  --out FILE       the fitted scene, a file --scene reads\n"
-        "  --params FILE    CSV parameter,value,lo,hi,mean,range_lo,range_hi: the best\n"
-        "                   value, the 95%% interval and the weighted mean\n"
+        "  --params FILE    CSV parameter,value,lo,hi,mean,range_lo,range_hi,unit: the\n"
+        "                   best value, the 95%% interval and the weighted mean (unit\n"
+        "                   auto: multiples of each part's automatic contact time)\n"
         "  --gof FILE       CSV part,n,classes,loglik,chi2,df,p: goodness of fit\n"
         "  --help           this help\n",
         prog);
@@ -112,8 +114,16 @@ static int parse_spec(char *spec, pd_fit_param *params, int *nparams, int *fit_i
         pd_fit_param *p = &params[(*nparams)++];
         p->key = item;
         p->log = strcmp(item, "contact_time") == 0;
-        if (!number(eq + 1, (size_t)(colon - eq - 1), &p->lo) ||
-            !number(colon + 1, strlen(colon + 1), &p->hi))
+        /* contact_time=0.3x:3x: multiples of each part's automatic duration. */
+        size_t nlo = (size_t)(colon - eq - 1), nhi = strlen(colon + 1);
+        int xlo = nlo > 1 && colon[-1] == 'x', xhi = nhi > 1 && colon[nhi] == 'x';
+        if ((xlo || xhi) && !(p->log && xlo && xhi))
+            return fit_fail("--fit: %s: %s", item,
+                            p->log ? "a range in multiples of auto has both ends so, as 0.3x:3x"
+                                   : "only contact_time takes multiples of auto (0.3x:3x)");
+        p->multiple = xlo;
+        if (!number(eq + 1, nlo - (size_t)xlo, &p->lo) ||
+            !number(colon + 1, nhi - (size_t)xhi, &p->hi))
             return fit_fail("--fit: %s: expected a range LO:HI of two numbers, got '%s'", item,
                             eq + 1);
     }
@@ -205,9 +215,11 @@ static void write_scene(FILE *f, const pd_fit_result *r, const pd_fit_param *par
         if (in[i].count)
             fprintf(f, " %s", in[i].path);
     fprintf(f, "\n# 95%% intervals:");
-    for (int i = 0; i < r->nparams; i++)
-        fprintf(f, " %s %.6g [%.6g, %.6g]%s", params[i].key, r->value[i], r->lo[i], r->hi[i],
-                i + 1 < r->nparams ? ";" : "");
+    for (int i = 0; i < r->nparams; i++) {
+        const char *x = params[i].multiple ? "x" : "";
+        fprintf(f, " %s %.6g%s [%.6g%s, %.6g%s]%s", params[i].key, r->value[i], x, r->lo[i], x,
+                r->hi[i], x, i + 1 < r->nparams ? ";" : "");
+    }
     fprintf(f, "\n");
     /* Every parameter as pd_scene_set reads it: a range of the base scene
      * stays a range. */
@@ -220,12 +232,25 @@ static void write_scene(FILE *f, const pd_fit_result *r, const pd_fit_param *par
             s->gravity);
 }
 
+/* The unit of a parameter's values as --fit gave them ("auto": multiples of
+ * each part's automatic contact time). */
+static const char *param_unit(const pd_fit_param *q)
+{
+    static const char *const keys[] = {"height", "belt_speed", "vibration", "gravity",
+                                       "contact_time", "tumble"};
+    static const char *const units[] = {"m", "m/s", "deg", "m/s^2", "s", "rad/s"};
+    if (q->multiple)
+        return "auto";
+    int i = choice(q->key, keys, 6);
+    return i < 0 ? "" : units[i];
+}
+
 static void write_params(FILE *f, const pd_fit_result *r, const pd_fit_param *params)
 {
-    fprintf(f, "parameter,value,lo,hi,mean,range_lo,range_hi\n");
+    fprintf(f, "parameter,value,lo,hi,mean,range_lo,range_hi,unit\n");
     for (int i = 0; i < r->nparams; i++)
-        fprintf(f, "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g\n", params[i].key, r->value[i],
-                r->lo[i], r->hi[i], r->mean[i], params[i].lo, params[i].hi);
+        fprintf(f, "%s,%.10g,%.10g,%.10g,%.10g,%.10g,%.10g,%s\n", params[i].key, r->value[i],
+                r->lo[i], r->hi[i], r->mean[i], params[i].lo, params[i].hi, param_unit(&params[i]));
 }
 
 static void write_gof(FILE *f, const pd_fit_result *r, const fit_input *in, int nin)
@@ -258,10 +283,13 @@ static void print_table(const pd_fit_result *r, const fit_input *in, int nin)
 static void print_summary(const pd_fit_result *r, const pd_fit_param *params, const fit_input *in,
                           int nin, int fit_initial, double wall, double cpu)
 {
-    for (int i = 0; i < r->nparams; i++)
-        fprintf(stderr, "%s: fit: %s = %.4g, 95%% interval [%.4g, %.4g] (weighted mean %.4g; "
-                "range %g:%g)\n", prog, params[i].key, r->value[i], r->lo[i], r->hi[i],
-                r->mean[i], params[i].lo, params[i].hi);
+    for (int i = 0; i < r->nparams; i++) {
+        const char *x = params[i].multiple ? "x" : "";
+        fprintf(stderr, "%s: fit: %s = %.4g%s, 95%% interval [%.4g%s, %.4g%s] (weighted mean "
+                "%.4g%s; range %g%s:%g%s)%s\n", prog, params[i].key, r->value[i], x, r->lo[i], x,
+                r->hi[i], x, r->mean[i], x, params[i].lo, x, params[i].hi, x,
+                params[i].multiple ? " in multiples of each part's automatic duration" : "");
+    }
     if (fit_initial)
         fprintf(stderr, "%s: fit: initial %s: maximised log-likelihood uniform %.2f, bootstrap "
                 "%.2f, stationary %.2f\n", prog, initial_name(r->initial),

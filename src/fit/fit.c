@@ -42,14 +42,25 @@ typedef struct {
     double *pose_p; /* scratch, the largest part's poses */
 } model;
 
+/* A value of q as pd_scene_set reads it: a multiple of auto as the
+ * zero-width range "Mx:Mx", which every drop of every part draws as M times
+ * that part's own automatic duration (the fixed run's bytes for that
+ * duration). */
+static void param_text(const pd_fit_param *q, double v, char *text, size_t size)
+{
+    if (q->multiple)
+        snprintf(text, size, "%.17gx:%.17gx", v, v);
+    else
+        snprintf(text, size, "%.17g", v);
+}
+
 /* The scene at theta (in the problem's scale: log for a log parameter). */
 static pd_status scene_at(const model *m, const double *theta, pd_scene *sc, pd_diag *diag)
 {
     *sc = m->base;
     for (int i = 0; i < m->d; i++) {
-        char text[64];
-        double v = m->params[i].log ? exp(theta[i]) : theta[i];
-        snprintf(text, sizeof text, "%.17g", v);
+        char text[80];
+        param_text(&m->params[i], m->params[i].log ? exp(theta[i]) : theta[i], text, sizeof text);
         pd_status st = pd_scene_set(sc, m->params[i].key, text, diag);
         if (st != PD_OK)
             return st;
@@ -169,11 +180,16 @@ static pd_status check_params(const pd_fit_param *params, int d, const pd_scene 
         if (q->log && !(q->lo > 0))
             return pd_fail(diag, PD_ERR_USAGE, "%s: a log range needs LO > 0, got %g", q->key,
                            q->lo);
+        if (q->multiple != 0 && (q->multiple != 1 || strcmp(q->key, "contact_time") != 0))
+            return pd_fail(diag, PD_ERR_USAGE, "%s: multiple is %d: expected 0%s", q->key,
+                           q->multiple, strcmp(q->key, "contact_time") == 0
+                                            ? " or 1"
+                                            : " (only contact_time takes multiples of auto)");
         /* Both ends must be values the scene accepts. */
         pd_scene sc = *base;
-        char text[64];
+        char text[80];
         for (int e = 0; e < 2; e++) {
-            snprintf(text, sizeof text, "%.17g", e ? q->hi : q->lo);
+            param_text(q, e ? q->hi : q->lo, text, sizeof text);
             pd_status st = pd_scene_set(&sc, q->key, text, diag);
             if (st != PD_OK)
                 return st;

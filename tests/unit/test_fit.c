@@ -302,16 +302,17 @@ static int box_counts(const box_part *b, double e, long n, uint64_t seed, long *
     return 1;
 }
 
-static pd_status box_fit(const box_part *b, const long *count, long nsim, int npoints,
-                         pd_fit_result **fr)
+static const pd_fit_param box_e = {"restitution", 0.05, 0.7, 0, 0};
+
+static pd_status box_fit(const box_part *b, const long *count, pd_fit_param prm, long nsim,
+                         int max_evals, int npoints, pd_fit_result **fr)
 {
     pd_fit_part fp = {b->part, b->res, b->class_of, b->nclasses, count};
-    pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
     pd_fit_options o;
     pd_fit_options_default(&o);
     o.ndrops = nsim;
     o.npoints = npoints;
-    o.max_evals = 40;
+    o.max_evals = max_evals;
     pd_diag diag;
     pd_diag_init(&diag);
     return pd_fit_run(&fp, 1, &prm, 1, NULL, &o, fr, &diag);
@@ -330,7 +331,7 @@ static void test_recovery(void)
     CHECK(b.nclasses <= 8);
     CHECK(box_counts(&b, truth, 300, 1000, count));
     pd_fit_result *fr = NULL;
-    CHECK_STATUS(box_fit(&b, count, 500, 8, &fr), PD_OK);
+    CHECK_STATUS(box_fit(&b, count, box_e, 500, 40, 8, &fr), PD_OK);
     if (fr) {
         /* A 95% interval holds the truth (one draw: a 95% event, fixed by
          * the seeds); the best value is within 3 of the interval's sds. */
@@ -360,7 +361,7 @@ static void test_recovery(void)
             CHECK(box_counts(&b, truth, 300, 2000 + (uint64_t)r, count));
             fr = NULL;
             pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
-            pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+            pd_fit_param prm = {"restitution", 0.05, 0.7, 0, 0};
             pd_fit_options o;
             pd_fit_options_default(&o);
             o.ndrops = 500;
@@ -380,7 +381,7 @@ static void test_recovery(void)
         CHECK(covered >= bound);
         CHECK(box_counts(&b, truth, 3000, 5000, count));
         fr = NULL;
-        CHECK_STATUS(box_fit(&b, count, 5000, 16, &fr), PD_OK);
+        CHECK_STATUS(box_fit(&b, count, box_e, 5000, 40, 16, &fr), PD_OK);
         if (fr)
             w3000 = fr->hi[0] - fr->lo[0];
         pd_fit_result_free(fr);
@@ -395,18 +396,68 @@ static void test_recovery(void)
     box_free(&b);
 }
 
-/* The initial mode as a discrete choice: each fitted, the best kept. */
-static void test_initial_choice(void)
+/* The contact time in multiples of each part's automatic duration: for one
+ * part, the same fit as in seconds over the range scaled by that duration
+ * (the same drops at every point: an invariance, to the round-off of the
+ * log scale's ends); the fitted scene gives every part its own multiple of
+ * its own duration. */
+static void test_contact_multiple(const box_part *bp)
 {
-    box_part b;
-    CHECK(box_make(&b));
-    if (!b.class_of) {
-        box_free(&b);
-        return;
+    box_part b = *bp;
+    long count[8] = {240, 48, 12, 0, 0, 0, 0, 0};
+    double a = pd_contact_time_auto_part(b.part);
+    pd_fit_result *fx = NULL, *fs = NULL;
+    const pd_fit_param in_auto = {"contact_time", 0.3, 3.0, 1, 1};
+    const pd_fit_param in_s = {"contact_time", 0.3 * a, 3.0 * a, 1, 0};
+    CHECK_STATUS(box_fit(&b, count, in_auto, 100, 8, 2, &fx), PD_OK);
+    CHECK_STATUS(box_fit(&b, count, in_s, 100, 8, 2, &fs), PD_OK);
+    if (fx && fs) {
+        /* Round-off: the log of the ends, a few ulps each, compounded over
+         * the simplex's steps. */
+        CHECK_REL(fx->value[0] * a, fs->value[0], 1e-9, "the same fit, scaled by auto");
+        CHECK_REL(fx->lo[0] * a, fs->lo[0], 1e-9, "the same fit, scaled by auto");
+        CHECK_REL(fx->hi[0] * a, fs->hi[0], 1e-9, "the same fit, scaled by auto");
+        CHECK_REL(fx->loglik, fs->loglik, 1e-12, "the same drops, the same counts");
+        CHECK_INT(fx->evaluations, fs->evaluations);
+        const pd_dist *d = &fx->scene.range[PD_PARAM_CONTACT_TIME];
+        CHECK_INT(d->auto_multiple, 1);
+        CHECK(d->lo == fx->value[0] && d->hi == fx->value[0]);
+        /* A part twice the size gets twice its duration (similar parts:
+         * auto goes as the size), from the same scene. */
+        pd_vec3 pts[8];
+        pd_diag diag;
+        pd_diag_init(&diag);
+        pd_part *big = part_of(convex_mesh(pts, pts_box(0.02, 0.04, 0.06, pts)), NULL, &diag);
+        CHECK(big != NULL);
+        if (big) {
+            double v[PD_NPARAMS];
+            pd_scene_draw(&fx->scene, pd_contact_time_auto_size(big), 1, 7, v, NULL);
+            CHECK_REL(v[PD_PARAM_CONTACT_TIME], fx->value[0] * pd_contact_time_auto_part(big),
+                      1e-12, "a product and a quotient of doubles");
+            CHECK_REL(v[PD_PARAM_CONTACT_TIME], 2.0 * fx->value[0] * a, 1e-9,
+                      "auto in proportion to the size for similar parts");
+        }
+        pd_part_free(big);
     }
+    pd_fit_result_free(fx);
+    pd_fit_result_free(fs);
+    fx = NULL;
+    /* Multiples are the contact time's only, within auto's 1e-3 to 1e3. */
+    const pd_fit_param not_ct = {"mu", 0.1, 0.5, 0, 1}, two = {"contact_time", 0.3, 3.0, 1, 2};
+    const pd_fit_param beyond = {"contact_time", 0.3, 2e3, 1, 1};
+    CHECK_STATUS(box_fit(&b, count, not_ct, 100, 8, 2, &fx), PD_ERR_USAGE);
+    CHECK_STATUS(box_fit(&b, count, two, 100, 8, 2, &fx), PD_ERR_USAGE);
+    CHECK_STATUS(box_fit(&b, count, beyond, 100, 8, 2, &fx), PD_ERR_RANGE);
+    CHECK(fx == NULL);
+}
+
+/* The initial mode as a discrete choice: each fitted, the best kept. */
+static void test_initial_choice(const box_part *bp)
+{
+    box_part b = *bp;
     long count[8] = {240, 48, 12, 0, 0, 0, 0, 0};
     pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
-    pd_fit_param prm = {"restitution", 0.05, 0.7, 0};
+    pd_fit_param prm = {"restitution", 0.05, 0.7, 0, 0};
     pd_fit_options o;
     pd_fit_options_default(&o);
     o.ndrops = 100;
@@ -433,17 +484,11 @@ static void test_initial_choice(void)
         CHECK_NEAR(fr->loglik, best, 1e-9 * fabs(best), "the same drops, round-off of sums");
     }
     pd_fit_result_free(fr);
-    box_free(&b);
 }
 
-static void test_errors(void)
+static void test_errors(const box_part *bp)
 {
-    box_part b;
-    CHECK(box_make(&b));
-    if (!b.class_of) {
-        box_free(&b);
-        return;
-    }
+    box_part b = *bp;
     long count[8] = {10, 5, 1, 0, 0, 0, 0, 0};
     pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
     pd_fit_result *fr = NULL;
@@ -451,18 +496,18 @@ static void test_errors(void)
     pd_fit_options_default(&fo);
     pd_diag diag;
     pd_diag_init(&diag);
-    pd_fit_param bad_key = {"colour", 0, 1, 0};
+    pd_fit_param bad_key = {"colour", 0, 1, 0, 0};
     CHECK_STATUS(pd_fit_run(&fp, 1, &bad_key, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
     CHECK(strstr(diag.message, "colour") != NULL);
-    pd_fit_param empty = {"mu", 0.5, 0.5, 0};
+    pd_fit_param empty = {"mu", 0.5, 0.5, 0, 0};
     CHECK_STATUS(pd_fit_run(&fp, 1, &empty, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
-    pd_fit_param outside = {"restitution", 0.5, 1.5, 0};
+    pd_fit_param outside = {"restitution", 0.5, 1.5, 0, 0};
     CHECK_STATUS(pd_fit_run(&fp, 1, &outside, 1, NULL, &fo, &fr, &diag), PD_ERR_RANGE);
-    pd_fit_param twice[] = {{"mu", 0.1, 0.5, 0}, {"mu", 0.2, 0.6, 0}};
+    pd_fit_param twice[] = {{"mu", 0.1, 0.5, 0, 0}, {"mu", 0.2, 0.6, 0, 0}};
     CHECK_STATUS(pd_fit_run(&fp, 1, twice, 2, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
-    pd_fit_param logzero = {"contact_time", 0.0, 1e-3, 1};
+    pd_fit_param logzero = {"contact_time", 0.0, 1e-3, 1, 0};
     CHECK_STATUS(pd_fit_run(&fp, 1, &logzero, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
-    pd_fit_param ok = {"mu", 0.1, 0.5, 0};
+    pd_fit_param ok = {"mu", 0.1, 0.5, 0, 0};
     CHECK_STATUS(pd_fit_run(&fp, 1, &ok, 0, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
     pd_fit_part nocount = fp;
     nocount.count = NULL;
@@ -481,7 +526,31 @@ static void test_errors(void)
     CHECK_STATUS(pd_fit_run(&fp, 1, &ok, 1, NULL, NULL, &fr, &diag), PD_ERR_USAGE);
     CHECK(strstr(diag.message, "options") != NULL);
     CHECK(fr == NULL);
+}
+
+/* The fits of the 1 x 2 x 3 cm box that need no recovery: one box for all. */
+static void test_box_fits(void)
+{
+    box_part b;
+    CHECK(box_make(&b));
+    if (b.class_of) {
+        test_initial_choice(&b);
+        test_contact_multiple(&b);
+        test_errors(&b);
+    }
     box_free(&b);
+}
+
+/* Whether the file at path has a line starting with key that holds what. */
+static int stext_has(const char *path, const char *key, const char *what)
+{
+    char *text = slurp(path);
+    const char *line = text ? strstr(text, key) : NULL;
+    const char *end = line ? strchr(line + 1, '\n') : NULL;
+    const char *hit = line ? strstr(line, what) : NULL;
+    int ok = hit && (!end || hit < end);
+    free(text);
+    return ok;
 }
 
 /* posedrop fit as a user runs it: refused input (exit 2, nothing on
@@ -508,6 +577,10 @@ static void test_command(void)
     expect_failure(args, 2, "LO < HI");
     snprintf(args, sizeof args, "fit --fit mu=0.1:x %s --measured %s", box, counts);
     expect_failure(args, 2, "two numbers");
+    snprintf(args, sizeof args, "fit --fit contact_time=0.3x:3 %s --measured %s", box, counts);
+    expect_failure(args, 2, "both ends");
+    snprintf(args, sizeof args, "fit --fit mu=0.1x:0.5x %s --measured %s", box, counts);
+    expect_failure(args, 2, "only contact_time");
     snprintf(args, sizeof args, "fit --fit colour=0:1 %s --measured %s", box, counts);
     expect_failure(args, 2, "colour");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s", box);
@@ -537,7 +610,8 @@ static void test_command(void)
     char base[128];
     snprintf(base, sizeof base, "%s/base.scene", tmpdir);
     write_file(base, "tumble = 0:1\n");
-    snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7 -n 100 --max-evals 5 --points 2 "
+    snprintf(args, sizeof args, "fit --fit restitution=0.05:0.7,contact_time=0.3x:3x -n 100 "
+             "--max-evals 5 --points 2 "
              "%s --measured %s --predict parts/canonical/box_1x1x2.off --out %s --params %s "
              "--scene %s", box, counts, scene, params, base);
     char *out = NULL, *err = NULL;
@@ -577,7 +651,12 @@ static void test_command(void)
     CHECK(stext && strstr(stext, "\nrestitution = ") != NULL);
     free(stext);
     char *ptext = slurp(params);
-    CHECK(ptext && strncmp(ptext, "parameter,value,lo,hi,mean,range_lo,range_hi\nrestitution,", 57) == 0);
+    CHECK(ptext && strncmp(ptext, "parameter,value,lo,hi,mean,range_lo,range_hi,unit\n"
+                                  "restitution,", 62) == 0);
+    /* The contact time's values are multiples (unit auto), its range the
+     * one given, and the scene holds the multiple for every part. */
+    CHECK(ptext && strstr(ptext, ",0.3,3,auto\n") != NULL);
+    CHECK(stext_has(scene, "\ncontact_time = ", "x:"));
     free(ptext);
     char cmd[256];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
@@ -592,7 +671,6 @@ void suite_fit(void)
     test_dispersion();
     test_coverage_crn();
     test_recovery();
-    test_initial_choice();
-    test_errors();
+    test_box_fits();
     test_command();
 }
