@@ -2,16 +2,23 @@
 # paper-loo.sh: the leave-one-out mode of scripts/paper.sh (-L), which
 # describes it and passes its arguments:
 #
-#   paper-loo.sh BIN TABLES OUTDIR SPEC DROPS INITIAL EVALS POINTS [CONTACT_TIME]
+#   paper-loo.sh BIN TABLES OUTDIR SPEC DROPS INITIAL EVALS POINTS SEED JOBS HELD [CONTACT_TIME]
 #
-# For each of the paper's four parts, fits SPEC to the other three parts'
-# physical counts (posedrop fit) and predicts the fourth; prints its table and
-# at the end e16 and TV per held-out part with the fitted values.
+# For each of the paper's four parts (or HELD alone, when not empty), fits
+# SPEC to the other three parts' physical counts (posedrop fit) and predicts
+# the fourth; prints its table and at the end e16 and TV per held-out part
+# with the fitted values. JOBS folds run at once, each on one thread when
+# JOBS > 1 (the folds are independent, and a fold's evaluations of a few
+# hundred drops keep one thread busier than two).
 set -u
-bin=$1 tables=$2 outdir=$3 spec=$4 n=$5 initial=$6 evals=$7 points=$8 contact_time=${9:-}
+bin=$1 tables=$2 outdir=$3 spec=$4 n=$5 initial=$6 evals=$7 points=$8 seed=$9 jobs=${10}
+held_only=${11} contact_time=${12:-}
 here=$(cd "$(dirname "$0")/.." && pwd)
 parts="insulator_cap white_button rect_black_button square_black_button"
+folds=${held_only:-$parts}
 status=0
+threads=()
+[ "$jobs" -gt 1 ] && threads=(-j 1)
 scene="$outdir/loo.base.scene"
 { echo "initial = $initial"; [ -n "$contact_time" ] && echo "contact_time = $contact_time"; } > "$scene"
 for part in $parts; do
@@ -21,16 +28,30 @@ for part in $parts; do
 done
 summary="$outdir/loo.summary.txt"
 : > "$summary"
-for held in $parts; do
-    args=()
+fit_fold() { # held
+    local held=$1 part args=()
     for part in $parts; do
         [ "$part" = "$held" ] && continue
         args+=(--part "$here/parts/$part.off" --measured "$outdir/$part.measured.csv")
     done
-    "$bin" fit --fit "$spec" -n "$n" --max-evals "$evals" --points "$points" --scene "$scene" \
-        "${args[@]}" --predict "$here/parts/$held.off" --params "$outdir/loo.$held.params.csv" \
-        --out "$outdir/loo.$held.scene" > "$outdir/loo.$held.csv" 2> "$outdir/loo.$held.err" ||
-        { cat "$outdir/loo.$held.err" >&2; status=1; continue; }
+    "$bin" fit --fit "$spec" -n "$n" --max-evals "$evals" --points "$points" --seed "$seed" \
+        "${threads[@]}" --scene "$scene" "${args[@]}" --predict "$here/parts/$held.off" \
+        --params "$outdir/loo.$held.params.csv" --out "$outdir/loo.$held.scene" \
+        > "$outdir/loo.$held.csv" 2> "$outdir/loo.$held.err"
+    echo $? > "$outdir/loo.$held.status"
+}
+running=0
+for held in $folds; do
+    if [ "$running" -ge "$jobs" ]; then
+        wait -n
+        running=$((running - 1))
+    fi
+    fit_fold "$held" &
+    running=$((running + 1))
+done
+wait
+for held in $folds; do
+    [ "$(cat "$outdir/loo.$held.status")" = 0 ] || { cat "$outdir/loo.$held.err" >&2; status=1; continue; }
     # The held-out part's classes with posedrop's QS and PQS and the two
     # predictions, in the form eq16.awk reads.
     awk -F, '
@@ -88,7 +109,8 @@ for held in $parts; do
         "$tqs" "$tpqs" "$tbest" "$tavg" "$fitted" "$cost" >> "$summary"
 done
 printf '\nleave-one-out: each part predicted from a scene fitted to the other three (fit %s,\n' "$spec"
-printf '%s drops per part and evaluation, initial %s when not fitted); e16 and TV in percent\n' "$n" "$initial"
+printf '%s drops per part and evaluation, initial %s when not fitted, seed %s); e16 and TV in percent\n' \
+    "$n" "$initial" "$seed"
 awk -F'|' '
     BEGIN { printf "%-20s | %5s %5s %5s %6s %6s | %5s %5s %6s %6s | %s\n", "held out", "QS", "PQS",
             "Dyn", "best", "avg", "TV QS", "PQS", "best", "avg", "fitted (95%)" }

@@ -3,7 +3,8 @@
 # columns beside the paper's.
 #
 #   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV]
-#   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-o DIR]
+#   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-s SEED]
+#                       [-P JOBS] [-H PART] [-t CONTACT_TIME] [-o DIR]
 #
 # For each of the paper's four parts (parts/<name>.off, rebuilt from the
 # paper's photographs; parts/README.md), runs posedrop's QS and PQS and the
@@ -35,7 +36,13 @@
 # part with the fitted values of each fold. DROPS (default 400) are simulated
 # per part and evaluation, INITIAL (default uniform here) is the initial mode
 # when it is not fitted, EVALS (40) and POINTS (12) bound the search and the
-# weighting.
+# weighting, SEED (1) is the drops' seed of every evaluation; JOBS (1) folds
+# run at once, one thread each when more than one; -H PART runs the one fold
+# that holds PART out (insulator_cap, white_button, rect_black_button,
+# square_black_button).
+#
+# POSEDROP names the binary (default: the newest build/*/posedrop, which after
+# a sanitizer check is the sanitized one: give build/opt/posedrop for timings).
 set -u
 . "$(dirname "$0")/args.sh"
 n=2000
@@ -49,6 +56,9 @@ evals=40
 points=12
 n_given=
 initial_given=
+seed=1
+jobs=1
+held=
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
@@ -58,14 +68,24 @@ while [ $# -gt 0 ]; do
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
         -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
         -t) args_value "$@"; contact_time=$2; shift 2 ;;
+        -s) args_value "$@"; seed=$2; shift 2 ;;
+        -P) args_value "$@"; args_count -P "$2"; jobs=$2; shift 2 ;;
+        -H) args_value "$@"; held=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,38p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,45p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
+case " insulator_cap white_button rect_black_button square_black_button " in
+    *" $held "*) ;;
+    *) [ -z "$held" ] || args_die "-H: expected one of insulator_cap, white_button, rect_black_button, square_black_button, got '$held'" ;;
+esac
+case "$seed" in
+    *[!0-9]*) args_die "-s: expected a whole number, got '$seed'" ;;
+esac
 here=$(cd "$(dirname "$0")/.." && pwd)
-bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
+bin=${POSEDROP:-$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)}
 [ -n "$bin" ] || { echo "paper.sh: posedrop not built (run make)" >&2; exit 2; }
 if [ -z "$tables" ]; then
     for t in "$here/../shared/data/paper-tables.csv" "$here/parts/paper-tables.csv"; do
@@ -82,7 +102,7 @@ if [ "$loo" = 1 ]; then
     [ -n "$n_given" ] || n=400
     [ -n "$initial_given" ] || initial=uniform
     exec "$here/scripts/paper-loo.sh" "$bin" "$tables" "$outdir" "$spec" "$n" "$initial" "$evals" \
-        "$points" ${contact_time:+"$contact_time"}
+        "$points" "$seed" "$jobs" "$held" ${contact_time:+"$contact_time"}
 fi
 # What the tables' blocks and rows are, so that the output reads without
 # docs/validation.md.
