@@ -97,8 +97,12 @@ for held in $folds; do
     dyn=$(awk -F, -v part="$held" 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
         $c["part"] == part { s += $c["p_physical"] * ($c["p_dynamic"] > $c["p_physical"] ? $c["p_dynamic"] - $c["p_physical"] : $c["p_physical"] - $c["p_dynamic"]) }
         END { printf "%.1f", s / 100 }' "$tables")
-    fitted=$(awk -F, 'NR > 1 { printf "%s%s %.3g [%.3g, %.3g]", sep, $1, $2, $3, $4; sep = "; " }' \
+    fitted=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+        { x = $c["unit"] == "auto" ? "x" : ""
+          printf "%s%s %.3g%s [%.3g%s, %.3g%s]", sep, $1, $2, x, $3, x, $4, x; sep = "; " }' \
         "$outdir/loo.$held.params.csv")
+    mode=$(sed -n 's/.*: fit: initial \([a-z]*\): maximised.*/\1/p' "$outdir/loo.$held.err")
+    fitted="$fitted${mode:+; initial $mode}"
     cost=$(sed -n 's/.*: fit: \([0-9]* evaluations, [0-9]* drops simulated\).*; \(.*\) s wall, \(.*\) s CPU/\1, \2 s wall, \3 s CPU/p' \
         "$outdir/loo.$held.err")
     read -r eqs tqs <<< "$(e p_qs)"
