@@ -29,14 +29,14 @@
 # its trials) become pose,count files in posedrop's class numbering (the QS
 # rank pairing above); for each part, the scene parameters SPEC (default
 # mu=0.1:0.8,restitution=0.05:0.7,height=0.06:0.2; 'initial' among them fits
-# the initial mode too) are fitted to the other three parts and the fourth is
-# predicted: at the best fit and averaged over the likelihood-weighted values,
-# with its 95% interval. Prints each held-out part's table (the paper's
+# the initial mode too, at about twice the cost) are fitted to the other
+# three parts and the fourth is predicted: at the best fit and averaged over
+# the likelihood-weighted values, with its 95% interval. Prints each held-out part's table (the paper's
 # columns, posedrop's QS and PQS, the two predictions), then e16 and TV per
 # part with the fitted values of each fold. DROPS (default 400) are simulated
-# per part and evaluation, INITIAL (default uniform here) is the initial mode
-# when it is not fitted, EVALS (40) and POINTS (12) bound the search and the
-# weighting, SEED (1) is the drops' seed of every evaluation; JOBS (1) folds
+# per part and evaluation, INITIAL (default stationary) is the initial mode
+# when it is not fitted, EVALS (25) and POINTS (8) bound the search and the
+# weighting, SEED (1) is the drops' seed of every evaluation; JOBS (2) folds
 # run at once, one thread each when more than one; -H PART runs the one fold
 # that holds PART out (insulator_cap, white_button, rect_black_button,
 # square_black_button).
@@ -52,17 +52,16 @@ outdir=results
 tables=""
 loo=0
 spec=mu=0.1:0.8,restitution=0.05:0.7,height=0.06:0.2
-evals=40
-points=12
+evals=25
+points=8
 n_given=
-initial_given=
 seed=1
-jobs=1
+jobs=2
 held=
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
-        -i) args_value "$@"; initial=$2; initial_given=1; shift 2 ;;
+        -i) args_value "$@"; initial=$2; shift 2 ;;
         -L) loo=1; shift ;;
         -f) args_value "$@"; spec=$2; shift 2 ;;
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
@@ -79,7 +78,8 @@ while [ $# -gt 0 ]; do
 done
 case " insulator_cap white_button rect_black_button square_black_button " in
     *" $held "*) ;;
-    *) [ -z "$held" ] || args_die "-H: expected one of insulator_cap, white_button, rect_black_button, square_black_button, got '$held'" ;;
+    *) [ -z "$held" ] || args_die "-H: expected one of insulator_cap, white_button, \
+rect_black_button, square_black_button, got '$held'" ;;
 esac
 case "$seed" in
     *[!0-9]*) args_die "-s: expected a whole number, got '$seed'" ;;
@@ -100,7 +100,6 @@ why=$("$bin" --initial "$initial" ${contact_time:+--contact-time "$contact_time"
 mkdir -p "$outdir" || exit 2
 if [ "$loo" = 1 ]; then
     [ -n "$n_given" ] || n=400
-    [ -n "$initial_given" ] || initial=uniform
     exec "$here/scripts/paper-loo.sh" "$bin" "$tables" "$outdir" "$spec" "$n" "$initial" "$evals" \
         "$points" "$seed" "$jobs" "$held" ${contact_time:+"$contact_time"}
 fi
