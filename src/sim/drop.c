@@ -224,6 +224,23 @@ static void lift_onto_floor(const pd_body *b, pd_state *s, double g, double lift
     s->w = v3_scale(s->w, k);
 }
 
+/* Plans the flight from s when *f_at < 0 (nothing planned since the motion
+ * last changed) and sets *f_at to 0; 0 when the plan fails, the drop then
+ * marked failed. */
+static int plan_if_stale(const pd_body *b, const pd_state *s, double g, pd_flight *f, double *f_at,
+                         pd_trial *out)
+{
+    if (*f_at >= 0.0)
+        return 1;
+    pd_status st = pd_flight_plan(b, s, g, f);
+    if (st != PD_OK) {
+        pd_drop_failed(out, PD_STAGE_FLIGHT, st);
+        return 0;
+    }
+    *f_at = 0.0;
+    return 1;
+}
+
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
@@ -286,13 +303,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         /* The flight from s: planned afresh after anything that changed the
          * motion, else the one s already lies on, at its time f_at. */
-        if (f_at < 0.0) {
-            if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
-                pd_drop_failed(out, PD_STAGE_FLIGHT, st);
-                break;
-            }
-            f_at = 0.0;
-        }
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+            break;
         if (!resolved) {
             pd_impact imp;
             /* hint: the lowest vertex of s where decided_at looked the
@@ -315,11 +327,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  * part step by step, paid for out of the motion. */
                 w->rest_depth = fmax(w->rest_depth, -imp.height);
                 lift_onto_floor(m->body, &s, g, -imp.height, rest_from - s.x.z);
-                if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
-                    pd_drop_failed(out, PD_STAGE_FLIGHT, st);
-                    break;
-                }
-                f_at = 0.0;
+                f_at = -1.0; /* planned by the rest step, if no impulse comes first */
             }
             if (imp.kind == PD_IMPACT_AT) {
                 if ((st = pd_flight_eval(&f, imp.t, &s)) != PD_OK) {
@@ -418,6 +426,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
          * lands meanwhile (a face's other corners after its first one
          * rebounds), which then starts below the floor. */
         phase_ok = 1;
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+            break;
         double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
         if (rise > m->settle.v_rest)
             dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
@@ -432,8 +442,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
          * back (lift_onto_floor), or than the outcome test allows for
          * (PD_REST_TURN_REL): lifted partly for free, a slowly rocking part
          * gained height every step and never settled below a low barrier. */
-        double turn = v3_norm(s.w) * m->body->rmax;
         double payable = fmax(energy_height(m->body, &s, g) - s.x.z, m->settle.margin);
+        double turn = v3_norm(s.w) * m->body->rmax;
         if (turn * dt > payable)
             dt = payable / turn;
         f_at += dt;
