@@ -516,6 +516,18 @@ static int lands_first(const pd_phase *p, const pd_state *s, double slip_min, do
     return 0;
 }
 
+/* pd_phase_slide_edge_from_rest on a copy of pivot phase p (which has no
+ * force solve set up), replacing p where it succeeds. */
+static int slide_edge(pd_phase *p, const pd_state *s, double *accel)
+{
+    pd_phase q = *p;
+    pd_phase_map(&q);
+    if (!pd_phase_slide_edge_from_rest(&q, s, accel))
+        return 0;
+    *p = q;
+    return 1;
+}
+
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase)
 {
@@ -582,7 +594,9 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
         return 0;
     }
     double least = margins(&p, &t, &F, slip_min, g, &floor_v, &up), accel;
-    if (!(least > 0.0) && !pivot && F.cone[0] <= 0.0 && pd_phase_slide_from_rest(&p, &t, &accel)) {
+    if (!(least > 0.0) && (nc == 1 ? F.cone[0] <= 0.0 && pd_phase_slide_from_rest(&p, &t, &accel)
+                                   : pivot && fmin(F.cone[0], F.cone[1]) <= 0.0 &&
+                                         slide_edge(&p, &t, &accel))) {
         /* One contact that cannot stick: it slides from rest, and the
          * phase follows it (microcollisions would stop its slip at each
          * one, every rest step, until it slipped faster than friction

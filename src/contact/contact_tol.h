@@ -77,6 +77,22 @@
  * phase is then refused, and microcollisions go on as before). Not a
  * setting: every zero found is exact to round-off. */
 #define PD_PHASE_START_CELLS 36
+/* An edge whose two contacts start to slide from rest: their directions by
+ * Newton's method from the best common one, at most this many iterations
+ * (quadratic convergence takes a handful from a start within a cell; a
+ * planar slide, the common case, starts on its answer); not converged, the
+ * phase is refused as before. */
+#define PD_PHASE_START_NEWTON 30
+/* ...converged when the two residuals (cross products of direction and
+ * tangential acceleration, m/s^2) sum to at most this times g: the
+ * accelerations' round-off is ~1e-16 of their few g, so 1e-12 is reached
+ * in a step or two of quadratic convergence, and it turns the directions
+ * by ~1e-12 rad, nothing the phase's 1e-8 error per step can see. */
+#define PD_TOL_PHASE_START_RESIDUAL 1e-12
+/* ...with the Jacobian from differences of this step in each angle (rad):
+ * about the square root of the residual's relative round-off, where a
+ * forward difference is most accurate. */
+#define PD_PHASE_START_DIFF 1e-7
 
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */

@@ -508,6 +508,112 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
     return 1;
 }
 
+/* The free acceleration of contact i at s (body frame; up, the world's):
+ * gravity, the gyroscopic angular acceleration and the centripetal term. */
+static pd_vec3 free_accel(const pd_phase *p, const pd_state *s, pd_vec3 up, int i)
+{
+    const pd_body *b = p->b;
+    pd_vec3 w = s->w, wr = v3_cross(w, p->r[i]);
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
+    return v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[i]), v3_cross(w, wr)));
+}
+
+/* Both contacts of an edge sliding along world directions th[0], th[1]:
+ * each one's cross product of its direction with its tangential
+ * acceleration (world) into r[], the slip's acceleration along its
+ * direction into along[], its normal force into lambda[]; 0 if the 2 x 2
+ * system of the normal forces is singular. */
+static int edge_residual(const pd_phase *p, const double R[3][3], const pd_vec3 af[2],
+                         const double th[2], double r[2], double along[2], double lambda[2])
+{
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), X = v3(R[0][0], R[0][1], R[0][2]);
+    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), d[2];
+    double c[2], sn[2];
+    for (int k = 0; k < 2; k++) {
+        c[k] = cos(th[k]), sn[k] = sin(th[k]);
+        d[k] = v3_sub(up, v3_add(v3_scale(X, p->mu * c[k]), v3_scale(Y, p->mu * sn[k])));
+    }
+    double A[6][AUG];
+    for (int i = 0; i < 2; i++) {
+        for (int j = 0; j < 2; j++)
+            A[i][j] = v3_dot(up, m3_vec(CONST_M3(p->M[i][j]), d[j]));
+        A[i][2] = -v3_dot(up, af[i]);
+    }
+    if (!solve_small(2, A))
+        return 0;
+    lambda[0] = A[0][2], lambda[1] = A[1][2];
+    for (int k = 0; k < 2; k++) {
+        pd_vec3 a = af[k];
+        for (int j = 0; j < 2; j++)
+            a = v3_add(a, v3_scale(m3_vec(CONST_M3(p->M[k][j]), d[j]), lambda[j]));
+        double ax = v3_dot(X, a), ay = v3_dot(Y, a);
+        r[k] = c[k] * ay - sn[k] * ax;
+        along[k] = c[k] * ax + sn[k] * ay;
+    }
+    return 1;
+}
+
+int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
+{
+    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
+    const pd_vec3 af[2] = {free_accel(p, s, up, 0), free_accel(p, s, up, 1)};
+    /* A start: the common direction, of PD_PHASE_START_CELLS round the
+     * circle, where both slips grow under positive normal forces with the
+     * smallest residual; then Newton's method on both directions (its
+     * Jacobian by differences), to round-off of the residual. */
+    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL;
+    for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
+        double t = 2.0 * M_PI * k / PD_PHASE_START_CELLS, tt[2] = {t, t};
+        if (!edge_residual(p, CONST_M3(R), af, tt, r, along, lambda) || !(lambda[0] > 0.0) ||
+            !(lambda[1] > 0.0) || !(along[0] > 0.0) || !(along[1] > 0.0))
+            continue;
+        double e = r[0] * r[0] + r[1] * r[1];
+        if (e < best)
+            best = e, th[0] = th[1] = t;
+    }
+    if (!(best < HUGE_VAL))
+        return 0;
+    double h = PD_PHASE_START_DIFF;
+    int converged = 0;
+    for (int it = 0; it < PD_PHASE_START_NEWTON && !converged; it++) {
+        if (!edge_residual(p, CONST_M3(R), af, th, r, along, lambda))
+            return 0;
+        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * p->g) {
+            converged = 1;
+            break;
+        }
+        double J[2][2], rh[2], ah[2], lh[2];
+        for (int k = 0; k < 2; k++) {
+            double tk[2] = {th[0], th[1]};
+            tk[k] += h;
+            if (!edge_residual(p, CONST_M3(R), af, tk, rh, ah, lh))
+                return 0;
+            J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
+        }
+        double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        if (!(fabs(det) > 0.0))
+            return 0;
+        th[0] -= (J[1][1] * r[0] - J[0][1] * r[1]) / det;
+        th[1] -= (J[0][0] * r[1] - J[1][0] * r[0]) / det;
+    }
+    if (!converged || !(lambda[0] > 0.0) || !(lambda[1] > 0.0) || !(along[0] > 0.0) ||
+        !(along[1] > 0.0))
+        return 0;
+    for (int k = 0; k < 2; k++) {
+        p->mode[k] = SLIDE;
+        p->from_rest[k] = 1;
+        p->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
+        p->drill[k] = 0.0;
+    }
+    *accel = fmin(along[0], along[1]);
+    return 1;
+}
+
 int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out)
 {
     return forces(p, s, 0, out);

@@ -66,6 +66,13 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
  * none (sticking holds, or no direction gives a positive normal force). */
 int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
+/* Both contacts of an edge, sticking (a pivot) where a force leaves the
+ * friction cone, start to slide from rest: each along a direction in which
+ * its slip then grows (as above), both found together. Sets p (mapped) so,
+ * the slower slip's acceleration into *accel, and returns 1; 0 (p
+ * unchanged) if no such pair is found. */
+int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel);
+
 /* The forces of state s (SI). 0, or 1 where the model does not hold (a
  * sliding contact with no slip to give friction a direction, a singular
  * system). */

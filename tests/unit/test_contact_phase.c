@@ -568,6 +568,27 @@ static void test_drilling_top(void)
     drop_teardown(&fx);
 }
 
+/* A phase from resting state s on contacts[0..nc) at scene sc: admitted,
+ * contact 0 moving along `out` (horizontal), friction taking energy (to the
+ * phase's ODE error, 1e-8 m g L). */
+static void slide_phase(const drop_fixture *fx, const pd_scene *sc, pd_state s, const int *contacts,
+                        int nc, pd_vec3 out)
+{
+    const pd_body *b = fx->model->body;
+    pd_vec3 c0 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    pd_phase phase;
+    CHECK(pd_contact_phase_start(&fx->model->settle, sc, &s, contacts, nc, &phase));
+    double E0 = total_energy(b, G, &s), dt = 0.0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    CHECK_STATUS(pd_contact_phase(&fx->model->settle, ode, pivot, sc, &phase, &s, 1.0, &dt), PD_OK);
+    CHECK(dt > 0.0);
+    pd_vec3 c1 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
+    CHECK(v3_dot(v3_sub(c1, c0), out) > 0.0);
+    CHECK(total_energy(b, G, &s) <= E0 + 1e-8 * b->mass * G * b->size);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+}
+
 /* A 1 cm cube on one corner at rest, leaning (its centre of mass not above
  * the corner) with too little friction to hold the corner, starts to slide
  * from rest. Inertia isotropic (I = m a^2 / 6), so in the vertical plane of
@@ -613,18 +634,50 @@ static void test_slide_from_rest(void)
     /* The phase: admitted, and the corner slides outward, friction taking
      * energy (to the phase's ODE error). */
     sc.mu = 0.5 * mu_star;
-    pd_phase phase;
-    pd_state t = s;
-    CHECK(pd_contact_phase_start(&fx.model->settle, &sc, &t, contacts, nc, &phase));
-    double E0 = total_energy(b, G, &t), dt = 0.0;
-    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
-    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &t, 1.0, &dt), PD_OK);
-    CHECK(dt > 0.0);
-    pd_vec3 c0 = v3_add(s.x, r), c1 = v3_add(t.x, quat_rotate(t.q, b->verts[contacts[0]]));
-    CHECK(v3_dot(v3_sub(c1, c0), v3(r.x, r.y, 0.0)) > 0.0);
-    CHECK(total_energy(b, G, &t) <= E0 + 1e-8 * b->mass * G * L);
-    pd_ode_free(pivot);
-    pd_ode_free(ode);
+    slide_phase(&fx, &sc, s, contacts, nc, v3(r.x, r.y, 0.0));
+    drop_teardown(&fx);
+}
+
+/* The 1 x 2 x 3 cm box on its long edge, at rest, leaning tilt past
+ * balance with too little friction to hold the edge: both of the edge's
+ * contacts slide from rest, outward and together (the motion is planar),
+ * under the closed form of test_slide_from_rest with I the moment about the
+ * edge's direction and (rho, h) the arm from the edge to the centre. */
+static void test_edge_slide_from_rest(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    int contacts[8], nc;
+    pd_state s = on_edge(b, 0.2, contacts, &nc);
+    CHECK_INT(nc, 2);
+    /* The edge lies along the world's x (on_edge turns about it): the arm
+     * across it is (y, z). */
+    pd_vec3 r = quat_rotate(s.q, b->verts[contacts[0]]);
+    double rho = fabs(r.y), h = -r.z, Im = b->moment[0] / b->mass, L = b->size;
+    double mu_star = h * rho / (Im + h * h), out = r.y > 0.0 ? 1.0 : -1.0;
+    double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * L);
+    for (int k = 0; k < 2; k++) {
+        double mu = (k ? 1.1 : 0.5) * mu_star, accel = 0.0;
+        pd_phase p;
+        pd_phase_init(&p, b, G, mu, &s, contacts, nc, slip_start);
+        CHECK(p.mode[0] == PD_PHASE_STICK && p.mode[1] == PD_PHASE_STICK);
+        int slides = pd_phase_slide_edge_from_rest(&p, &s, &accel);
+        CHECK_INT(slides, !k);
+        if (!slides)
+            continue;
+        double lambda = G / (1.0 / b->mass + rho * (rho - mu * h) / b->moment[0]);
+        double a = lambda * (h * rho - mu * (Im + h * h)) / b->moment[0];
+        CHECK_REL(accel, a, 1e-9, "closed form; Newton's stop at 1e-12 g of the residual");
+        for (int i = 0; i < 2; i++) {
+            CHECK_NEAR(p.t0[i].x, 0.0, 1e-9, "outward across the edge, by symmetry");
+            CHECK_NEAR(p.t0[i].y, out, 1e-9, "outward across the edge, by symmetry");
+        }
+    }
+    sc.mu = 0.5 * mu_star;
+    slide_phase(&fx, &sc, s, contacts, nc, v3(0.0, out, 0.0));
     drop_teardown(&fx);
 }
 
@@ -639,4 +692,5 @@ void suite_contact_phase(void)
     test_reference_agreement();
     test_start_modes();
     test_slide_from_rest();
+    test_edge_slide_from_rest();
 }
