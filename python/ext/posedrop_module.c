@@ -1074,6 +1074,8 @@ static PyObject *Drops_arrays(DropsObject *self, PyObject *unused)
               put(d, "collision_limited", PyLong_FromLong(s->collision_limited)) ||
               put(d, "failed", PyLong_FromLong(s->failed)) ||
               put(d, "first_failed", PyLong_FromLong(s->first_failed)) ||
+              put(d, "failed_stage", PyLong_FromLong((long)s->failed_stage)) ||
+              put(d, "failed_status", PyLong_FromLong((long)s->failed_status)) ||
               put(d, "time_limit", PyFloat_FromDouble(s->time_limit)) ||
               put(d, "energy_gain", PyLong_FromLong(s->energy_gain)) ||
               put(d, "fallbacks", PyLong_FromLong(s->fallbacks)) ||
