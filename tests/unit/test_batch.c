@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/stat.h>
 #include "check.h"
 #include "cli_run.h"
 #include "suites.h"
@@ -124,6 +125,18 @@ static void test_merge_refusals(void)
     expect_merge_failure(s2, NULL, "shard 1/2 is missing");
     expect_merge_failure(s1, "parts/paper-tables.csv", "not a shard");
     expect_merge_failure(s1, "/nonexistent/shard", "/nonexistent/shard");
+    /* A named pipe no program writes to: refused at once, where open()
+     * waited for a writer for ever (timeout ends a regression with 124). */
+    char fifo[128], fcmd[512], *fout, *ferr;
+    snprintf(fifo, sizeof fifo, "%s/nowriter", tmpdir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    snprintf(fcmd, sizeof fcmd, "timeout 60 %s merge %s %s", PD_CLI_PATH, s1, fifo);
+    CHECK_INT(run_cmd(fcmd, 1, &fout, &ferr), 2);
+    CHECK(strstr(ferr, "nowriter: a named pipe that gave nothing to read") != NULL);
+    CHECK_INT((int)strlen(fout), 0);
+    free(fout);
+    free(ferr);
+    remove(fifo);
 
     /* Another version's shard: its first line says so. */
     char path[128], cmd[512], *out, *err;
