@@ -673,7 +673,9 @@ def main():
                          "(0, the default: QS only; docs/validation.md)")
     ap.add_argument("--min-tip", type=float, default=MIN_TIP,
                     help="smallest tip angle, degrees, a stable pose may have (%g)" % MIN_TIP)
-    ap.add_argument("--grid", type=int, default=8, help="grid points per dimension (8)")
+    ap.add_argument("--grid", type=int, default=None,
+                    help="grid points per dimension (8; 3 for the black buttons, "
+                         "whose 6 and 8 dimensions would make 8 too many)")
     ap.add_argument("--starts", type=int, default=3,
                     help="Nelder-Mead starts from the best grid points (3)")
     ap.add_argument("--outdir", default=os.path.join(ROOT, "parts"))
@@ -692,7 +694,8 @@ def main():
             for name in args.fit or list(DIMS):
                 if name not in DIMS:
                     ap.error("unknown part " + name)
-                dims[name], nev = fit(name, dims[name], args.grid, args.starts, tmpdir,
+                grid = args.grid or (3 if len(FIT[name]) > 4 else 8)
+                dims[name], nev = fit(name, dims[name], grid, args.starts, tmpdir,
                                        args.pqs_weight, args.min_tip)
                 print("%s: fitted after %d evaluations: %r" % (name, nev, dims[name]),
                       file=sys.stderr)
