@@ -519,39 +519,52 @@ static pd_vec3 free_accel(const pd_phase *p, const pd_state *s, pd_vec3 up, int 
     return v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[i]), v3_cross(w, wr)));
 }
 
-/* Both contacts of an edge sliding along world directions th[0], th[1]:
- * each one's cross product of its direction with its tangential
- * acceleration (world) into r[], the slip's acceleration along its
- * direction into along[], its normal force into lambda[]; 0 if the 2 x 2
- * system of the normal forces is singular. */
-static int edge_residual(const pd_phase *p, const double R[3][3], const pd_vec3 af[2],
-                         const double th[2], double r[2], double along[2], double lambda[2])
+/* What an edge's slide from rest needs of the state, once: the world's axes
+ * in the body frame, each contact's free acceleration, and each response
+ * M[k][j] applied to up, X and Y (the force direction d = up - mu (c X +
+ * s Y) is their combination). */
+typedef struct {
+    pd_vec3 up, X, Y, af[2], Mu[2][2], MX[2][2], MY[2][2];
+    double mu;
+} edge_setup;
+
+/* Both contacts of the edge sliding along the world's horizontal unit
+ * directions (c[k], s[k]): each one's cross product of its direction with its
+ * tangential acceleration (world) into r[], the slip's acceleration along
+ * its direction into along[], its normal force into lambda[]; 0 if the
+ * 2 x 2 system of the normal forces is singular. */
+static int edge_residual(const edge_setup *e, const double c[2], const double sn[2], double r[2],
+                         double along[2], double lambda[2])
 {
-    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), X = v3(R[0][0], R[0][1], R[0][2]);
-    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), d[2];
-    double c[2], sn[2];
-    for (int k = 0; k < 2; k++) {
-        c[k] = cos(th[k]), sn[k] = sin(th[k]);
-        d[k] = v3_sub(up, v3_add(v3_scale(X, p->mu * c[k]), v3_scale(Y, p->mu * sn[k])));
-    }
+    pd_vec3 Md[2][2];
+    for (int k = 0; k < 2; k++)
+        for (int j = 0; j < 2; j++)
+            Md[k][j] = v3_sub(e->Mu[k][j], v3_add(v3_scale(e->MX[k][j], e->mu * c[j]),
+                                                  v3_scale(e->MY[k][j], e->mu * sn[j])));
     double A[6][AUG];
     for (int i = 0; i < 2; i++) {
         for (int j = 0; j < 2; j++)
-            A[i][j] = v3_dot(up, m3_vec(CONST_M3(p->M[i][j]), d[j]));
-        A[i][2] = -v3_dot(up, af[i]);
+            A[i][j] = v3_dot(e->up, Md[i][j]);
+        A[i][2] = -v3_dot(e->up, e->af[i]);
     }
     if (!solve_small(2, A))
         return 0;
     lambda[0] = A[0][2], lambda[1] = A[1][2];
     for (int k = 0; k < 2; k++) {
-        pd_vec3 a = af[k];
-        for (int j = 0; j < 2; j++)
-            a = v3_add(a, v3_scale(m3_vec(CONST_M3(p->M[k][j]), d[j]), lambda[j]));
-        double ax = v3_dot(X, a), ay = v3_dot(Y, a);
+        pd_vec3 a = v3_add(e->af[k], v3_add(v3_scale(Md[k][0], lambda[0]), v3_scale(Md[k][1], lambda[1])));
+        double ax = v3_dot(e->X, a), ay = v3_dot(e->Y, a);
         r[k] = c[k] * ay - sn[k] * ax;
         along[k] = c[k] * ax + sn[k] * ay;
     }
     return 1;
+}
+
+/* edge_residual at angles th[0], th[1]. */
+static int edge_residual_at(const edge_setup *e, const double th[2], double r[2], double along[2],
+                            double lambda[2])
+{
+    const double c[2] = {cos(th[0]), cos(th[1])}, sn[2] = {sin(th[0]), sin(th[1])};
+    return edge_residual(e, c, sn, r, along, lambda);
 }
 
 int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
@@ -560,28 +573,38 @@ int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
         return 0;
     double R[3][3];
     quat_to_matrix(s->q, R);
-    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]);
-    const pd_vec3 af[2] = {free_accel(p, s, up, 0), free_accel(p, s, up, 1)};
+    edge_setup e;
+    e.up = v3(R[2][0], R[2][1], R[2][2]), e.X = v3(R[0][0], R[0][1], R[0][2]);
+    e.Y = v3(R[1][0], R[1][1], R[1][2]), e.mu = p->mu;
+    for (int k = 0; k < 2; k++) {
+        e.af[k] = free_accel(p, s, e.up, k);
+        for (int j = 0; j < 2; j++) {
+            e.Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.up);
+            e.MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.X);
+            e.MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.Y);
+        }
+    }
     /* A start: the common direction, of PD_PHASE_START_CELLS round the
-     * circle, where both slips grow under positive normal forces with the
-     * smallest residual; then Newton's method on both directions (its
-     * Jacobian by differences), to round-off of the residual. */
-    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL;
+     * circle (turned by one rotation each), where both slips grow under
+     * positive normal forces with the smallest residual; then Newton's
+     * method on both directions (its Jacobian by differences), to round-off
+     * of the residual. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
+    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL, c = 1.0, sn = 0.0;
     for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
-        double t = 2.0 * M_PI * k / PD_PHASE_START_CELLS, tt[2] = {t, t};
-        if (!edge_residual(p, CONST_M3(R), af, tt, r, along, lambda) || !(lambda[0] > 0.0) ||
-            !(lambda[1] > 0.0) || !(along[0] > 0.0) || !(along[1] > 0.0))
-            continue;
-        double e = r[0] * r[0] + r[1] * r[1];
-        if (e < best)
-            best = e, th[0] = th[1] = t;
+        const double cc[2] = {c, c}, ss[2] = {sn, sn};
+        if (edge_residual(&e, cc, ss, r, along, lambda) && lambda[0] > 0.0 && lambda[1] > 0.0 &&
+            along[0] > 0.0 && along[1] > 0.0 && r[0] * r[0] + r[1] * r[1] < best)
+            best = r[0] * r[0] + r[1] * r[1], th[0] = th[1] = step * k;
+        double c1 = c * cd - sn * sd;
+        sn = sn * cd + c * sd, c = c1;
     }
     if (!(best < HUGE_VAL))
         return 0;
     double h = PD_PHASE_START_DIFF;
     int converged = 0;
     for (int it = 0; it < PD_PHASE_START_NEWTON && !converged; it++) {
-        if (!edge_residual(p, CONST_M3(R), af, th, r, along, lambda))
+        if (!edge_residual_at(&e, th, r, along, lambda))
             return 0;
         if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * p->g) {
             converged = 1;
@@ -591,7 +614,7 @@ int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
         for (int k = 0; k < 2; k++) {
             double tk[2] = {th[0], th[1]};
             tk[k] += h;
-            if (!edge_residual(p, CONST_M3(R), af, tk, rh, ah, lh))
+            if (!edge_residual_at(&e, tk, rh, ah, lh))
                 return 0;
             J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
         }
