@@ -597,18 +597,25 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
     if (!(least > 0.0) && (nc == 1 ? F.cone[0] <= 0.0 && pd_phase_slide_from_rest(&p, &t, &accel)
                                    : pivot && fmin(F.cone[0], F.cone[1]) <= 0.0 &&
                                          slide_edge(&p, &t, &accel))) {
-        /* One contact that cannot stick: it slides from rest, and the
-         * phase follows it (microcollisions would stop its slip at each
-         * one, every rest step, until it slipped faster than friction
-         * can stop in one), unless another vertex lands first. */
+        /* A contact or an edge that cannot stick: it slides from rest,
+         * and the phase follows it (microcollisions would stop its slip
+         * at each one, every rest step, until it slipped faster than
+         * friction can stop in one), unless another vertex lands first. */
         if (pd_phase_forces_of(&p, &t, &F))
             return 0;
         least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
         if (least > 0.0 && lands_first(&p, &t, slip_min, 2.0 * slip_min / accel))
             return 0;
     }
-    if (!(least > 0.0))
+    if (!(least > 0.0)) {
+        /* An edge one of whose contacts would pull on the floor (its normal
+         * force not positive) lifts off there: the other's phase, alone,
+         * is the edge's. */
+        for (int i = 0; i < nc && nc == 2; i++)
+            if (!(g[i] > 0.0) && g[1 - i] > 0.0)
+                return pd_contact_phase_start(st, sc, s, contacts + 1 - i, 1, phase);
         return 0;
+    }
     /* The phase goes on with the modes the projection was for: taken
      * afresh from t, a contact that slid above the start threshold and
      * slips less after the projection would count as sticking, and its

@@ -681,6 +681,36 @@ static void test_edge_slide_from_rest(void)
     drop_teardown(&fx);
 }
 
+/* A tetrahedron resting on its edge AB, its centre of mass beyond A: the
+ * weight's moment about A lifts B, whose normal force would be negative in
+ * an edge phase. B lifts off, and the phase is A's alone (the edge's start
+ * was refused, and microcollisions took it a rest step at a time). */
+static void test_edge_lifts_one_end(void)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.mu = 1.0; /* A sticks */
+    drop_fixture fx;
+    const pd_vec3 p[4] = {{0, 0, 0}, {0.01, 0, 0}, {-0.015, 0.005, 0.01}, {-0.015, -0.005, 0.01}};
+    if (!drop_setup(&fx, convex_mesh(p, 4), &sc))
+        return;
+    const pd_body *b = fx.model->body;
+    /* The part's own frame as the world's: A and B on the floor. */
+    pd_state s = {v3_add(fx.part->origin, b->com), b->frame, v3(0, 0, 0), v3(0, 0, 0)};
+    int contacts[8], nc = lowest_vertices(b, s.q, contacts);
+    CHECK_INT(nc, 2);
+    if (nc != 2)
+        return;
+    int a = pd_body_vertex_world(b, &s, contacts[0]).x < pd_body_vertex_world(b, &s, contacts[1]).x ? 0 : 1;
+    CHECK_NEAR(pd_body_vertex_world(b, &s, contacts[a]).z, 0.0, 1e-15, "A on the floor");
+    pd_phase phase;
+    CHECK(pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, nc, &phase));
+    CHECK_INT(phase.nc, 1);
+    CHECK_INT(phase.v[0], contacts[a]);
+    CHECK_INT(phase.mode[0], PD_PHASE_STICK);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
     test_drilling_top();
@@ -693,4 +723,5 @@ void suite_contact_phase(void)
     test_start_modes();
     test_slide_from_rest();
     test_edge_slide_from_rest();
+    test_edge_lifts_one_end();
 }
