@@ -12,15 +12,17 @@
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
- * phase_forces.c solves it). A contact whose sticking force would leave
- * the friction cone, at rest, slides from rest (pd_phase_slide_from_rest):
- * its friction along the direction its slip then grows in, until the slip
- * reaches the start threshold, and along its slip from there, in the same
+ * phase_forces.c solves it). A resting contact, or both contacts of a
+ * resting edge, whose sticking force would leave the friction cone slide
+ * from rest (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest):
+ * friction along the direction each slip then grows in, until the slip
+ * reaches the start threshold, and along the slip from there, in the same
  * phase; unless another vertex is predicted to land first (lands_first).
- * Sliding friction does negative work and sticking contacts none, so the
- * energy can only fall. Two sticking
- * contacts are a rotation about their edge, integrated as one angle
- * (contact_pivot.c), the commonest phase of a part rolling on a rim. The
+ * An edge one of whose contacts would pull on the floor is the other
+ * contact's phase. Sliding friction does negative work and sticking
+ * contacts none, so the energy can only fall. Two sticking contacts are a
+ * rotation about their edge, integrated as one angle (contact_pivot.c),
+ * the commonest phase of a part rolling on a rim. The
  * ODE is integrated by gsl_adapter's Cash-Karp pair (rkck) in units of the
  * part (length L, time sqrt(L/g)); the phase ends, handing the state back
  * to the microcollisions, just before any of:
