@@ -410,6 +410,17 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
     return 0;
 }
 
+/* The free acceleration of contact i at s (body frame; up, the world's):
+ * gravity, the gyroscopic angular acceleration and the centripetal term. */
+static pd_vec3 free_accel(const pd_phase *p, const pd_state *s, pd_vec3 up, int i)
+{
+    const pd_body *b = p->b;
+    pd_vec3 w = s->w, wr = v3_cross(w, p->r[i]);
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
+    return v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[i]), v3_cross(w, wr)));
+}
+
 /* Sliding along the world's horizontal unit direction t = (c, s), contact
  * 0's normal force is A / k and k times its tangential acceleration (world)
  * is affine in (c, s): k a_x = p0 + p1 c + p2 s, k a_y = q0 + q1 c + q2 s
@@ -428,14 +439,10 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
 {
     if (p->nc != 1 || p->mode[0] != STICK || !p->mapped || !(p->mu > 0.0))
         return 0;
-    const pd_body *b = p->b;
     double R[3][3];
     quat_to_matrix(s->q, R);
     pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), X = v3(R[0][0], R[0][1], R[0][2]);
-    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), w = s->w, wr = v3_cross(w, p->r[0]);
-    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
-    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
-    pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
+    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), af = free_accel(p, s, up, 0);
     /* The force is lambda d, d = n - mu t (body frame: up - mu (c X + s Y)),
      * so M d = m0 - mu (c mx + s my), k = up . M d, lambda = A / k with
      * A = -up . af, and k a = k af + A M d. */
@@ -468,7 +475,7 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
              * when the same end moves twice), to round-off. */
             double lc = c0, ls = s0, flo = f0, hc = c1, hs = s1, fhi = f1;
             int side = 0;
-            for (int i = 0; i < 60; i++) {
+            for (int i = 0; i < 60; i++) { /* a bound: it stalls at round-off first */
                 double u = flo / (flo - fhi);
                 double mc = lc + u * (hc - lc), ms = ls + u * (hs - ls), n = sqrt(mc * mc + ms * ms);
                 mc /= n, ms /= n;
@@ -506,17 +513,6 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
     p->drill[0] = 0.0; /* a sliding contact's friction goes to its slip */
     *accel = best;
     return 1;
-}
-
-/* The free acceleration of contact i at s (body frame; up, the world's):
- * gravity, the gyroscopic angular acceleration and the centripetal term. */
-static pd_vec3 free_accel(const pd_phase *p, const pd_state *s, pd_vec3 up, int i)
-{
-    const pd_body *b = p->b;
-    pd_vec3 w = s->w, wr = v3_cross(w, p->r[i]);
-    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
-    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
-    return v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[i]), v3_cross(w, wr)));
 }
 
 /* What an edge's slide from rest needs of the state, once: the world's axes
