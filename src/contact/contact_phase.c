@@ -57,6 +57,17 @@ pd_ode *pd_contact_phase_ode_alloc_tol(double tol_scale)
     return pd_ode_alloc_method(PD_ODE_RKCK, NY, tol, tol);
 }
 
+pd_ode *pd_contact_phase_spin_ode_alloc_tol(double tol_scale)
+{
+    double tol = tol_scale * PD_TOL_PHASE_ODE_REL;
+    return pd_ode_alloc_method(PD_ODE_RK8PD, NY, tol, tol);
+}
+
+int pd_contact_phase_spins_fast(const pd_body *b, double g, const pd_state *s)
+{
+    return v3_norm(s->w) * sqrt(b->size / g) > PD_PHASE_SPIN_FAST;
+}
+
 /* The same pair and tolerance for a pivot's angle (rad) and rate (per
  * sqrt(L/g)): an error of e in the angle moves the part by e L at most,
  * as an error of e in the full motion's position (per L) does. */
@@ -191,8 +202,12 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
         g[k] = HUGE_VAL;
     for (int i = 0; i < p->nc; i++) {
         g[i] = F->fn[i] / mg;
-        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg : (F->slip[i] - slip_min) / V0;
+        g[2 + i] = p->mode[i] == PD_PHASE_SLIDE ? (F->slip[i] - slip_min) / V0 : F->cone[i] / mg;
     }
+    /* A clipped contact (one alone, so the second contact's slot is free):
+     * also until its slip reaches the speed at which a slide starts. */
+    if (p->mode[0] == PD_PHASE_CLIP)
+        g[3] = (2.0 * slip_min - F->slip[0]) / V0;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     *up_out = up;
     /* With a drilling contact: the spin about the normal, in the direction
@@ -538,6 +553,12 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
         pd_pivot_state(&pv, 0.0, w, &u, &F);
     } else if (pd_phase_forces_of(&p, &t, &F)) {
         return 0;
+    } else if (nc == 1 && p.mode[0] == PD_PHASE_STICK && F.cone[0] < 0.0) {
+        /* Sticking, but held only by more friction than the cone gives:
+         * it starts to slip, at the cone's edge (phase_forces.h). */
+        p.mode[0] = PD_PHASE_CLIP;
+        if (pd_phase_forces_of(&p, &t, &F))
+            return 0;
     }
     if (!(margins(&p, &t, &F, slip_min, g, &floor_v, &up) > 0.0))
         return 0;

@@ -18,7 +18,7 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 
-enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
+enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK, CLIP = PD_PHASE_CLIP };
 
 /* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
  * n + m columns) and B's columns become X's, by Gaussian elimination with
@@ -184,9 +184,34 @@ static int solve_layout(const pd_phase *p, const layout *L, pd_vec3 up, int dril
     return 1;
 }
 
+/* No contact slides: the constrained rows are the body axes (a clipped
+ * contact's sticking force is solved first, then clipped). */
 static int all_stick(const pd_phase *p)
 {
-    return p->mode[0] == STICK && (p->nc == 1 || p->mode[1] == STICK);
+    return p->mode[0] != SLIDE && (p->nc == 1 || p->mode[1] != SLIDE);
+}
+
+/* A lone clipped contact (phase_forces.h): its sticking force fs (body
+ * frame) becomes lambda d, d = n + mu t the cone's edge along fs's
+ * tangential direction t, lambda holding the normal acceleration at zero
+ * with the drilling couple, -drill lambda n, turning the part as it does
+ * the sticking force; *excess: how far fs lies outside the cone. 1 where
+ * fs has no tangential direction. */
+static int clip_force(const pd_phase *p, pd_vec3 up, pd_vec3 af, pd_vec3 *f, double *excess)
+{
+    double fn = v3_dot(*f, up);
+    pd_vec3 ft = v3_sub(*f, v3_scale(up, fn));
+    double t = v3_norm(ft);
+    if (!(t > 0.0))
+        return 1;
+    *excess = t - p->mu * fn;
+    pd_vec3 d = v3_add(up, v3_scale(ft, p->mu / t));
+    pd_vec3 u = v3_cross(pd_body_inv_inertia(p->b, up), p->r[0]);
+    double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d)) - p->drill[0] * v3_dot(up, u);
+    if (!(fabs(k) > 0.0))
+        return 1;
+    *f = v3_scale(d, -v3_dot(up, af) / k);
+    return 0;
 }
 
 /* The velocity of contact j of state s (world), R the body-to-world matrix;
@@ -378,6 +403,9 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         for (int k = 0; k < L.n; k++)
             f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
     }
+    double excess = 0.0;
+    if (p->mode[0] == CLIP && clip_force(p, up, af[0], &f[0], &excess))
+        return 1;
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
     for (int j = 0; j < p->nc; j++)
@@ -389,7 +417,8 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         F = v3_add(F, f[j]);
         double fn = v3_dot(f[j], up);
         out->fn[j] = fn;
-        out->cone[j] = p->mode[j] == STICK ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+        out->cone[j] = p->mode[j] == STICK  ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+                       : p->mode[j] == CLIP ? excess
                                             : HUGE_VAL;
     }
     out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));

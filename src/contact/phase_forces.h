@@ -6,7 +6,15 @@
 
 #include "dynamics/body.h"
 
-enum { PD_PHASE_SLIDE, PD_PHASE_STICK };
+/* PD_PHASE_CLIP: a lone contact that sticks (slips slower than a slide
+ * starts) but whose sticking force would leave the friction cone: it starts
+ * to slip. Its force is the sticking force's direction of pull clipped to
+ * the cone's edge, mu fn along the tangent the sticking force pulls along,
+ * with fn holding the normal acceleration at zero, so the force is
+ * continuous where the phase began and the contact slips from rest at the
+ * rate the excess gives (contact_phase.c ends the phase where the sticking
+ * force is back inside the cone or the slip has become a slide). */
+enum { PD_PHASE_SLIDE, PD_PHASE_STICK, PD_PHASE_CLIP };
 
 /* One phase's contacts and what its force solve needs. In the body frame a
  * contact's response to a force is a constant 3 x 3 matrix, and a sticking
@@ -17,7 +25,8 @@ typedef struct {
     const pd_body *b;
     int nc;
     int v[2];          /* contact vertices */
-    int mode[2];       /* PD_PHASE_SLIDE or PD_PHASE_STICK */
+    int mode[2];       /* PD_PHASE_SLIDE, PD_PHASE_STICK or (one contact)
+                          PD_PHASE_CLIP */
     double mu, g;      /* SI */
     double drill[2];   /* a sticking contact of a phase that can spin about
                           the floor's normal (not a pivot): its drilling
@@ -34,7 +43,9 @@ typedef struct {
 
 /* What the forces of a state give: the com's acceleration (world), wdot
  * (body), and per contact its normal force, its margin inside the friction
- * cone (sticking: mu fn - |ft|; sliding: infinite) and its slip speed. */
+ * cone (sticking: mu fn - |ft|; clipped: how far the sticking force is
+ * outside it, |ft| - mu fn of the sticking solution; sliding: infinite) and
+ * its slip speed. */
 typedef struct {
     pd_vec3 acc, wdot;
     double fn[2], cone[2], slip[2];

@@ -268,7 +268,7 @@ static void test_start_modes(void)
         started++;
         for (int i = 0; i < nc; i++) {
             pd_vec3 ui = contact_speed(b, &s, contacts[i]);
-            if (p.mode[i] == PD_PHASE_STICK)
+            if (p.mode[i] != PD_PHASE_SLIDE) /* sticking, or clipped from rest */
                 moving += v3_norm(ui) > 1e-12 * V0; /* round-off of the projection */
             else
                 slow += !(hypot(ui.x, ui.y) > slip_min);
@@ -415,9 +415,11 @@ static double least_margin(const pd_phase *p, const pd_state *s)
     double mg = b->mass * G, V0 = sqrt(G * b->size), least = HUGE_VAL, floor_z = HUGE_VAL;
     for (int i = 0; i < p->nc; i++) {
         least = fmin(least, F.fn[i] / mg);
-        least = fmin(least, p->mode[i] == PD_PHASE_STICK
+        least = fmin(least, p->mode[i] != PD_PHASE_SLIDE
                                 ? F.cone[i] / mg
                                 : (F.slip[i] - PD_TOL_PHASE_SLIP_REL * V0) / V0);
+        if (p->mode[i] == PD_PHASE_CLIP) /* until its slip would start a slide */
+            least = fmin(least, (2.0 * PD_TOL_PHASE_SLIP_REL * V0 - F.slip[i]) / V0);
         floor_z = fmin(floor_z, s->x.z + quat_rotate(s->q, b->verts[p->v[i]]).z);
     }
     for (int i = 0; i < b->nverts; i++)
@@ -565,8 +567,74 @@ static void test_drilling_top(void)
     drop_teardown(&fx);
 }
 
+/* A lone vertex at rest whose sticking force would need more friction than
+ * the cone gives (the box released on a corner, friction 0.1) starts to
+ * slip: the phase starts clipped (before, it was refused, and such a
+ * contact went to microcollisions, thousands a millisecond for a small
+ * spinning part), its friction mu fn exactly, the contact held on the floor
+ * (no normal acceleration), the energy never rising beyond the integration
+ * error, and the phase ending before the slip passes the speed at which a
+ * slide starts (twice the end threshold). */
+static void test_slip_onset(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.1);
+    if (!b)
+        return;
+    /* Per part units: sqrt(g L) and m g L. */
+    double V0 = sqrt(G * b->size), mgL = b->mass * G * b->size;
+    test_rng rng = {53};
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    int clipped = 0, rises = 0, off_cone = 0, lifts = 0, fast = 0;
+    for (int k = 0; k < 300; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))), v3(0, 0, 0),
+                      v3(0, 0, 0)};
+        int contacts[8], nc = lowest_vertices(b, s.q, contacts);
+        if (nc != 1)
+            continue;
+        s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
+        pd_phase p;
+        if (!pd_contact_phase_start(&fx.model->settle, &sc, &s, contacts, 1, &p) ||
+            p.mode[0] != PD_PHASE_CLIP)
+            continue;
+        clipped++;
+        pd_phase_forces F;
+        if (pd_phase_forces_of(&p, &s, &F)) {
+            CHECK(0);
+            continue;
+        }
+        /* Its force on the cone's edge: the centre's horizontal
+         * acceleration is the friction's, mu fn / m. */
+        off_cone += fabs(hypot(F.acc.x, F.acc.y) - sc.mu * F.fn[0] / b->mass) >
+                    1e-12 * G * (1.0 + sc.mu);
+        /* The contact's normal acceleration: the centre's, plus the turn's
+         * (at rest, wdot x r alone). */
+        pd_vec3 rw = quat_rotate(s.q, b->verts[contacts[0]]);
+        lifts += fabs(F.acc.z + v3_cross(quat_rotate(s.q, F.wdot), rw).z) > 1e-12 * G;
+        double E0 = total_energy(b, G, &s), t;
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &p, &s, 0.5, &t) != PD_OK)
+            continue;
+        rises += total_energy(b, G, &s) > E0 + 1e-8 * mgL;
+        pd_vec3 u = contact_speed(b, &s, contacts[0]);
+        fast += hypot(u.x, u.y) > 2.0 * PD_TOL_PHASE_SLIP_REL * V0 * (1.0 + 1e-6);
+    }
+    CHECK(clipped >= 50);
+    CHECK_INT(off_cone, 0);
+    CHECK_INT(lifts, 0);
+    CHECK_INT(rises, 0);
+    CHECK_INT(fast, 0);
+    pd_note("contact_phase: %d of 300 corners at rest started slipping\n", clipped);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
+    test_slip_onset();
     test_drilling_top();
     test_event_location();
     test_specialised_forces();
