@@ -79,6 +79,33 @@
  * 3.0, 2.2, 2.2, 2.0), so they keep rkck, cheaper for their short phases. */
 #define PD_PHASE_SPIN_FAST 5.0
 
+/* A contact that starts to slide from rest (phase_forces.h,
+ * pd_phase_slide_from_rest) takes a direction in which its tangential
+ * acceleration stays along its slip: a zero of a cross product over the
+ * circle of directions, found by a sign change between neighbouring ones of
+ * this many, then narrowed to round-off. Why 36: times the normal force's
+ * denominator the cross product is a trigonometric polynomial of degree 2,
+ * with at most four zeros, so cells of 10 degrees miss only two zeros
+ * closer than that, where the slide's direction is ill-defined anyway (the
+ * phase is then refused, and microcollisions go on as before). Not a
+ * setting: every zero found is exact to round-off. */
+#define PD_PHASE_START_CELLS 36
+
+/* lands_first (contact_phase.c) judges a slide from rest by the first order
+ * of the other vertices' heights over the time the slide takes to reach a
+ * slide's speed; it is believed only where the part turns by less than this
+ * (rad) over that time. Why 1 radian: the first order of a height that a
+ * turn moves as sin(w t) is off by a sixth of it there and by more beyond,
+ * where a spinning part's corners bob up and down within the horizon (a
+ * 0.1 mm top on a corner turns thousands of radians over its slow slide's):
+ * believed there, lands_first refused the slide at every start and
+ * microcollisions carried the slip, 100,000 of them within seconds in 8 of
+ * 200 drops. Ordinary parts turn far less: against a build that believed
+ * it at any turn (and without the rest of the tops' changes), the cube,
+ * box and coin ended on the same pose in each of 2000 drops, the cap in
+ * 1986. */
+#define PD_PHASE_LANDS_TURN 1.0
+
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */
 
