@@ -628,6 +628,74 @@ static void test_slide_from_rest(void)
     drop_teardown(&fx);
 }
 
+/* A clipped contact (PD_PHASE_CLIP, the slip onset where the slide from rest
+ * finds no direction or cannot be judged): the box at rest on a corner,
+ * friction 0.1, its sticking force outside the cone, clipped: its friction
+ * mu fn exactly, the contact held on the floor (no normal acceleration), the
+ * sticking force's excess over the cone reported as its margin, the energy
+ * never rising beyond the integration error over its phase, and the phase
+ * ending before the slip passes the speed at which a slide starts (twice
+ * the end threshold). */
+static void test_clipped_slip(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.1);
+    if (!b)
+        return;
+    /* Per part units: sqrt(g L) and m g L. */
+    double V0 = sqrt(G * b->size), mgL = b->mass * G * b->size;
+    test_rng rng = {53};
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    int clipped = 0, rises = 0, off_cone = 0, lifts = 0, fast = 0;
+    for (int k = 0; k < 300; k++) {
+        double r[3][3];
+        rng_rotation(&rng, r);
+        pd_state s = {v3(0, 0, 0), quat_normalize(quat_from_matrix(CR(r))), v3(0, 0, 0),
+                      v3(0, 0, 0)};
+        int contacts[8], nc = lowest_vertices(b, s.q, contacts);
+        if (nc != 1)
+            continue;
+        s.x.z = -quat_rotate(s.q, b->verts[contacts[0]]).z;
+        pd_phase p;
+        pd_phase_forces F;
+        pd_phase_init(&p, b, G, sc.mu, &s, contacts, 1, 2.0 * PD_TOL_PHASE_SLIP_REL * V0);
+        if (pd_phase_forces_of(&p, &s, &F) || !(F.cone[0] < 0.0))
+            continue;
+        double outside = -F.cone[0];
+        p.mode[0] = PD_PHASE_CLIP;
+        clipped++;
+        if (pd_phase_forces_of(&p, &s, &F)) {
+            CHECK(0);
+            continue;
+        }
+        off_cone += fabs(F.cone[0] - outside) > 1e-12 * b->mass * G;
+        /* Its force on the cone's edge: the centre's horizontal
+         * acceleration is the friction's, mu fn / m. */
+        off_cone += fabs(hypot(F.acc.x, F.acc.y) - sc.mu * F.fn[0] / b->mass) >
+                    1e-12 * G * (1.0 + sc.mu);
+        /* The contact's normal acceleration: the centre's, plus the turn's
+         * (at rest, wdot x r alone). */
+        pd_vec3 rw = quat_rotate(s.q, b->verts[contacts[0]]);
+        lifts += fabs(F.acc.z + v3_cross(quat_rotate(s.q, F.wdot), rw).z) > 1e-12 * G;
+        double E0 = total_energy(b, G, &s), t;
+        if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &p, &s, 0.5, &t) != PD_OK)
+            continue;
+        rises += total_energy(b, G, &s) > E0 + 1e-8 * mgL;
+        pd_vec3 u = contact_speed(b, &s, contacts[0]);
+        fast += hypot(u.x, u.y) > 2.0 * PD_TOL_PHASE_SLIP_REL * V0 * (1.0 + 1e-6);
+    }
+    CHECK(clipped >= 50);
+    CHECK_INT(off_cone, 0);
+    CHECK_INT(lifts, 0);
+    CHECK_INT(rises, 0);
+    CHECK_INT(fast, 0);
+    pd_note("contact_phase: %d of 300 corners at rest clipped\n", clipped);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
 /* A lone vertex that sticks until its force reaches the cone goes on
  * sliding from rest within the same phase, so no sticking phase ends at its cone
  * (where one did, the next started just short of the crossing again: a
@@ -684,6 +752,7 @@ static void test_slip_onset_in_phase(void)
 
 void suite_contact_phase(void)
 {
+    test_clipped_slip();
     test_slip_onset_in_phase();
     test_drilling_top();
     test_event_location();
