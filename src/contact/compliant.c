@@ -44,7 +44,7 @@ void pd_compliant_from_law(const pd_compliant_law *law, const pd_body *b, double
                            pd_compliant *c)
 {
     c->law = *law;
-    c->h1 = tol_scale * PD_COMPLIANT_STEP / (c->law.omega * (1.0 + c->law.chi * c->law.s_peak));
+    c->h1 = tol_scale * c->law.step / c->law.omega;
     c->band = PD_COMPLIANT_BAND_REL * b->size;
     c->sweep_tol = tol_scale * PD_COMPLIANT_SWEEP_TOL;
 }
@@ -153,7 +153,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
     for (long step = 0;; step++) {
         up = quat_rotate_inv(s->q, v3(0, 0, 1));
         pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
-        int npush = 0, nbelow = 0, arriving = 0;
+        int npush = 0, nbelow = 0, arriving = 0, entering = 0;
         double deepest = 0.0, speed = 0.0, load = 0.0, elastic = 0.0;
         for (int j = 0; j < w->ncand; j++) {
             int i = w->cand[j];
@@ -164,6 +164,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 w->active[i] = 0;
                 if (uz < 0.0 && z < -2.0 * uz * h)
                     arriving = 1;
+                entering += uz < 0.0 && z < -uz * c->h1;
                 continue;
             }
             if (!w->active[i]) {
@@ -226,7 +227,11 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             break;
         }
 
-        h = c->h1 / sqrt(nbelow > 1 ? (double)nbelow : 1.0);
+        /* Counting the contacts that come below within the step: a face
+         * landing flat must not take its first step in contact at one
+         * contact's length. */
+        int n = nbelow + entering;
+        h = c->h1 / sqrt(n > 1 ? (double)n : 1.0);
         /* Gravity and the normal impulses. */
         pd_vec3 dv = v3(0, 0, -g * h), dw = v3(0, 0, 0);
         double pn_max = 0.0;
