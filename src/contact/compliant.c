@@ -283,7 +283,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
                     double cap = mu * w->pn[j];
                     if (px * px + py * py > cap * cap) {
-                        double fn = hypot(fx, fy), ax = fx / fn, ay = fy / fn;
+                        /* hypot only where the squares underflow: it
+                         * costs as much as the rest of the sweep. */
+                        double fn = sqrt(fx * fx + fy * fy);
+                        if (!(fn > 0.0))
+                            fn = hypot(fx, fy);
+                        double ax = fx / fn, ay = fy / fn;
                         double kaa = kxx * ax * ax + 2.0 * kxy * ax * ay + kyy * ay * ay;
                         double mag = fmin(cap, fn / kaa);
                         px = -mag * ax;
