@@ -91,18 +91,17 @@
 /* The step with one contact is the longest whose rebound from a flat
  * landing (the scaled law, pd_compliant_law_step) is within
  * PD_COMPLIANT_E_TOL of the law's restitution, wherever in a step the
- * contact starts; with n contacts below the floor it is shortened by
- * sqrt(n), since n springs of one contact's stiffness on a rigid body
+ * contact starts; with n contacts below the floor or coming below within
+ * the step it is shortened by sqrt(n), since n springs of one contact's stiffness on a rigid body
  * vibrate up to sqrt(n) times faster (the trace of their coupling).
  * Why 1e-3: a rebound off by a thousandth of the approach speed, either
  * sign by where the touch falls in the step (the error averaged over the
  * touch is a few 1e-6 at e = 0.3), is far below what a pose statistic
  * resolves (restitutions themselves are known to a few percent), and
  * halving the step moves no pose probability beyond sampling noise
- * (tests/unit/test_compliant.c). The error is second order in the step: at
- * e = 0.3 this is about 15 steps per contact duration (a fixed 40 gave
- * 1.5e-4), at e = 0.9 about 30 (14 gave 5e-3), at e = 0.1 the bound below
- * (95 gave 4e-7).
+ * (tests/unit/test_compliant.c). At e = 0.3 this is about 19 steps per
+ * contact duration (a fixed 40 gave 1.5e-4), at e = 0.9 about 29 (15 gave
+ * 5e-3), at e = 0.1 the bound below, 25 (98 gave 4e-7).
  * PD_COMPLIANT_STEP_MAX bounds the step by the law's fastest rate, its
  * oscillation 1 / omega and its damping rate at the deepest (omega chi
  * s_peak): the explicit step is unstable beyond about 2, and at 1 it keeps
@@ -110,8 +109,9 @@
  * turning. The touches tried are PD_COMPLIANT_STEP_PHASES evenly spread
  * over a step from its start (a touch at a step's start is the worst at
  * e = 0.3; between the touches tried the error varies smoothly), and a step is
- * sought at most PD_COMPLIANT_STEP_TRIES times (each try at least halves
- * an error that is second order in the step). */
+ * sought at most PD_COMPLIANT_STEP_TRIES times (each try shortens it by
+ * the square root of the error's excess, as for an error of second order,
+ * by at most half; the error falls at least as the step). */
 #define PD_COMPLIANT_E_TOL 1e-3
 #define PD_COMPLIANT_STEP_MAX 1.0
 #define PD_COMPLIANT_STEP_PHASES 16
