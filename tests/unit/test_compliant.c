@@ -609,7 +609,7 @@ static void test_rigid_limit_planar(void)
  * rebounds at e times the approach speed with no spin: within
  * PD_COMPLIANT_E_TOL at the model's step, the error the step is chosen for
  * on one contact (the step shortened by the square root of the contacts
- * coming below; measured 1.7e-4 on four, 2.4e-4 on two), which must shrink
+ * coming below; measured 1.3e-4 on four, 2.0e-4 on two), which must shrink
  * at least as fast as the step (converging; it is second order here). */
 static void test_flat_landings(void)
 {
