@@ -48,12 +48,17 @@ pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *ta
 /* The step of compliant.c's integration (semi-implicit Euler: the force
  * from the penetration and its rate at the step's start, then the position
  * from the new velocity) for the scaled law with damping ratio chi, in
- * scaled time: the longest that rebounds within PD_COMPLIANT_E_TOL of the
- * law's own restitution e, the worst of PD_COMPLIANT_STEP_PHASES touches
- * spread evenly over a step, and at most PD_COMPLIANT_STEP_MAX over the
- * law's fastest rate (1 + chi s_peak). PD_ERR_NO_CONVERGENCE if no step
- * meets it within PD_COMPLIANT_STEP_TRIES. */
+ * scaled time: the shortest at which, going up from steps far inside it,
+ * the rebound leaves PD_COMPLIANT_E_TOL of the law's own restitution e
+ * (the worst of PD_COMPLIANT_STEP_PHASES touches spread evenly over a
+ * step), found to PD_COMPLIANT_STEP_REL, and at most PD_COMPLIANT_STEP_MAX
+ * over the law's fastest rate (1 + chi s_peak). PD_ERR_NO_CONVERGENCE if
+ * even PD_COMPLIANT_STEP_TRIES halvings do not meet it. */
 pd_status pd_compliant_law_step(double chi, double e, double s_peak, double *step);
+
+/* 1 if the scaled step h rebounds within PD_COMPLIANT_E_TOL of e from
+ * every touch pd_compliant_law_step tries. */
+int pd_compliant_law_step_meets(double chi, double e, double h);
 
 /* The laws for the restitutions of a range [e_lo, e_hi], for runs whose
  * restitution each drop draws (a law costs ~0.7 ms, a drop of a small part

@@ -73,7 +73,7 @@
  * infinite (the contact never restores) and its duration with it. Why 0.01:
  * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
  * below what any pose statistic resolves, while chi stays at 100 and a
- * contact takes about 850 of compliant.c's steps. */
+ * contact takes about 210 of compliant.c's steps. */
 #define PD_COMPLIANT_E_MIN 0.01
 
 /* Relative accuracy of chi and tau: far below anything a drop resolves, and
@@ -99,23 +99,31 @@
  * touch is a few 1e-6 at e = 0.3), is far below what a pose statistic
  * resolves (restitutions themselves are known to a few percent), and
  * halving the step moves no pose probability beyond sampling noise
- * (tests/unit/test_compliant.c). At e = 0.3 this is about 19 steps per
- * contact duration (a fixed 40 gave 1.5e-4), at e = 0.9 about 29 (15 gave
- * 5e-3), at e = 0.1 the bound below, 25 (98 gave 4e-7).
+ * (tests/unit/test_compliant.c). At e = 0.3 this is about 16 steps per
+ * contact duration (a fixed 40 gave 1.5e-4), at e = 0.9 about 28 (15 gave
+ * 5e-3), at e = 0.1 the bound below, 25 (98 gave 4e-7), at e = 0.01 212
+ * (848).
  * PD_COMPLIANT_STEP_MAX bounds the step by the law's fastest rate, its
  * oscillation 1 / omega and its damping rate at the deepest (omega chi
  * s_peak): the explicit step is unstable beyond about 2, and at 1 it keeps
  * half of that in reserve for several contacts' coupling and the body's
  * turning. The touches tried are PD_COMPLIANT_STEP_PHASES evenly spread
  * over a step from its start (a touch at a step's start is the worst at
- * e = 0.3; between the touches tried the error varies smoothly), and a step is
- * sought at most PD_COMPLIANT_STEP_TRIES times (each try shortens it by
- * the square root of the error's excess, as for an error of second order,
- * by at most half; the error falls at least as the step). */
+ * e = 0.3; between the touches tried the error varies smoothly). The search
+ * starts PD_COMPLIANT_STEP_START times below the bound (the error there is
+ * about its square times smaller), halving while that misses (at most
+ * PD_COMPLIANT_STEP_TRIES times), doubles up to the first step that misses
+ * and bisects to PD_COMPLIANT_STEP_REL of the step: the step moves less than
+ * that with it, far less than the tolerance does. A step interpolated in a
+ * table of laws that misses the tolerance is shortened by
+ * PD_COMPLIANT_STEP_SHRINK at a time (a tenth: a few checks at most). */
 #define PD_COMPLIANT_E_TOL 1e-3
 #define PD_COMPLIANT_STEP_MAX 1.0
 #define PD_COMPLIANT_STEP_PHASES 16
+#define PD_COMPLIANT_STEP_START 64.0
 #define PD_COMPLIANT_STEP_TRIES 60
+#define PD_COMPLIANT_STEP_REL 1e-3
+#define PD_COMPLIANT_STEP_SHRINK 0.9
 
 /* Vertices within this times L above the floor are watched for contact, and
  * the list is rebuilt once the part may have moved half of it. Why 0.02: a

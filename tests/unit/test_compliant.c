@@ -457,15 +457,15 @@ static void touch_sweep(const model_fixture *fx, pd_compliant_work *w, const pd_
  * Random bodies at T = 1e-7 s (gravity over T, g T / v ~ 1e-7, is nothing):
  * frictionless, outgoing velocities within 1e-4 (the issue's bound) at an
  * eighth of the model's step, and within 1e-2 at the model's own step (the
- * explicit step's error, second order: measured up to 1.6e-3 falling to
- * 4e-5 at an eighth); sliding fast (20 to 100 mu times the approach speed),
+ * explicit step's error, second order: measured up to 1.5e-3 falling to
+ * 5e-5 at an eighth); sliding fast (20 to 100 mu times the approach speed),
  * within 1e-2 (measured up to 3e-3: the two laws' difference, up to 2.2e-3,
  * and the step's first-order error with friction). Frictionless, the
  * vertex's rebound is within PD_COMPLIANT_E_TOL of e wherever in a step
  * the touch falls (touch_sweep: the step is chosen on 16 touches, so a
  * touch between them may miss by a little more, 5% of the tolerance
  * allowed; measured up to 1.0 of it), and at half the step the worst falls
- * at least as the step (measured 1.9-fold: at e near 0.9 the error of a
+ * at least as the step (measured 2.5-fold: at e near 0.9 the error of a
  * touch at a step's start is first order, of those elsewhere in the step
  * second order, and their mean a few 1e-6); before the step was chosen for
  * it, a fixed fraction of the law's time scale, it was off by up to 5e-3 at
@@ -609,7 +609,7 @@ static void test_rigid_limit_planar(void)
  * rebounds at e times the approach speed with no spin: within
  * PD_COMPLIANT_E_TOL at the model's step, the error the step is chosen for
  * on one contact (the step shortened by the square root of the contacts
- * coming below; measured 1.3e-4 on four, 2.0e-4 on two), which must shrink
+ * coming below; measured 1.9e-4 on four, 2.6e-4 on two), which must shrink
  * at least as fast as the step (converging; it is second order here). */
 static void test_flat_landings(void)
 {
