@@ -89,11 +89,34 @@ void pd_compliant_work_free(pd_compliant_work *w)
     free(w);
 }
 
-/* The inverse mass of the body at r along unit directions a and c, all in
- * the body frame: a.c / m + (r x a) I^-1 (r x c). */
+/* The velocity at r2 along c per unit impulse at r1 along a (unit
+ * directions, all in the body frame): a.c / m + (r1 x a) I^-1 (r2 x c). */
+static double inv_mass2(const pd_body *b, pd_vec3 r1, pd_vec3 a, pd_vec3 r2, pd_vec3 c)
+{
+    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r1, a), pd_body_inv_inertia(b, v3_cross(r2, c)));
+}
+
+/* The inverse mass of the body at r along a and c. */
 static double inv_mass(const pd_body *b, pd_vec3 r, pd_vec3 a, pd_vec3 c)
 {
-    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r, a), pd_body_inv_inertia(b, v3_cross(r, c)));
+    return inv_mass2(b, r, a, r, c);
+}
+
+/* The square of the fastest normal vibration of two contacts i and j on
+ * the body, over one contact's (omega^2): the larger eigenvalue of
+ * K^1/2 A K^1/2, A their normal inverse masses coupled through the body and
+ * K their stiffnesses (a contact not yet touching: the one it will get).
+ * At most 2 (the trace bound), 1 + |coupling| when both are as stiff as
+ * their touch made them. */
+static double pair_mode(const pd_compliant_work *w, const pd_body *b, pd_vec3 up, double omega2,
+                        int i, int j)
+{
+    pd_vec3 ri = b->verts[i], rj = b->verts[j];
+    double aii = inv_mass(b, ri, up, up), ajj = inv_mass(b, rj, up, up);
+    double aij = inv_mass2(b, ri, up, rj, up);
+    double ki = w->active[i] ? w->k[i] : omega2 / aii, kj = w->active[j] ? w->k[j] : omega2 / ajj;
+    double p = ki * aii, q = kj * ajj, half = 0.5 * (p - q);
+    return (0.5 * (p + q) + sqrt(half * half + ki * kj * aij * aij)) / omega2;
 }
 
 static void rebuild_candidates(const pd_compliant *c, pd_compliant_work *w, const pd_body *b,
@@ -153,7 +176,7 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
     for (long step = 0;; step++) {
         up = quat_rotate_inv(s->q, v3(0, 0, 1));
         pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
-        int npush = 0, nbelow = 0, arriving = 0, entering = 0;
+        int npush = 0, nbelow = 0, arriving = 0, entering = 0, pair[2] = {-1, -1};
         double deepest = 0.0, speed = 0.0, load = 0.0, elastic = 0.0;
         for (int j = 0; j < w->ncand; j++) {
             int i = w->cand[j];
@@ -164,7 +187,11 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 w->active[i] = 0;
                 if (uz < 0.0 && z < -2.0 * uz * h)
                     arriving = 1;
-                entering += uz < 0.0 && z < -uz * c->h1;
+                if (uz < 0.0 && z < -uz * c->h1) {
+                    if (nbelow + entering < 2)
+                        pair[nbelow + entering] = i;
+                    entering++;
+                }
                 continue;
             }
             if (!w->active[i]) {
@@ -177,6 +204,8 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 last_touch = t;
             }
             double d = -z;
+            if (nbelow + entering < 2)
+                pair[nbelow + entering] = i;
             nbelow++;
             deepest = fmax(deepest, d);
             speed = fmax(speed, fabs(uz));
@@ -229,9 +258,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
 
         /* Counting the contacts that come below within the step: a face
          * landing flat must not take its first step in contact at one
-         * contact's length. */
+         * contact's length. Two: their fastest mode exactly (a closed
+         * form; on a cube's edge about 1.14 times one contact's square
+         * against the bound's 2); more: the trace bound n. */
         int n = nbelow + entering;
-        h = c->h1 / sqrt(n > 1 ? (double)n : 1.0);
+        double stiff = n == 2 ? pair_mode(w, b, up, omega2, pair[0], pair[1]) : (double)n;
+        h = c->h1 / sqrt(stiff > 1.0 ? stiff : 1.0);
         /* Gravity and the normal impulses. */
         pd_vec3 dv = v3(0, 0, -g * h), dw = v3(0, 0, 0);
         double pn_max = 0.0;

@@ -92,8 +92,10 @@
  * landing (the scaled law, pd_compliant_law_step) is within
  * PD_COMPLIANT_E_TOL of the law's restitution, wherever in a step the
  * contact starts; with n contacts below the floor or coming below within
- * the step it is shortened by sqrt(n), since n springs of one contact's stiffness on a rigid body
- * vibrate up to sqrt(n) times faster (the trace of their coupling).
+ * the step it is shortened by sqrt(n), since n springs of one contact's
+ * stiffness on a rigid body vibrate up to sqrt(n) times faster (the trace
+ * of their coupling), and with two by the square root of their fastest
+ * mode's stiffness over one contact's (exact, compliant.c's pair_mode).
  * Why 1e-3: a rebound off by a thousandth of the approach speed, either
  * sign by where the touch falls in the step (the error averaged over the
  * touch is a few 1e-6 at e = 0.3), is far below what a pose statistic

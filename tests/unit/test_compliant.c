@@ -609,7 +609,7 @@ static void test_rigid_limit_planar(void)
  * rebounds at e times the approach speed with no spin: within
  * PD_COMPLIANT_E_TOL at the model's step, the error the step is chosen for
  * on one contact (the step shortened by the square root of the contacts
- * coming below; measured 1.9e-4 on four, 2.6e-4 on two), which must shrink
+ * coming below, or of the two's fastest mode; measured 1.9e-4 on four, 3.5e-4 on two), which must shrink
  * at least as fast as the step (converging; it is second order here). */
 static void test_flat_landings(void)
 {
