@@ -12,15 +12,22 @@
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
- * phase_forces.c solves it). Sliding friction does negative work and
- * sticking contacts none, so the energy can only fall. Two sticking
+ * phase_forces.c solves it). A contact whose sticking force would leave
+ * the friction cone, at rest, slides from rest (pd_phase_slide_from_rest):
+ * its friction along the direction its slip then grows in, until the slip
+ * reaches the start threshold, and along its slip from there, in the same
+ * phase; unless another vertex is predicted to land first (lands_first).
+ * Sliding friction does negative work and sticking contacts none, so the
+ * energy can only fall. Two sticking
  * contacts are a rotation about their edge, integrated as one angle
  * (contact_pivot.c), the commonest phase of a part rolling on a rim. The
  * ODE is integrated by gsl_adapter's Cash-Karp pair (rkck) in units of the
  * part (length L, time sqrt(L/g)); the phase ends, handing the state back
  * to the microcollisions, just before any of:
  *  - a normal force reaching zero (a contact lifts off),
- *  - a sliding contact's slip falling below PD_TOL_PHASE_SLIP_REL sqrt(g L),
+ *  - a sliding contact's slip falling below PD_TOL_PHASE_SLIP_REL sqrt(g L)
+ *    (one sliding from rest: reaching twice that ends nothing, its friction
+ *    turns to its slip),
  *  - a sticking contact's force leaving the friction cone (it starts to slip),
  *  - another vertex reaching the floor (an impact),
  *  - the system becoming singular (as in Painleve's paradox),
@@ -191,7 +198,9 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
         g[k] = HUGE_VAL;
     for (int i = 0; i < p->nc; i++) {
         g[i] = F->fn[i] / mg;
-        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg : (F->slip[i] - slip_min) / V0;
+        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg
+                   : p->from_rest[i]                ? (2.0 * slip_min - F->slip[i]) / V0
+                                                    : (F->slip[i] - slip_min) / V0;
     }
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     *up_out = up;
@@ -474,6 +483,39 @@ static void phase_of(pd_phase *p, const pd_settle *st, const pd_scene *sc, const
             p->drill[i] = wn > 0.0 ? k : wn < 0.0 ? -k : 0.0;
 }
 
+/* 1 if a vertex other than the contacts of phase p at s, coming down at its
+ * present rate (height_jet's first order), lands within time dt (s). Then
+ * a contact sliding from rest would hand over to microcollisions before its
+ * slip reached the start threshold (a part rolling over a rim of close
+ * vertices, parts/cap.off, does nearly every time), leaving a small slip
+ * that makes the landing's microcollision a slow sliding integration where,
+ * stuck, it would have been cheap. First order, not second: the second's
+ * term is mostly the part toppling from rest, which speeds its slip too,
+ * so it refused slides that reached the threshold first more often than not
+ * (docs/performance.md). */
+static int lands_first(const pd_phase *p, const pd_state *s, double slip_min, double dt)
+{
+    const pd_body *b = p->b;
+    motion mo = motion_of(p);
+    double y[NY], tau = dt / p->T;
+    point a;
+    to_y(&mo, s, y);
+    point_at(&mo, slip_min, 0.0, y, &a);
+    if (!(a.least > -1.0))
+        return 0;
+    for (int i = 0; i < p->nc; i++)
+        for (int k = b->adj_start[p->v[i]]; k < b->adj_start[p->v[i] + 1]; k++) {
+            int w = b->adj[k];
+            if (is_contact(p, w))
+                continue;
+            double j[3];
+            height_jet(p, &a, w, j);
+            if (j[0] + j[1] * tau <= 0.0)
+                return 1;
+        }
+    return 0;
+}
+
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase)
 {
@@ -539,7 +581,19 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
     } else if (pd_phase_forces_of(&p, &t, &F)) {
         return 0;
     }
-    if (!(margins(&p, &t, &F, slip_min, g, &floor_v, &up) > 0.0))
+    double least = margins(&p, &t, &F, slip_min, g, &floor_v, &up), accel;
+    if (!(least > 0.0) && !pivot && F.cone[0] <= 0.0 && pd_phase_slide_from_rest(&p, &t, &accel)) {
+        /* One contact that cannot stick: it slides from rest, and the
+         * phase follows it (microcollisions would stop its slip at each
+         * one, every rest step, until it slipped faster than friction
+         * can stop in one), unless another vertex lands first. */
+        if (pd_phase_forces_of(&p, &t, &F))
+            return 0;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+        if (least > 0.0 && lands_first(&p, &t, slip_min, 2.0 * slip_min / accel))
+            return 0;
+    }
+    if (!(least > 0.0))
         return 0;
     /* The phase goes on with the modes the projection was for: taken
      * afresh from t, a contact that slid above the start threshold and
@@ -548,6 +602,23 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
     *s = t;
     *phase = p;
     return 1;
+}
+
+/* Where the phase would end at a: a contact sliding from rest whose slip
+ * has reached the start threshold (its margin the least) slides on as any
+ * other, its friction along its own slip from here, and a is evaluated
+ * again for that. 1 if the phase goes on. */
+static int slides_on(const motion *mo, pd_phase *p, double slip_min, point *a)
+{
+    for (int i = 0; i < p->nc; i++)
+        if (p->from_rest[i] && a->g[2 + i] <= a->least) {
+            double y[NY];
+            memcpy(y, a->y, sizeof y);
+            p->from_rest[i] = 0;
+            point_at(mo, slip_min, a->tau, y, a);
+            return a->least > 0.0;
+        }
+    return 0;
 }
 
 pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_ode,
@@ -620,8 +691,11 @@ pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_o
                                 : predicted_event(&p, prev, cur,
                                                   fmin(ahead_steps * h,
                                                        ahead_intervals * (cur->tau - prev->tau)));
-            if (dt <= tol)
-                break;
+            if (dt <= tol) {
+                if (!slides_on(&mo, &p, slip_min, cur))
+                    break;
+                continue;
+            }
             if (isfinite(dt)) {
                 target = cur->tau + dt - 0.5 * tol;
                 h = target - cur->tau;
@@ -647,8 +721,12 @@ pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_o
             bracket = 1;
             dt = time_to_event(&mo, slip_min, cur, end);
         }
-        if (dt <= tol)
-            break;
+        if (dt <= tol) {
+            if (!slides_on(&mo, &p, slip_min, cur))
+                break;
+            bracket = 0, target = INFINITY;
+            continue;
+        }
         target = cur->tau + (modelled ? dt - 0.5 * tol : dt);
         h = target - cur->tau;
     }

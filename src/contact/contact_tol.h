@@ -66,6 +66,18 @@
  * microcollisions go on, so nothing is lost but time. */
 #define PD_PHASE_MAX_STEPS 10000
 
+/* A contact that starts to slide from rest (phase_forces.h,
+ * pd_phase_slide_from_rest) takes a direction in which its tangential
+ * acceleration stays along its slip: a zero of a cross product over the
+ * circle of directions, found by a sign change between neighbouring ones of
+ * this many, then narrowed to round-off. Why 36: times the normal force's
+ * denominator the cross product is a trigonometric polynomial of degree 2,
+ * with at most four zeros, so cells of 10 degrees miss only two zeros
+ * closer than that, where the slide's direction is ill-defined anyway (the
+ * phase is then refused, and microcollisions go on as before). Not a
+ * setting: every zero found is exact to round-off. */
+#define PD_PHASE_START_CELLS 36
+
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */
 

@@ -251,6 +251,21 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     pd_phase_map(p);
 }
 
+/* mu times the world direction of sliding contact j's slip, from its
+ * velocity vel (world) of tangential speed sl, or its start direction while
+ * it slides from rest; 0 where it has no direction. */
+static int friction_dir(const pd_phase *p, int j, pd_vec3 vel, double sl, double *cx, double *cy)
+{
+    if (p->from_rest[j]) {
+        *cx = p->mu * p->t0[j].x, *cy = p->mu * p->t0[j].y;
+        return 1;
+    }
+    if (!(sl > 0.0))
+        return 0;
+    *cx = p->mu * vel.x / sl, *cy = p->mu * vel.y / sl;
+    return 1;
+}
+
 /* One sliding contact, the commonest phase (314 of the coin's 334
  * median-band phases), written out: the force is lambda d, d = n - mu s the
  * sliding direction (body frame), lambda from the one row n . (a_free +
@@ -263,11 +278,10 @@ static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s,
     const pd_body *b = p->b;
     pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), w = s->w;
     pd_vec3 wr, vel = contact_velocity(p, R, s, 0, &wr);
-    double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
-    if (!(sl > 0.0))
+    double sl = sqrt(vel.x * vel.x + vel.y * vel.y), cx, cy;
+    if (!friction_dir(p, 0, vel, sl, &cx, &cy))
         return 1;
     pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
-    double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
     pd_vec3 d = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
                    up.z - cx * R[0][2] - cy * R[1][2]);
     double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d));
@@ -306,11 +320,11 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         af[j] = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[j]), v3_cross(w, wr)));
         dir[j] = up;
         if (p->mode[j] == SLIDE) {
-            if (!(sl > 0.0))
-                return 1;
             /* R^T (-mu s_x, -mu s_y, 1): rows 0 and 1 of R are the world's
              * x and y axes in the body frame. */
-            double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+            double cx, cy;
+            if (!friction_dir(p, j, vel, sl, &cx, &cy))
+                return 1;
             dir[j] = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
                         up.z - cx * R[0][2] - cy * R[1][2]);
         }
@@ -394,6 +408,104 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
     }
     out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));
     return 0;
+}
+
+/* Sliding along the world's horizontal unit direction t = (c, s), contact
+ * 0's normal force is A / k and k times its tangential acceleration (world)
+ * is affine in (c, s): k a_x = p0 + p1 c + p2 s, k a_y = q0 + q1 c + q2 s
+ * (pd_phase_slide_from_rest). Of that, k times the cross product t x a, a
+ * quadratic form in (c, s), and k itself. */
+typedef struct {
+    double k0, k1, k2, p0, p1, p2, q0, q1, q2;
+} slide_form;
+
+static double form_cross(const slide_form *f, double c, double s)
+{
+    return c * (f->q0 + f->q1 * c + f->q2 * s) - s * (f->p0 + f->p1 * c + f->p2 * s);
+}
+
+int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
+{
+    if (p->nc != 1 || p->mode[0] != STICK || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    const pd_body *b = p->b;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), X = v3(R[0][0], R[0][1], R[0][2]);
+    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), w = s->w, wr = v3_cross(w, p->r[0]);
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
+    pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
+    /* The force is lambda d, d = n - mu t (body frame: up - mu (c X + s Y)),
+     * so M d = m0 - mu (c mx + s my), k = up . M d, lambda = A / k with
+     * A = -up . af, and k a = k af + A M d. */
+    double A = -v3_dot(up, af), mu = p->mu;
+    if (!(A > 0.0))
+        return 0; /* nothing presses the contact onto the floor */
+    const double(*M)[3] = CONST_M3(p->M[0][0]);
+    pd_vec3 m0 = m3_vec(M, up), mx = m3_vec(M, X), my = m3_vec(M, Y);
+    double xa = v3_dot(X, af), ya = v3_dot(Y, af);
+    slide_form f = {v3_dot(up, m0), -mu * v3_dot(up, mx), -mu * v3_dot(up, my), 0, 0, 0, 0, 0, 0};
+    f.p0 = f.k0 * xa + A * v3_dot(X, m0);
+    f.p1 = f.k1 * xa - A * mu * v3_dot(X, mx);
+    f.p2 = f.k2 * xa - A * mu * v3_dot(X, my);
+    f.q0 = f.k0 * ya + A * v3_dot(Y, m0);
+    f.q1 = f.k1 * ya - A * mu * v3_dot(Y, mx);
+    f.q2 = f.k2 * ya - A * mu * v3_dot(Y, my);
+    /* The directions the slip keeps are the zeros of t x a with k > 0;
+     * those it grows along (t . a > 0) are the ones a slide from rest can
+     * take. Bracketed between neighbours of PD_PHASE_START_CELLS directions
+     * round the circle (turned by one rotation each, no trigonometry), each
+     * then narrowed to round-off. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
+    double best = 0.0, bc = 0.0, bs = 0.0, c0 = 1.0, s0 = 0.0, f0 = form_cross(&f, c0, s0);
+    for (int k = 1; k <= PD_PHASE_START_CELLS; k++) {
+        double c1 = k == PD_PHASE_START_CELLS ? 1.0 : c0 * cd - s0 * sd;
+        double s1 = k == PD_PHASE_START_CELLS ? 0.0 : s0 * cd + c0 * sd, f1 = form_cross(&f, c1, s1);
+        if ((f0 <= 0.0) != (f1 <= 0.0)) {
+            /* Regula falsi along the chord, projected onto the circle
+             * (the Illinois variant, which halves the retained end's value
+             * when the same end moves twice), to round-off. */
+            double lc = c0, ls = s0, flo = f0, hc = c1, hs = s1, fhi = f1;
+            int side = 0;
+            for (int i = 0; i < 60; i++) {
+                double u = flo / (flo - fhi);
+                double mc = lc + u * (hc - lc), ms = ls + u * (hs - ls), n = sqrt(mc * mc + ms * ms);
+                mc /= n, ms /= n;
+                if ((mc == lc && ms == ls) || (mc == hc && ms == hs))
+                    break;
+                double fm = form_cross(&f, mc, ms);
+                if (fm == 0.0) {
+                    lc = mc, ls = ms;
+                    break;
+                }
+                if ((fm <= 0.0) == (flo <= 0.0)) {
+                    lc = mc, ls = ms, flo = fm;
+                    if (side == -1)
+                        fhi *= 0.5;
+                    side = -1;
+                } else {
+                    hc = mc, hs = ms, fhi = fm;
+                    if (side == 1)
+                        flo *= 0.5;
+                    side = 1;
+                }
+            }
+            double kk = f.k0 + f.k1 * lc + f.k2 * ls;
+            double along = (lc * (f.p0 + f.p1 * lc + f.p2 * ls) + ls * (f.q0 + f.q1 * lc + f.q2 * ls)) / kk;
+            if (kk > 0.0 && along > best)
+                best = along, bc = lc, bs = ls;
+        }
+        c0 = c1, s0 = s1, f0 = f1;
+    }
+    if (!(best > 0.0))
+        return 0;
+    p->mode[0] = SLIDE;
+    p->from_rest[0] = 1;
+    p->t0[0] = v3(bc, bs, 0.0);
+    p->drill[0] = 0.0; /* a sliding contact's friction goes to its slip */
+    *accel = best;
+    return 1;
 }
 
 int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out)

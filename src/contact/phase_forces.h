@@ -24,6 +24,10 @@ typedef struct {
                           friction's couple per unit normal force,
                           (2/3) mu a (m), signed as the spin at the phase's
                           start; 0: none (pd_phase_modes sets none) */
+    int from_rest[2];  /* a sliding contact that started from rest: its
+                          friction's direction is t0, not its slip's, until it
+                          slips (pd_phase_slide_from_rest) */
+    pd_vec3 t0[2];     /* ...that direction, world, unit, horizontal */
     double L, T;       /* units: length, time */
     pd_vec3 r[2];      /* contact vertices, body frame */
     double M[2][2][3][3]; /* M[i][j] f: acceleration of contact i by force f at j */
@@ -52,6 +56,15 @@ void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd
 void pd_phase_map(pd_phase *p);
 void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
                    const int *contacts, int nc, double slip_start);
+
+/* A single sticking contact whose force leaves the friction cone starts to
+ * slide from rest, in a direction t0 in which it then accelerates: sliding
+ * friction -mu fn t0 leaves the contact's tangential acceleration along +t0.
+ * Sets contact 0 of p (mapped, one contact) sliding from rest along the
+ * direction of that kind it accelerates fastest in, its slip's acceleration
+ * along it into *accel (m/s^2), and returns 1; 0 (p unchanged) if there is
+ * none (sticking holds, or no direction gives a positive normal force). */
+int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
 /* The forces of state s (SI). 0, or 1 where the model does not hold (a
  * sliding contact with no slip to give friction a direction, a singular

@@ -231,8 +231,9 @@ static pd_vec3 contact_speed(const pd_body *b, const pd_state *s, int v)
 }
 
 /* A start near the slip threshold: the phase's modes are those its start
- * projected for, so every sticking contact starts at rest and every sliding
- * one above the end threshold, and the energy never rises in the phase. The
+ * projected for, so every sticking contact starts at rest, and every sliding
+ * one above the end threshold or, sliding from rest where it cannot stick,
+ * at rest; the energy never rises in the phase. The
  * box on a vertex or an edge, at random or on an edge at a random tilt
  * (where the other end of the edge moves normally), its velocities scaled so that the
  * first contact slips at 0.5-4 times the end threshold, where the start's
@@ -248,7 +249,7 @@ static void test_start_modes(void)
     double slip_min = PD_TOL_PHASE_SLIP_REL * V0;
     pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
     test_rng rng = {97};
-    int started = 0, moving = 0, slow = 0;
+    int started = 0, moving = 0, slow = 0, from_rest = 0;
     double worst = -HUGE_VAL; /* the largest energy rise, per m g L */
     for (int k = 0; k < 2000; k++) {
         pd_state s;
@@ -268,10 +269,11 @@ static void test_start_modes(void)
         started++;
         for (int i = 0; i < nc; i++) {
             pd_vec3 ui = contact_speed(b, &s, contacts[i]);
-            if (p.mode[i] == PD_PHASE_STICK)
+            if (p.mode[i] == PD_PHASE_STICK || p.from_rest[i])
                 moving += v3_norm(ui) > 1e-12 * V0; /* round-off of the projection */
             else
                 slow += !(hypot(ui.x, ui.y) > slip_min);
+            from_rest += p.from_rest[i];
         }
         double E0 = total_energy(b, G, &s), t;
         if (pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &p, &s, 0.5, &t) == PD_OK)
@@ -284,8 +286,9 @@ static void test_start_modes(void)
      * error: measured 1.2e-8 m g L (2e-4 when the phase took its modes
      * afresh from the projected state). */
     CHECK_NEAR(fmax(worst, 0.0), 0.0, 10.0 * PD_TOL_PHASE_ODE_REL, "ODE error over a phase");
-    pd_note("contact_phase: %d starts near the slip threshold, energy rising at most %.1e m g L\n",
-           started, worst);
+    pd_note("contact_phase: %d starts near the slip threshold (%d sliding from rest), energy rising "
+            "at most %.1e m g L\n",
+            started, from_rest, worst);
     pd_ode_free(pivot);
     pd_ode_free(ode);
     drop_teardown(&fx);
@@ -565,6 +568,66 @@ static void test_drilling_top(void)
     drop_teardown(&fx);
 }
 
+/* A 1 cm cube on one corner at rest, leaning (its centre of mass not above
+ * the corner) with too little friction to hold the corner, starts to slide
+ * from rest. Inertia isotropic (I = m a^2 / 6), so in the vertical plane of
+ * the corner's arm r from the centre (rho horizontal, -h vertical) the
+ * corner slides outward, along r's horizontal part, under the normal force
+ * lambda = g / (1/m + rho (rho - mu h) / I) and with acceleration
+ * lambda (h rho - mu (I/m + h^2)) / I, positive below mu* = h rho /
+ * (I/m + h^2). Above mu* the corner sticks: no slide. Microcollisions used
+ * to stop such a corner's slip at every rest step; the phase now takes it
+ * (pd_contact_phase_start refused it, its sticking force outside the cone),
+ * friction only taking energy. */
+static void test_slide_from_rest(void)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    drop_fixture fx;
+    if (!drop_setup(&fx, mesh_box(0.01, 0.01, 0.01), &sc))
+        return;
+    const pd_body *b = fx.model->body;
+    pd_quat q = quat_mul(quat_axis_angle(v3(1, 0, 0), 0.3), quat_onto_down(v3_unit(v3(1, 1, 1))));
+    int contacts[8], nc = lowest_vertices(b, q, contacts);
+    CHECK_INT(nc, 1);
+    pd_vec3 r = quat_rotate(q, b->verts[contacts[0]]);
+    pd_state s = {v3(0, 0, -r.z), q, v3(0, 0, 0), v3(0, 0, 0)};
+    double rho = hypot(r.x, r.y), h = -r.z, Im = b->moment[0] / b->mass;
+    double mu_star = h * rho / (Im + h * h), L = b->size;
+    double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * L);
+    for (int k = 0; k < 2; k++) {
+        double mu = (k ? 1.1 : 0.5) * mu_star, accel = 0.0;
+        pd_phase p;
+        pd_phase_init(&p, b, G, mu, &s, contacts, nc, slip_start);
+        CHECK_INT(p.mode[0], PD_PHASE_STICK);
+        int slides = pd_phase_slide_from_rest(&p, &s, &accel);
+        CHECK_INT(slides, !k);
+        if (!slides)
+            continue;
+        double lambda = G / (1.0 / b->mass + rho * (rho - mu * h) / b->moment[0]);
+        double a = lambda * (h * rho - mu * (Im + h * h)) / b->moment[0];
+        CHECK_REL(accel, a, 1e-12, "closed form; round-off of the narrowed zero");
+        CHECK_NEAR(p.t0[0].x - r.x / rho, 0.0, 1e-12, "outward along the arm, by symmetry");
+        CHECK_NEAR(p.t0[0].y - r.y / rho, 0.0, 1e-12, "outward along the arm, by symmetry");
+    }
+    /* The phase: admitted, and the corner slides outward, friction taking
+     * energy (to the phase's ODE error). */
+    sc.mu = 0.5 * mu_star;
+    pd_phase phase;
+    pd_state t = s;
+    CHECK(pd_contact_phase_start(&fx.model->settle, &sc, &t, contacts, nc, &phase));
+    double E0 = total_energy(b, G, &t), dt = 0.0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &t, 1.0, &dt), PD_OK);
+    CHECK(dt > 0.0);
+    pd_vec3 c0 = v3_add(s.x, r), c1 = v3_add(t.x, quat_rotate(t.q, b->verts[contacts[0]]));
+    CHECK(v3_dot(v3_sub(c1, c0), v3(r.x, r.y, 0.0)) > 0.0);
+    CHECK(total_energy(b, G, &t) <= E0 + 1e-8 * b->mass * G * L);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
 void suite_contact_phase(void)
 {
     test_drilling_top();
@@ -575,4 +638,5 @@ void suite_contact_phase(void)
     test_random_phases();
     test_reference_agreement();
     test_start_modes();
+    test_slide_from_rest();
 }
