@@ -100,17 +100,17 @@
 /* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
 #define PD_COMPLIANT_LAW_MAX_HALVINGS 200
 
-/* The step with one contact is the longest whose rebound from a flat
- * landing (the scaled law, pd_compliant_law_step) is within
+/* The step with one contact is, going up from short steps, the last whose
+ * rebound from a flat landing (the scaled law, pd_compliant_law_step) is within
  * PD_COMPLIANT_E_TOL of the law's restitution, wherever in a step the
  * contact starts; with n contacts below the floor or coming below within
  * the step it is shortened by sqrt(n), since n springs of one contact's
  * stiffness on a rigid body vibrate up to sqrt(n) times faster (the trace
  * of their coupling), and with two by the square root of their fastest
- * mode's stiffness over one contact's (exact, compliant.c's pair_mode).
- * Why 1e-3: a rebound off by a thousandth of the approach speed, either
- * sign by where the touch falls in the step (the error averaged over the
- * touch is a few 1e-6 at e = 0.3), is far below what a pose statistic
+ * mode's stiffness over one contact's (exact, compliant.c's pair_mode). Why
+ * 1e-3: a rebound off by a thousandth of the approach speed, either sign by
+ * where the touch falls in the step (the error averaged over the touch is
+ * under 1e-6 at e = 0.3, 0.6, 0.9), is far below what a pose statistic
  * resolves (restitutions themselves are known to a few percent), and
  * halving the step moves no pose probability beyond sampling noise
  * (tests/unit/test_compliant.c). At e = 0.3 this is about 16 steps per
@@ -127,9 +127,9 @@
  * starts PD_COMPLIANT_STEP_START times below the bound (the error there is
  * about its square times smaller), halving while that misses (at most
  * PD_COMPLIANT_STEP_TRIES times), doubles up to the first step that misses
- * and bisects to PD_COMPLIANT_STEP_REL of the step: the step moves less than
- * that with it, far less than the tolerance does. A step interpolated in a
- * table of laws that misses the tolerance is shortened by
+ * and bisects to PD_COMPLIANT_STEP_REL of the step: the step moves less
+ * than that with it, far less than the tolerance does. A step interpolated
+ * in a table of laws that misses the tolerance is shortened by
  * PD_COMPLIANT_STEP_SHRINK at a time (a tenth: a few checks at most). */
 #define PD_COMPLIANT_E_TOL 1e-3
 #define PD_COMPLIANT_STEP_MAX 1.0

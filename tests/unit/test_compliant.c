@@ -467,7 +467,7 @@ static void touch_sweep(const model_fixture *fx, pd_compliant_work *w, const pd_
  * allowed; measured up to 1.0 of it), and at half the step the worst falls
  * at least as the step (measured 2.5-fold: at e near 0.9 the error of a
  * touch at a step's start is first order, of those elsewhere in the step
- * second order, and their mean a few 1e-6); before the step was chosen for
+ * second order, and their mean under 1e-6); before the step was chosen for
  * it, a fixed fraction of the law's time scale, it was off by up to 5e-3 at
  * e = 0.9. The drop loop itself resolves a lone vertex by the rigid law. */
 static void test_rigid_limit(void)
