@@ -19,6 +19,8 @@ struct pd_compliant_work {
     double *pn;             /* normal impulse */
     double *ptx, *pty;      /* tangential impulses, accumulated over sweeps */
     double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
+    pd_vec3 *armx, *army;   /* r x ex, r x ey: the slip along ex is v.x + w.(r x ex) */
+    pd_vec3 *turnx, *turny; /* I^-1 (r x ex), I^-1 (r x ey): the turn per unit impulse */
     int hint;
     const pd_cancel_flag *cancel; /* may be NULL */
 };
@@ -65,8 +67,12 @@ pd_compliant_work *pd_compliant_work_alloc(const pd_body *b)
     w->ptx = malloc(n * sizeof *w->ptx);
     w->pty = malloc(n * sizeof *w->pty);
     w->kt = malloc(n * sizeof *w->kt);
+    w->armx = malloc(n * sizeof *w->armx);
+    w->army = malloc(n * sizeof *w->army);
+    w->turnx = malloc(n * sizeof *w->turnx);
+    w->turny = malloc(n * sizeof *w->turny);
     if (!w->cand || !w->active || !w->k || !w->lam || !w->push || !w->pn || !w->ptx ||
-        !w->pty || !w->kt) {
+        !w->pty || !w->kt || !w->armx || !w->army || !w->turnx || !w->turny) {
         pd_compliant_work_free(w);
         return NULL;
     }
@@ -86,7 +92,18 @@ void pd_compliant_work_free(pd_compliant_work *w)
     free(w->ptx);
     free(w->pty);
     free(w->kt);
+    free(w->armx);
+    free(w->army);
+    free(w->turnx);
+    free(w->turny);
     free(w);
+}
+
+/* The larger of a and b, both finite (fmax is a call where it must
+ * handle NaN). */
+static inline double max2(double a, double b)
+{
+    return a > b ? a : b;
 }
 
 /* The velocity at r2 along c per unit impulse at r1 along a (unit
@@ -174,8 +191,11 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
 
     double t = 0.0, last_touch = 0.0, moved = 0.0, h = c->h1;
     for (long step = 0;; step++) {
-        up = quat_rotate_inv(s->q, v3(0, 0, 1));
-        pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
+        /* The world's axes in the body frame: the rows of the rotation. */
+        double R[3][3];
+        quat_to_matrix(s->q, R);
+        up = v3(R[2][0], R[2][1], R[2][2]);
+        pd_vec3 ex = v3(R[0][0], R[0][1], R[0][2]), ey = v3(R[1][0], R[1][1], R[1][2]);
         int npush = 0, nbelow = 0, arriving = 0, entering = 0, pair[2] = {-1, -1};
         double deepest = 0.0, speed = 0.0, load = 0.0, elastic = 0.0;
         for (int j = 0; j < w->ncand; j++) {
@@ -207,9 +227,9 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             if (nbelow + entering < 2)
                 pair[nbelow + entering] = i;
             nbelow++;
-            deepest = fmax(deepest, d);
-            speed = fmax(speed, fabs(uz));
-            load = fmax(load, w->k[i] * d);
+            deepest = max2(deepest, d);
+            speed = max2(speed, fabs(uz));
+            load = max2(load, w->k[i] * d);
             elastic += 0.5 * w->k[i] * d * d;
             double f = w->k[i] * d * (1.0 + w->lam[i] * (-uz));
             if (f > 0.0) {
@@ -297,17 +317,20 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             for (int j = 0; j < npush; j++) {
                 pd_vec3 r_i = b->verts[w->push[j]];
                 w->ptx[j] = w->pty[j] = 0.0;
-                w->kt[j][0] = inv_mass(b, r_i, ex, ex);
-                w->kt[j][1] = inv_mass(b, r_i, ex, ey);
-                w->kt[j][2] = inv_mass(b, r_i, ey, ey);
+                w->armx[j] = v3_cross(r_i, ex);
+                w->army[j] = v3_cross(r_i, ey);
+                w->turnx[j] = pd_body_inv_inertia(b, w->armx[j]);
+                w->turny[j] = pd_body_inv_inertia(b, w->army[j]);
+                w->kt[j][0] = 1.0 / m + v3_dot(w->armx[j], w->turnx[j]);
+                w->kt[j][1] = v3_dot(w->armx[j], w->turny[j]);
+                w->kt[j][2] = 1.0 / m + v3_dot(w->army[j], w->turny[j]);
             }
             double stop = c->sweep_tol * mu * pn_max;
             for (int sweep = 0; sweep < PD_COMPLIANT_SWEEPS; sweep++) {
                 double change = 0.0;
                 for (int j = 0; j < npush; j++) {
-                    pd_vec3 r_i = b->verts[w->push[j]];
-                    pd_vec3 wr = v3_cross(s->w, r_i);
-                    double ux = s->v.x + v3_dot(wr, ex), uy = s->v.y + v3_dot(wr, ey);
+                    double ux = s->v.x + v3_dot(s->w, w->armx[j]);
+                    double uy = s->v.y + v3_dot(s->w, w->army[j]);
                     double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
                     double det = kxx * kyy - kxy * kxy;
                     double fx = ux - (kxx * w->ptx[j] + kxy * w->pty[j]);
@@ -331,9 +354,9 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     w->pty[j] = py;
                     s->v.x += ddx / m;
                     s->v.y += ddy / m;
-                    pd_vec3 pb = v3_add(v3_scale(ex, ddx), v3_scale(ey, ddy));
-                    s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(r_i, pb)));
-                    change = fmax(change, fmax(fabs(ddx), fabs(ddy)));
+                    s->w = v3_add(s->w, v3_add(v3_scale(w->turnx[j], ddx),
+                                               v3_scale(w->turny[j], ddy)));
+                    change = max2(change, max2(fabs(ddx), fabs(ddy)));
                 }
                 /* One contact: the slip without its own friction, which
                  * sets its impulse, does not depend on that impulse, so
