@@ -66,6 +66,19 @@
  * microcollisions go on, so nothing is lost but time. */
 #define PD_PHASE_MAX_STEPS 10000
 
+/* A phase starting with the part turning faster than this many radians per
+ * sqrt(L/g) is integrated by rk8pd rather than rkck (contact_phase.c). At
+ * the phase tolerance rkck's steps turn the part by about 0.2 rad, so from
+ * about 5 rad per sqrt(L/g) (where the first trial step, 0.05 sqrt(L/g),
+ * turns it 0.25 rad) its steps are set by the turn, not by the phase's
+ * events, and rk8pd's steps, about 4 times longer for twice the right-hand
+ * sides, cost half as much: a 0.1 mm cube spinning as a top on a vertex at
+ * 15 rad per sqrt(L/g) took 9.5-9.8 ms of CPU per simulated second with
+ * rkck and 4.8-5.3 ms with rk8pd. Ordinary drops' phases start below 3 (the
+ * cube, the 1 x 2 x 3 box, the coin and the cap, 300 drops each: at most
+ * 3.0, 2.2, 2.2, 2.0), so they keep rkck, cheaper for their short phases. */
+#define PD_PHASE_SPIN_FAST 5.0
+
 /* A contact that starts to slide from rest (phase_forces.h,
  * pd_phase_slide_from_rest) takes a direction in which its tangential
  * acceleration stays along its slip: a zero of a cross product over the
@@ -77,6 +90,21 @@
  * phase is then refused, and microcollisions go on as before). Not a
  * setting: every zero found is exact to round-off. */
 #define PD_PHASE_START_CELLS 36
+
+/* lands_first (contact_phase.c) judges a slide from rest by the first order
+ * of the other vertices' heights over the time the slide takes to reach a
+ * slide's speed; it is believed only where the part turns by less than this
+ * (rad) over that time. Why 1 radian: the first order of a height that a
+ * turn moves as sin(w t) is off by a sixth of it there and by more beyond,
+ * where a spinning part's corners bob up and down within the horizon (a
+ * 0.1 mm top on a corner turns thousands of radians over its slow slide's):
+ * believed there, lands_first refused the slide at every start and
+ * microcollisions carried the slip, 100,000 of them within seconds in 8 of
+ * 200 drops. Ordinary parts turn far less: against a build that believed
+ * it at any turn (and without the rest of the tops' changes), the cube,
+ * box and coin ended on the same pose in each of 2000 drops, the cap in
+ * 1986. */
+#define PD_PHASE_LANDS_TURN 1.0
 
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */

@@ -18,7 +18,7 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 
-enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
+enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK, CLIP = PD_PHASE_CLIP };
 
 /* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
  * n + m columns) and B's columns become X's, by Gaussian elimination with
@@ -184,9 +184,34 @@ static int solve_layout(const pd_phase *p, const layout *L, pd_vec3 up, int dril
     return 1;
 }
 
+/* No contact slides: the constrained rows are the body axes (a clipped
+ * contact's sticking force is solved first, then clipped). */
 static int all_stick(const pd_phase *p)
 {
-    return p->mode[0] == STICK && (p->nc == 1 || p->mode[1] == STICK);
+    return p->mode[0] != SLIDE && (p->nc == 1 || p->mode[1] != SLIDE);
+}
+
+/* A lone clipped contact (phase_forces.h): its sticking force fs (body
+ * frame) becomes lambda d, d = n + mu t the cone's edge along fs's
+ * tangential direction t, lambda holding the normal acceleration at zero
+ * with the drilling couple, -drill lambda n, turning the part as it does
+ * the sticking force; *excess: how far fs lies outside the cone. 1 where
+ * fs has no tangential direction. */
+static int clip_force(const pd_phase *p, pd_vec3 up, pd_vec3 af, pd_vec3 *f, double *excess)
+{
+    double fn = v3_dot(*f, up);
+    pd_vec3 ft = v3_sub(*f, v3_scale(up, fn));
+    double t = v3_norm(ft);
+    if (!(t > 0.0))
+        return 1;
+    *excess = t - p->mu * fn;
+    pd_vec3 d = v3_add(up, v3_scale(ft, p->mu / t));
+    pd_vec3 u = v3_cross(pd_body_inv_inertia(p->b, up), p->r[0]);
+    double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d)) - p->drill[0] * v3_dot(up, u);
+    if (!(fabs(k) > 0.0))
+        return 1;
+    *f = v3_scale(d, -v3_dot(up, af) / k);
+    return 0;
 }
 
 /* The velocity of contact j of state s (world), R the body-to-world matrix;
@@ -266,6 +291,23 @@ static int friction_dir(const pd_phase *p, int j, pd_vec3 vel, double sl, double
     return 1;
 }
 
+/* Contact 0 of a lone contact sliding from rest, af its free acceleration
+ * (body frame): how far its sticking force would lie outside the friction
+ * cone, |ft| - mu fn of the sticking solution (P, set while it stuck). Where
+ * this is no longer positive the contact would stick again, and its slide
+ * from rest is over (contact_phase.c): a top precessing on a corner needs
+ * a little more friction than the cone gives for a moment of each turn,
+ * and slides with friction fixed along the start direction would go on
+ * past it, pushing the contact back along its slip. */
+static double stick_excess(const pd_phase *p, pd_vec3 up, pd_vec3 af)
+{
+    pd_vec3 f = v3(-(p->P[0][0] * af.x + p->P[0][1] * af.y + p->P[0][2] * af.z),
+                   -(p->P[1][0] * af.x + p->P[1][1] * af.y + p->P[1][2] * af.z),
+                   -(p->P[2][0] * af.x + p->P[2][1] * af.y + p->P[2][2] * af.z));
+    double fn = v3_dot(f, up);
+    return v3_norm(v3_sub(f, v3_scale(up, fn))) - p->mu * fn;
+}
+
 /* One sliding contact, the commonest phase (314 of the coin's 334
  * median-band phases), written out: the force is lambda d, d = n - mu s the
  * sliding direction (body frame), lambda from the one row n . (a_free +
@@ -291,7 +333,7 @@ static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s,
     out->wdot = v3_add(a0, pd_body_inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
     out->acc = v3(-cx * lm, -cy * lm, lm - p->g);
     out->fn[0] = lambda;
-    out->cone[0] = HUGE_VAL;
+    out->cone[0] = p->from_rest[0] ? stick_excess(p, up, af) : HUGE_VAL;
     out->slip[0] = sl;
     return 0;
 }
@@ -392,6 +434,9 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         for (int k = 0; k < L.n; k++)
             f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
     }
+    double excess = 0.0;
+    if (p->mode[0] == CLIP && clip_force(p, up, af[0], &f[0], &excess))
+        return 1;
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
     for (int j = 0; j < p->nc; j++)
@@ -404,6 +449,8 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         double fn = v3_dot(f[j], up);
         out->fn[j] = fn;
         out->cone[j] = p->mode[j] == STICK ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+                       : p->mode[j] == CLIP ? excess
+                       : p->from_rest[j]    ? stick_excess(p, up, af[j])
                                             : HUGE_VAL;
     }
     out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));

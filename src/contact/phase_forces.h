@@ -6,7 +6,19 @@
 
 #include "dynamics/body.h"
 
-enum { PD_PHASE_SLIDE, PD_PHASE_STICK };
+/* PD_PHASE_CLIP: a lone contact that sticks (slips slower than a slide
+ * starts) but whose sticking force lies just outside the friction cone,
+ * where pd_phase_slide_from_rest finds no direction (its two candidate
+ * directions merge as the excess vanishes, closer than its search
+ * resolves), or turning too fast for the slide to be judged
+ * (contact_phase.c): it starts to slip all the same. Its force is the sticking
+ * force's pull clipped to the cone's edge, mu fn along the tangent the
+ * sticking force pulls along, with fn holding the normal acceleration at
+ * zero, so the force is continuous where it began and the contact slips
+ * from rest at the rate the excess gives; the limit of the slide from rest
+ * as the excess vanishes (contact_phase.c ends it where the sticking force
+ * is back inside the cone or the slip has become a slide). */
+enum { PD_PHASE_SLIDE, PD_PHASE_STICK, PD_PHASE_CLIP };
 
 /* One phase's contacts and what its force solve needs. In the body frame a
  * contact's response to a force is a constant 3 x 3 matrix, and a sticking
@@ -17,7 +29,8 @@ typedef struct {
     const pd_body *b;
     int nc;
     int v[2];          /* contact vertices */
-    int mode[2];       /* PD_PHASE_SLIDE or PD_PHASE_STICK */
+    int mode[2];       /* PD_PHASE_SLIDE, PD_PHASE_STICK or (one contact)
+                          PD_PHASE_CLIP */
     double mu, g;      /* SI */
     double drill[2];   /* a sticking contact of a phase that can spin about
                           the floor's normal (not a pivot): its drilling
@@ -38,7 +51,10 @@ typedef struct {
 
 /* What the forces of a state give: the com's acceleration (world), wdot
  * (body), and per contact its normal force, its margin inside the friction
- * cone (sticking: mu fn - |ft|; sliding: infinite) and its slip speed. */
+ * cone (sticking: mu fn - |ft|; sliding from rest or clipped: how far its
+ * sticking force would lie outside the cone, |ft| - mu fn of the sticking
+ * solution, which the slip from rest lasts while it is positive; sliding:
+ * infinite) and its slip speed. */
 typedef struct {
     pd_vec3 acc, wdot;
     double fn[2], cone[2], slip[2];

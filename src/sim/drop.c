@@ -266,6 +266,11 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     /* The options as the drop runs them: an automatic time limit resolved
      * (the model's, for its part and scene). */
     pd_sim_options run = *o;
+    /* Under an automatic limit, the time a part spends spinning on one
+     * vertex under drilling friction (a top) is left out of it, up to the
+     * longest such spin its energy allows: that time is the drilling's,
+     * not the part's natural time, which the limit is made of. */
+    double top_left = run.time_limit > 0 ? 0.0 : m->top_time;
     if (!(run.time_limit > 0))
         run.time_limit = m->time_limit;
     o = &run;
@@ -423,10 +428,18 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if ((st = pd_contact_phase(&m->settle, w->phase, w->pivot, sc, &phase, &s,
-                                       o->time_limit - t, &dt)) != PD_OK) {
+            int top = phase.nc == 1 && phase.drill[0] != 0.0;
+            pd_ode *ode = pd_contact_phase_spins_fast(m->body, g, &s) ? w->phase_spin : w->phase;
+            if ((st = pd_contact_phase(&m->settle, ode, w->pivot, sc, &phase, &s,
+                                       o->time_limit - t + (top ? top_left : 0.0), &dt)) !=
+                PD_OK) {
                 pd_drop_failed(out, PD_STAGE_CONTACT_PHASE, st);
                 break;
+            }
+            if (top) {
+                double spun = fmin(dt, top_left);
+                top_left -= spun;
+                run.time_limit += spun;
             }
             t += dt;
             phase_ok = 0;

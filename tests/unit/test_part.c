@@ -178,8 +178,8 @@ static void test_orientation(void)
 /* parts/square_black_button.off with one top corner of its flange moved through
  * the part to y = -1 m (issue 22): a spike folded back through the body,
  * whose far side counts negatively. The static estimate took it, the drops
- * refused it ("principal moments -1.62e-09"); now the part build refuses it,
- * saying why, and with a given centre of mass both take it. */
+ * refused it; now the part build refuses it, saying why (docs/limits.md
+ * gives its moments), and with a given centre of mass both take it. */
 static void test_folded_through(void)
 {
     char *text = slurp("parts/square_black_button.off");
