@@ -129,7 +129,7 @@
  * infinite (the contact never restores) and its duration with it. Why 0.01:
  * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
  * below what any pose statistic resolves, while chi stays at 100 and a
- * contact takes about 850 of compliant.c's steps. */
+ * contact takes about 210 of compliant.c's steps. */
 #define PD_COMPLIANT_E_MIN 0.01
 
 /* Relative accuracy of chi and tau: far below anything a drop resolves, and
@@ -144,17 +144,44 @@
 /* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
 #define PD_COMPLIANT_LAW_MAX_HALVINGS 200
 
-/* The step, as a fraction of the fastest time scale of one contact: its
- * oscillation 1 / omega, shortened by the damping rate the law reaches at
- * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
- * floor, since n springs of one contact's stiffness on a rigid body vibrate
- * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
- * 40 steps per contact duration at e = 0.3 with one contact (850 at the
- * smallest e, 0.01); a flat landing's rebound then comes out within 4e-4 of
- * e, and halving it moves no pose probability beyond sampling noise
- * (tests/unit/test_compliant.c). Larger: the explicit step loses accuracy,
- * and stability beyond 2. */
-#define PD_COMPLIANT_STEP 0.25
+/* The step with one contact is, going up from short steps, the last whose
+ * rebound from a flat landing (the scaled law, pd_compliant_law_step) is within
+ * PD_COMPLIANT_E_TOL of the law's restitution, wherever in a step the
+ * contact starts; with n contacts below the floor or coming below within
+ * the step it is shortened by sqrt(n), since n springs of one contact's
+ * stiffness on a rigid body vibrate up to sqrt(n) times faster (the trace
+ * of their coupling), and with two by the square root of their fastest
+ * mode's stiffness over one contact's (exact, compliant.c's pair_mode). Why
+ * 1e-3: a rebound off by a thousandth of the approach speed, either sign by
+ * where the touch falls in the step (the error averaged over the touch is
+ * under 1e-6 at e = 0.3, 0.6, 0.9), is far below what a pose statistic
+ * resolves (restitutions themselves are known to a few percent), and
+ * halving the step moves no pose probability beyond sampling noise
+ * (tests/unit/test_compliant.c). At e = 0.3 this is about 16 steps per
+ * contact duration (a fixed 40 gave 1.5e-4), at e = 0.9 about 28 (15 gave
+ * 5e-3), at e = 0.1 the bound below, 25 (98 gave 4e-7), at e = 0.01 212
+ * (848).
+ * PD_COMPLIANT_STEP_MAX bounds the step by the law's fastest rate, its
+ * oscillation 1 / omega and its damping rate at the deepest (omega chi
+ * s_peak): the explicit step is unstable beyond about 2, and at 1 it keeps
+ * half of that in reserve for several contacts' coupling and the body's
+ * turning. The touches tried are PD_COMPLIANT_STEP_PHASES evenly spread
+ * over a step from its start (a touch at a step's start is the worst at
+ * e = 0.3; between the touches tried the error varies smoothly). The search
+ * starts PD_COMPLIANT_STEP_START times below the bound (the error there is
+ * about its square times smaller), halving while that misses (at most
+ * PD_COMPLIANT_STEP_TRIES times), doubles up to the first step that misses
+ * and bisects to PD_COMPLIANT_STEP_REL of the step: the step moves less
+ * than that with it, far less than the tolerance does. A step interpolated
+ * in a table of laws that misses the tolerance is shortened by
+ * PD_COMPLIANT_STEP_SHRINK at a time (a tenth: a few checks at most). */
+#define PD_COMPLIANT_E_TOL 1e-3
+#define PD_COMPLIANT_STEP_MAX 1.0
+#define PD_COMPLIANT_STEP_PHASES 16
+#define PD_COMPLIANT_STEP_START 64.0
+#define PD_COMPLIANT_STEP_TRIES 60
+#define PD_COMPLIANT_STEP_REL 1e-3
+#define PD_COMPLIANT_STEP_SHRINK 0.9
 
 /* Vertices within this times L above the floor are watched for contact, and
  * the list is rebuilt once the part may have moved half of it. Why 0.02: a
@@ -167,7 +194,7 @@
 /* Gauss-Seidel sweeps over the contacts' friction impulses per step, at
  * most, and the stop: no impulse moved by more than this times its cone's
  * radius in a sweep. Why 1e-6: the friction impulses are then converged far
- * below the step's own error (PD_COMPLIANT_STEP); sticking faces converge in
+ * below the step's own error (PD_COMPLIANT_E_TOL); sticking faces converge in
  * a few sweeps. 32 only stops a pathological coupling. */
 #define PD_COMPLIANT_SWEEPS 32
 #define PD_COMPLIANT_SWEEP_TOL 1e-6
