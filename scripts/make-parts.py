@@ -15,15 +15,18 @@ Usage:
   scripts/make-parts.py --set insulator_cap.H=14 change a dimension for this run
   scripts/make-parts.py --report        also print posedrop's QS per pose class
                                         against the paper's QS column
-  scripts/make-parts.py --fit [PART..] [--save]
+  scripts/make-parts.py --fit [PART..] [--save] [--min-tip DEG] [--pqs-weight W]
                                         search the FIT dimensions of each part
                                         (coarse grid, then Nelder-Mead) so that
                                         posedrop's grouped QS column matches the
-                                        paper's; prints the fitted DIMS and writes
-                                        the OFF files from them; --save also
-                                        writes them into DIMS below
+                                        paper's, no pose class tipping over at
+                                        less than DEG degrees (2); prints the
+                                        fitted DIMS and writes the OFF files
+                                        from them; --save also writes them into
+                                        DIMS below; W > 0 adds W times the
+                                        squared PQS residuals (0: QS only)
 
-Only the QS column is used for fitting (QS depends only on the hull and the
+By default only the QS column is fitted (QS depends only on the hull and the
 centre of mass); PQS and the dynamic columns stay out-of-sample predictions.
 Python 3 standard library only.  posedrop must be built (make all).
 """
@@ -73,6 +76,7 @@ DIMS = {
         "c": 5.965,     # 45-degree chamfer on the closed end's outer edge
         "w": 1.5,     # wall thickness (bore radius R - w)
         "tt": 2.0,    # thickness of the closed end
+        "n": 32,      # sides of the polygons standing for its circles
     },
     "white_button": {
         "R": 10.0,    # cap radius
@@ -80,28 +84,29 @@ DIMS = {
         "c": 1.0,     # chamfer on the cap's top edge
         "rs": 4.789,    # stem radius
         "hs": 7.816,    # stem length below the cap
+        "n": 32,      # sides of the polygons standing for its circles
     },
     "rect_black_button": {
         "a": 16.0,    # cap length (x)
-        "b": 10.347,     # cap width (y)
-        "hc": 8.743,    # cap height
+        "b": 10.587,     # cap width (y)
+        "hc": 8.956,    # cap height
         "sa": 6.0,    # stem length (x)
-        "sb": 4.0,    # stem width (y)
-        "hs": 2.241,    # stem height below the cap
+        "sb": 4.521,    # stem width (y)
+        "hs": 2.372,    # stem height below the cap
         "ta": 12.0,   # raised top (step) length (x)
-        "tb": 6.0,    # raised top width (y)
-        "ht": 1.19,    # raised top height
+        "tb": 6.884,    # raised top width (y)
+        "ht": 1.226,    # raised top height
     },
     "square_black_button": {
         "a": 12.0,    # cap side (x and y)
-        "k": 3.673,     # corner chamfer of the cap (octagonal outline)
-        "hc": 2.189,    # cap height
-        "sa": 5.5,    # stem length (x)
-        "sb": 3.2,    # stem width (y)
-        "hs": 3.617,    # stem height below the flange
-        "fa": 7.7,    # flange length (x) between stem and cap
-        "fb": 8.2,    # flange width (y)
-        "hf": 0.721,    # flange thickness
+        "k": 3.749,     # corner chamfer of the cap (octagonal outline)
+        "hc": 2.177,    # cap height
+        "sa": 3.014,    # stem length (x)
+        "sb": 2.0,    # stem width (y)
+        "hs": 3.787,    # stem height below the flange
+        "fa": 6.361,    # flange length (x) between stem and cap
+        "fb": 9.495,    # flange width (y)
+        "hf": 1.503,    # flange thickness
     },
 }
 
@@ -110,20 +115,32 @@ FIT = {
                       ("c", 0.2, 6.0)],
     "white_button": [("hc", 2.0, 14.0), ("rs", 1.5, 5.0), ("hs", 2.0, 16.0)],
     "rect_black_button": [("b", 5.0, 15.0), ("hc", 2.0, 10.0),
-                          ("hs", 2.0, 12.0), ("ht", 0.5, 4.0)],
+                          ("hs", 2.0, 12.0), ("ht", 0.5, 4.0),
+                          ("tb", 2.0, 9.0), ("sb", 2.0, 8.0)],
     "square_black_button": [("k", 0.5, 4.0), ("hc", 2.0, 10.0),
-                            ("hs", 2.0, 12.0), ("hf", 0.5, 4.0)],
+                            ("hs", 2.0, 12.0), ("hf", 0.5, 4.0),
+                            ("sa", 3.0, 7.0), ("sb", 2.0, 6.0),
+                            ("fa", 6.0, 10.0), ("fb", 6.0, 10.0)],
 }
+
+# Every pose the paper counts is a pose its real part rests in (Figure 2
+# photographs the rectangular button in all seven), so none may be a knife
+# edge: the fit penalises, TIP_WEIGHT per squared degree, each pose class
+# whose tip angle (the tilt that brings the centre of mass over an edge of
+# its support polygon) is below MIN_TIP degrees.  A QS-only fit without this
+# parks poses on knife edges, where a facet just stable collects the QS of
+# its neighbours but no dropped part can stay.
+MIN_TIP = 2.0
+TIP_WEIGHT = 100.0
 
 # Order of the proper rotations about z that map each shape onto itself: two
 # stable facets are one pose class when a rotation by a multiple of 2*pi/ORDER
 # maps one's normal onto the other's.
-NSEG = 32  # sides of the polygonal circles
 
 
 def order_of(name, d):
     if name in ("insulator_cap", "white_button"):
-        return NSEG
+        return int(d["n"])
     if name == "square_black_button" and abs(d["sa"] - d["sb"]) < 1e-12 \
             and abs(d["fa"] - d["fb"]) < 1e-12:
         return 4
@@ -137,7 +154,7 @@ def order_of(name, d):
 # triangles); an end ring that is not a pole is closed by one polygon.
 
 
-def circle(r, z, n=NSEG):
+def circle(r, z, n):
     if r == 0.0:
         return [(0.0, 0.0, z)] * n
     return [(r * math.cos(2 * math.pi * i / n), r * math.sin(2 * math.pi * i / n), z)
@@ -157,7 +174,7 @@ def octagon(sx, sy, k, z):
             (-hx, hy - k, z), (-hx, -hy + k, z), (-hx + k, -hy, z), (hx - k, -hy, z)]
 
 
-def revolve(profile, n=NSEG):
+def revolve(profile, n):
     """Rings of a solid of revolution from an (r, z) profile."""
     return [circle(r, z, n) for r, z in profile]
 
@@ -240,6 +257,13 @@ def inside_profile(outer, r, z, margin):
     return crossings % 2 == 1
 
 
+def sides(d):
+    n = d["n"]
+    if n != int(n) or n < 3:
+        raise ValueError("n: the number of sides must be a whole number >= 3")
+    return int(n)
+
+
 def build_insulator_cap(d):
     R, H, RL, t, c, w, tt = (d[k] for k in ("R", "H", "RL", "t", "c", "w", "tt"))
     if not (0 < c < R and RL > R and 0 < t < H - c and 0 < tt < H - 1.0
@@ -260,7 +284,7 @@ def build_insulator_cap(d):
             raise ValueError("insulator_cap: the bore breaks through the wall")
     if inner[-2][0] <= 0 or k - rb <= 0:
         raise ValueError("insulator_cap: the bore breaks through the wall")
-    return revolve(outer + inner)
+    return revolve(outer + inner, sides(d))
 
 
 def build_white_button(d):
@@ -274,7 +298,7 @@ def build_white_button(d):
     else:
         profile += [(R, top)]
     profile += [(R, hs), (rs, hs), (rs, 0.0), (0.0, 0.0)]
-    return revolve(profile)
+    return revolve(profile, sides(d))
 
 
 def build_rect_black_button(d):
@@ -319,9 +343,9 @@ BUILDERS = {
 
 DESCRIPTION = {
     "insulator_cap": "insulator cap: closed-end cylindrical cup (hollow, wall w), "
-                     "chamfered closed end, lip at the open end; %d-sided solid of revolution" % NSEG,
+                     "chamfered closed end, lip at the open end; an n-sided solid of revolution",
     "white_button": "large white stereo pushbutton: solid round cap with a chamfered "
-                    "top edge on a smaller round stem; %d-sided solid of revolution" % NSEG,
+                    "top edge on a smaller round stem; an n-sided solid of revolution",
     "rect_black_button": "rectangular black stereo button: rectangular cap with a "
                          "raised top step on a smaller rectangular stem",
     "square_black_button": "square black stereo button: square cap with cut corners "
@@ -403,10 +427,67 @@ def group(rows, order):
     return classes
 
 
+def centroid(verts, faces):
+    """Centre of mass of the closed mesh at uniform density."""
+    vol, c = 0.0, [0.0, 0.0, 0.0]
+    for f in faces:
+        p0 = verts[f[0]]
+        for k in range(1, len(f) - 1):
+            p1, p2 = verts[f[k]], verts[f[k + 1]]
+            v = signed_volume([p0, p1, p2], [[0, 1, 2]])
+            vol += v
+            for i in range(3):
+                c[i] += v * (p0[i] + p1[i] + p2[i]) / 4.0
+    return [x / vol for x in c]
+
+
+def hull_2d(points):
+    """Convex hull of 2-D points, counter-clockwise (monotone chain)."""
+    pts = sorted(set(points))
+    if len(pts) < 3:
+        return pts
+    cross = lambda o, a, b: (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+    lower, upper = [], []
+    for p in pts:
+        while len(lower) >= 2 and cross(lower[-2], lower[-1], p) <= 0:
+            lower.pop()
+        lower.append(p)
+    for p in reversed(pts):
+        while len(upper) >= 2 and cross(upper[-2], upper[-1], p) <= 0:
+            upper.pop()
+        upper.append(p)
+    return lower[:-1] + upper[:-1]
+
+
+def tip_angle(verts, com, n):
+    """Degrees the part must tilt, resting on the facet with outward normal n,
+    before its centre of mass passes over an edge of the support polygon (the
+    hull vertices in the facet's plane): atan(distance to the nearest edge /
+    height of the centre of mass).  0 is a knife edge."""
+    dot = lambda a, b: a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    size = max(max(v[i] for v in verts) - min(v[i] for v in verts) for i in range(3))
+    top = max(dot(n, v) for v in verts)
+    a = (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)
+    u = (a[1] * n[2] - a[2] * n[1], a[2] * n[0] - a[0] * n[2], a[0] * n[1] - a[1] * n[0])
+    u = [x / math.sqrt(dot(u, u)) for x in u]
+    w = (n[1] * u[2] - n[2] * u[1], n[2] * u[0] - n[0] * u[2], n[0] * u[1] - n[1] * u[0])
+    poly = hull_2d([(round(dot(u, v), 9), round(dot(w, v), 9)) for v in verts
+                    if top - dot(n, v) < 1e-6 * size])
+    q = (dot(u, com), dot(w, com))
+    dist = min(((b[0] - p[0]) * (q[1] - p[1]) - (b[1] - p[1]) * (q[0] - p[0]))
+               / math.hypot(b[0] - p[0], b[1] - p[1]) for p, b in zip(poly, poly[1:] + poly[:1]))
+    return math.degrees(math.atan2(dist, top - dot(n, com)))
+
+
 def evaluate(name, d, tmpdir):
     path = os.path.join(tmpdir, name + ".off")
-    make(name, d, path)
-    return group(run_posedrop(path), order_of(name, d))
+    verts, faces = loft(BUILDERS[name](d))
+    write_off(path, name, d, verts, faces)
+    classes = group(run_posedrop(path), order_of(name, d))
+    com = centroid(verts, faces)
+    for c in classes:
+        c["tip"] = tip_angle(verts, com, c["normal"])
+    return classes
 
 
 def match(name, classes):
@@ -421,13 +502,18 @@ def match(name, classes):
     return pairs
 
 
-def cost(name, classes):
-    paper = sorted(PAPER_QS[name], reverse=True)
-    model = [c["qs"] for c in classes]
-    n = max(len(paper), len(model))
-    paper += [0.0] * (n - len(paper))
-    model += [0.0] * (n - len(model))
-    sse = sum((p - m) ** 2 for p, m in zip(paper, model))
+def cost(name, classes, pqs_weight, min_tip):
+    """Squared QS residuals in the QS-rank pairing, plus pqs_weight times the
+    squared PQS residuals in the same pairing (PQS too depends only on the
+    hull and the centre of mass), plus TIP_WEIGHT times the squared shortfall,
+    in degrees, of each class's tip angle below min_tip, plus 1000 per missing
+    or extra class."""
+    pairs = match(name, classes)
+    sse = sum((p - (c["qs"] if c else 0.0)) ** 2 for p, c in zip(PAPER_QS[name], pairs))
+    sse += pqs_weight * sum((p - (c["pqs"] if c else 0.0)) ** 2
+                            for p, c in zip(PAPER_PQS[name], pairs))
+    sse += sum(c["qs"] ** 2 + pqs_weight * c["pqs"] ** 2 for c in classes[len(pairs):])
+    sse += TIP_WEIGHT * sum(max(0.0, min_tip - c["tip"]) ** 2 for c in classes)
     if len(classes) != len(PAPER_QS[name]):
         sse += 1000.0 * abs(len(classes) - len(PAPER_QS[name]))
     return sse
@@ -438,14 +524,14 @@ def cost(name, classes):
 # clamping into the box) from the best grid points.
 
 
-def objective(name, base, names, x, tmpdir, memo):
+def objective(name, base, names, x, tmpdir, memo, pqs_weight, min_tip):
     key = tuple(round(v, 6) for v in x)
     if key in memo:
         return memo[key]
     d = dict(base)
     d.update(zip(names, x))
     try:
-        val = cost(name, evaluate(name, d, tmpdir))
+        val = cost(name, evaluate(name, d, tmpdir), pqs_weight, min_tip)
     except (ValueError, subprocess.CalledProcessError):
         val = 1e9
     memo[key] = val
@@ -490,25 +576,34 @@ def nelder_mead(f, x0, lo, hi, step, iters=200, tol=1e-4):
     return pts[best], vals[best]
 
 
-def fit(name, base, grid_n, starts, tmpdir):
-    names = [p[0] for p in FIT[name]]
-    lo = [p[1] for p in FIT[name]]
-    hi = [p[2] for p in FIT[name]]
-    memo = {}
-    f = lambda x: objective(name, base, names, x, tmpdir, memo)
-    axes = [[a + (b - a) * (i + 0.5) / grid_n for i in range(grid_n)] for a, b in zip(lo, hi)]
-    grid = sorted(((f(list(x)), list(x)) for x in itertools.product(*axes)),
-                  key=lambda t: t[0])
-    best_x, best_v = grid[0][1], grid[0][0]
-    for v0, x0 in grid[:starts]:
-        step = [(b - a) / grid_n for a, b in zip(lo, hi)]
-        x, v = nelder_mead(f, x0, lo, hi, step)
-        x, v = nelder_mead(f, x, lo, hi, [s / 4 for s in step])
-        if v < best_v:
-            best_x, best_v = x, v
-    d = dict(base)
-    d.update((k, round(v, 3)) for k, v in zip(names, best_x))
-    return d, len(memo)
+def fit(name, base, grid_n, starts, tmpdir, pqs_weight, min_tip):
+    """Grid and Nelder-Mead over the continuous FIT dimensions, once for each
+    combination of the discrete ones (those given as a list of values)."""
+    cont = [p for p in FIT[name] if len(p) == 3]
+    disc = [p for p in FIT[name] if len(p) == 2]
+    names = [p[0] for p in cont]
+    lo = [p[1] for p in cont]
+    hi = [p[2] for p in cont]
+    best_d, best_v, nev = dict(base), math.inf, 0
+    for values in itertools.product(*[p[1] for p in disc]):
+        b = dict(base)
+        b.update(zip([p[0] for p in disc], values))
+        memo = {}
+        f = lambda x: objective(name, b, names, x, tmpdir, memo, pqs_weight, min_tip)
+        axes = [[a + (h - a) * (i + 0.5) / grid_n for i in range(grid_n)]
+                for a, h in zip(lo, hi)]
+        grid = sorted(((f(list(x)), list(x)) for x in itertools.product(*axes)),
+                      key=lambda t: t[0])
+        step = [(h - a) / grid_n for a, h in zip(lo, hi)]
+        for v0, x0 in grid[:starts]:
+            x, v = nelder_mead(f, x0, lo, hi, step)
+            x, v = nelder_mead(f, x, lo, hi, [st / 4 for st in step])
+            if v < best_v:
+                best_v = v
+                best_d = dict(b)
+                best_d.update((k, round(xv, 3)) for k, xv in zip(names, x))
+        nev += len(memo)
+    return best_d, nev
 
 
 # ---------------------------------------------------------------------------
@@ -517,27 +612,27 @@ def fit(name, base, grid_n, starts, tmpdir):
 def report(name, d, tmpdir):
     classes = evaluate(name, d, tmpdir)
     pairs = match(name, classes)
-    print("%s: %d pose classes (paper: %d); QS sum of squared residuals %.2f"
-          % (name, len(classes), len(PAPER_QS[name]),
-             sum((PAPER_QS[name][i] - (c["qs"] if c else 0)) ** 2
-                 for i, c in enumerate(pairs))))
-    print("| paper pose | facet class (normal) | facets | paper QS | posedrop QS "
+    sq = lambda col, paper: sum((p - (c[col] if c else 0.0)) ** 2 for p, c in zip(paper, pairs))
+    print("%s: %d pose classes (paper: %d); sum of squared residuals: QS %.2f, PQS %.2f;"
+          " smallest tip angle %.2f degrees"
+          % (name, len(classes), len(PAPER_QS[name]), sq("qs", PAPER_QS[name]),
+             sq("pqs", PAPER_PQS[name]), min(c["tip"] for c in classes)))
+    print("| paper pose | facet class (normal) | facets | tip (deg) | paper QS | posedrop QS "
           "| residual | paper PQS | posedrop PQS |")
-    print("|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|")
     for i, c in enumerate(pairs):
         if c is None:
-            print("| %d | (none) | 0 | %.1f | 0 | %+.1f | %.1f | 0 |"
+            print("| %d | (none) | 0 | - | %.1f | 0 | %+.1f | %.1f | 0 |"
                   % (i + 1, PAPER_QS[name][i], -PAPER_QS[name][i], PAPER_PQS[name][i]))
             continue
-        print("| %d | (%.3f, %.3f, %.3f) | %d | %.1f | %.1f | %+.1f | %.1f | %.1f |"
+        print("| %d | (%.3f, %.3f, %.3f) | %d | %.2f | %.1f | %.1f | %+.1f | %.1f | %.1f |"
               % (i + 1, c["normal"][0], c["normal"][1], c["normal"][2], len(c["members"]),
-                 PAPER_QS[name][i], c["qs"], c["qs"] - PAPER_QS[name][i],
+                 c["tip"], PAPER_QS[name][i], c["qs"], c["qs"] - PAPER_QS[name][i],
                  PAPER_PQS[name][i], c["pqs"]))
-    extra = classes[len(pairs):]
-    for c in extra:
-        print("| - | (%.3f, %.3f, %.3f) | %d | - | %.1f | - | - | %.1f |"
+    for c in classes[len(pairs):]:
+        print("| - | (%.3f, %.3f, %.3f) | %d | %.2f | - | %.1f | - | - | %.1f |"
               % (c["normal"][0], c["normal"][1], c["normal"][2], len(c["members"]),
-                 c["qs"], c["pqs"]))
+                 c["tip"], c["qs"], c["pqs"]))
     print()
 
 
@@ -573,7 +668,14 @@ def main():
                     help="with --fit: write the fitted values into DIMS in this script")
     ap.add_argument("--report", action="store_true",
                     help="print posedrop's grouped QS against the paper's")
-    ap.add_argument("--grid", type=int, default=8, help="grid points per dimension (8)")
+    ap.add_argument("--pqs-weight", type=float, default=0.0,
+                    help="weight of the squared PQS residuals beside the QS ones "
+                         "(0, the default: QS only; docs/validation.md)")
+    ap.add_argument("--min-tip", type=float, default=MIN_TIP,
+                    help="smallest tip angle, degrees, a stable pose may have (%g)" % MIN_TIP)
+    ap.add_argument("--grid", type=int, default=None,
+                    help="grid points per dimension (8; 3 for the black buttons, "
+                         "whose 6 and 8 dimensions would make 8 too many)")
     ap.add_argument("--starts", type=int, default=3,
                     help="Nelder-Mead starts from the best grid points (3)")
     ap.add_argument("--outdir", default=os.path.join(ROOT, "parts"))
@@ -592,7 +694,9 @@ def main():
             for name in args.fit or list(DIMS):
                 if name not in DIMS:
                     ap.error("unknown part " + name)
-                dims[name], nev = fit(name, dims[name], args.grid, args.starts, tmpdir)
+                grid = args.grid or (3 if len(FIT[name]) > 4 else 8)
+                dims[name], nev = fit(name, dims[name], grid, args.starts, tmpdir,
+                                       args.pqs_weight, args.min_tip)
                 print("%s: fitted after %d evaluations: %r" % (name, nev, dims[name]),
                       file=sys.stderr)
             print("DIMS = {")

@@ -260,7 +260,12 @@ typedef struct pd_sim_options {
                                or not the intervals are that narrow; 10^7 */
     double time_limit;      /* s of simulated time per drop, > 0, or
                                PD_TIME_LIMIT_AUTO (0, the default):
-                               pd_time_limit_auto for the part and scene */
+                               pd_time_limit_auto for the part and scene,
+                               which the impulse engine extends by the time
+                               a drop spins on one vertex under drilling
+                               friction (a top), up to the longest such
+                               spin the drop's energy allows
+                               (docs/limits.md, "Tops") */
     int max_collisions;     /* per drop, >= 1; 100000 */
     int keep_trials;        /* 1: fill result->trials (one record per drop); 0 */
     pd_cancel_flag *cancel; /* may be NULL; see below */

@@ -107,6 +107,24 @@ PD_API pd_status pd_static_estimate(const pd_part *part, const pd_static_options
 
 PD_API void pd_static_result_free(pd_static_result *result);
 
+/* The rigid transform that sets the part resting on a pose: its facet on
+ * the floor z = 0, facing down, the part above it. transform is a 4x4
+ * homogeneous matrix, row-major (transform[4 r + c]), that maps a point of
+ * the mesh in its file's frame, in metres (pd_part.origin added to the
+ * part's own positions), to the floor's frame. Its rotation's rows are
+ * x, y, z with z = -pose->normal, x = (-z_y, z_x, 0) normalised, or (1, 0, 0)
+ * when that is shorter than PD_PRINT_ZERO (a horizontal facet: round-off in
+ * an axis-aligned normal does not spin the frame), y = z x x: the convention
+ * of trimesh.poses.compute_stable_poses. The translation is along z only
+ * and puts the lowest hull vertex on z = 0; the centre of mass then stands
+ * at pose->height. pose is one of a pd_static_result's for this part (its
+ * facet and normal are used). Returns PD_ERR_USAGE (a NULL argument, a
+ * normal that is not a unit vector within 1e-9), PD_ERR_NONFINITE (a normal
+ * that is not finite) or PD_ERR_RANGE (a facet not of the part's hull),
+ * leaving transform untouched. */
+PD_API pd_status pd_pose_transform(const pd_part *part, const pd_pose *pose, double transform[16],
+                                   pd_diag *diag);
+
 /* Solid angle (sr) of triangle abc seen from the origin, by the atan2 form of
  * Van Oosterom and Strackee (1983): full relative precision for tiny and thin
  * triangles. Positive when dot(a, cross(b - a, c - a)) > 0, as for a hull

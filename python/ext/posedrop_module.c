@@ -580,49 +580,6 @@ static PyObject *Part_estimate(PartObject *self, PyObject *args, PyObject *kw)
     return (PyObject *)p;
 }
 
-/* The 4x4 transform that sets the part resting on its pose's facet on the
- * plane z = 0, in trimesh.poses.compute_stable_poses's convention: rows x,
- * y, z of the rotation with z = -normal (the facet faces down), x =
- * (-z_y, z_x, 0) normalised or (1, 0, 0) when that vanishes, y = z cross x;
- * translated along z only, so that the lowest hull vertex is at z = 0. The
- * vanishing test uses the command's print threshold, so that a normal whose
- * round-off leaves 1e-17 in x and y is treated as the axis it prints as. */
-static void resting_transform(const pd_part *part, pd_vec3 n, double T[16])
-{
-    double z[3] = {-n.x, -n.y, -n.z}, x[3] = {-z[1], z[0], 0.0}, y[3];
-    double len = sqrt(x[0] * x[0] + x[1] * x[1]);
-    if (len < PD_PRINT_ZERO) {
-        x[0] = 1.0;
-        x[1] = 0.0;
-    } else {
-        x[0] /= len;
-        x[1] /= len;
-    }
-    y[0] = z[1] * x[2] - z[2] * x[1];
-    y[1] = z[2] * x[0] - z[0] * x[2];
-    y[2] = z[0] * x[1] - z[1] * x[0];
-    double ylen = sqrt(y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
-    for (int k = 0; k < 3; k++)
-        y[k] /= ylen;
-    const pd_hull *h = part->hull;
-    const pd_vec3 o = part->origin;
-    double low = INFINITY;
-    for (int i = 0; i < h->nverts; i++) {
-        double hz = z[0] * (h->verts[i].x + o.x) + z[1] * (h->verts[i].y + o.y) +
-                    z[2] * (h->verts[i].z + o.z);
-        if (hz < low)
-            low = hz;
-    }
-    const double rows[3][3] = {{x[0], x[1], x[2]}, {y[0], y[1], y[2]}, {z[0], z[1], z[2]}};
-    for (int r = 0; r < 3; r++) {
-        for (int c = 0; c < 3; c++)
-            T[4 * r + c] = rows[r][c];
-        T[4 * r + 3] = r == 2 ? -low : 0.0;
-    }
-    T[12] = T[13] = T[14] = 0.0;
-    T[15] = 1.0;
-}
-
 static PyObject *Poses_poses(PosesObject *self, PyObject *unused)
 {
     (void)unused;
@@ -655,7 +612,13 @@ static PyObject *Poses_poses(PosesObject *self, PyObject *unused)
         ((double *)height)[i] = p->height;
         ((double *)qs)[i] = p->p_qs;
         ((double *)pqs)[i] = p->p_pqs;
-        resting_transform(self->part->part, p->normal, (double *)tf + 16 * i);
+        pd_diag diag;
+        pd_diag_init(&diag);
+        pd_status st = pd_pose_transform(self->part->part, p, (double *)tf + 16 * i, &diag);
+        if (st != PD_OK) {
+            Py_DECREF(d);
+            return raise_status(st, diag.message);
+        }
     }
     return d;
 }
@@ -1074,6 +1037,8 @@ static PyObject *Drops_arrays(DropsObject *self, PyObject *unused)
               put(d, "collision_limited", PyLong_FromLong(s->collision_limited)) ||
               put(d, "failed", PyLong_FromLong(s->failed)) ||
               put(d, "first_failed", PyLong_FromLong(s->first_failed)) ||
+              put(d, "failed_stage", PyLong_FromLong((long)s->failed_stage)) ||
+              put(d, "failed_status", PyLong_FromLong((long)s->failed_status)) ||
               put(d, "time_limit", PyFloat_FromDouble(s->time_limit)) ||
               put(d, "energy_gain", PyLong_FromLong(s->energy_gain)) ||
               put(d, "fallbacks", PyLong_FromLong(s->fallbacks)) ||

@@ -202,3 +202,46 @@ def test_failed_end_words_are_the_documented_ones():
                                                 Status.ERR_USAGE, Status.ERR_RANGE)}
     assert list(words.values()) == ["no_convergence", "non_finite_number", "out_of_memory",
                                     "internal_error", "invalid_argument", "value_out_of_range"]
+
+
+def test_no_failure_has_no_failed_stage_or_status():
+    drops = posedrop.Part.from_file(CAP).drop(30, seed=2, time_limit=0.3)
+    assert drops.failed == 0 and drops.first_failed == -1 and drops.time_limited > 0
+    assert drops.failed_stage is None and drops.failed_status is None
+    # The library's pd_sim_result fields, as the binding hands them over.
+    raw = drops._h.arrays()
+    assert raw["failed_stage"] == 0 and raw["failed_status"] == Status.OK
+    assert drops.grouped().failed_stage is None
+
+
+class _FailingHandle:
+    """The arrays of a real run with drop k marked failed at stage and
+    status, as the library records one (no public input makes a drop fail:
+    see test_failed_end_words_are_the_documented_ones)."""
+
+    def __init__(self, handle, k, stage, status):
+        self.d = dict(handle.arrays())
+        self.d.update(failed=1, unsettled=self.d["unsettled"] + 1, first_failed=k,
+                      failed_stage=stage, failed_status=status)
+        for key, value in (("trial_end", posedrop.END_NAMES.index("failed")),
+                           ("trial_stage", stage), ("trial_status", status),
+                           ("trial_pose", -1)):
+            column = bytearray(self.d[key])
+            column[4 * k:4 * k + 4] = np.int32(value).tobytes()
+            self.d[key] = bytes(column)
+
+    def arrays(self):
+        return self.d
+
+
+@pytest.mark.parametrize("stage,status,words", [
+    (2, Status.ERR_NO_CONVERGENCE, ("flight", "no_convergence")),
+    (8, Status.ERR_NONFINITE, ("engine_step", "non_finite_number"))])
+def test_failed_stage_and_status_name_the_first_failed_drop(stage, status, words):
+    poses = posedrop.Part.from_file(CAP).stable_poses()
+    real = poses.drop(20, seed=3, trials=True)
+    drops = posedrop.Drops(poses, _FailingHandle(real._h, 7, stage, int(status)))
+    assert (drops.failed_stage, drops.failed_status) == words
+    # The words of that drop's end in the trials (--trials' end column).
+    assert drops.trials.end_text[drops.first_failed] == "failed:%s:%s" % words
+    assert drops.failed == list(drops.trials.end_text).count("failed:%s:%s" % words)

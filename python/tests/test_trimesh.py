@@ -207,10 +207,18 @@ def test_transform_rests_the_part_on_its_facet(name, units):
                                                              abs=PLANE_REL * part.size)
 
 
-# trimesh 5.2 with numpy 2 cannot read square_black_button.off (its OFF
-# reader multiplies strings); the other shipped parts load.
-@pytest.mark.parametrize("name,units", [p for p in SHIPPED
-                                        if p[0] != "square_black_button.off"])
+# trimesh's OFF reader (5.2.0) fails on a face of more than four corners:
+# it fans the face's indices while they are still strings, which numpy (1.26
+# and 2 alike) refuses to multiply. square_black_button.off's octagonal cap
+# top is the one such face among the shipped parts. Expected to fail, and
+# strictly, so that a trimesh that reads it shows here (docs/python.md).
+NO_TRIMESH = pytest.mark.xfail(raises=TypeError, strict=True,
+                               reason="trimesh fans an octagon's string indices")
+
+
+@pytest.mark.parametrize("name,units", [
+    pytest.param(*p, marks=NO_TRIMESH) if p[0] == "square_black_button.off" else p
+    for p in SHIPPED])
 def test_trimesh_loaded_parts_give_the_commands_numbers(name, units):
     """A shipped part read by trimesh (unprocessed: its vertices and the
     same fan triangles) gives the command's rows to the last digit."""

@@ -107,7 +107,10 @@ static const cli_option options[] = {
      "simulated seconds a drop may take before it ends\n"
      "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
      "(default): 100 (sqrt(L/g) + sqrt(2h/g)) for a part of size\n"
-     "L dropped from h, 19.8 s for a 1 cm cube from 0.12 m"},
+     "L dropped from h, 19.8 s for a 1 cm cube from 0.12 m; the\n"
+     "impulse engine leaves out the time a drop spends spinning\n"
+     "on one vertex (a top), up to the longest spin drilling\n"
+     "friction allows it"},
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},

@@ -92,7 +92,7 @@ int cli_files_apart(const cli_file *files, int n);
 void fragile_warn(const char *path, const pd_sim_result *sim);
 
 /* sha256.c: the file's SHA-256 as 64 hex digits; 0 with errno set on a read
- * error. */
+ * error (EPIPE: a named pipe that gave nothing, its content read already). */
 int sha256_file(const char *path, char hex[65]);
 
 #endif

@@ -5,6 +5,7 @@
 #include <stdint.h>
 #include <stdio.h>
 #include <string.h>
+#include "base/file_read.h"
 #include "cli/cli.h"
 
 typedef struct {
@@ -75,17 +76,19 @@ int sha256_file(const char *path, char hex[65])
                                    0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
     sha256 s = {.bytes = 0, .used = 0};
     memcpy(s.h, h0, sizeof h0);
-    FILE *f = fopen(path, "rb");
+    /* A part read from a named pipe is gone once read: opened again, the
+     * pipe has no writer, and open(2) would wait for one for ever. */
+    FILE *f = pd_file_fopen_read(path);
     if (!f)
         return 0;
     unsigned char buf[65536];
     size_t got;
     while ((got = fread(buf, 1, sizeof buf, f)) > 0)
         update(&s, buf, got);
-    int ok = !ferror(f);
+    int ok = !ferror(f), gone = pd_file_check_fifo(fileno(f), s.bytes, path, NULL) != PD_OK;
     fclose(f);
-    if (!ok) {
-        errno = EIO;
+    if (!ok || gone) {
+        errno = ok ? EPIPE : EIO;
         return 0;
     }
     /* Padding: a 1 bit, zeros to 56 bytes of a block, the bit length. */

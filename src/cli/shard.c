@@ -14,6 +14,7 @@
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
+#include "base/file_read.h"
 #include "cli/cli.h"
 
 /* The largest shard count: far beyond a cluster's job array limits (Slurm's
@@ -328,12 +329,19 @@ static int read_shard(const char *file, shard_file *s)
 {
     memset(s, 0, sizeof *s);
     s->file = file;
-    FILE *f = fopen(file, "r");
+    FILE *f = pd_file_fopen_read(file);
     if (!f) {
         fprintf(stderr, "%s: %s: cannot read: %s\n", prog, file, strerror(errno));
         return 0;
     }
     char *l1 = read_line(f), *l2 = l1 ? read_line(f) : NULL, *hdr = l2 ? read_line(f) : NULL;
+    pd_diag pipe;
+    pd_diag_init(&pipe);
+    if (!l1 && pd_file_check_fifo(fileno(f), 0, file, &pipe) != PD_OK) {
+        fprintf(stderr, "%s: %s\n", prog, pipe.message);
+        fclose(f);
+        return 0;
+    }
     char version[64], buf[64];
     int ok = 1, lineno = 3;
     if (!l1 || strncmp(l1, "# posedrop ", 11) != 0 || sscanf(l1 + 11, "%63s", version) != 1 ||

@@ -19,6 +19,8 @@ struct pd_compliant_work {
     double *pn;             /* normal impulse */
     double *ptx, *pty;      /* tangential impulses, accumulated over sweeps */
     double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
+    pd_vec3 *armx, *army;   /* r x ex, r x ey: the slip along ex is v.x + w.(r x ex) */
+    pd_vec3 *turnx, *turny; /* I^-1 (r x ex), I^-1 (r x ey): the turn per unit impulse */
     int hint;
     const pd_cancel_flag *cancel; /* may be NULL */
 };
@@ -44,7 +46,7 @@ void pd_compliant_from_law(const pd_compliant_law *law, const pd_body *b, double
                            pd_compliant *c)
 {
     c->law = *law;
-    c->h1 = tol_scale * PD_COMPLIANT_STEP / (c->law.omega * (1.0 + c->law.chi * c->law.s_peak));
+    c->h1 = tol_scale * c->law.step / c->law.omega;
     c->band = PD_COMPLIANT_BAND_REL * b->size;
     c->sweep_tol = tol_scale * PD_COMPLIANT_SWEEP_TOL;
 }
@@ -65,8 +67,12 @@ pd_compliant_work *pd_compliant_work_alloc(const pd_body *b)
     w->ptx = malloc(n * sizeof *w->ptx);
     w->pty = malloc(n * sizeof *w->pty);
     w->kt = malloc(n * sizeof *w->kt);
+    w->armx = malloc(n * sizeof *w->armx);
+    w->army = malloc(n * sizeof *w->army);
+    w->turnx = malloc(n * sizeof *w->turnx);
+    w->turny = malloc(n * sizeof *w->turny);
     if (!w->cand || !w->active || !w->k || !w->lam || !w->push || !w->pn || !w->ptx ||
-        !w->pty || !w->kt) {
+        !w->pty || !w->kt || !w->armx || !w->army || !w->turnx || !w->turny) {
         pd_compliant_work_free(w);
         return NULL;
     }
@@ -86,14 +92,48 @@ void pd_compliant_work_free(pd_compliant_work *w)
     free(w->ptx);
     free(w->pty);
     free(w->kt);
+    free(w->armx);
+    free(w->army);
+    free(w->turnx);
+    free(w->turny);
     free(w);
 }
 
-/* The inverse mass of the body at r along unit directions a and c, all in
- * the body frame: a.c / m + (r x a) I^-1 (r x c). */
+/* The larger of a and b, both finite (fmax is a call where it must
+ * handle NaN). */
+static inline double max2(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+/* The velocity at r2 along c per unit impulse at r1 along a (unit
+ * directions, all in the body frame): a.c / m + (r1 x a) I^-1 (r2 x c). */
+static double inv_mass2(const pd_body *b, pd_vec3 r1, pd_vec3 a, pd_vec3 r2, pd_vec3 c)
+{
+    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r1, a), pd_body_inv_inertia(b, v3_cross(r2, c)));
+}
+
+/* The inverse mass of the body at r along a and c. */
 static double inv_mass(const pd_body *b, pd_vec3 r, pd_vec3 a, pd_vec3 c)
 {
-    return v3_dot(a, c) / b->mass + v3_dot(v3_cross(r, a), pd_body_inv_inertia(b, v3_cross(r, c)));
+    return inv_mass2(b, r, a, r, c);
+}
+
+/* The square of the fastest normal vibration of two contacts i and j on
+ * the body, over one contact's (omega^2): the larger eigenvalue of
+ * K^1/2 A K^1/2, A their normal inverse masses coupled through the body and
+ * K their stiffnesses (a contact not yet touching: the one it will get).
+ * At most 2 (the trace bound), 1 + |coupling| when both are as stiff as
+ * their touch made them. */
+static double pair_mode(const pd_compliant_work *w, const pd_body *b, pd_vec3 up, double omega2,
+                        int i, int j)
+{
+    pd_vec3 ri = b->verts[i], rj = b->verts[j];
+    double aii = inv_mass(b, ri, up, up), ajj = inv_mass(b, rj, up, up);
+    double aij = inv_mass2(b, ri, up, rj, up);
+    double ki = w->active[i] ? w->k[i] : omega2 / aii, kj = w->active[j] ? w->k[j] : omega2 / ajj;
+    double p = ki * aii, q = kj * ajj, half = 0.5 * (p - q);
+    return (0.5 * (p + q) + sqrt(half * half + ki * kj * aij * aij)) / omega2;
 }
 
 static void rebuild_candidates(const pd_compliant *c, pd_compliant_work *w, const pd_body *b,
@@ -151,9 +191,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
 
     double t = 0.0, last_touch = 0.0, moved = 0.0, h = c->h1;
     for (long step = 0;; step++) {
-        up = quat_rotate_inv(s->q, v3(0, 0, 1));
-        pd_vec3 ex = quat_rotate_inv(s->q, v3(1, 0, 0)), ey = quat_rotate_inv(s->q, v3(0, 1, 0));
-        int npush = 0, nbelow = 0, arriving = 0;
+        /* The world's axes in the body frame: the rows of the rotation. */
+        double R[3][3];
+        quat_to_matrix(s->q, R);
+        up = v3(R[2][0], R[2][1], R[2][2]);
+        pd_vec3 ex = v3(R[0][0], R[0][1], R[0][2]), ey = v3(R[1][0], R[1][1], R[1][2]);
+        int npush = 0, nbelow = 0, arriving = 0, entering = 0, pair[2] = {-1, -1};
         double deepest = 0.0, speed = 0.0, load = 0.0, elastic = 0.0;
         for (int j = 0; j < w->ncand; j++) {
             int i = w->cand[j];
@@ -164,6 +207,11 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 w->active[i] = 0;
                 if (uz < 0.0 && z < -2.0 * uz * h)
                     arriving = 1;
+                if (uz < 0.0 && z < -uz * c->h1) {
+                    if (nbelow + entering < 2)
+                        pair[nbelow + entering] = i;
+                    entering++;
+                }
                 continue;
             }
             if (!w->active[i]) {
@@ -176,10 +224,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                 last_touch = t;
             }
             double d = -z;
+            if (nbelow + entering < 2)
+                pair[nbelow + entering] = i;
             nbelow++;
-            deepest = fmax(deepest, d);
-            speed = fmax(speed, fabs(uz));
-            load = fmax(load, w->k[i] * d);
+            deepest = max2(deepest, d);
+            speed = max2(speed, fabs(uz));
+            load = max2(load, w->k[i] * d);
             elastic += 0.5 * w->k[i] * d * d;
             double f = w->k[i] * d * (1.0 + w->lam[i] * (-uz));
             if (f > 0.0) {
@@ -226,7 +276,14 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             break;
         }
 
-        h = c->h1 / sqrt(nbelow > 1 ? (double)nbelow : 1.0);
+        /* Counting the contacts that come below within the step: a face
+         * landing flat must not take its first step in contact at one
+         * contact's length. Two: their fastest mode exactly (a closed
+         * form; on a cube's edge about 1.14 times one contact's square
+         * against the bound's 2); more: the trace bound n. */
+        int n = nbelow + entering;
+        double stiff = n == 2 ? pair_mode(w, b, up, omega2, pair[0], pair[1]) : (double)n;
+        h = c->h1 / sqrt(stiff > 1.0 ? stiff : 1.0);
         /* Gravity and the normal impulses. */
         pd_vec3 dv = v3(0, 0, -g * h), dw = v3(0, 0, 0);
         double pn_max = 0.0;
@@ -260,17 +317,20 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
             for (int j = 0; j < npush; j++) {
                 pd_vec3 r_i = b->verts[w->push[j]];
                 w->ptx[j] = w->pty[j] = 0.0;
-                w->kt[j][0] = inv_mass(b, r_i, ex, ex);
-                w->kt[j][1] = inv_mass(b, r_i, ex, ey);
-                w->kt[j][2] = inv_mass(b, r_i, ey, ey);
+                w->armx[j] = v3_cross(r_i, ex);
+                w->army[j] = v3_cross(r_i, ey);
+                w->turnx[j] = pd_body_inv_inertia(b, w->armx[j]);
+                w->turny[j] = pd_body_inv_inertia(b, w->army[j]);
+                w->kt[j][0] = 1.0 / m + v3_dot(w->armx[j], w->turnx[j]);
+                w->kt[j][1] = v3_dot(w->armx[j], w->turny[j]);
+                w->kt[j][2] = 1.0 / m + v3_dot(w->army[j], w->turny[j]);
             }
             double stop = c->sweep_tol * mu * pn_max;
             for (int sweep = 0; sweep < PD_COMPLIANT_SWEEPS; sweep++) {
                 double change = 0.0;
                 for (int j = 0; j < npush; j++) {
-                    pd_vec3 r_i = b->verts[w->push[j]];
-                    pd_vec3 wr = v3_cross(s->w, r_i);
-                    double ux = s->v.x + v3_dot(wr, ex), uy = s->v.y + v3_dot(wr, ey);
+                    double ux = s->v.x + v3_dot(s->w, w->armx[j]);
+                    double uy = s->v.y + v3_dot(s->w, w->army[j]);
                     double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
                     double det = kxx * kyy - kxy * kxy;
                     double fx = ux - (kxx * w->ptx[j] + kxy * w->pty[j]);
@@ -278,7 +338,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
                     double cap = mu * w->pn[j];
                     if (px * px + py * py > cap * cap) {
-                        double fn = hypot(fx, fy), ax = fx / fn, ay = fy / fn;
+                        /* hypot only where the squares underflow: it
+                         * costs as much as the rest of the sweep. */
+                        double fn = sqrt(fx * fx + fy * fy);
+                        if (!(fn > 0.0))
+                            fn = hypot(fx, fy);
+                        double ax = fx / fn, ay = fy / fn;
                         double kaa = kxx * ax * ax + 2.0 * kxy * ax * ay + kyy * ay * ay;
                         double mag = fmin(cap, fn / kaa);
                         px = -mag * ax;
@@ -289,9 +354,9 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                     w->pty[j] = py;
                     s->v.x += ddx / m;
                     s->v.y += ddy / m;
-                    pd_vec3 pb = v3_add(v3_scale(ex, ddx), v3_scale(ey, ddy));
-                    s->w = v3_add(s->w, pd_body_inv_inertia(b, v3_cross(r_i, pb)));
-                    change = fmax(change, fmax(fabs(ddx), fabs(ddy)));
+                    s->w = v3_add(s->w, v3_add(v3_scale(w->turnx[j], ddx),
+                                               v3_scale(w->turny[j], ddy)));
+                    change = max2(change, max2(fabs(ddx), fabs(ddy)));
                 }
                 /* One contact: the slip without its own friction, which
                  * sets its impulse, does not depend on that impulse, so

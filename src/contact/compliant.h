@@ -13,8 +13,9 @@
  * the body, solved by Gauss-Seidel sweeps). Vertices that reach the floor
  * while the impact lasts join it.
  *
- * The motion is stepped by semi-implicit (symplectic) Euler in the body
- * frame, the step a fixed fraction of the fastest contact oscillation.
+ * The motion is stepped by semi-implicit (symplectic) Euler in the body frame,
+ * the step set by the law's rebound error (pd_compliant_law_step) and
+ * shortened for several contacts.
  * The run ends when
  *   - no vertex is below the floor and none will reach it within two steps
  *     (SEPARATED: flight again);

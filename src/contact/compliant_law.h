@@ -26,6 +26,8 @@ typedef struct pd_compliant_law {
     double chi;     /* damping ratio of the scaled law */
     double tau;     /* duration of one contact in scaled time */
     double s_peak;  /* the deepest scaled penetration (at step ends: an estimate) */
+    double step;    /* the step with one contact in scaled time (omega h):
+                       pd_compliant_law_step's */
     double omega;   /* rad/s: tau / T; k = m omega^2 */
 } pd_compliant_law;
 
@@ -43,6 +45,21 @@ pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law);
 pd_status pd_compliant_law_contact(double chi, double tol, double *e, double *tau,
                                    double *s_peak);
 
+/* The step of compliant.c's integration (semi-implicit Euler: the force
+ * from the penetration and its rate at the step's start, then the position
+ * from the new velocity) for the scaled law with damping ratio chi, in
+ * scaled time: the shortest at which, going up from steps far inside it,
+ * the rebound leaves PD_COMPLIANT_E_TOL of the law's own restitution e
+ * (the worst of PD_COMPLIANT_STEP_PHASES touches spread evenly over a
+ * step), found to PD_COMPLIANT_STEP_REL, and at most PD_COMPLIANT_STEP_MAX
+ * over the law's fastest rate (1 + chi s_peak). PD_ERR_NO_CONVERGENCE if
+ * even PD_COMPLIANT_STEP_TRIES halvings do not meet it. */
+pd_status pd_compliant_law_step(double chi, double e, double s_peak, double *step);
+
+/* 1 if the scaled step h rebounds within PD_COMPLIANT_E_TOL of e from
+ * every touch pd_compliant_law_step tries. */
+int pd_compliant_law_step_meets(double chi, double e, double h);
+
 /* The laws for the restitutions of a range [e_lo, e_hi], for runs whose
  * restitution each drop draws (a law costs ~0.7 ms, a drop of a small part
  * less): exact at PD_COMPLIANT_TABLE_NODES restitutions evenly spaced in
@@ -52,7 +69,8 @@ typedef struct pd_compliant_table {
     int n;          /* nodes (1 when the range is one restitution) */
     pd_compliant_law one; /* n == 1: the exact law, for T = 1 */
     double x_lo, dx; /* log of the lowest restitution, the nodes' step in log e */
-    double y[3][PD_COMPLIANT_TABLE_NODES]; /* chi e / (1 - e), log tau, s_peak at the nodes */
+    double y[4][PD_COMPLIANT_TABLE_NODES]; /* chi e / (1 - e), log tau, s_peak and log step
+                                              at the nodes */
 } pd_compliant_table;
 
 pd_status pd_compliant_table_init(double e_lo, double e_hi, pd_compliant_table *table);

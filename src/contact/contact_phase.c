@@ -12,7 +12,19 @@
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
- * phase_forces.c solves it). Sliding friction does negative work and
+ * phase_forces.c solves it). A resting contact, or both contacts of a
+ * resting edge, whose sticking force would leave the friction cone slide
+ * from rest (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest):
+ * friction along the direction each slip then grows in, until the slip
+ * reaches the start threshold, and along the slip from there, in the same
+ * phase; unless another vertex is predicted to land first (lands_first).
+ * It slides from rest only while its sticking force stays outside the cone
+ * (else it would stick again). Where no direction is found for one contact
+ * (just outside the cone's edge) or the part turns too fast for lands_first
+ * to judge, it slips clipped (PD_PHASE_CLIP, phase_forces.h). A sticking
+ * contact whose force reaches the cone goes on either way within the phase
+ * (slip_onset). An edge one of whose contacts would pull on the floor is
+ * the other contact's phase. Sliding friction does negative work and
  * sticking contacts none, so the energy can only fall. Two sticking
  * contacts are a rotation about their edge, integrated as one angle
  * (contact_pivot.c), the commonest phase of a part rolling on a rim. The
@@ -20,7 +32,9 @@
  * part (length L, time sqrt(L/g)); the phase ends, handing the state back
  * to the microcollisions, just before any of:
  *  - a normal force reaching zero (a contact lifts off),
- *  - a sliding contact's slip falling below PD_TOL_PHASE_SLIP_REL sqrt(g L),
+ *  - a sliding contact's slip falling below PD_TOL_PHASE_SLIP_REL sqrt(g L)
+ *    (one sliding from rest: reaching twice that ends nothing, its friction
+ *    turns to its slip),
  *  - a sticking contact's force leaving the friction cone (it starts to slip),
  *  - another vertex reaching the floor (an impact),
  *  - the system becoming singular (as in Painleve's paradox),
@@ -55,6 +69,17 @@ pd_ode *pd_contact_phase_ode_alloc_tol(double tol_scale)
 {
     double tol = tol_scale * PD_TOL_PHASE_ODE_REL;
     return pd_ode_alloc_method(PD_ODE_RKCK, NY, tol, tol);
+}
+
+pd_ode *pd_contact_phase_spin_ode_alloc_tol(double tol_scale)
+{
+    double tol = tol_scale * PD_TOL_PHASE_ODE_REL;
+    return pd_ode_alloc_method(PD_ODE_RK8PD, NY, tol, tol);
+}
+
+int pd_contact_phase_spins_fast(const pd_body *b, double g, const pd_state *s)
+{
+    return v3_norm(s->w) * sqrt(b->size / g) > PD_PHASE_SPIN_FAST;
 }
 
 /* The same pair and tolerance for a pivot's angle (rad) and rate (per
@@ -191,8 +216,18 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
         g[k] = HUGE_VAL;
     for (int i = 0; i < p->nc; i++) {
         g[i] = F->fn[i] / mg;
-        g[2 + i] = p->mode[i] == PD_PHASE_STICK ? F->cone[i] / mg : (F->slip[i] - slip_min) / V0;
+        g[2 + i] = p->mode[i] != PD_PHASE_SLIDE ? F->cone[i] / mg
+                   : p->from_rest[i]                ? (2.0 * slip_min - F->slip[i]) / V0
+                                                    : (F->slip[i] - slip_min) / V0;
     }
+    /* A lone contact slipping from rest (so the second contact's slot is
+     * free): also while its sticking force lies outside the cone (sliding
+     * from rest), or until its slip reaches the speed a slide starts at
+     * (clipped). */
+    if (p->nc == 1 && p->from_rest[0])
+        g[3] = F->cone[0] / mg;
+    else if (p->mode[0] == PD_PHASE_CLIP)
+        g[3] = (2.0 * slip_min - F->slip[0]) / V0;
     pd_vec3 up = quat_rotate_inv(s->q, v3(0.0, 0.0, 1.0));
     *up_out = up;
     /* With a drilling contact: the spin about the normal, in the direction
@@ -474,6 +509,51 @@ static void phase_of(pd_phase *p, const pd_settle *st, const pd_scene *sc, const
             p->drill[i] = wn > 0.0 ? k : wn < 0.0 ? -k : 0.0;
 }
 
+/* 1 if a vertex other than the contacts of phase p at s, coming down at its
+ * present rate (height_jet's first order), lands within time dt (s). Then
+ * a contact sliding from rest would hand over to microcollisions before its
+ * slip reached the start threshold (a part rolling over a rim of close
+ * vertices, parts/cap.off, does nearly every time), leaving a small slip
+ * that makes the landing's microcollision a slow sliding integration where,
+ * stuck, it would have been cheap. First order, not second: the second's
+ * term is mostly the part toppling from rest, which speeds its slip too,
+ * so it refused slides that reached the threshold first more often than not
+ * (docs/performance.md). */
+static int lands_first(const pd_phase *p, const pd_state *s, double slip_min, double dt)
+{
+    const pd_body *b = p->b;
+    motion mo = motion_of(p);
+    double y[NY], tau = dt / p->T;
+    point a;
+    to_y(&mo, s, y);
+    point_at(&mo, slip_min, 0.0, y, &a);
+    if (!(a.least > -1.0))
+        return 0;
+    for (int i = 0; i < p->nc; i++)
+        for (int k = b->adj_start[p->v[i]]; k < b->adj_start[p->v[i] + 1]; k++) {
+            int w = b->adj[k];
+            if (is_contact(p, w))
+                continue;
+            double j[3];
+            height_jet(p, &a, w, j);
+            if (j[0] + j[1] * tau <= 0.0)
+                return 1;
+        }
+    return 0;
+}
+
+/* pd_phase_slide_edge_from_rest on a copy of pivot phase p (which has no
+ * force solve set up), replacing p where it succeeds. */
+static int slide_edge(pd_phase *p, const pd_state *s, double *accel)
+{
+    pd_phase q = *p;
+    pd_phase_map(&q);
+    if (!pd_phase_slide_edge_from_rest(&q, s, accel))
+        return 0;
+    *p = q;
+    return 1;
+}
+
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase)
 {
@@ -539,14 +619,122 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
     } else if (pd_phase_forces_of(&p, &t, &F)) {
         return 0;
     }
-    if (!(margins(&p, &t, &F, slip_min, g, &floor_v, &up) > 0.0))
+    double least = margins(&p, &t, &F, slip_min, g, &floor_v, &up), accel;
+    int stuck_out = !(least > 0.0) && !pivot && nc == 1 && p.mode[0] == PD_PHASE_STICK &&
+                    F.cone[0] <= 0.0;
+    pd_phase q = p;
+    if (stuck_out && pd_phase_slide_from_rest(&p, &t, &accel)) {
+        /* One contact that cannot stick: it slides from rest, and the
+         * phase follows it (microcollisions would stop its slip at each
+         * one, every rest step, until it slipped faster than friction
+         * can stop in one), unless another vertex lands first. */
+        if (pd_phase_forces_of(&p, &t, &F))
+            return 0;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+        double horizon = 2.0 * slip_min / accel;
+        if (least > 0.0 && lands_first(&p, &t, slip_min, horizon)) {
+            /* Believed where the part turns little over the horizon; where
+             * it turns more, a vertex's height is not its first order (a
+             * top's corners bob at its spin) and the slip goes on clipped. */
+            if (v3_norm(t.w) * horizon < PD_PHASE_LANDS_TURN)
+                return 0;
+            p = q, least = 0.0;
+        } else {
+            stuck_out = 0;
+        }
+    } else if (!(least > 0.0) && pivot && fmin(F.cone[0], F.cone[1]) <= 0.0 &&
+               slide_edge(&p, &t, &accel)) {
+        /* An edge that cannot stick: both its contacts slide from rest,
+         * as one contact's would above, unless another vertex lands
+         * first. */
+        if (pd_phase_forces_of(&p, &t, &F))
+            return 0;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+        if (least > 0.0 && lands_first(&p, &t, slip_min, 2.0 * slip_min / accel))
+            return 0;
+    }
+    if (stuck_out) {
+        /* Outside the cone, but so near its edge that the slide from rest
+         * has no direction found, or turning too fast for lands_first to
+         * judge the slide (a top precessing on a corner, the excess tiny
+         * and the slide slow, which mostly ends with the sticking force
+         * back inside the cone): it starts to slip all the same, clipped
+         * (phase_forces.h), the slide's limit at the cone's edge. */
+        p.mode[0] = PD_PHASE_CLIP;
+        if (pd_phase_forces_of(&p, &t, &F))
+            return 0;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+    }
+    if (!(least > 0.0)) {
+        /* An edge one of whose contacts would pull on the floor (its normal
+         * force not positive) lifts off there: the other's phase, alone,
+         * is the edge's. */
+        for (int i = 0; i < nc && nc == 2; i++)
+            if (!(g[i] > 0.0) && g[1 - i] > 0.0)
+                return pd_contact_phase_start(st, sc, s, contacts + 1 - i, 1, phase);
         return 0;
+    }
     /* The phase goes on with the modes the projection was for: taken
      * afresh from t, a contact that slid above the start threshold and
      * slips less after the projection would count as sticking, and its
      * force would push it along at that slip, doing work. */
     *s = t;
     *phase = p;
+    return 1;
+}
+
+/* Where the phase would end at a: a contact sliding from rest whose slip
+ * has reached the start threshold (its margin the least) slides on as any
+ * other, its friction along its own slip from here, and a is evaluated
+ * again for that. 1 if the phase goes on. */
+static int slides_on(const motion *mo, pd_phase *p, double slip_min, point *a)
+{
+    for (int i = 0; i < p->nc; i++)
+        if (p->from_rest[i] && a->g[2 + i] <= a->least) {
+            double y[NY];
+            memcpy(y, a->y, sizeof y);
+            p->from_rest[i] = 0;
+            point_at(mo, slip_min, a->tau, y, a);
+            return a->least > 0.0;
+        }
+    return 0;
+}
+
+/* At a located event within tol of cur, the crossing of end's margins:
+ * where the one margin crossed is a lone sticking contact's friction cone,
+ * the contact starts to slide from rest there, within the phase: cur steps
+ * past the crossing (dt to it, then half the tolerance) and the contact
+ * goes on sliding from rest (pd_phase_slide_from_rest) or, where that
+ * finds no direction (mostly: so near the cone's edge), clipped
+ * (phase_forces.h). Ending the phase there instead handed a contact that
+ * grazes the cone back and forth between phases that each stopped short
+ * of the crossing and microcollisions that each put it back (60,000 of
+ * them in 0.01 s on a 0.1 mm top). 1 if cur is the slide's new start, with
+ * positive margins; 0 (cur and p as they were) to end the phase. */
+static int slip_onset(const motion *mo, pd_ode *ode, pd_phase *p, double slip_min, double dt,
+                      double tol, point *cur, const point *end)
+{
+    if (!(p->nc == 1 && p->mode[0] == PD_PHASE_STICK && end->least > -1.0 && end->g[2] <= 0.0))
+        return 0;
+    for (int k = 0; k < NMARGIN; k++)
+        if (k != 2 && !(end->g[k] > 0.0))
+            return 0;
+    double y[NY], tau = cur->tau, h = dt + 0.5 * tol, accel;
+    memcpy(y, cur->y, sizeof y);
+    if (pd_ode_step_from(ode, phase_rhs, (void *)mo, &tau, cur->tau + h, &h, y, cur->dydt) !=
+        PD_OK)
+        return 0;
+    pd_phase q = *p;
+    point at;
+    point_at(mo, slip_min, tau, y, &at); /* for its state */
+    if (!pd_phase_slide_from_rest(p, &at.s, &accel))
+        p->mode[0] = PD_PHASE_CLIP; /* so near the cone's edge, its limit */
+    point_at(mo, slip_min, tau, y, &at);
+    if (!(at.least > 0.0)) {
+        *p = q;
+        return 0;
+    }
+    *cur = at;
     return 1;
 }
 
@@ -620,8 +808,15 @@ pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_o
                                 : predicted_event(&p, prev, cur,
                                                   fmin(ahead_steps * h,
                                                        ahead_intervals * (cur->tau - prev->tau)));
-            if (dt <= tol)
-                break;
+            if (dt <= tol) {
+                if (slides_on(&mo, &p, slip_min, cur))
+                    continue;
+                if (!bracket || !slip_onset(&mo, ode, &p, slip_min, dt, tol, cur, end))
+                    break;
+                *s = cur->s;
+                bracket = 0, target = INFINITY;
+                continue;
+            }
             if (isfinite(dt)) {
                 target = cur->tau + dt - 0.5 * tol;
                 h = target - cur->tau;
@@ -647,8 +842,14 @@ pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_o
             bracket = 1;
             dt = time_to_event(&mo, slip_min, cur, end);
         }
-        if (dt <= tol)
-            break;
+        if (dt <= tol) {
+            if (!slides_on(&mo, &p, slip_min, cur) &&
+                !(modelled && slip_onset(&mo, ode, &p, slip_min, dt, tol, cur, end)))
+                break;
+            *s = cur->s;
+            bracket = 0, target = INFINITY;
+            continue;
+        }
         target = cur->tau + (modelled ? dt - 0.5 * tol : dt);
         h = target - cur->tau;
     }

@@ -17,6 +17,13 @@ pd_ode *pd_contact_pivot_ode_alloc(void);
 /* The same with their tolerance times tol_scale (in (0, 1]), for tests of
  * convergence. */
 pd_ode *pd_contact_phase_ode_alloc_tol(double tol_scale);
+/* The full motion's integrator for a phase that starts spinning fast
+ * (pd_contact_phase_spins_fast), the same tolerance times tol_scale; NULL
+ * if out of memory. */
+pd_ode *pd_contact_phase_spin_ode_alloc_tol(double tol_scale);
+/* 1 if body b in state s turns faster than PD_PHASE_SPIN_FAST per
+ * sqrt(L/g) under gravity g: its phase takes the spin integrator. */
+int pd_contact_phase_spins_fast(const pd_body *b, double g, const pd_state *s);
 pd_ode *pd_contact_pivot_ode_alloc_tol(double tol_scale);
 
 /* 1 if state s, touching the floor at body vertices contacts[0..nc), is a

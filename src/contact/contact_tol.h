@@ -66,6 +66,62 @@
  * microcollisions go on, so nothing is lost but time. */
 #define PD_PHASE_MAX_STEPS 10000
 
+/* A phase starting with the part turning faster than this many radians per
+ * sqrt(L/g) is integrated by rk8pd rather than rkck (contact_phase.c). At
+ * the phase tolerance rkck's steps turn the part by about 0.2 rad, so from
+ * about 5 rad per sqrt(L/g) (where the first trial step, 0.05 sqrt(L/g),
+ * turns it 0.25 rad) its steps are set by the turn, not by the phase's
+ * events, and rk8pd's steps, about 4 times longer for twice the right-hand
+ * sides, cost half as much: a 0.1 mm cube spinning as a top on a vertex at
+ * 15 rad per sqrt(L/g) took 9.5-9.8 ms of CPU per simulated second with
+ * rkck and 4.8-5.3 ms with rk8pd. Ordinary drops' phases start below 3 (the
+ * cube, the 1 x 2 x 3 box, the coin and the cap, 300 drops each: at most
+ * 3.0, 2.2, 2.2, 2.0), so they keep rkck, cheaper for their short phases. */
+#define PD_PHASE_SPIN_FAST 5.0
+
+/* A contact that starts to slide from rest (phase_forces.h,
+ * pd_phase_slide_from_rest) takes a direction in which its tangential
+ * acceleration stays along its slip: a zero of a cross product over the
+ * circle of directions, found by a sign change between neighbouring ones of
+ * this many, then narrowed to round-off. Why 36: times the normal force's
+ * denominator the cross product is a trigonometric polynomial of degree 2,
+ * with at most four zeros, so cells of 10 degrees miss only two zeros
+ * closer than that, where the slide's direction is ill-defined anyway (the
+ * phase is then refused, and microcollisions go on as before). Not a
+ * setting: every zero found is exact to round-off. */
+#define PD_PHASE_START_CELLS 36
+/* An edge whose two contacts start to slide from rest: their directions by
+ * Newton's method from the best common one, at most this many iterations
+ * (quadratic convergence takes a handful from a start within a cell; a
+ * planar slide, the common case, starts on its answer); not converged, the
+ * phase is refused as before. */
+#define PD_PHASE_START_NEWTON 30
+/* ...converged when the two residuals (cross products of direction and
+ * tangential acceleration, m/s^2) sum to at most this times g: the
+ * accelerations' round-off is ~1e-16 of their few g, so 1e-12 is reached
+ * in a step or two of quadratic convergence, and it turns the directions
+ * by ~1e-12 rad, nothing the phase's 1e-8 error per step can see. */
+#define PD_TOL_PHASE_START_RESIDUAL 1e-12
+/* ...with the Jacobian from differences of this step in each angle (rad):
+ * about the square root of the residual's relative round-off, where a
+ * forward difference is most accurate. */
+#define PD_PHASE_START_DIFF 1e-7
+
+/* lands_first (contact_phase.c) judges a slide from rest by the first order
+ * of the other vertices' heights over the time the slide takes to reach a
+ * slide's speed; it is believed only where the part turns by less than this
+ * (rad) over that time. Why 1 radian: the first order of a height that a
+ * turn moves as sin(w t) is off by a sixth of it there and by more beyond,
+ * where a spinning part's corners bob up and down within the horizon (a
+ * 0.1 mm top on a corner turns thousands of radians over its slow slide's):
+ * believed there, lands_first refused the slide at every start and
+ * microcollisions carried the slip, 100,000 of them within seconds in 8 of
+ * 200 drops. Ordinary parts turn far less: against a build that believed
+ * it at any turn (and without the rest of the tops' changes), the cube,
+ * box and coin ended on the same pose in each of 2000 drops, the cap in
+ * 1986. */
+#define PD_PHASE_LANDS_TURN 1.0
+
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */
 
@@ -73,7 +129,7 @@
  * infinite (the contact never restores) and its duration with it. Why 0.01:
  * a rebound of 1% of the approach speed carries 1e-4 of the impact's energy,
  * below what any pose statistic resolves, while chi stays at 100 and a
- * contact takes about 850 of compliant.c's steps. */
+ * contact takes about 210 of compliant.c's steps. */
 #define PD_COMPLIANT_E_MIN 0.01
 
 /* Relative accuracy of chi and tau: far below anything a drop resolves, and
@@ -88,17 +144,44 @@
 /* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
 #define PD_COMPLIANT_LAW_MAX_HALVINGS 200
 
-/* The step, as a fraction of the fastest time scale of one contact: its
- * oscillation 1 / omega, shortened by the damping rate the law reaches at
- * its deepest (omega chi s_peak), and by sqrt(n) with n contacts below the
- * floor, since n springs of one contact's stiffness on a rigid body vibrate
- * up to sqrt(n) times faster (the trace of their coupling). Why 0.25: about
- * 40 steps per contact duration at e = 0.3 with one contact (850 at the
- * smallest e, 0.01); a flat landing's rebound then comes out within 4e-4 of
- * e, and halving it moves no pose probability beyond sampling noise
- * (tests/unit/test_compliant.c). Larger: the explicit step loses accuracy,
- * and stability beyond 2. */
-#define PD_COMPLIANT_STEP 0.25
+/* The step with one contact is, going up from short steps, the last whose
+ * rebound from a flat landing (the scaled law, pd_compliant_law_step) is within
+ * PD_COMPLIANT_E_TOL of the law's restitution, wherever in a step the
+ * contact starts; with n contacts below the floor or coming below within
+ * the step it is shortened by sqrt(n), since n springs of one contact's
+ * stiffness on a rigid body vibrate up to sqrt(n) times faster (the trace
+ * of their coupling), and with two by the square root of their fastest
+ * mode's stiffness over one contact's (exact, compliant.c's pair_mode). Why
+ * 1e-3: a rebound off by a thousandth of the approach speed, either sign by
+ * where the touch falls in the step (the error averaged over the touch is
+ * under 1e-6 at e = 0.3, 0.6, 0.9), is far below what a pose statistic
+ * resolves (restitutions themselves are known to a few percent), and
+ * halving the step moves no pose probability beyond sampling noise
+ * (tests/unit/test_compliant.c). At e = 0.3 this is about 16 steps per
+ * contact duration (a fixed 40 gave 1.5e-4), at e = 0.9 about 28 (15 gave
+ * 5e-3), at e = 0.1 the bound below, 25 (98 gave 4e-7), at e = 0.01 212
+ * (848).
+ * PD_COMPLIANT_STEP_MAX bounds the step by the law's fastest rate, its
+ * oscillation 1 / omega and its damping rate at the deepest (omega chi
+ * s_peak): the explicit step is unstable beyond about 2, and at 1 it keeps
+ * half of that in reserve for several contacts' coupling and the body's
+ * turning. The touches tried are PD_COMPLIANT_STEP_PHASES evenly spread
+ * over a step from its start (a touch at a step's start is the worst at
+ * e = 0.3; between the touches tried the error varies smoothly). The search
+ * starts PD_COMPLIANT_STEP_START times below the bound (the error there is
+ * about its square times smaller), halving while that misses (at most
+ * PD_COMPLIANT_STEP_TRIES times), doubles up to the first step that misses
+ * and bisects to PD_COMPLIANT_STEP_REL of the step: the step moves less
+ * than that with it, far less than the tolerance does. A step interpolated
+ * in a table of laws that misses the tolerance is shortened by
+ * PD_COMPLIANT_STEP_SHRINK at a time (a tenth: a few checks at most). */
+#define PD_COMPLIANT_E_TOL 1e-3
+#define PD_COMPLIANT_STEP_MAX 1.0
+#define PD_COMPLIANT_STEP_PHASES 16
+#define PD_COMPLIANT_STEP_START 64.0
+#define PD_COMPLIANT_STEP_TRIES 60
+#define PD_COMPLIANT_STEP_REL 1e-3
+#define PD_COMPLIANT_STEP_SHRINK 0.9
 
 /* Vertices within this times L above the floor are watched for contact, and
  * the list is rebuilt once the part may have moved half of it. Why 0.02: a
@@ -111,7 +194,7 @@
 /* Gauss-Seidel sweeps over the contacts' friction impulses per step, at
  * most, and the stop: no impulse moved by more than this times its cone's
  * radius in a sweep. Why 1e-6: the friction impulses are then converged far
- * below the step's own error (PD_COMPLIANT_STEP); sticking faces converge in
+ * below the step's own error (PD_COMPLIANT_E_TOL); sticking faces converge in
  * a few sweeps. 32 only stops a pathological coupling. */
 #define PD_COMPLIANT_SWEEPS 32
 #define PD_COMPLIANT_SWEEP_TOL 1e-6

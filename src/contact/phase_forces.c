@@ -18,7 +18,7 @@
 #include "base/quat.h"
 #include "base/vec3.h"
 
-enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK };
+enum { SLIDE = PD_PHASE_SLIDE, STICK = PD_PHASE_STICK, CLIP = PD_PHASE_CLIP };
 
 /* Solves A X = B for m right-hand sides in place: Ab holds [A | B] (n rows,
  * n + m columns) and B's columns become X's, by Gaussian elimination with
@@ -184,9 +184,34 @@ static int solve_layout(const pd_phase *p, const layout *L, pd_vec3 up, int dril
     return 1;
 }
 
+/* No contact slides: the constrained rows are the body axes (a clipped
+ * contact's sticking force is solved first, then clipped). */
 static int all_stick(const pd_phase *p)
 {
-    return p->mode[0] == STICK && (p->nc == 1 || p->mode[1] == STICK);
+    return p->mode[0] != SLIDE && (p->nc == 1 || p->mode[1] != SLIDE);
+}
+
+/* A lone clipped contact (phase_forces.h): its sticking force fs (body
+ * frame) becomes lambda d, d = n + mu t the cone's edge along fs's
+ * tangential direction t, lambda holding the normal acceleration at zero
+ * with the drilling couple, -drill lambda n, turning the part as it does
+ * the sticking force; *excess: how far fs lies outside the cone. 1 where
+ * fs has no tangential direction. */
+static int clip_force(const pd_phase *p, pd_vec3 up, pd_vec3 af, pd_vec3 *f, double *excess)
+{
+    double fn = v3_dot(*f, up);
+    pd_vec3 ft = v3_sub(*f, v3_scale(up, fn));
+    double t = v3_norm(ft);
+    if (!(t > 0.0))
+        return 1;
+    *excess = t - p->mu * fn;
+    pd_vec3 d = v3_add(up, v3_scale(ft, p->mu / t));
+    pd_vec3 u = v3_cross(pd_body_inv_inertia(p->b, up), p->r[0]);
+    double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d)) - p->drill[0] * v3_dot(up, u);
+    if (!(fabs(k) > 0.0))
+        return 1;
+    *f = v3_scale(d, -v3_dot(up, af) / k);
+    return 0;
 }
 
 /* The velocity of contact j of state s (world), R the body-to-world matrix;
@@ -251,6 +276,38 @@ void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_
     pd_phase_map(p);
 }
 
+/* mu times the world direction of sliding contact j's slip, from its
+ * velocity vel (world) of tangential speed sl, or its start direction while
+ * it slides from rest; 0 where it has no direction. */
+static int friction_dir(const pd_phase *p, int j, pd_vec3 vel, double sl, double *cx, double *cy)
+{
+    if (p->from_rest[j]) {
+        *cx = p->mu * p->t0[j].x, *cy = p->mu * p->t0[j].y;
+        return 1;
+    }
+    if (!(sl > 0.0))
+        return 0;
+    *cx = p->mu * vel.x / sl, *cy = p->mu * vel.y / sl;
+    return 1;
+}
+
+/* Contact 0 of a lone contact sliding from rest, af its free acceleration
+ * (body frame): how far its sticking force would lie outside the friction
+ * cone, |ft| - mu fn of the sticking solution (P, set while it stuck). Where
+ * this is no longer positive the contact would stick again, and its slide
+ * from rest is over (contact_phase.c): a top precessing on a corner needs
+ * a little more friction than the cone gives for a moment of each turn,
+ * and slides with friction fixed along the start direction would go on
+ * past it, pushing the contact back along its slip. */
+static double stick_excess(const pd_phase *p, pd_vec3 up, pd_vec3 af)
+{
+    pd_vec3 f = v3(-(p->P[0][0] * af.x + p->P[0][1] * af.y + p->P[0][2] * af.z),
+                   -(p->P[1][0] * af.x + p->P[1][1] * af.y + p->P[1][2] * af.z),
+                   -(p->P[2][0] * af.x + p->P[2][1] * af.y + p->P[2][2] * af.z));
+    double fn = v3_dot(f, up);
+    return v3_norm(v3_sub(f, v3_scale(up, fn))) - p->mu * fn;
+}
+
 /* One sliding contact, the commonest phase (314 of the coin's 334
  * median-band phases), written out: the force is lambda d, d = n - mu s the
  * sliding direction (body frame), lambda from the one row n . (a_free +
@@ -263,11 +320,10 @@ static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s,
     const pd_body *b = p->b;
     pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), w = s->w;
     pd_vec3 wr, vel = contact_velocity(p, R, s, 0, &wr);
-    double sl = sqrt(vel.x * vel.x + vel.y * vel.y);
-    if (!(sl > 0.0))
+    double sl = sqrt(vel.x * vel.x + vel.y * vel.y), cx, cy;
+    if (!friction_dir(p, 0, vel, sl, &cx, &cy))
         return 1;
     pd_vec3 af = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[0]), v3_cross(w, wr)));
-    double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
     pd_vec3 d = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
                    up.z - cx * R[0][2] - cy * R[1][2]);
     double k = v3_dot(up, m3_vec(CONST_M3(p->M[0][0]), d));
@@ -277,7 +333,7 @@ static int slide_one(const pd_phase *p, const double R[3][3], const pd_state *s,
     out->wdot = v3_add(a0, pd_body_inv_inertia(b, v3_cross(p->r[0], v3_scale(d, lambda))));
     out->acc = v3(-cx * lm, -cy * lm, lm - p->g);
     out->fn[0] = lambda;
-    out->cone[0] = HUGE_VAL;
+    out->cone[0] = p->from_rest[0] ? stick_excess(p, up, af) : HUGE_VAL;
     out->slip[0] = sl;
     return 0;
 }
@@ -306,11 +362,11 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         af[j] = v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[j]), v3_cross(w, wr)));
         dir[j] = up;
         if (p->mode[j] == SLIDE) {
-            if (!(sl > 0.0))
-                return 1;
             /* R^T (-mu s_x, -mu s_y, 1): rows 0 and 1 of R are the world's
              * x and y axes in the body frame. */
-            double cx = p->mu * vel.x / sl, cy = p->mu * vel.y / sl;
+            double cx, cy;
+            if (!friction_dir(p, j, vel, sl, &cx, &cy))
+                return 1;
             dir[j] = v3(up.x - cx * R[0][0] - cy * R[1][0], up.y - cx * R[0][1] - cy * R[1][1],
                         up.z - cx * R[0][2] - cy * R[1][2]);
         }
@@ -378,6 +434,9 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         for (int k = 0; k < L.n; k++)
             f[L.c[k]] = v3_add(f[L.c[k]], v3_scale(L.col[k], x[k][0]));
     }
+    double excess = 0.0;
+    if (p->mode[0] == CLIP && clip_force(p, up, af[0], &f[0], &excess))
+        return 1;
     pd_vec3 F = v3(0.0, 0.0, 0.0);
     out->wdot = a0;
     for (int j = 0; j < p->nc; j++)
@@ -390,10 +449,235 @@ static int forces(const pd_phase *p, const pd_state *s, int general, pd_phase_fo
         double fn = v3_dot(f[j], up);
         out->fn[j] = fn;
         out->cone[j] = p->mode[j] == STICK ? p->mu * fn - v3_norm(v3_sub(f[j], v3_scale(up, fn)))
+                       : p->mode[j] == CLIP ? excess
+                       : p->from_rest[j]    ? stick_excess(p, up, af[j])
                                             : HUGE_VAL;
     }
     out->acc = v3_add(m3_vec(CONST_M3(R), v3_scale(F, 1.0 / b->mass)), v3(0.0, 0.0, -p->g));
     return 0;
+}
+
+/* The free acceleration of contact i at s (body frame; up, the world's):
+ * gravity, the gyroscopic angular acceleration and the centripetal term. */
+static pd_vec3 free_accel(const pd_phase *p, const pd_state *s, pd_vec3 up, int i)
+{
+    const pd_body *b = p->b;
+    pd_vec3 w = s->w, wr = v3_cross(w, p->r[i]);
+    pd_vec3 Iw = v3(b->moment[0] * w.x, b->moment[1] * w.y, b->moment[2] * w.z);
+    pd_vec3 a0 = v3_neg(pd_body_inv_inertia(b, v3_cross(w, Iw)));
+    return v3_add(v3_scale(up, -p->g), v3_add(v3_cross(a0, p->r[i]), v3_cross(w, wr)));
+}
+
+/* Sliding along the world's horizontal unit direction t = (c, s), contact
+ * 0's normal force is A / k and k times its tangential acceleration (world)
+ * is affine in (c, s): k a_x = p0 + p1 c + p2 s, k a_y = q0 + q1 c + q2 s
+ * (pd_phase_slide_from_rest). Of that, k times the cross product t x a, a
+ * quadratic form in (c, s), and k itself. */
+typedef struct {
+    double k0, k1, k2, p0, p1, p2, q0, q1, q2;
+} slide_form;
+
+static double form_cross(const slide_form *f, double c, double s)
+{
+    return c * (f->q0 + f->q1 * c + f->q2 * s) - s * (f->p0 + f->p1 * c + f->p2 * s);
+}
+
+int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
+{
+    if (p->nc != 1 || p->mode[0] != STICK || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    pd_vec3 up = v3(R[2][0], R[2][1], R[2][2]), X = v3(R[0][0], R[0][1], R[0][2]);
+    pd_vec3 Y = v3(R[1][0], R[1][1], R[1][2]), af = free_accel(p, s, up, 0);
+    /* The force is lambda d, d = n - mu t (body frame: up - mu (c X + s Y)),
+     * so M d = m0 - mu (c mx + s my), k = up . M d, lambda = A / k with
+     * A = -up . af, and k a = k af + A M d. */
+    double A = -v3_dot(up, af), mu = p->mu;
+    if (!(A > 0.0))
+        return 0; /* nothing presses the contact onto the floor */
+    const double(*M)[3] = CONST_M3(p->M[0][0]);
+    pd_vec3 m0 = m3_vec(M, up), mx = m3_vec(M, X), my = m3_vec(M, Y);
+    double xa = v3_dot(X, af), ya = v3_dot(Y, af);
+    slide_form f = {v3_dot(up, m0), -mu * v3_dot(up, mx), -mu * v3_dot(up, my), 0, 0, 0, 0, 0, 0};
+    f.p0 = f.k0 * xa + A * v3_dot(X, m0);
+    f.p1 = f.k1 * xa - A * mu * v3_dot(X, mx);
+    f.p2 = f.k2 * xa - A * mu * v3_dot(X, my);
+    f.q0 = f.k0 * ya + A * v3_dot(Y, m0);
+    f.q1 = f.k1 * ya - A * mu * v3_dot(Y, mx);
+    f.q2 = f.k2 * ya - A * mu * v3_dot(Y, my);
+    /* The directions the slip keeps are the zeros of t x a with k > 0;
+     * those it grows along (t . a > 0) are the ones a slide from rest can
+     * take. Bracketed between neighbours of PD_PHASE_START_CELLS directions
+     * round the circle (turned by one rotation each, no trigonometry), each
+     * then narrowed to round-off. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
+    double best = 0.0, bc = 0.0, bs = 0.0, c0 = 1.0, s0 = 0.0, f0 = form_cross(&f, c0, s0);
+    for (int k = 1; k <= PD_PHASE_START_CELLS; k++) {
+        double c1 = k == PD_PHASE_START_CELLS ? 1.0 : c0 * cd - s0 * sd;
+        double s1 = k == PD_PHASE_START_CELLS ? 0.0 : s0 * cd + c0 * sd, f1 = form_cross(&f, c1, s1);
+        if ((f0 <= 0.0) != (f1 <= 0.0)) {
+            /* Regula falsi along the chord, projected onto the circle
+             * (the Illinois variant, which halves the retained end's value
+             * when the same end moves twice), to round-off. */
+            double lc = c0, ls = s0, flo = f0, hc = c1, hs = s1, fhi = f1;
+            int side = 0;
+            for (int i = 0; i < 60; i++) { /* a bound: it stalls at round-off first */
+                double u = flo / (flo - fhi);
+                double mc = lc + u * (hc - lc), ms = ls + u * (hs - ls), n = sqrt(mc * mc + ms * ms);
+                mc /= n, ms /= n;
+                if ((mc == lc && ms == ls) || (mc == hc && ms == hs))
+                    break;
+                double fm = form_cross(&f, mc, ms);
+                if (fm == 0.0) {
+                    lc = mc, ls = ms;
+                    break;
+                }
+                if ((fm <= 0.0) == (flo <= 0.0)) {
+                    lc = mc, ls = ms, flo = fm;
+                    if (side == -1)
+                        fhi *= 0.5;
+                    side = -1;
+                } else {
+                    hc = mc, hs = ms, fhi = fm;
+                    if (side == 1)
+                        flo *= 0.5;
+                    side = 1;
+                }
+            }
+            double kk = f.k0 + f.k1 * lc + f.k2 * ls;
+            double along = (lc * (f.p0 + f.p1 * lc + f.p2 * ls) + ls * (f.q0 + f.q1 * lc + f.q2 * ls)) / kk;
+            if (kk > 0.0 && along > best)
+                best = along, bc = lc, bs = ls;
+        }
+        c0 = c1, s0 = s1, f0 = f1;
+    }
+    if (!(best > 0.0))
+        return 0;
+    p->mode[0] = SLIDE;
+    p->from_rest[0] = 1;
+    p->t0[0] = v3(bc, bs, 0.0);
+    p->drill[0] = 0.0; /* a sliding contact's friction goes to its slip */
+    *accel = best;
+    return 1;
+}
+
+/* What an edge's slide from rest needs of the state, once: the world's axes
+ * in the body frame, each contact's free acceleration, and each response
+ * M[k][j] applied to up, X and Y (the force direction d = up - mu (c X +
+ * s Y) is their combination). */
+typedef struct {
+    pd_vec3 up, X, Y, af[2], Mu[2][2], MX[2][2], MY[2][2];
+    double mu;
+} edge_setup;
+
+/* Both contacts of the edge sliding along the world's horizontal unit
+ * directions (c[k], s[k]): each one's cross product of its direction with its
+ * tangential acceleration (world) into r[], the slip's acceleration along
+ * its direction into along[], its normal force into lambda[]; 0 if the
+ * 2 x 2 system of the normal forces is singular. */
+static int edge_residual(const edge_setup *e, const double c[2], const double sn[2], double r[2],
+                         double along[2], double lambda[2])
+{
+    pd_vec3 Md[2][2];
+    for (int k = 0; k < 2; k++)
+        for (int j = 0; j < 2; j++)
+            Md[k][j] = v3_sub(e->Mu[k][j], v3_add(v3_scale(e->MX[k][j], e->mu * c[j]),
+                                                  v3_scale(e->MY[k][j], e->mu * sn[j])));
+    double A[6][AUG];
+    for (int i = 0; i < 2; i++) {
+        for (int j = 0; j < 2; j++)
+            A[i][j] = v3_dot(e->up, Md[i][j]);
+        A[i][2] = -v3_dot(e->up, e->af[i]);
+    }
+    if (!solve_small(2, A))
+        return 0;
+    lambda[0] = A[0][2], lambda[1] = A[1][2];
+    for (int k = 0; k < 2; k++) {
+        pd_vec3 a = v3_add(e->af[k], v3_add(v3_scale(Md[k][0], lambda[0]), v3_scale(Md[k][1], lambda[1])));
+        double ax = v3_dot(e->X, a), ay = v3_dot(e->Y, a);
+        r[k] = c[k] * ay - sn[k] * ax;
+        along[k] = c[k] * ax + sn[k] * ay;
+    }
+    return 1;
+}
+
+/* edge_residual at angles th[0], th[1]. */
+static int edge_residual_at(const edge_setup *e, const double th[2], double r[2], double along[2],
+                            double lambda[2])
+{
+    const double c[2] = {cos(th[0]), cos(th[1])}, sn[2] = {sin(th[0]), sin(th[1])};
+    return edge_residual(e, c, sn, r, along, lambda);
+}
+
+int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
+{
+    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    edge_setup e;
+    e.up = v3(R[2][0], R[2][1], R[2][2]), e.X = v3(R[0][0], R[0][1], R[0][2]);
+    e.Y = v3(R[1][0], R[1][1], R[1][2]), e.mu = p->mu;
+    for (int k = 0; k < 2; k++) {
+        e.af[k] = free_accel(p, s, e.up, k);
+        for (int j = 0; j < 2; j++) {
+            e.Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.up);
+            e.MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.X);
+            e.MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.Y);
+        }
+    }
+    /* A start: the common direction, of PD_PHASE_START_CELLS round the
+     * circle (turned by one rotation each), where both slips grow under
+     * positive normal forces with the smallest residual; then Newton's
+     * method on both directions (its Jacobian by differences), to round-off
+     * of the residual. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
+    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL, c = 1.0, sn = 0.0;
+    for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
+        const double cc[2] = {c, c}, ss[2] = {sn, sn};
+        if (edge_residual(&e, cc, ss, r, along, lambda) && lambda[0] > 0.0 && lambda[1] > 0.0 &&
+            along[0] > 0.0 && along[1] > 0.0 && r[0] * r[0] + r[1] * r[1] < best)
+            best = r[0] * r[0] + r[1] * r[1], th[0] = th[1] = step * k;
+        double c1 = c * cd - sn * sd;
+        sn = sn * cd + c * sd, c = c1;
+    }
+    if (!(best < HUGE_VAL))
+        return 0;
+    double h = PD_PHASE_START_DIFF;
+    int converged = 0;
+    for (int it = 0; it < PD_PHASE_START_NEWTON && !converged; it++) {
+        if (!edge_residual_at(&e, th, r, along, lambda))
+            return 0;
+        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * p->g) {
+            converged = 1;
+            break;
+        }
+        double J[2][2], rh[2], ah[2], lh[2];
+        for (int k = 0; k < 2; k++) {
+            double tk[2] = {th[0], th[1]};
+            tk[k] += h;
+            if (!edge_residual_at(&e, tk, rh, ah, lh))
+                return 0;
+            J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
+        }
+        double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        if (!(fabs(det) > 0.0))
+            return 0;
+        th[0] -= (J[1][1] * r[0] - J[0][1] * r[1]) / det;
+        th[1] -= (J[0][0] * r[1] - J[1][0] * r[0]) / det;
+    }
+    if (!converged || !(lambda[0] > 0.0) || !(lambda[1] > 0.0) || !(along[0] > 0.0) ||
+        !(along[1] > 0.0))
+        return 0;
+    for (int k = 0; k < 2; k++) {
+        p->mode[k] = SLIDE;
+        p->from_rest[k] = 1;
+        p->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
+        p->drill[k] = 0.0;
+    }
+    *accel = fmin(along[0], along[1]);
+    return 1;
 }
 
 int pd_phase_forces_of(const pd_phase *p, const pd_state *s, pd_phase_forces *out)

@@ -6,7 +6,19 @@
 
 #include "dynamics/body.h"
 
-enum { PD_PHASE_SLIDE, PD_PHASE_STICK };
+/* PD_PHASE_CLIP: a lone contact that sticks (slips slower than a slide
+ * starts) but whose sticking force lies just outside the friction cone,
+ * where pd_phase_slide_from_rest finds no direction (its two candidate
+ * directions merge as the excess vanishes, closer than its search
+ * resolves), or turning too fast for the slide to be judged
+ * (contact_phase.c): it starts to slip all the same. Its force is the sticking
+ * force's pull clipped to the cone's edge, mu fn along the tangent the
+ * sticking force pulls along, with fn holding the normal acceleration at
+ * zero, so the force is continuous where it began and the contact slips
+ * from rest at the rate the excess gives; the limit of the slide from rest
+ * as the excess vanishes (contact_phase.c ends it where the sticking force
+ * is back inside the cone or the slip has become a slide). */
+enum { PD_PHASE_SLIDE, PD_PHASE_STICK, PD_PHASE_CLIP };
 
 /* One phase's contacts and what its force solve needs. In the body frame a
  * contact's response to a force is a constant 3 x 3 matrix, and a sticking
@@ -17,13 +29,18 @@ typedef struct {
     const pd_body *b;
     int nc;
     int v[2];          /* contact vertices */
-    int mode[2];       /* PD_PHASE_SLIDE or PD_PHASE_STICK */
+    int mode[2];       /* PD_PHASE_SLIDE, PD_PHASE_STICK or (one contact)
+                          PD_PHASE_CLIP */
     double mu, g;      /* SI */
     double drill[2];   /* a sticking contact of a phase that can spin about
                           the floor's normal (not a pivot): its drilling
                           friction's couple per unit normal force,
                           (2/3) mu a (m), signed as the spin at the phase's
                           start; 0: none (pd_phase_modes sets none) */
+    int from_rest[2];  /* a sliding contact that started from rest: its
+                          friction's direction is t0, not its slip's, until it
+                          slips (pd_phase_slide_from_rest) */
+    pd_vec3 t0[2];     /* ...that direction, world, unit, horizontal */
     double L, T;       /* units: length, time */
     pd_vec3 r[2];      /* contact vertices, body frame */
     double M[2][2][3][3]; /* M[i][j] f: acceleration of contact i by force f at j */
@@ -34,7 +51,10 @@ typedef struct {
 
 /* What the forces of a state give: the com's acceleration (world), wdot
  * (body), and per contact its normal force, its margin inside the friction
- * cone (sticking: mu fn - |ft|; sliding: infinite) and its slip speed. */
+ * cone (sticking: mu fn - |ft|; sliding from rest or clipped: how far its
+ * sticking force would lie outside the cone, |ft| - mu fn of the sticking
+ * solution, which the slip from rest lasts while it is positive; sliding:
+ * infinite) and its slip speed. */
 typedef struct {
     pd_vec3 acc, wdot;
     double fn[2], cone[2], slip[2];
@@ -52,6 +72,22 @@ void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd
 void pd_phase_map(pd_phase *p);
 void pd_phase_init(pd_phase *p, const pd_body *b, double g, double mu, const pd_state *s,
                    const int *contacts, int nc, double slip_start);
+
+/* A single sticking contact whose force leaves the friction cone starts to
+ * slide from rest, in a direction t0 in which it then accelerates: sliding
+ * friction -mu fn t0 leaves the contact's tangential acceleration along +t0.
+ * Sets contact 0 of p (mapped, one contact) sliding from rest along the
+ * direction of that kind it accelerates fastest in, its slip's acceleration
+ * along it into *accel (m/s^2), and returns 1; 0 (p unchanged) if there is
+ * none (sticking holds, or no direction gives a positive normal force). */
+int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
+
+/* Both contacts of an edge, sticking (a pivot) where a force leaves the
+ * friction cone, start to slide from rest: each along a direction in which
+ * its slip then grows (as above), both found together. Sets p (mapped) so,
+ * the slower slip's acceleration into *accel, and returns 1; 0 (p
+ * unchanged) if no such pair is found. */
+int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
 /* The forces of state s (SI). 0, or 1 where the model does not hold (a
  * sliding contact with no slip to give friction a direction, a singular

@@ -1,7 +1,6 @@
 /* mesh.c: units, reading a mesh file whole, telling its format, and the small
  * operations on a pd_mesh (clone, size, free). */
 #include <errno.h>
-#include <fcntl.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -12,6 +11,7 @@
 #include "mesh/mesh_internal.h"
 #include "mesh/mesh_reader.h"
 #include "posedrop/mesh.h"
+#include "base/file_read.h"
 #include "base/vec3.h"
 
 double pd_units_scale(pd_units units)
@@ -252,10 +252,10 @@ static pd_status slurp(int fd, const char *path, size_t max, pd_mesh_format form
             break;
         n += (size_t)got;
     }
-    if (n == 0 && S_ISFIFO(sb.st_mode)) {
+    pd_status st = pd_file_check_fifo(fd, n, path, diag);
+    if (st != PD_OK) {
         free(buf);
-        return pd_fail(diag, PD_ERR_IO, "%s: a named pipe that gave nothing to read (no "
-                       "program was writing to it)", path);
+        return st;
     }
     *out = buf;
     *size = n;
@@ -267,17 +267,9 @@ pd_status pd_mesh_read_capped(const char *path, const pd_mesh_read_options *opti
 {
     if (!path || !mesh)
         return pd_fail(diag, PD_ERR_USAGE, "pd_mesh_read: NULL %s", path ? "mesh" : "path");
-    /* Without O_NONBLOCK, opening a named pipe waits for a writer, for ever
-     * if none comes; once open, reads wait for data as usual. */
-    int fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+    int fd = pd_file_open_read(path);
     if (fd < 0)
         return pd_fail(diag, PD_ERR_IO, "%s: cannot open: %s", path, strerror(errno));
-    int flags = fcntl(fd, F_GETFL);
-    if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) < 0) {
-        int err = errno;
-        close(fd);
-        return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(err));
-    }
     unsigned char *data = NULL;
     size_t size = 0;
     pd_mesh_format format = options ? options->format : PD_FORMAT_AUTO;

@@ -15,9 +15,11 @@ pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag);
  * (exact signs of orientation: sharing a vertex or an edge, or touching
  * without crossing, is not crossing; coplanar pairs are not examined).
  * *ta < *tb are their indices and *at a point of the crossing (rounded), or
- * *ta = *tb = -1 when there is none. PD_OK or PD_ERR_NOMEM. Near-linear in
- * the triangles for a surface whose triangles are small against it (sort and
- * sweep of their bounding boxes along the axis that suits them best). */
-pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at);
+ * *ta = *tb = -1 when there is none; *tested (when not NULL) the number of
+ * pairs that reached the exact test. PD_OK or PD_ERR_NOMEM. Pairs sharing a
+ * vertex are found from the directions about it, the others by a tree of
+ * oriented boxes: about n log n for the usual surfaces, long thin triangles
+ * across the axes and fans of them about one corner included. */
+pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at, size_t *tested);
 
 #endif

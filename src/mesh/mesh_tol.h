@@ -26,4 +26,20 @@
  * other. */
 #define PD_TOL_WINDING 0.25
 
+/* The self-crossing search (mesh_selfx.c) passes a pair of triangles to its
+ * exact test unless a projection of bounding boxes sets them apart. Each
+ * projection is a few dot products of coordinates of magnitude R (the largest
+ * of the welded mesh) with unit vectors orthonormal to round-off, off by a
+ * few 1e-16 R; it is widened by this times R, a thousandfold margin, so that
+ * rounding never drops a pair that crosses. Larger: pairs apart by less are
+ * tested exactly (slower, never wrong). Smaller than the round-off: a
+ * crossing pair could be missed. */
+#define PD_SELFX_PAD_REL 1e-12
+
+/* The same for the boxes of directions from a shared vertex (unit vectors,
+ * and the meeting point of two tangents of at most 1/(1 - cos 120 deg) = 2
+ * away: round-off of a few 1e-16): an absolute widening with the same
+ * margin. */
+#define PD_SELFX_ARC_PAD 1e-12
+
 #endif

@@ -157,7 +157,7 @@ static pd_status check_no_crossing(const pd_part *p, pd_diag *diag)
 {
     int ta, tb;
     pd_vec3 at;
-    if (pd_mesh_self_crossing(p->mesh, &ta, &tb, &at) != PD_OK)
+    if (pd_mesh_self_crossing(p->mesh, &ta, &tb, &at, NULL) != PD_OK)
         return PD_ERR_NOMEM;
     if (ta < 0)
         return PD_OK;

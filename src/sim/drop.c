@@ -224,6 +224,41 @@ static void lift_onto_floor(const pd_body *b, pd_state *s, double g, double lift
     s->w = v3_scale(s->w, k);
 }
 
+/* The longest step, at most dt, over which no vertex falls by more than
+ * depth, where the centre falls at speed vz at most: a vertex at r moves
+ * vertically at vz plus (w x r).z, and (w x r).z is at most |w_h| rmax with
+ * w_h the horizontal part of the world angular velocity (spin about the
+ * vertical moves no vertex up or down). Torque-free motion turns w by at most
+ * spin_accel wmax^2 per unit time (body.h), so over a step t a vertex falls
+ * by at most (vz + |w_h| rmax) t + spin_accel wmax^2 rmax t^2 / 2. */
+static double turn_step(const pd_body *b, const pd_state *s, double wmax, double vz, double depth,
+                        double dt)
+{
+    pd_vec3 ww = quat_rotate(s->q, s->w);
+    double lin = vz + hypot(ww.x, ww.y) * b->rmax;
+    double quad = 0.5 * b->spin_accel * wmax * wmax * b->rmax;
+    if ((lin + quad * dt) * dt <= depth)
+        return dt;
+    return 2.0 * depth / (lin + sqrt(lin * lin + 4.0 * quad * depth));
+}
+
+/* Plans the flight from s when *f_at < 0 (nothing planned since the motion
+ * last changed) and sets *f_at to 0; 0 when the plan fails, the drop then
+ * marked failed. */
+static int plan_if_stale(const pd_body *b, const pd_state *s, double g, pd_flight *f, double *f_at,
+                         pd_trial *out)
+{
+    if (*f_at >= 0.0)
+        return 1;
+    pd_status st = pd_flight_plan(b, s, g, f);
+    if (st != PD_OK) {
+        pd_drop_failed(out, PD_STAGE_FLIGHT, st);
+        return 0;
+    }
+    *f_at = 0.0;
+    return 1;
+}
+
 void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  const pd_sim_options *o, long index, const double *init_cdf, pd_trial *out,
                  long *energy_gain, long *fallbacks)
@@ -231,6 +266,11 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     /* The options as the drop runs them: an automatic time limit resolved
      * (the model's, for its part and scene). */
     pd_sim_options run = *o;
+    /* Under an automatic limit, the time a part spends spinning on one
+     * vertex under drilling friction (a top) is left out of it, up to the
+     * longest such spin its energy allows: that time is the drilling's,
+     * not the part's natural time, which the limit is made of. */
+    double top_left = run.time_limit > 0 ? 0.0 : m->top_time;
     if (!(run.time_limit > 0))
         run.time_limit = m->time_limit;
     o = &run;
@@ -286,13 +326,8 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         /* The flight from s: planned afresh after anything that changed the
          * motion, else the one s already lies on, at its time f_at. */
-        if (f_at < 0.0) {
-            if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
-                pd_drop_failed(out, PD_STAGE_FLIGHT, st);
-                break;
-            }
-            f_at = 0.0;
-        }
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+            break;
         if (!resolved) {
             pd_impact imp;
             /* hint: the lowest vertex of s where decided_at looked the
@@ -315,11 +350,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  * part step by step, paid for out of the motion. */
                 w->rest_depth = fmax(w->rest_depth, -imp.height);
                 lift_onto_floor(m->body, &s, g, -imp.height, rest_from - s.x.z);
-                if ((st = pd_flight_plan(m->body, &s, g, &f)) != PD_OK) {
-                    pd_drop_failed(out, PD_STAGE_FLIGHT, st);
-                    break;
-                }
-                f_at = 0.0;
+                f_at = -1.0; /* planned by the rest step, if no impulse comes first */
             }
             if (imp.kind == PD_IMPACT_AT) {
                 if ((st = pd_flight_eval(&f, imp.t, &s)) != PD_OK) {
@@ -397,10 +428,18 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
              * (no phase can start and stop at once forever). */
             double dt;
             f_at = -1.0;
-            if ((st = pd_contact_phase(&m->settle, w->phase, w->pivot, sc, &phase, &s,
-                                       o->time_limit - t, &dt)) != PD_OK) {
+            int top = phase.nc == 1 && phase.drill[0] != 0.0;
+            pd_ode *ode = pd_contact_phase_spins_fast(m->body, g, &s) ? w->phase_spin : w->phase;
+            if ((st = pd_contact_phase(&m->settle, ode, w->pivot, sc, &phase, &s,
+                                       o->time_limit - t + (top ? top_left : 0.0), &dt)) !=
+                PD_OK) {
                 pd_drop_failed(out, PD_STAGE_CONTACT_PHASE, st);
                 break;
+            }
+            if (top) {
+                double spun = fmin(dt, top_left);
+                top_left -= spun;
+                run.time_limit += spun;
             }
             t += dt;
             phase_ok = 0;
@@ -418,24 +457,22 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
          * lands meanwhile (a face's other corners after its first one
          * rebounds), which then starts below the floor. */
         phase_ok = 1;
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+            break;
         double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
         if (rise > m->settle.v_rest)
             dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
         /* Nor long enough for any vertex to sink further than
-         * PD_REST_SINK_REL below the floor at the part's speed bound: the
-         * step is blind to vertices other than the touching ones. */
-        double speed = fabs(s.v.z) + v3_norm(s.w) * m->body->rmax;
-        if (speed * dt > PD_REST_SINK_REL * m->body->size)
-            dt = PD_REST_SINK_REL * m->body->size / speed;
+         * PD_REST_SINK_REL below the floor: the step is blind to vertices
+         * other than the touching ones. */
+        dt = turn_step(m->body, &s, f.wmax, fabs(s.v.z), PD_REST_SINK_REL * m->body->size, dt);
         /* Nor long enough for the turn to carry a vertex deeper, beyond the
          * centre's fall, than the kinetic energy can pay for lifting the part
          * back (lift_onto_floor), or than the outcome test allows for
          * (PD_REST_TURN_REL): lifted partly for free, a slowly rocking part
          * gained height every step and never settled below a low barrier. */
-        double turn = v3_norm(s.w) * m->body->rmax;
         double payable = fmax(energy_height(m->body, &s, g) - s.x.z, m->settle.margin);
-        if (turn * dt > payable)
-            dt = payable / turn;
+        dt = turn_step(m->body, &s, f.wmax, 0.0, payable, dt);
         f_at += dt;
         rest_from = s.x.z;
         if ((st = pd_flight_eval(&f, f_at, &s)) != PD_OK) {

@@ -9,6 +9,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include "base/fail.h"
+#include "base/file_read.h"
 #include "base/number.h"
 #include "base/rng.h"
 #include "posedrop/sim.h"
@@ -501,7 +502,7 @@ static char *trim(char *s)
 static pd_status read_whole(const char *path, char **out, size_t *size, pd_diag *diag)
 {
     errno = 0;
-    FILE *f = fopen(path, "rb");
+    FILE *f = pd_file_fopen_read(path);
     if (!f)
         return pd_fail(diag, PD_ERR_IO, "%s: cannot open: %s", path,
                        errno ? strerror(errno) : "unknown error");
@@ -518,10 +519,15 @@ static pd_status read_whole(const char *path, char **out, size_t *size, pd_diag 
     errno = 0;
     size_t n = fread(buf, 1, SCENE_MAX_BYTES + 1, f);
     int err = ferror(f) ? (errno ? errno : EIO) : 0;
+    pd_status st = err ? PD_OK : pd_file_check_fifo(fileno(f), n, path, diag);
     fclose(f);
     if (err) {
         free(buf);
         return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(err));
+    }
+    if (st != PD_OK) {
+        free(buf);
+        return st;
     }
     if (n > SCENE_MAX_BYTES) {
         free(buf);

@@ -23,6 +23,40 @@ void pd_sim_model_free(pd_sim_model *m)
     free(m);
 }
 
+/* The high end of scene parameter k, its field where fixed. */
+static double param_hi(const pd_scene *sc, pd_scene_param k, double fixed)
+{
+    return sc->range[k].kind == PD_DIST_FIXED ? fixed : sc->range[k].hi;
+}
+
+/* The longest body b can spin as a top on one vertex before drilling
+ * friction over a patch of radius `patch` stops it (docs/limits.md,
+ * "Tops"), s; 0 where nothing drills. Only the drilling couple, (2/3) mu a
+ * N, has a moment about the vertical through a sticking vertex (gravity's
+ * is horizontal, the contact's forces act at it), and N is the weight on
+ * average over a spin that lasts, so the vertical angular momentum about
+ * the vertex, Lz, falls at (2/3) mu a m g. Lz is at most sqrt(2 E Imax),
+ * Imax = I3 + m rmax^2 bounding the moment about any axis through a
+ * vertex and E the most energy a drop can have: its fall from the highest
+ * drop height with the centre of mass rmax above the lowest vertex, the
+ * fastest belt and tumble; mu the lowest. */
+static double top_spin_down(const pd_body *b, const pd_scene *sc, double patch)
+{
+    double g = sc->gravity, m = b->mass, mu = sc->range[PD_PARAM_MU].kind == PD_DIST_FIXED
+                                                  ? sc->mu
+                                                  : sc->range[PD_PARAM_MU].lo;
+    if (!(mu > 0.0 && patch > 0.0))
+        return 0.0;
+    const pd_dist *belt = &sc->range[PD_PARAM_BELT_SPEED];
+    double v = belt->kind == PD_DIST_FIXED ? fabs(sc->belt_speed)
+                                           : fmax(fabs(belt->lo), fabs(belt->hi));
+    double w = param_hi(sc, PD_PARAM_TUMBLE, sc->tumble);
+    double E = m * g * (param_hi(sc, PD_PARAM_HEIGHT, sc->height) + b->rmax) + 0.5 * m * v * v +
+               0.5 * b->moment[2] * w * w;
+    double Lz = sqrt(2.0 * E * (b->moment[2] + m * b->rmax * b->rmax));
+    return Lz / (2.0 / 3.0 * mu * patch * m * g);
+}
+
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
                              const pd_scene *scene, const pd_sim_options *options,
                              pd_sim_model **model, pd_diag *diag)
@@ -124,6 +158,8 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
             m->settle.patch = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity) /
                               m->compliant.law.omega;
     }
+    if (st == PD_OK)
+        m->top_time = top_spin_down(m->body, scene, m->settle.patch);
     if (st != PD_OK) {
         pd_sim_model_free(m);
         return st;
@@ -150,14 +186,17 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     } else {
         w->impact = pd_impact_work_alloc_tol(model->tol_scale);
         w->phase = pd_contact_phase_ode_alloc_tol(model->tol_scale);
+        w->phase_spin = pd_contact_phase_spin_ode_alloc_tol(model->tol_scale);
         w->pivot = pd_contact_pivot_ode_alloc_tol(model->tol_scale);
         if (model->compliant_any)
             w->compliant_work = pd_compliant_work_alloc(model->body);
     }
-    if ((!w->impact || !w->phase || !w->pivot || (model->compliant_any && !w->compliant_work)) &&
+    if ((!w->impact || !w->phase || !w->phase_spin || !w->pivot ||
+         (model->compliant_any && !w->compliant_work)) &&
         !w->world) {
         pd_impact_work_free(w->impact);
         pd_ode_free(w->phase);
+        pd_ode_free(w->phase_spin);
         pd_ode_free(w->pivot);
         pd_compliant_work_free(w->compliant_work);
         free(w);
@@ -197,6 +236,7 @@ void pd_drop_work_free(pd_drop_work *w)
         return;
     pd_impact_work_free(w->impact);
     pd_ode_free(w->phase);
+    pd_ode_free(w->phase_spin);
     pd_ode_free(w->pivot);
     pd_compliant_work_free(w->compliant_work);
     if (w->world)

@@ -30,6 +30,10 @@ typedef struct pd_sim_model {
     const pd_engine *engine;    /* NULL: the impulse simulator */
     double dt;                  /* the stepping engine's fixed step */
     double time_limit;          /* s: options->time_limit, or pd_time_limit_auto's */
+    double top_time;            /* s: the longest the part can spin as a top on
+                                   one vertex before drilling friction stops
+                                   it (0: nothing drills); an automatic
+                                   limit leaves that time out (drop.c) */
     double v_eps;               /* approach speeds below this are contact, not impact */
     double contact_time;        /* s: the scene's, PD_CONTACT_TIME_AUTO resolved */
     int compliant_on;           /* the impulse engine with contact_time > 0 */
@@ -47,6 +51,8 @@ typedef struct pd_sim_model {
 typedef struct pd_drop_work {
     pd_impact_work *impact;
     pd_ode *phase;              /* the sliding phases' integrator */
+    pd_ode *phase_spin;         /* and theirs when spinning fast
+                                   (pd_contact_phase_spins_fast) */
     pd_ode *pivot;              /* and the pivots' (contact_pivot.h) */
     pd_engine_world *world;     /* the stepping engine's, or NULL */
     pd_compliant_work *compliant_work; /* with model->compliant_any, else NULL */

@@ -13,6 +13,12 @@
  * PD_TOL_PLANE_REL), two orders above. */
 #define PD_TOL_NORMAL_TIE 1e-9
 
+/* pd_pose_transform takes the pose's normal as the rotation's third row, so
+ * it must be a unit vector: one the library computed is, to ~1e-16; this
+ * leaves room for a caller's own conversions (a float round trip gives
+ * 1e-7: refused) and refuses a normal that was never normalised. */
+#define PD_TOL_POSE_UNIT 1e-9
+
 /* Descent must lower the centre of mass along every quasi-static link. A rise
  * smaller than this (relative to L) is accepted as error of the facet planes;
  * a larger one is reported as PD_ERR_INTERNAL. Why 2 PD_TOL_PLANE_REL: a

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "base/fail.h"
+#include "base/file_read.h"
 #include "base/stats.h"
 #include "base/text.h"
 #include "viz/viz.h"
@@ -60,7 +61,7 @@ typedef struct {
 
 pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
 {
-    FILE *f = fopen(path, "r");
+    FILE *f = pd_file_fopen_read(path);
     if (!f)
         return pd_fail(diag, PD_ERR_IO, "%s: cannot read: %s", path, strerror(errno));
     char line[LINE_MAX_LEN];
@@ -153,6 +154,8 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
     }
     if (st == PD_OK && ferror(f))
         st = pd_fail(diag, PD_ERR_IO, "%s: read error", path);
+    if (st == PD_OK && lineno == 0)
+        st = pd_file_check_fifo(fileno(f), 0, path, diag);
     fclose(f);
     double total = 0.0;
     for (int i = 0; i < nrows; i++)

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
+#include <sys/stat.h>
 #include "check.h"
 #include "cli_run.h"
 #include "suites.h"
@@ -124,6 +125,18 @@ static void test_merge_refusals(void)
     expect_merge_failure(s2, NULL, "shard 1/2 is missing");
     expect_merge_failure(s1, "parts/paper-tables.csv", "not a shard");
     expect_merge_failure(s1, "/nonexistent/shard", "/nonexistent/shard");
+    /* A named pipe no program writes to: refused at once, where open()
+     * waited for a writer for ever (timeout ends a regression with 124). */
+    char fifo[128], fcmd[512], *fout, *ferr;
+    snprintf(fifo, sizeof fifo, "%s/nowriter", tmpdir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    snprintf(fcmd, sizeof fcmd, "timeout 60 %s merge %s %s", PD_CLI_PATH, s1, fifo);
+    CHECK_INT(run_cmd(fcmd, 1, &fout, &ferr), 2);
+    CHECK(strstr(ferr, "nowriter: a named pipe that gave nothing to read") != NULL);
+    CHECK_INT((int)strlen(fout), 0);
+    free(fout);
+    free(ferr);
+    remove(fifo);
 
     /* Another version's shard: its first line says so. */
     char path[128], cmd[512], *out, *err;
@@ -409,6 +422,41 @@ static void test_sha256(void)
     free(err);
 }
 
+/* posedrop's short forms through the batch: letters with their values glued
+ * or not, prefixes of long names, '=': the same rows as posedrop's own run
+ * with the full names, under a part column. */
+static void test_batch_short_forms(void)
+{
+    char cmd[512], *out, *err, *bout, *berr;
+    snprintf(cmd, sizeof cmd, "scripts/posedrop-batch -j1 -o %s/short -n25 -h 0.1 --see=3 "
+             "--mu 0.4 -v -0.02 --init uniform -- parts/cap.off", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &bout, &berr), 0);
+    CHECK_INT(run("-n 25 -h 0.1 --seed 3 --mu 0.4 -v -0.02 --initial uniform parts/cap.off",
+                  &out, &err), 0);
+    char path[160];
+    snprintf(path, sizeof path, "%s/short/all.csv", tmpdir);
+    char *all = slurp(path);
+    /* all.csv: the command's rows, each after "cap,". */
+    int rows = 0, same = all != NULL;
+    const char *a = all ? strchr(all, '\n') : NULL, *o = strchr(out, '\n');
+    while (same && a && o && a[1] && o[1]) {
+        a++;
+        o++;
+        const char *ea = strchr(a, '\n'), *eo = strchr(o, '\n');
+        same = ea && eo && strncmp(a, "cap,", 4) == 0 && ea - a - 4 == eo - o &&
+               strncmp(a + 4, o, (size_t)(eo - o)) == 0;
+        rows += same;
+        a = ea;
+        o = eo;
+    }
+    CHECK(same && rows > 1);
+    free(all);
+    free(out);
+    free(err);
+    free(bout);
+    free(berr);
+}
+
 /* Every script under scripts/ refuses a bad argument with one line on stderr
  * that names the script and what was wrong, exit status 2, nothing on
  * stdout, and nothing left in the directory it ran in (the issue's case:
@@ -425,6 +473,18 @@ static void test_script_refusals(void)
         {"posedrop-batch -o", "posedrop-batch: -o needs a value"},
         {"posedrop-batch -o results -- a.stl", "posedrop-batch: a.stl: no such readable file"},
         {"posedrop-batch -o results -- $R/parts/cap.off $R/parts/cap.off", "two parts named 'cap'"},
+        /* posedrop's options in the forms it takes (a prefix, '=', a letter
+         * with its value glued or not) are the options they name. */
+        {"posedrop-batch -o results --sens=t.csv --mu 0.2:0.4 -- $R/parts/cap.off "
+         "$R/parts/button.off", "--sensitivity t.csv would be written by the run of each of the 2"},
+        {"posedrop-batch -o results -n5 --tri t.csv -- $R/parts/cap.off $R/parts/button.off",
+         "--trials t.csv would be written by the run of each of the 2 parts"},
+        {"posedrop-batch -o results --s 3 -- $R/parts/cap.off",
+         "option '--s' is the start of more than one of posedrop's options' names"},
+        {"posedrop-batch -o results -x 3 -- $R/parts/cap.off", "unknown option '-x' for posedrop"},
+        {"posedrop-batch -o results --fac=1 -- $R/parts/cap.off",
+         "option '--facets' takes no value"},
+        {"posedrop-batch -o results -h -- $R/parts/cap.off", "option '-h' needs a value"},
         {"collect-csv nofile.csv", "collect-csv: nofile.csv: no such readable file"},
         {"collect-csv", "collect-csv: no CSV files given"},
         {"cost-accuracy.sh -s 0", "cost-accuracy.sh: -s: expected a whole number"},
@@ -489,6 +549,7 @@ void suite_batch(void)
     test_slurm();
     test_mpi();
     test_script_refusals();
+    test_batch_short_forms();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

@@ -1051,6 +1051,37 @@ static void test_time_limit(void)
     expect_failure(args, 2, "steps of 0.001 s per drop");
 }
 
+/* --scene and --measured naming a named pipe that no program writes to:
+ * refused at once (exit 2, the pipe named, nothing on stdout) as the part
+ * is, where they waited in open() for ever; `timeout` ends a regression
+ * with 124 instead of hanging the suite. A pipe with its writer there is
+ * read as before. */
+static void test_fifo_inputs(void)
+{
+    char fifo[160], cmd[512], *out, *err;
+    snprintf(fifo, sizeof fifo, "%s/nowriter", tmpdir);
+    CHECK(mkfifo(fifo, 0600) == 0);
+    const char *opts[] = {"--scene", "--chart /dev/null --measured"};
+    for (int i = 0; i < 2; i++) {
+        snprintf(cmd, sizeof cmd, "timeout 60 %s -n 5 %s %s parts/cap.off", PD_CLI_PATH, opts[i],
+                 fifo);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 2);
+        CHECK_INT((int)strlen(out), 0);
+        if (!strstr(err, "a named pipe that gave nothing to read"))
+            printf("     %s: %s", cmd, err);
+        CHECK(strstr(err, "nowriter: a named pipe that gave nothing to read") != NULL);
+        free(out);
+        free(err);
+    }
+    snprintf(cmd, sizeof cmd, "printf 'mu = 0.4\\n' | timeout 60 %s --scene /dev/stdin -n 5 "
+             "--trials /dev/null parts/cap.off", PD_CLI_PATH);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    CHECK(strstr(out, "pose,") == out);
+    free(out);
+    free(err);
+    remove(fifo);
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -1077,6 +1108,7 @@ void suite_cli(void)
     test_stationary();
     test_scale_warnings();
     test_time_limit();
+    test_fifo_inputs();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

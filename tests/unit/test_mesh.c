@@ -5,6 +5,7 @@
  * correctly, so the reader must return the same double as the C literal.
  * Every malformed input must fail with its own status and a message that
  * names the file and, for text formats, the line. */
+#include <math.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -801,6 +802,15 @@ static void normal_of(ll t[3][3], ll n[3])
     n[2] = u[0] * v[1] - u[1] * v[0];
 }
 
+static int shared_corners(const int a[3], const int b[3])
+{
+    int n = 0;
+    for (int i = 0; i < 3; i++)
+        for (int j = 0; j < 3; j++)
+            n += a[i] == b[j];
+    return n;
+}
+
 static ll dotl(const ll a[3], const ll b[3]) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 
 /* The chord of t on the plane of o: its two ends along dir, lo <= hi. */
@@ -856,6 +866,36 @@ static int cross_ref(ll p[3][3], ll q[3][3])
     return pn[0] * qd[1] < qn[1] * pd[0] && qn[0] * pd[1] < pn[1] * qd[0];
 }
 
+/* Triangles a and b of a mesh of integer corners c, by the reference. */
+static int cross_ref_tris(ll (*c)[3], int (*tri)[3], int a, int b)
+{
+    ll p[3][3], q[3][3];
+    for (int i = 0; i < 3; i++)
+        for (int k = 0; k < 3; k++) {
+            p[i][k] = c[tri[a][i]][k];
+            q[i][k] = c[tri[b][i]][k];
+        }
+    return cross_ref(p, q);
+}
+
+/* pd_mesh_self_crossing on a mesh of integer corners c against every pair's
+ * reference (pairs sharing an edge never cross): 1 when it finds a crossing
+ * exactly when some pair crosses and the pair it names does; *any says
+ * whether one does. */
+static int agrees_with_ref(ll (*c)[3], pd_vec3 *v, int nv, int (*tri)[3], int nt, int *any)
+{
+    *any = 0;
+    for (int a = 0; a < nt && !*any; a++)
+        for (int b = a + 1; b < nt && !*any; b++)
+            *any = shared_corners(tri[a], tri[b]) < 2 && cross_ref_tris(c, tri, a, b);
+    pd_mesh m = {nv, v, nt, tri};
+    int ta, tb;
+    pd_vec3 at;
+    if (pd_mesh_self_crossing(&m, &ta, &tb, &at, NULL) != PD_OK || (ta >= 0) != *any)
+        return 0;
+    return ta < 0 || (ta < tb && cross_ref_tris(c, tri, ta, tb));
+}
+
 /* pd_mesh_self_crossing on two triangles against the reference, over random
  * small integer triangles (degenerate contacts are frequent: vertices on
  * the other's plane, on its edges, shared vertices and edges), and on a
@@ -888,7 +928,7 @@ static void test_self_crossing(void)
         pd_mesh m = {6, v, 2, tri};
         int ta, tb;
         pd_vec3 at;
-        pd_status st = pd_mesh_self_crossing(&m, &ta, &tb, &at);
+        pd_status st = pd_mesh_self_crossing(&m, &ta, &tb, &at, NULL);
         int want = cross_ref(p, q);
         crossings += want;
         agree += st == PD_OK && (ta >= 0) == want;
@@ -919,37 +959,115 @@ static void test_self_crossing(void)
         for (int t = 0; t < NT; t++)
             for (int k = 0; k < 3; k++)
                 tri[t][k] = (int)(rng_uniform(&rng) * NV);
-        int any = 0, named = 0, ta, tb;
-        for (int a = 0; a < NT; a++)
-            for (int b = a + 1; b < NT; b++) {
-                ll p[3][3], q[3][3];
-                int sh = 0;
-                for (int i = 0; i < 3; i++)
-                    for (int j = 0; j < 3; j++)
-                        sh += tri[a][i] == tri[b][j];
-                for (int i = 0; i < 3; i++)
-                    for (int k = 0; k < 3; k++) {
-                        p[i][k] = c[tri[a][i]][k];
-                        q[i][k] = c[tri[b][i]][k];
-                    }
-                any |= sh < 2 && cross_ref(p, q);
-            }
-        pd_mesh m = {NV, v, NT, tri};
-        pd_vec3 at;
-        CHECK_STATUS(pd_mesh_self_crossing(&m, &ta, &tb, &at), PD_OK);
-        if (ta >= 0) {
-            ll p[3][3], q[3][3];
-            for (int i = 0; i < 3; i++)
-                for (int k = 0; k < 3; k++) {
-                    p[i][k] = c[tri[ta][i]][k];
-                    q[i][k] = c[tri[tb][i]][k];
-                }
-            named = ta < tb && cross_ref(p, q);
-        }
-        CHECK_INT(ta >= 0, any);
-        if (ta >= 0)
-            CHECK(named);
+        int any;
+        CHECK(agrees_with_ref(c, v, NV, tri, NT, &any));
     }
+}
+
+/* Meshes of small triangles on a random walk of integer points (corners
+ * and edges shared often, points repeated under other indices): the search
+ * finds a crossing exactly when the brute-force reference finds one, and
+ * the pair it names crosses. Larger than the meshes above, so that the tree
+ * of boxes has levels above its leaves. */
+static void test_self_crossing_many(void)
+{
+    test_rng rng = {20261128};
+    int found = 0, cases = 1000, agree = 0;
+    for (int it = 0; it < cases; it++) {
+        enum { NV = 40, NT = 12 };
+        pd_vec3 v[NV];
+        ll c[NV][3];
+        int tri[NT][3];
+        /* A random walk of steps in [-2, 2]: triangles on nearby indices are
+         * small against the whole, and many pairs far apart. */
+        for (int i = 0; i < NV; i++) {
+            for (int k = 0; k < 3; k++)
+                c[i][k] = (i ? c[i - 1][k] : 0) + (ll)(rng_uniform(&rng) * 5.0) - 2;
+            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
+        }
+        for (int t = 0; t < NT; t++) {
+            int base = (int)(rng_uniform(&rng) * NV);
+            for (int k = 0; k < 3; k++)
+                tri[t][k] = k == 0 ? base : (base + 1 + (int)(rng_uniform(&rng) * 4)) % NV;
+        }
+        int any;
+        agree += agrees_with_ref(c, v, NV, tri, NT, &any);
+        found += any;
+    }
+    CHECK_INT(agree, cases);
+    /* Both answers occur. */
+    pd_note("self-crossing, %d of %d meshes of 12 triangles on 40 vertices cross\n", found, cases);
+    CHECK(found > 0 && found < cases);
+}
+
+/* A rod of the given number of sides, radius 0.05 and length 1, capped by
+ * fans about one corner, turned off the axes (about (1, 2, 3) by 0.7 rad);
+ * shifted by dx across its axis. Its 2 (2 n - 2) triangles are written from
+ * t0 on, its 2 n vertices from v0 on. */
+static void turned_rod(int n, double dx, pd_vec3 *v, int v0, int (*tri)[3], int t0)
+{
+    pd_vec3 ax = v3_unit(v3(1, 2, 3));
+    double th = 0.7, co = cos(th), si = sin(th);
+    for (int e = 0; e < 2; e++)
+        for (int i = 0; i < n; i++) {
+            double a = 2.0 * M_PI * i / n;
+            pd_vec3 p = v3(e, 0.05 * cos(a) + dx, 0.05 * sin(a));
+            p = v3_add(v3_add(v3_scale(p, co), v3_scale(v3_cross(ax, p), si)),
+                       v3_scale(ax, v3_dot(ax, p) * (1.0 - co)));
+            v[v0 + e * n + i] = p;
+        }
+    int t = t0;
+    for (int i = 0; i < n; i++) {
+        int j = (i + 1) % n;
+        int q[2][3] = {{i, j, n + j}, {i, n + j, n + i}};
+        for (int h = 0; h < 2; h++, t++)
+            for (int k = 0; k < 3; k++)
+                tri[t][k] = v0 + q[h][k];
+    }
+    for (int i = 1; i < n - 1; i++, t += 2)
+        for (int k = 0; k < 3; k++) {
+            int f0[3] = {0, i + 1, i}, f1[3] = {n, n + i, n + i + 1};
+            tri[t][k] = v0 + f0[k];
+            tri[t + 1][k] = v0 + f1[k];
+        }
+}
+
+/* The rod of docs/limits.md: long slivers across every axis, and caps fanned
+ * about one corner, flat only to round-off. The pairs that reach the exact
+ * test grow in proportion to the triangles (a search whose pairs grow as
+ * their square, as a sort and sweep of axis-aligned boxes did, tests 16
+ * times more per triangle at 16 times the sides); two such rods, one moved
+ * across the other by half its radius, cross, and the pair named does. */
+static void test_self_crossing_rod(void)
+{
+    double per[2];
+    int sides[2] = {250, 4000};
+    for (int r = 0; r < 2; r++) {
+        int n = sides[r], nt = 2 * (2 * n - 2);
+        pd_vec3 *v = malloc(sizeof *v * 4 * (size_t)n);
+        int(*tri)[3] = malloc(sizeof *tri * 2 * (size_t)nt);
+        turned_rod(n, 0.0, v, 0, tri, 0);
+        pd_mesh m = {2 * n, v, nt, tri};
+        int ta, tb;
+        pd_vec3 at;
+        size_t tested;
+        CHECK_STATUS(pd_mesh_self_crossing(&m, &ta, &tb, &at, &tested), PD_OK);
+        CHECK_INT(ta, -1);
+        per[r] = (double)tested / nt;
+        pd_note("self-crossing, turned rod of %d sides (%d triangles): %zu pairs tested, %.2f "
+                "per triangle\n", n, nt, tested, per[r]);
+        if (r == 0) {
+            turned_rod(n, 0.025, v, 2 * n, tri, nt);
+            pd_mesh two = {4 * n, v, 2 * nt, tri};
+            CHECK_STATUS(pd_mesh_self_crossing(&two, &ta, &tb, &at, NULL), PD_OK);
+            CHECK(ta >= 0 && ta < nt && tb >= nt);
+        }
+        free(v);
+        free(tri);
+    }
+    /* Near-linear: a factor 2 allows for the log of the tree's depth and
+     * the corner fans' overlaps; quadratic growth gives 16. */
+    CHECK(per[1] < 2.0 * per[0]);
 }
 
 void suite_mesh(void)
@@ -967,4 +1085,6 @@ void suite_mesh(void)
     test_weld();
     test_clone_size();
     test_self_crossing();
+    test_self_crossing_many();
+    test_self_crossing_rod();
 }

@@ -386,6 +386,15 @@ static void c_static_result_free(const fixture *f, int k, outcome *o)
     free_unless_null(k, r, pd_static_result_free);
 }
 
+static void c_pose_transform(const fixture *f, int k, outcome *o)
+{
+    double t[16], before[16];
+    memset(t, 0x5a, sizeof t);
+    memcpy(before, t, sizeof t);
+    o->st = pd_pose_transform(P(0, f->part), P(1, &f->res->poses[0]), P(2, t), P(3, &o->diag));
+    o->touched = o->st != PD_OK && memcmp(t, before, sizeof t) != 0;
+}
+
 static void c_solid_angle_triangle(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -658,6 +667,7 @@ static const entry table[] = {
     {"pd_static_options_check", "options ?diag", c_static_options_check},
     {"pd_static_estimate", "part ?options result ?diag", c_static_estimate},
     {"pd_static_result_free", "?result", c_static_result_free},
+    {"pd_pose_transform", "part pose transform ?diag", c_pose_transform},
     {"pd_solid_angle_triangle", "", c_solid_angle_triangle},
     {"pd_status_str", "", c_status_str},
     {"pd_status_is_input_error", "", c_status_is_input_error},

@@ -886,6 +886,129 @@ static void test_pose_order(void)
     pd_part_free(part);
 }
 
+/* The transform of each pose against what it claims: applied to the part
+ * in its file's frame, the pose's hull facet lies on z = 0 facing down (its
+ * outward normal -z), no hull vertex is below the floor, and the centre of
+ * mass stands at the pose's height above a point of the facet. On random
+ * convex parts turned, scaled from 1e-3 to 1e3 and moved far off the
+ * origin (pd_part.origin nonzero), and on a box along the axes (the
+ * horizontal facets' fixed x axis). Tolerances relative to the part's size
+ * L: its facets are planar to PD_TOL_PLANE_REL L (merged facets), the rest
+ * is round-off of coordinates up to 1e3 L from the origin. */
+static void check_pose_transforms(const pd_part *part, const pd_static_result *r)
+{
+    const pd_hull *h = part->hull;
+    double L = part->size, far = v3_norm(part->origin) + L;
+    double tol = 2.0 * PD_TOL_PLANE_REL * L + 1e-12 * far;
+    for (int i = 0; i < r->nposes; i++) {
+        const pd_pose *p = &r->poses[i];
+        double T[16];
+        CHECK_STATUS(pd_pose_transform(part, p, T, NULL), PD_OK);
+        double R[3][3];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++)
+                R[a][b] = T[4 * a + b];
+        for (int a = 0; a < 3; a++)
+            for (int b = 0; b < 3; b++) {
+                double d = R[a][0] * R[b][0] + R[a][1] * R[b][1] + R[a][2] * R[b][2];
+                CHECK_NEAR(d, a == b ? 1.0 : 0.0, 1e-14, "orthonormal rows, round-off");
+            }
+        pd_vec3 cx = v3(R[0][0], R[0][1], R[0][2]), cy = v3(R[1][0], R[1][1], R[1][2]);
+        pd_vec3 cz = v3(R[2][0], R[2][1], R[2][2]);
+        CHECK_NEAR(v3_dot(v3_cross(cx, cy), cz), 1.0, 1e-14, "a rotation: det +1, round-off");
+        CHECK(T[2] == 0.0 && T[12] == 0.0 && T[13] == 0.0 && T[14] == 0.0 && T[15] == 1.0);
+        /* The facet's outward normal turns to -z. */
+        pd_vec3 n = rot_apply(CR(R), h->normal[p->facet]);
+        CHECK_NEAR(v3_dist(n, v3(0, 0, -1)), 0.0, 1e-12, "rotation of a unit vector, round-off");
+        double lowest = HUGE_VAL, fz = 0.0;
+        for (int v = 0; v < h->nverts; v++) {
+            pd_vec3 w = rot_apply(CR(R), v3_add(h->verts[v], part->origin));
+            lowest = fmin(lowest, w.z + T[11]);
+        }
+        CHECK_NEAR(lowest, 0.0, tol, "the lowest hull vertex on the floor, round-off");
+        pd_vec3 poly[64];
+        int nc = h->facet_start[p->facet + 1] - h->facet_start[p->facet];
+        for (int c = 0; c < nc && c < 64; c++) {
+            int v = h->facet_vert[h->facet_start[p->facet] + c];
+            poly[c] = rot_apply(CR(R), v3_add(h->verts[v], part->origin));
+            poly[c].z += T[11];
+            fz = fmax(fz, fabs(poly[c].z));
+        }
+        CHECK_NEAR(fz, 0.0, tol, "the facet on the floor: its plane tolerance");
+        pd_vec3 com = rot_apply(CR(R), v3_add(part->com, part->origin));
+        com.z += T[11];
+        CHECK_NEAR(com.z, p->height, tol, "the pose's height, plane tolerance");
+        CHECK(com.z > 0.0);
+        /* Above the facet: on the inner side of each edge, the loop being
+         * clockwise seen from above once the facet faces down. */
+        double worst = HUGE_VAL;
+        for (int c = 0; c < nc && c < 64; c++) {
+            pd_vec3 a = poly[c], b = poly[(c + 1) % nc];
+            double e = hypot(b.x - a.x, b.y - a.y);
+            double side = ((a.x - com.x) * (b.y - com.y) - (a.y - com.y) * (b.x - com.x)) / e;
+            worst = fmin(worst, -side);
+        }
+        CHECK(worst > -PD_TOL_KNIFE_REL * L - tol);
+    }
+}
+
+static void test_pose_transform(void)
+{
+    test_rng rng = {20261127};
+    const double scales[] = {1e-3, 1.0, 1e3};
+    for (int trial = 0; trial < 6; trial++) {
+        pd_mesh *m = random_convex(&rng, 24);
+        double R[3][3];
+        rng_rotation(&rng, R);
+        double s = scales[trial % 3];
+        pd_vec3 t = v3_scale(v3(rng_range(&rng, -1e3, 1e3), rng_range(&rng, -1e3, 1e3),
+                                rng_range(&rng, -1e3, 1e3)), s);
+        mesh_transform(m, CR(R), s, t);
+        pd_part *part = part_of(m, NULL, NULL);
+        pd_static_result *r = part ? estimate(part, NULL) : NULL;
+        CHECK(r != NULL && r->nposes > 0);
+        if (r)
+            check_pose_transforms(part, r);
+        if (r && trial == 0)
+            CHECK(v3_norm(part->origin) > 0.0);
+        pd_static_result_free(r);
+        pd_part_free(part);
+    }
+    pd_vec3 pts[8];
+    int np = pts_box(0.03, 0.02, 0.01, pts);
+    pd_part *box = part_of(convex_mesh(pts, np), NULL, NULL);
+    pd_static_result *r = box ? estimate(box, NULL) : NULL;
+    CHECK(r != NULL && r->nposes == 6);
+    if (!r) {
+        pd_part_free(box);
+        return;
+    }
+    check_pose_transforms(box, r);
+    /* Resting on its largest face, z down: x stays (1, 0, 0) up to sign
+     * conventions of trimesh's frame, exactly. */
+    const pd_pose *down = pose_with_normal(r, v3(0, 0, -1));
+    double T[16];
+    CHECK(down && pd_pose_transform(box, down, T, NULL) == PD_OK && T[0] == 1.0 && T[1] == 0.0);
+    /* Refusals leave the transform alone. */
+    double before[16];
+    for (int k = 0; k < 16; k++)
+        T[k] = before[k] = -7.0;
+    pd_pose bad = r->poses[0];
+    pd_diag d;
+    pd_diag_init(&d);
+    bad.normal = v3_scale(bad.normal, 2.0);
+    CHECK_STATUS(pd_pose_transform(box, &bad, T, &d), PD_ERR_USAGE);
+    CHECK(strstr(d.message, "not a unit vector") != NULL);
+    bad.normal = v3(NAN, 0, 0);
+    CHECK_STATUS(pd_pose_transform(box, &bad, T, &d), PD_ERR_NONFINITE);
+    bad = r->poses[0];
+    bad.facet = box->hull->nfacets;
+    CHECK_STATUS(pd_pose_transform(box, &bad, T, &d), PD_ERR_RANGE);
+    CHECK(memcmp(T, before, sizeof T) == 0);
+    pd_static_result_free(r);
+    pd_part_free(box);
+}
+
 void suite_static(void)
 {
     test_solid_angle();
@@ -900,4 +1023,5 @@ void suite_static(void)
     test_pqs();
     test_hard_cases();
     test_pose_order();
+    test_pose_transform();
 }

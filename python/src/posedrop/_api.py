@@ -27,6 +27,12 @@ _STATUS_WORDS = tuple(t.replace(" ", "_").replace("-", "_").replace("/", "_")
                       for t in _STATUS_TEXTS)
 
 
+def _failure_words(stage, status):
+    """A failed drop's pd_drop_stage and pd_status as the words of
+    failed:STAGE:STATUS."""
+    return _STAGE_NAMES[stage], _STATUS_WORDS[status]
+
+
 def _usage(message):
     return InputError(_STATUS["ERR_USAGE"], "invalid argument", message)
 
@@ -511,7 +517,7 @@ class Trials:
         self.status = _i32(d["trial_status"])
         text = np.array(END_NAMES, dtype=object)[self.end]
         for i in np.flatnonzero(self.end == _FAILED):
-            text[i] = "failed:%s:%s" % (_STAGE_NAMES[self.stage[i]], _STATUS_WORDS[self.status[i]])
+            text[i] = "failed:%s:%s" % _failure_words(self.stage[i], self.status[i])
         self.end_text = text.astype(str)
         drawn = _f64(d["trial_param"], len(self.pose), len(PARAM_NAMES))
         self.params = {}
@@ -604,6 +610,12 @@ class Drops:
         where and how).
     first_failed : int
         The first failed drop's index in the run, -1 if none.
+    failed_stage, failed_status : str or None
+        Where and how that drop failed (``pd_sim_result``'s
+        ``failed_stage`` and ``failed_status``), as the words of its
+        ``failed:STAGE:STATUS`` end (e.g. ``"flight"`` and
+        ``"no_convergence"``); None when no drop failed. Known without
+        ``trials=True``.
     time_limit : float
         The time limit the drops ran with, s: the ``time_limit`` given, or
         the part's automatic one.
@@ -637,6 +649,8 @@ class Drops:
                     "time_limit", "energy_gain", "fallbacks", "collisions", "partial",
                     "bootstrap_rounds", "stationarity", "seed"):
             setattr(self, key, d[key])
+        self.failed_stage, self.failed_status = (
+            _failure_words(d["failed_stage"], d["failed_status"]) if self.failed else (None, None))
         k = d["nposes"]
         self.trials = Trials(d) if "trial_q0" in d else None
         stationary = "transitions" in d
