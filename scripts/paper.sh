@@ -29,8 +29,8 @@
 # its trials) become pose,count files in posedrop's class numbering (the QS
 # rank pairing above); for each part, the scene parameters SPEC (default
 # mu=0.1:0.8,restitution=0.05:0.7,height=0.06:0.2; 'initial' among them fits
-# the initial mode too, at about twice the cost) are fitted to the other
-# three parts and the fourth is predicted: at the best fit and averaged over
+# the initial mode too: three searches, about the stationary start's cost)
+# are fitted to the other three parts and the fourth is predicted: at the best fit and averaged over
 # the likelihood-weighted values, with its 95% interval. Prints each held-out part's table (the paper's
 # columns, posedrop's QS and PQS, the two predictions), then e16 and TV per
 # part with the fitted values of each fold. DROPS (default 400) are simulated
