@@ -355,7 +355,6 @@ static void taylor_step(collision *c, double *tau, double t1, double *hnext)
         P[2][m] = S[k] * r;
         X[m] = c->K[0][0] * P[0][m] + c->K[0][1] * P[1][m] + c->K[0][2] * P[2][m];
         Y[m] = c->K[1][0] * P[0][m] + c->K[1][1] * P[1][m] + c->K[1][2] * P[2][m];
-        Z[m] = c->K[2][0] * P[0][m] + c->K[2][1] * P[1][m] + c->K[2][2] * P[2][m];
         /* the sum's terms pair up, j with m - j */
         double acc = 0.0;
         for (int j = 1; 2 * j < m; j++)
@@ -365,6 +364,7 @@ static void taylor_step(collision *c, double *tau, double t1, double *hnext)
             acc += X[m / 2] * X[m / 2] + Y[m / 2] * Y[m / 2] - S[m / 2] * S[m / 2];
         S[m] = acc / (2.0 * S[0]);
         if (work) {
+            Z[m] = c->K[2][0] * P[0][m] + c->K[2][1] * P[1][m] + c->K[2][2] * P[2][m];
             double w = 0.0;
             for (int j = 0; j <= k; j++)
                 w += Z[j] * S[k - j];
