@@ -14,35 +14,10 @@
 #include "impact/impact_tol.h"
 
 enum {
-    FORM_TAU, /* g = |u_t|: every ordinary step (rhs_tau) */
     FORM_PZ,  /* g = 1: sigma = pz, one step onto Poisson's end */
     FORM_UZ,  /* g = 1 / (du_z/dpz): sigma = u_z, one step onto maximum compression */
     FORM_W    /* g = 1 / u_z: sigma = W, one step onto the energetic end */
 };
-
-/* Eq. 14 in tau, dpz/dtau = |u_t|: p' = (-mu u_x, -mu u_y, |u_t|),
- * W' = u_z |u_t|. Its right-hand side is Lipschitz: nothing is divided by
- * |u_t|, and the origin of the tangential plane becomes a rest point
- * approached exponentially in tau instead of a singularity reached at a
- * finite pz. In pz the flow near the origin turns the sliding direction at a
- * rate ~1/|u_t| (stiff: an explicit step must shrink with |u_t|, measured ~50
- * steps to come within 1e-9); in tau it turns at a bounded rate, and a
- * trajectory cannot step over the origin. Integrating in pz where the slip
- * is large did not pay: rk8pd's steps there are as long in pz as in tau
- * (the turning of the direction sets both), and were refused more often. */
-static int rhs_tau(double tau, const double y[], double dydt[], void *user)
-{
-    (void)tau;
-    const collision *c = user;
-    pd_vec3 u = coll_u(c, y);
-    double s = sqrt(u.x * u.x + u.y * u.y); /* |u| <~ 1 here: no overflow for hypot to guard */
-    dydt[PX] = -c->mu * u.x;
-    dydt[PY] = -c->mu * u.y;
-    dydt[PZ] = s;
-    if (c->law == PD_IMPACT_ENERGETIC)
-        dydt[PW] = u.z * s;
-    return 0;
-}
 
 /* Eq. 14 in pz: p' = (-mu t, 1), W' = u_z. */
 static int rhs_pz(double pz, const double y[], double dydt[], void *user)
@@ -91,7 +66,7 @@ static int rhs_w(double w, const double y[], double dydt[], void *user)
     return 0;
 }
 
-static const pd_ode_fn form_rhs[] = {rhs_tau, rhs_pz, rhs_uz, rhs_w};
+static const pd_ode_fn form_rhs[] = {rhs_pz, rhs_uz, rhs_w};
 
 /* The step in tau assumed before the first Taylor step sets its own, in
  * units of the flow's rate: u_t' = |u_t| a - mu B u_t changes at most at
@@ -317,14 +292,21 @@ static int low_order_event_step(collision *c, pd_ode_fn fn, double e0, double e1
     return 1;
 }
 
-/* Order of the Taylor step in tau. Why 16: on the 12109 impacts of 400
- * cube, box and coin drops, orders 12, 16, 20 took 3.75, 3.13, 2.94 steps an
- * impact (rk8pd 4.16) and 112M, 111M, 123M instructions (rk8pd 145M); the
- * impulse's worst error against a 1e-13 reference 1.5e-9, 1.3e-9, 4.0e-9
- * (rk8pd 2.9e-9). Lower: more steps; higher: each step's convolutions
- * (quadratic in the order) cost more than the steps saved. Against rk8pd in
- * tau it takes 6.6 steps to rk8pd's 10.9 tried on the slides that pass near
- * zero slip, and never refuses one. */
+/* Every ordinary step is of eq. 14 in tau, dpz/dtau = |u_t|:
+ * p' = (-mu u_x, -mu u_y, |u_t|), W' = u_z |u_t| (taylor_step). Its
+ * right-hand side is Lipschitz: nothing is divided by |u_t|, and the origin
+ * of the tangential plane becomes a rest point approached exponentially in
+ * tau instead of a singularity reached at a finite pz. In pz the flow near
+ * the origin turns the sliding direction at a rate ~1/|u_t| (stiff: an
+ * explicit step must shrink with |u_t|); in tau it turns at a bounded
+ * rate, and a trajectory cannot step over the origin. Integrating in pz where the slip
+ * is large did not pay: rk8pd's steps there are as long in pz as in tau
+ * (the turning of the direction sets both), and were refused more often.
+ *
+ * Order of the Taylor step in tau: lower orders take more steps, higher
+ * ones cost more per step (its convolutions grow as the order squared) than
+ * they save; 16 took the fewest instructions on the impacts of recorded
+ * drops, within the tolerance (docs/performance.md, the Taylor step). */
 #define TAYLOR_ORDER 16
 
 /* One step of the tau flow by its Taylor series at the current state, to
