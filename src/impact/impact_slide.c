@@ -1,5 +1,7 @@
-/* impact_slide.c: a collision's sliding phase, eq. 14 integrated with GSL's
- * rk8pd (see impact_collision.h).
+/* impact_slide.c: a collision's sliding phase, eq. 14 integrated in tau by
+ * its Taylor series between events, and onto an event by one step of a
+ * Runge-Kutta pair (GSL's rk8pd if the fifth-order one is refused) in the
+ * event's own variable (see impact_collision.h).
  *
  * Eq. 14 gives p and W as functions of pz. The integrator runs in a
  * parameter sigma of our choosing, with dpz/dsigma = g > 0 along the
@@ -12,35 +14,10 @@
 #include "impact/impact_tol.h"
 
 enum {
-    FORM_TAU, /* g = |u_t|: every ordinary step (rhs_tau) */
     FORM_PZ,  /* g = 1: sigma = pz, one step onto Poisson's end */
     FORM_UZ,  /* g = 1 / (du_z/dpz): sigma = u_z, one step onto maximum compression */
     FORM_W    /* g = 1 / u_z: sigma = W, one step onto the energetic end */
 };
-
-/* Eq. 14 in tau, dpz/dtau = |u_t|: p' = (-mu u_x, -mu u_y, |u_t|),
- * W' = u_z |u_t|. Its right-hand side is Lipschitz: nothing is divided by
- * |u_t|, and the origin of the tangential plane becomes a rest point
- * approached exponentially in tau instead of a singularity reached at a
- * finite pz. In pz the flow near the origin turns the sliding direction at a
- * rate ~1/|u_t| (stiff: an explicit step must shrink with |u_t|, measured ~50
- * steps to come within 1e-9); in tau it turns at a bounded rate, and a
- * trajectory cannot step over the origin. Integrating in pz where the slip
- * is large did not pay: rk8pd's steps there are as long in pz as in tau
- * (the turning of the direction sets both), and were refused more often. */
-static int rhs_tau(double tau, const double y[], double dydt[], void *user)
-{
-    (void)tau;
-    const collision *c = user;
-    pd_vec3 u = coll_u(c, y);
-    double s = sqrt(u.x * u.x + u.y * u.y); /* |u| <~ 1 here: no overflow for hypot to guard */
-    dydt[PX] = -c->mu * u.x;
-    dydt[PY] = -c->mu * u.y;
-    dydt[PZ] = s;
-    if (c->law == PD_IMPACT_ENERGETIC)
-        dydt[PW] = u.z * s;
-    return 0;
-}
 
 /* Eq. 14 in pz: p' = (-mu t, 1), W' = u_z. */
 static int rhs_pz(double pz, const double y[], double dydt[], void *user)
@@ -89,15 +66,13 @@ static int rhs_w(double w, const double y[], double dydt[], void *user)
     return 0;
 }
 
-static const pd_ode_fn form_rhs[] = {rhs_tau, rhs_pz, rhs_uz, rhs_w};
+static const pd_ode_fn form_rhs[] = {rhs_pz, rhs_uz, rhs_w};
 
-/* First trial step in tau, in units of the flow's rate: u_t' = |u_t| a -
- * mu B u_t changes at most at |a| + mu |B| (Frobenius norm) per unit tau.
- * Measured, rk8pd's first accepted steps at 1e-11 are about this long: 0.1
- * spent a step or two growing to it, 0.6 had more refused. At 1e-9, 0.6
- * took 3-4% fewer instructions, but its first step, accepted near the
- * tolerance, doubled the worst impulse error (3.1e-9 against 1.75e-9 from a
- * 1e-13 reference, 4e4 random impacts). */
+/* The step in tau assumed before the first Taylor step sets its own, in
+ * units of the flow's rate: u_t' = |u_t| a - mu B u_t changes at most at
+ * |a| + mu |B| (Frobenius norm) per unit tau. An event ahead within it is
+ * landed on by one step in its own variable (henon_form). 0.3 is about
+ * rk8pd's first accepted step at 1e-11 (measured). */
 #define TAU_FIRST_STEP 0.3
 
 /* Incoming rays are looked for once the slip falls below this (units of
@@ -317,6 +292,90 @@ static int low_order_event_step(collision *c, pd_ode_fn fn, double e0, double e1
     return 1;
 }
 
+/* Every ordinary step is of eq. 14 in tau, dpz/dtau = |u_t|:
+ * p' = (-mu u_x, -mu u_y, |u_t|), W' = u_z |u_t| (taylor_step). Its
+ * right-hand side is Lipschitz: nothing is divided by |u_t|, and the origin
+ * of the tangential plane becomes a rest point approached exponentially in
+ * tau instead of a singularity reached at a finite pz. In pz the flow near
+ * the origin turns the sliding direction at a rate ~1/|u_t| (stiff: an
+ * explicit step must shrink with |u_t|); in tau it turns at a bounded
+ * rate, and a trajectory cannot step over the origin. Integrating in pz where the slip
+ * is large did not pay: rk8pd's steps there are as long in pz as in tau
+ * (the turning of the direction sets both), and were refused more often.
+ *
+ * Order of the Taylor step in tau: lower orders take more steps, higher
+ * ones cost more per step (its convolutions grow as the order squared) than
+ * they save; 16 took the fewest instructions on the impacts of recorded
+ * drops, within the tolerance (docs/performance.md, the Taylor step). */
+#define TAYLOR_ORDER 16
+
+/* One step of the tau flow by its Taylor series at the current state, to
+ * tau + min(t1 - tau, the series' own step). The coefficients follow from
+ * the flow: p_t' = -mu u_t, pz' = s, W' = u_z s, u = u0 + K p (so u's
+ * coefficients are K times p's), and s's from s^2 = u_x^2 + u_y^2:
+ * 2 s_0 s_m = sum_{j=0..m} (x_j x_{m-j} + y_j y_{m-j}) - sum_{j=1..m-1} s_j s_{m-j}.
+ * The step is the longest at which each of the last two terms stays within
+ * the tolerance c->tol (1 + |y_i|) of every component, a tenth shorter:
+ * the terms of a series of radius R fall as (h/R)^k, so the omitted tail is
+ * below the last term once h is well inside R. *hnext is that step. */
+static void taylor_step(collision *c, double *tau, double t1, double *hnext)
+{
+    const int work = c->law == PD_IMPACT_ENERGETIC, N = TAYLOR_ORDER;
+    double P[3][TAYLOR_ORDER + 1], W[TAYLOR_ORDER + 1];
+    double X[TAYLOR_ORDER + 1], Y[TAYLOR_ORDER + 1], Z[TAYLOR_ORDER + 1], S[TAYLOR_ORDER + 1];
+    for (int i = 0; i < 3; i++)
+        P[i][0] = c->y[i];
+    W[0] = c->y[PW];
+    pd_vec3 u = coll_u(c, c->y);
+    X[0] = u.x, Y[0] = u.y, Z[0] = u.z;
+    S[0] = sqrt(u.x * u.x + u.y * u.y);
+    for (int k = 0; k < N; k++) {
+        const int m = k + 1;
+        const double r = 1.0 / m;
+        P[0][m] = -c->mu * X[k] * r;
+        P[1][m] = -c->mu * Y[k] * r;
+        P[2][m] = S[k] * r;
+        X[m] = c->K[0][0] * P[0][m] + c->K[0][1] * P[1][m] + c->K[0][2] * P[2][m];
+        Y[m] = c->K[1][0] * P[0][m] + c->K[1][1] * P[1][m] + c->K[1][2] * P[2][m];
+        /* the sum's terms pair up, j with m - j */
+        double acc = 0.0;
+        for (int j = 1; 2 * j < m; j++)
+            acc += X[j] * X[m - j] + Y[j] * Y[m - j] - S[j] * S[m - j];
+        acc = 2.0 * (acc + X[0] * X[m] + Y[0] * Y[m]);
+        if (m % 2 == 0)
+            acc += X[m / 2] * X[m / 2] + Y[m / 2] * Y[m / 2] - S[m / 2] * S[m / 2];
+        S[m] = acc / (2.0 * S[0]);
+        if (work) {
+            Z[m] = c->K[2][0] * P[0][m] + c->K[2][1] * P[1][m] + c->K[2][2] * P[2][m];
+            double w = 0.0;
+            for (int j = 0; j <= k; j++)
+                w += Z[j] * S[k - j];
+            W[m] = w * r;
+        }
+    }
+    double r1 = 0.0, r0 = 0.0; /* the last two terms' largest ratio to their tolerance */
+    for (int i = 0; i < (work ? NSTATE : NSTATE_P); i++) {
+        const double *a = i < 3 ? P[i] : W;
+        double tol = c->tol * (1.0 + fabs(a[0]));
+        r1 = fmax(r1, fabs(a[N - 1]) / tol);
+        r0 = fmax(r0, fabs(a[N]) / tol);
+    }
+    double h = 0.9 * fmin(r1 > 0.0 ? pow(r1, -1.0 / (N - 1)) : HUGE_VAL,
+                          r0 > 0.0 ? pow(r0, -1.0 / N) : HUGE_VAL);
+    *hnext = h;
+    int last = !(h < t1 - *tau);
+    if (last)
+        h = t1 - *tau;
+    for (int i = 0; i < (work ? NSTATE : NSTATE_P); i++) {
+        const double *a = i < 3 ? P[i] : W;
+        double v = a[N];
+        for (int k = N - 1; k >= 0; k--)
+            v = v * h + a[k];
+        c->y[i] = v;
+    }
+    *tau = last ? t1 : *tau + h;
+}
+
 pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
 {
     const double tols = PD_TOL_IMPACT_EVENT_REL; /* |u0| = 1 */
@@ -393,8 +452,8 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
             hlim = cap;
             ev = cap_event;
         }
-        /* No event ahead: let the controller grow the step (it grows by at
-         * most 5x, so 10 h never truncates it). */
+        /* No event ahead: let the step grow (a Taylor step longer than 10 h
+         * is only cut short). */
         double t1 = ev == EV_NONE ? tau + 10.0 * h : tau + hlim;
         /* An event closer than round-off of tau is here: take it rather than
          * ask the integrator for a step it cannot represent. */
@@ -413,12 +472,8 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
         /* The step is given the derivative at its start, evaluates none at
          * its end and keeps no history, so the jumps of the state between
          * steps (closed forms, retries) need no restart. */
-        double dy[NSTATE];
-        rhs_tau(tau, c->y, dy, c);
-        pd_status st = pd_ode_step_from(ode, rhs_tau, c, &tau, t1, &h, c->y, dy);
+        taylor_step(c, &tau, t1, &h);
         ++*nsteps;
-        if (st != PD_OK)
-            return st;
         cap = INFINITY;
         cap_event = EV_NONE;
 

@@ -16,7 +16,10 @@
  * for 30% fewer steps; the energetic law's bookkeeping error stays 200 times
  * below PD_TOL_IMPACT_ENERGY_REL. Larger (1e-8): the maximum error doubles,
  * past the events'. Smaller: steps for nothing; below ~1e-13 the controller
- * chases round-off of p (1e-16 times the condition number of K, up to 1e6). */
+ * chases round-off of p (1e-16 times the condition number of K, up to 1e6).
+ * The Taylor step between events (impact_slide.c) holds its last two terms
+ * to the same bound: on 12109 impacts recorded from drops its worst impulse
+ * error against a 1e-13 reference is 1.3e-9 |u0|/K, rk8pd's 2.9e-9. */
 #define PD_TOL_IMPACT_ODE_REL 1e-9
 
 /* Event location: sticking is declared when the tangential contact speed
@@ -37,8 +40,8 @@
 
 /* Largest number of integrator steps (accepted or refused for an event) one
  * collision may take before PD_ERR_NO_CONVERGENCE. Why 1000: collisions
- * recorded from drops take 5-12 steps on average and random impacts at most
- * ~30 (test_impact.c), since a stable stick approached along a slowly closing
+ * recorded from drops take 3-12 steps on average and random impacts at most
+ * ~36 (test_impact.c), since a stable stick approached along a slowly closing
  * invariant ray (stiff for an explicit integrator) is snapped onto that ray
  * or finished along it in closed form (impact_slide.c). 1000 bounds the
  * cost of a collision to ~1 ms and still stops a runaway; the drop then
