@@ -309,6 +309,12 @@ static int low_order_event_step(collision *c, pd_ode_fn fn, double e0, double e1
  * drops, within the tolerance (docs/performance.md, the Taylor step). */
 #define TAYLOR_ORDER 16
 
+/* The Taylor step's length is this share of the one at which its last two
+ * terms reach the tolerance: a series of radius R has terms falling as
+ * (h/R)^k, so a step a tenth inside that keeps the omitted tail below the
+ * last term kept (taylor_step). */
+#define TAYLOR_SAFETY 0.9
+
 /* One step of the tau flow by its Taylor series at the current state, to
  * tau + min(t1 - tau, the series' own step). The coefficients follow from
  * the flow: p_t' = -mu u_t, pz' = s, W' = u_z s, u = u0 + K p (so u's
@@ -360,7 +366,7 @@ static void taylor_step(collision *c, double *tau, double t1, double *hnext)
         r1 = fmax(r1, fabs(a[N - 1]) / tol);
         r0 = fmax(r0, fabs(a[N]) / tol);
     }
-    double h = 0.9 * fmin(r1 > 0.0 ? pow(r1, -1.0 / (N - 1)) : HUGE_VAL,
+    double h = TAYLOR_SAFETY * fmin(r1 > 0.0 ? pow(r1, -1.0 / (N - 1)) : HUGE_VAL,
                           r0 > 0.0 ? pow(r0, -1.0 / N) : HUGE_VAL);
     *hnext = h;
     int last = !(h < t1 - *tau);
