@@ -141,8 +141,9 @@
  * stops a failure. */
 #define PD_COMPLIANT_LAW_MAX_STEPS 100000
 
-/* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
-#define PD_COMPLIANT_LAW_MAX_HALVINGS 200
+/* Trials of chi in its bracket (regula falsi, compliant_law.c), at most:
+ * about 10 reach PD_COMPLIANT_LAW_TOL; 200 only stop a failure. */
+#define PD_COMPLIANT_LAW_MAX_TRIALS 200
 
 /* The step with one contact is, going up from short steps, the last whose
  * rebound from a flat landing (the scaled law, pd_compliant_law_step) is within
@@ -225,5 +226,19 @@
 #define PD_COMPLIANT_LAW_HORIZON 1e3
 #define PD_COMPLIANT_LAW_HENON_STEPS 64
 #define PD_COMPLIANT_LAW_CHI_MAX 1e6
+
+/* The first bracket of chi: PD_COMPLIANT_LAW_CHI_RATIO (1 +-
+ * PD_COMPLIANT_LAW_CHI_SPREAD) times (1 - e) / e. chi e / (1 - e) is 1.01
+ * at e = 0.01, 1.11 at 0.1, 1.32 at 0.3, 1.50 at 0.9 and tends to about
+ * 1.6 as e -> 1, so this bracket, 0.9 to 1.8, holds the root at every e.
+ * A table of laws brackets each node's within PD_COMPLIANT_TABLE_SPREAD of
+ * the value extrapolated from the nodes below (65 nodes over 0.01 to 1
+ * move it by under 2% a node, the extrapolation's error far less). Any
+ * bracket gives the same chi to PD_COMPLIANT_LAW_TOL (a bracket that misses
+ * the root is widened until it holds it); only the number of contacts
+ * integrated moves. */
+#define PD_COMPLIANT_LAW_CHI_RATIO 1.35
+#define PD_COMPLIANT_LAW_CHI_SPREAD (1.0 / 3.0)
+#define PD_COMPLIANT_TABLE_SPREAD 1e-3
 
 #endif
