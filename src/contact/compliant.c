@@ -210,10 +210,11 @@ static void push_tangent(const pd_compliant_work *w, int j, double m, double dx,
  * stop in a sweep; returns the sweeps made, or -1 if max_sweeps stopped
  * them. */
 static int friction_sweeps(pd_compliant_work *w, int n, double m, double mu, double stop,
-                           int max_sweeps, pd_vec3 *v, pd_vec3 *wv)
+                           int max_sweeps, int fresh, pd_vec3 *v, pd_vec3 *wv)
 {
-    for (int j = 0; j < n; j++)
-        w->ptx[j] = w->pty[j] = 0.0;
+    if (fresh)
+        for (int j = 0; j < n; j++)
+            w->ptx[j] = w->pty[j] = 0.0;
     for (int sweep = 0; sweep < max_sweeps; sweep++) {
         double change = 0.0;
         for (int j = 0; j < n; j++) {
@@ -385,15 +386,34 @@ static int friction_pair_stick(pd_compliant_work *w, double m, double mu, pd_vec
     return 1;
 }
 
-/* The step's friction: two contacts that can both stick in closed form
- * (pair set), else the sweeps. Returns the sweeps made (0: the closed
- * form), or -1 if max_sweeps stopped them. */
+/* The step's friction by the sweeps; with pair set, two contacts whose
+ * sweeps have not converged after PD_COMPLIANT_PAIR_AFTER are solved in
+ * closed form if both can stick, else their sweeps go on. Returns the
+ * sweeps made (0: the closed form), or -1 if max_sweeps stopped them.
+ * pair 2 tries the closed form first (for tests). */
 static int friction(pd_compliant_work *w, int n, double m, double mu, double stop, int max_sweeps,
                     int pair, pd_vec3 *v, pd_vec3 *wv)
 {
-    if (pair && n == 2 && friction_pair_stick(w, m, mu, v, wv))
+    if (pair == 2 && n == 2 && friction_pair_stick(w, m, mu, v, wv))
         return 0;
-    return friction_sweeps(w, n, m, mu, stop, max_sweeps, v, wv);
+    if (pair != 1 || n != 2 || max_sweeps <= PD_COMPLIANT_PAIR_AFTER)
+        return friction_sweeps(w, n, m, mu, stop, max_sweeps, 1, v, wv);
+    pd_vec3 v0 = *v, w0 = *wv;
+    int made = friction_sweeps(w, n, m, mu, stop, PD_COMPLIANT_PAIR_AFTER, 1, v, wv);
+    if (made >= 0)
+        return made;
+    double kept[4] = {w->ptx[0], w->pty[0], w->ptx[1], w->pty[1]};
+    if (friction_pair_stick(w, m, mu, &v0, &w0)) {
+        *v = v0;
+        *wv = w0;
+        return 0;
+    }
+    w->ptx[0] = kept[0];
+    w->pty[0] = kept[1];
+    w->ptx[1] = kept[2];
+    w->pty[1] = kept[3];
+    made = friction_sweeps(w, n, m, mu, stop, max_sweeps - PD_COMPLIANT_PAIR_AFTER, 0, v, wv);
+    return made < 0 ? -1 : made + PD_COMPLIANT_PAIR_AFTER;
 }
 
 int pd_compliant_friction(pd_compliant_work *w, const pd_body *b, int n, const pd_vec3 *r,

@@ -952,7 +952,7 @@ static void test_friction_pair_closed_form(void)
         pd_vec3 v = v3(v0, 0, 0), wv = v3(0, 0, 0);
         double p[4], u[2];
         int made = pd_compliant_friction(w, &b, 2, r, k == 0 ? wide : narrow, ex, ey, 1.0,
-                                         PD_COMPLIANT_SWEEP_TOL, PD_COMPLIANT_SWEEPS, 1, &v, &wv, p);
+                                         PD_COMPLIANT_SWEEP_TOL, PD_COMPLIANT_SWEEPS, 2, &v, &wv, p);
         CHECK_INT(made, 0);
         CHECK_REL(p[0] + p[2], P, 1e-12, "both stick: the total impulse stops the slip");
         CHECK_NEAR(p[1], 0.0, 1e-12 * fabs(P), "nothing across the segment");
@@ -976,7 +976,7 @@ static void test_friction_pair_closed_form(void)
     pd_vec3 v = v3(0, 0, 0), wv = v3(0, 0, spin);
     double p[4];
     int made = pd_compliant_friction(w, &b, 2, r, wide, ex, ey, 1.0, PD_COMPLIANT_SWEEP_TOL,
-                                     PD_COMPLIANT_SWEEPS, 1, &v, &wv, p);
+                                     PD_COMPLIANT_SWEEPS, 2, &v, &wv, p);
     CHECK_INT(made, 0);
     CHECK_NEAR(v3_norm(v), 0.0, 1e-12 * spin * a, "a spin stopped: no velocity");
     CHECK_NEAR(v3_norm(wv), 0.0, 1e-12 * spin, "a spin stopped: no turn");
