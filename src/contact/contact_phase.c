@@ -542,18 +542,6 @@ static int lands_first(const pd_phase *p, const pd_state *s, double slip_min, do
     return 0;
 }
 
-/* pd_phase_slide_edge_from_rest on a copy of pivot phase p (which has no
- * force solve set up), replacing p where it succeeds. */
-static int slide_edge(pd_phase *p, const pd_state *s, double *accel)
-{
-    pd_phase q = *p;
-    pd_phase_map(&q);
-    if (!pd_phase_slide_edge_from_rest(&q, s, accel))
-        return 0;
-    *p = q;
-    return 1;
-}
-
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
                            const int *contacts, int nc, pd_phase *phase)
 {
@@ -643,7 +631,7 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
             stuck_out = 0;
         }
     } else if (!(least > 0.0) && pivot && fmin(F.cone[0], F.cone[1]) <= 0.0 &&
-               slide_edge(&p, &t, &accel)) {
+               pd_phase_slide_edge_from_rest(&p, &t, &accel)) {
         /* An edge that cannot stick: both its contacts slide from rest,
          * as one contact's would above, unless another vertex lands
          * first. */

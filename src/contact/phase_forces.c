@@ -240,7 +240,9 @@ void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd
         p->v[1] = -1;
 }
 
-void pd_phase_map(pd_phase *p)
+/* The contacts' responses M, and mapped set, for phases that need no P
+ * (some contact slides). */
+static void map_responses(pd_phase *p)
 {
     const pd_body *b = p->b;
     int nc = p->nc;
@@ -255,6 +257,11 @@ void pd_phase_map(pd_phase *p)
                                    v3_cross(pd_body_inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
                 p->M[i][j][0][k] = a.x, p->M[i][j][1][k] = a.y, p->M[i][j][2][k] = a.z;
             }
+}
+
+void pd_phase_map(pd_phase *p)
+{
+    map_responses(p);
     if (!all_stick(p))
         return;
     /* Every contact sticks: the rows and unknowns are the body axes, K is
@@ -610,10 +617,18 @@ static int edge_residual_at(const edge_setup *e, const double th[2], double r[2]
     return edge_residual(e, c, sn, r, along, lambda);
 }
 
-int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
+int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *accel)
 {
-    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !p->mapped || !(p->mu > 0.0))
+    const pd_phase *p = out;
+    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !(p->mu > 0.0))
         return 0;
+    /* The responses alone: the sticking solve (P) is of no use to the
+     * search, nor to the sliding phase it sets. Into a copy, so that p is
+     * unchanged where the search fails. */
+    pd_phase q = *p;
+    if (!q.mapped)
+        map_responses(&q);
+    p = &q;
     double R[3][3];
     quat_to_matrix(s->q, R);
     edge_setup e;
@@ -671,11 +686,12 @@ int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
         !(along[1] > 0.0))
         return 0;
     for (int k = 0; k < 2; k++) {
-        p->mode[k] = SLIDE;
-        p->from_rest[k] = 1;
-        p->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
-        p->drill[k] = 0.0;
+        q.mode[k] = SLIDE;
+        q.from_rest[k] = 1;
+        q.t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
+        q.drill[k] = 0.0;
     }
+    *out = q;
     *accel = fmin(along[0], along[1]);
     return 1;
 }

@@ -84,8 +84,9 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
 /* Both contacts of an edge, sticking (a pivot) where a force leaves the
  * friction cone, start to slide from rest: each along a direction in which
- * its slip then grows (as above), both found together. Sets p (mapped) so,
- * the slower slip's acceleration into *accel, and returns 1; 0 (p
+ * its slip then grows (as above), both found together. p need not be
+ * mapped (a pivot's start sets up no solve). Sets p so, mapped for the
+ * slide, the slower slip's acceleration into *accel, and returns 1; 0 (p
  * unchanged) if no such pair is found. */
 int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
