@@ -617,6 +617,56 @@ static int edge_residual_at(const edge_setup *e, const double th[2], double r[2]
     return edge_residual(e, c, sn, r, along, lambda);
 }
 
+/* Newton's method on the edge's two directions th[] (its Jacobian by
+ * differences), to round-off of the residual (PD_TOL_PHASE_START_RESIDUAL
+ * of g); r, along and lambda at the last th. 1 if converged. */
+static int edge_newton(const edge_setup *e, double g, double th[2], double r[2], double along[2],
+                       double lambda[2])
+{
+    double h = PD_PHASE_START_DIFF;
+    for (int it = 0; it < PD_PHASE_START_NEWTON; it++) {
+        if (!edge_residual_at(e, th, r, along, lambda))
+            return 0;
+        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * g)
+            return 1;
+        double J[2][2], rh[2], ah[2], lh[2];
+        for (int k = 0; k < 2; k++) {
+            double tk[2] = {th[0], th[1]};
+            tk[k] += h;
+            if (!edge_residual_at(e, tk, rh, ah, lh))
+                return 0;
+            J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
+        }
+        double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
+        if (!(fabs(det) > 0.0))
+            return 0;
+        th[0] -= (J[1][1] * r[0] - J[0][1] * r[1]) / det;
+        th[1] -= (J[0][0] * r[1] - J[1][0] * r[0]) / det;
+    }
+    return 0;
+}
+
+/* Both normal forces positive and both slips growing. */
+static int edge_admissible(const double lambda[2], const double along[2])
+{
+    return lambda[0] > 0.0 && lambda[1] > 0.0 && along[0] > 0.0 && along[1] > 0.0;
+}
+
+/* q (a copy of the edge's phase) sliding from rest along th[] into *out,
+ * the slower slip's acceleration into *accel. */
+static void set_edge_slide(pd_phase *q, const double th[2], pd_phase *out, double *accel,
+                           const double along[2])
+{
+    for (int k = 0; k < 2; k++) {
+        q->mode[k] = SLIDE;
+        q->from_rest[k] = 1;
+        q->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
+        q->drill[k] = 0.0;
+    }
+    *out = *q;
+    *accel = fmin(along[0], along[1]);
+}
+
 int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *accel)
 {
     const pd_phase *p = out;
@@ -642,57 +692,43 @@ int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *acce
             e.MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.Y);
         }
     }
-    /* A start: the common direction, of PD_PHASE_START_CELLS round the
-     * circle (turned by one rotation each), where both slips grow under
-     * positive normal forces with the smallest residual; then Newton's
-     * method on both directions (its Jacobian by differences), to round-off
-     * of the residual. */
+    /* A first start: each contact's direction of tangential acceleration
+     * under its frictionless normal force, which a slide from rest keeps
+     * where friction turns neither (an isotropic response: a lone contact
+     * with equal moments) and which is near it otherwise; then Newton's
+     * method on both directions. Where that does not converge to an
+     * admissible pair, the common direction, of PD_PHASE_START_CELLS round
+     * the circle (turned by one rotation each), where both slips grow under
+     * positive normal forces with the smallest residual, and Newton's method
+     * from there. */
+    double th[2], r[2], along[2], lambda[2];
+    edge_setup e0 = e;
+    e0.mu = 0.0;
+    const double one[2] = {1.0, 1.0}, zero[2] = {0.0, 0.0};
+    if (edge_residual(&e0, one, zero, r, along, lambda)) {
+        /* along: each contact's acceleration along X, r: along Y. */
+        th[0] = atan2(r[0], along[0]), th[1] = atan2(r[1], along[1]);
+        if (edge_newton(&e, p->g, th, r, along, lambda) && edge_admissible(lambda, along)) {
+            set_edge_slide(&q, th, out, accel, along);
+            return 1;
+        }
+    }
     const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
-    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL, c = 1.0, sn = 0.0;
+    double best = HUGE_VAL, c = 1.0, sn = 0.0;
+    th[0] = th[1] = 0.0;
     for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
         const double cc[2] = {c, c}, ss[2] = {sn, sn};
-        if (edge_residual(&e, cc, ss, r, along, lambda) && lambda[0] > 0.0 && lambda[1] > 0.0 &&
-            along[0] > 0.0 && along[1] > 0.0 && r[0] * r[0] + r[1] * r[1] < best)
+        if (edge_residual(&e, cc, ss, r, along, lambda) && edge_admissible(lambda, along) &&
+            r[0] * r[0] + r[1] * r[1] < best)
             best = r[0] * r[0] + r[1] * r[1], th[0] = th[1] = step * k;
         double c1 = c * cd - sn * sd;
         sn = sn * cd + c * sd, c = c1;
     }
     if (!(best < HUGE_VAL))
         return 0;
-    double h = PD_PHASE_START_DIFF;
-    int converged = 0;
-    for (int it = 0; it < PD_PHASE_START_NEWTON && !converged; it++) {
-        if (!edge_residual_at(&e, th, r, along, lambda))
-            return 0;
-        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * p->g) {
-            converged = 1;
-            break;
-        }
-        double J[2][2], rh[2], ah[2], lh[2];
-        for (int k = 0; k < 2; k++) {
-            double tk[2] = {th[0], th[1]};
-            tk[k] += h;
-            if (!edge_residual_at(&e, tk, rh, ah, lh))
-                return 0;
-            J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
-        }
-        double det = J[0][0] * J[1][1] - J[0][1] * J[1][0];
-        if (!(fabs(det) > 0.0))
-            return 0;
-        th[0] -= (J[1][1] * r[0] - J[0][1] * r[1]) / det;
-        th[1] -= (J[0][0] * r[1] - J[1][0] * r[0]) / det;
-    }
-    if (!converged || !(lambda[0] > 0.0) || !(lambda[1] > 0.0) || !(along[0] > 0.0) ||
-        !(along[1] > 0.0))
+    if (!edge_newton(&e, p->g, th, r, along, lambda) || !edge_admissible(lambda, along))
         return 0;
-    for (int k = 0; k < 2; k++) {
-        q.mode[k] = SLIDE;
-        q.from_rest[k] = 1;
-        q.t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
-        q.drill[k] = 0.0;
-    }
-    *out = q;
-    *accel = fmin(along[0], along[1]);
+    set_edge_slide(&q, th, out, accel, along);
     return 1;
 }
 

@@ -681,6 +681,70 @@ static void test_edge_slide_from_rest(void)
     drop_teardown(&fx);
 }
 
+/* A tetrahedron of vertices v[4] (A = v[0], B = v[1] on the plane z = 0),
+ * set up for scene sc, at rest in its own frame as the world's, A and B on
+ * the floor: its body, or NULL; its lowest vertices into contacts, *nc. */
+static const pd_body *tetra_on_edge(drop_fixture *fx, const pd_scene *sc, const pd_vec3 v[4],
+                                    pd_state *s, int *contacts, int *nc)
+{
+    if (!drop_setup(fx, convex_mesh(v, 4), sc))
+        return NULL;
+    const pd_body *b = fx->model->body;
+    *s = (pd_state){v3_add(fx->part->origin, b->com), b->frame, v3(0, 0, 0), v3(0, 0, 0)};
+    *nc = lowest_vertices(b, s->q, contacts);
+    return b;
+}
+
+/* A tetrahedron resting on its edge AB at rest, its centre of mass off
+ * the edge's middle and leaning past it, with too little friction to hold
+ * the edge: the weight's moment yaws it as it topples, so its two contacts'
+ * slides from rest part. Where a pair is found, each contact's tangential
+ * acceleration under the phase's own force solve (pd_phase_forces_of, not
+ * the search's residual) lies along its direction, outward, under a
+ * positive normal force. Tolerance: Newton's stop at 1e-12 g of the
+ * residual, with the solves' round-off. */
+static void test_edge_slide_apart(void)
+{
+    const double mus[3] = {0.02, 0.05, 0.1};
+    int found = 0;
+    for (int k = 0; k < 3; k++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.mu = mus[k];
+        drop_fixture fx;
+        const pd_vec3 v[4] = {{0, 0, 0}, {0.01, 0, 0}, {0.002, 0.008, 0.008}, {0.003, -0.002, 0.009}};
+        pd_state s;
+        int contacts[8], nc;
+        const pd_body *b = tetra_on_edge(&fx, &sc, v, &s, contacts, &nc);
+        if (!b)
+            return;
+        CHECK_INT(nc, 2);
+        double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * b->size), accel = 0.0;
+        pd_phase p;
+        if (nc == 2) {
+            pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+            CHECK(p.mode[0] == PD_PHASE_STICK && p.mode[1] == PD_PHASE_STICK);
+        }
+        if (nc == 2 && pd_phase_slide_edge_from_rest(&p, &s, &accel)) {
+            found++;
+            pd_phase_forces F;
+            CHECK(!pd_phase_forces_of(&p, &s, &F));
+            pd_vec3 alpha = quat_rotate(s.q, F.wdot);
+            for (int i = 0; i < 2; i++) {
+                pd_vec3 r = quat_rotate(s.q, b->verts[contacts[i]]), t = p.t0[i];
+                pd_vec3 a = v3_add(F.acc, v3_cross(alpha, r));
+                CHECK_NEAR(t.x * a.y - t.y * a.x, 0.0, 1e-9 * G, "slip grows along its direction");
+                CHECK(t.x * a.x + t.y * a.y > 0.0);
+                CHECK(F.fn[i] > 0.0);
+            }
+            /* the two directions differ: not a planar slide */
+            CHECK(fabs(p.t0[0].x * p.t0[1].y - p.t0[0].y * p.t0[1].x) > 1e-3);
+        }
+        drop_teardown(&fx);
+    }
+    CHECK(found > 0);
+}
+
 /* A tetrahedron resting on its edge AB, its centre of mass beyond A: the
  * weight's moment about A lifts B, whose normal force would be negative in
  * an edge phase. B lifts off, and the phase is A's alone (the edge's start
@@ -692,12 +756,11 @@ static void test_edge_lifts_one_end(void)
     sc.mu = 1.0; /* A sticks */
     drop_fixture fx;
     const pd_vec3 p[4] = {{0, 0, 0}, {0.01, 0, 0}, {-0.015, 0.005, 0.01}, {-0.015, -0.005, 0.01}};
-    if (!drop_setup(&fx, convex_mesh(p, 4), &sc))
+    pd_state s;
+    int contacts[8], nc;
+    const pd_body *b = tetra_on_edge(&fx, &sc, p, &s, contacts, &nc);
+    if (!b)
         return;
-    const pd_body *b = fx.model->body;
-    /* The part's own frame as the world's: A and B on the floor. */
-    pd_state s = {v3_add(fx.part->origin, b->com), b->frame, v3(0, 0, 0), v3(0, 0, 0)};
-    int contacts[8], nc = lowest_vertices(b, s.q, contacts);
     CHECK_INT(nc, 2);
     if (nc != 2)
         return;
@@ -847,5 +910,6 @@ void suite_contact_phase(void)
     test_start_modes();
     test_slide_from_rest();
     test_edge_slide_from_rest();
+    test_edge_slide_apart();
     test_edge_lifts_one_end();
 }
