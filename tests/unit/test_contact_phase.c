@@ -681,6 +681,68 @@ static void test_edge_slide_from_rest(void)
     drop_teardown(&fx);
 }
 
+/* The 1 x 2 x 3 cm box on its long edge, leaning nearly onto a side face
+ * (1e-5 rad above the floor) and turning onto it: its edge cannot stick,
+ * and the face's far vertex lands before the slips reach a slide's speed
+ * (checked here to first order, as lands_first judges a lone contact).
+ * The edge's slide from rest is a phase all the same (it was refused, and
+ * microcollisions stopped the slip a rest step at a time until the
+ * landing); the phase slides the edge outward, ends before that vertex is
+ * below the floor by more than the event tolerance's travel, and friction
+ * only takes energy (to the phase's ODE error). */
+static void test_edge_slide_into_landing(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    const pd_body *b = drop_setup_box(&fx, &sc, 0.3);
+    if (!b)
+        return;
+    pd_vec3 he = half_extents(b);
+    const double eps = 1e-5, rate = 0.05 / sqrt(b->size / G);
+    int contacts[8], nc;
+    pd_state s = on_edge(b, 0.5 * M_PI - eps - atan2(he.y, he.z), contacts, &nc);
+    CHECK_INT(nc, 2);
+    if (nc != 2) {
+        drop_teardown(&fx);
+        return;
+    }
+    /* The pivot's rate about the edge (body x), turning onto the face. */
+    pd_vec3 r0 = quat_rotate(s.q, b->verts[contacts[0]]);
+    s.w = v3(rate, 0.0, 0.0);
+    s.v = v3_neg(v3_cross(quat_rotate(s.q, s.w), r0));
+    /* The landing vertex: the lowest other one, and its first-order height
+     * at the slide's horizon. */
+    double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * b->size), accel = 0.0;
+    pd_phase p;
+    pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+    CHECK(pd_phase_slide_edge_from_rest(&p, &s, &accel));
+    int w = -1;
+    double hw = HUGE_VAL;
+    for (int i = 0; i < b->nverts; i++) {
+        double z = pd_body_vertex_world(b, &s, i).z;
+        if (i != contacts[0] && i != contacts[1] && z < hw)
+            hw = z, w = i;
+    }
+    pd_vec3 rw = quat_rotate(s.q, b->verts[w]);
+    double vz = s.v.z + v3_cross(quat_rotate(s.q, s.w), rw).z;
+    CHECK(hw + vz * slip_start / accel <= 0.0); /* lands first */
+    pd_phase phase;
+    pd_state t = s;
+    CHECK(pd_contact_phase_start(&fx.model->settle, &sc, &t, contacts, nc, &phase));
+    CHECK_INT(phase.nc, 2);
+    CHECK(phase.mode[0] == PD_PHASE_SLIDE && phase.mode[1] == PD_PHASE_SLIDE);
+    CHECK(phase.from_rest[0] && phase.from_rest[1]);
+    double E0 = total_energy(b, G, &t), dt = 0.0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &t, 1.0, &dt), PD_OK);
+    CHECK(dt > 0.0);
+    CHECK(pd_body_vertex_world(b, &t, w).z >= -PD_TOL_PHASE_EVENT_REL * sqrt(b->size / G) * fabs(vz));
+    CHECK(total_energy(b, G, &t) <= E0 + 1e-8 * b->mass * G * b->size);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
 /* A tetrahedron of vertices v[4] (A = v[0], B = v[1] on the plane z = 0),
  * set up for scene sc, at rest in its own frame as the world's, A and B on
  * the floor: its body, or NULL; its lowest vertices into contacts, *nc. */
@@ -911,5 +973,6 @@ void suite_contact_phase(void)
     test_slide_from_rest();
     test_edge_slide_from_rest();
     test_edge_slide_apart();
+    test_edge_slide_into_landing();
     test_edge_lifts_one_end();
 }
