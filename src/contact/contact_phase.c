@@ -43,6 +43,7 @@
  * PD_TOL_PHASE_EVENT_REL sqrt(L/g) before it; and it ends the drop when the
  * energy test decides it. */
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 #include "contact/contact_phase.h"
 #include "contact/contact_pivot.h"
@@ -261,8 +262,12 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
 
 /* A point of the phase: its time, y and state, y's derivative, the angular
  * acceleration (body frame), the floor's contact, its margins and smallest
- * margin (-1 where the model fails) and, once asked for (rated), the force
- * margins' rates of change. */
+ * margin (-1 where the model fails), once asked for (rated), the force
+ * margins' rates of change and, once asked for (bit k of jets_set), the
+ * height jet of the contacts' k-th other neighbour (height_jet_of): the
+ * models of two successive steps share their middle point, and a point's
+ * jets were computed for the step before. */
+enum { NJETS = 64 };
 typedef struct {
     double tau, y[NY], dydt[NY];
     pd_state s;
@@ -270,12 +275,14 @@ typedef struct {
     int floor_v;
     double g[NMARGIN], dg[HEIGHT], least;
     int rated;
+    uint64_t jets_set;
+    double jet[NJETS][3];
 } point;
 
 static void point_at(const motion *mo, double slip_min, double tau, const double y[NY], point *a)
 {
     pd_phase_forces F;
-    a->tau = tau, a->rated = 0;
+    a->tau = tau, a->rated = 0, a->jets_set = 0;
     memcpy(a->y, y, sizeof a->y); /* fixed size, inlined; a pivot's y is a full buffer too */
     for (int k = 0; k < NMARGIN; k++)
         a->g[k] = HUGE_VAL;
@@ -319,6 +326,21 @@ static void height_jet(const pd_phase *p, const point *a, int w, double jet[3])
     pd_vec3 wr = v3_cross(a->s.w, r);
     jet[1] = v3_dot(a->up, wr) * p->T / p->L;
     jet[2] = (v3_dot(a->up_w, wr) + v3_dot(a->up, v3_cross(a->wdot, r))) * p->T * p->T / p->L;
+}
+
+/* height_jet of vertex w, the contacts' k-th neighbour other than
+ * themselves (in margins' order), at a: kept in a from its first use. */
+static const double *height_jet_of(const pd_phase *p, point *a, int k, int w, double tmp[3])
+{
+    if (k >= NJETS) {
+        height_jet(p, a, w, tmp);
+        return tmp;
+    }
+    if (!(a->jets_set >> k & 1)) {
+        height_jet(p, a, w, a->jet[k]);
+        a->jets_set |= (uint64_t)1 << k;
+    }
+    return a->jet[k];
 }
 
 /* The polynomial c[0] + c[1] s + ... + c[5] s^5, and its slope, at s. */
@@ -393,12 +415,11 @@ static double poly_zero(const double c[NCOEF], double s0, double s1, double g0, 
 /* The quintic in s (0 at a, 1 at b) of vertex w's height into c[0..NCOEF),
  * matching its value, slope and curvature at both ends (height_jet); the
  * height at b into c[NCOEF]; returns the height at a. */
-static double height_model(const pd_phase *p, const point *a, const point *b, int w,
+static double height_model(const pd_phase *p, point *a, point *b, int k, int w,
                            double c[NCOEF + 1])
 {
-    double len = b->tau - a->tau, ja[3], jb[3];
-    height_jet(p, a, w, ja);
-    height_jet(p, b, w, jb);
+    double len = b->tau - a->tau, ta[3], tb[3];
+    const double *ja = height_jet_of(p, a, k, w, ta), *jb = height_jet_of(p, b, k, w, tb);
     /* g0 + m0 s + c0/2 s^2 plus the cubic, quartic and quintic terms that
      * take up the misfits e0, e1, e2 of that quadratic's value, slope and
      * curvature at 1. */
@@ -448,12 +469,17 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
     }
     if (!(b->g[HEIGHT] <= 0.0))
         return len * frac;
+    int n = 0;
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
-            if (is_contact(p, w) || !(height_of(p, b->up, b->floor_v, w) <= 0.0))
+            if (is_contact(p, w))
                 continue;
-            double c[NCOEF + 1], g0 = height_model(p, a, b, w, c);
+            if (!(height_of(p, b->up, b->floor_v, w) <= 0.0)) {
+                n++;
+                continue;
+            }
+            double c[NCOEF + 1], g0 = height_model(p, a, b, n++, w, c);
             frac = fmin(frac, poly_zero(c, 0.0, 1.0, g0, c[NCOEF]));
         }
     return len * frac;
@@ -467,17 +493,18 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
  * event predicted within the tolerance), it extrapolates by at most that
  * tolerance beyond b, which the quintic matches to the same order as
  * within. */
-static double predicted_event(const pd_phase *p, const point *a, const point *b, double horizon)
+static double predicted_event(const pd_phase *p, point *a, point *b, double horizon)
 {
     const pd_body *bd = p->b;
     double len = b->tau - a->tau, s1 = 1.0 + horizon / len, best = INFINITY;
+    int n = 0;
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
             if (is_contact(p, w))
                 continue;
             double c[NCOEF + 1];
-            height_model(p, a, b, w, c);
+            height_model(p, a, b, n++, w, c);
             double g1 = poly(c, s1);
             if (!(g1 <= 0.0))
                 continue;
