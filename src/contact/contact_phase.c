@@ -18,7 +18,8 @@
  * friction along the direction each slip then grows in, until the slip
  * reaches the start threshold, and along the slip from there, in the same
  * phase. A lone contact's slide is refused where another vertex is
- * predicted to land first (lands_first); an edge's is not. It slides from rest only while its sticking force stays outside the cone
+ * predicted to land first (lands_first); an edge's is not. It slides from
+ * rest only while its sticking force stays outside the cone
  * (else it would stick again). Where no direction is found for one contact
  * (just outside the cone's edge) or the part turns too fast for lands_first
  * to judge, it slips clipped (PD_PHASE_CLIP, phase_forces.h). A sticking
@@ -665,8 +666,8 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
          * microcollisions, each stopping the slip its rest step had grown,
          * until the landing; unlike a lone contact's (parts/cap.off), the
          * slip the phase leaves does not make the landing's microcollision
-         * dearer (docs/performance.md: collisions per box drop 15.0 ->
-         * 14.0, 5% fewer instructions). */
+         * dearer (docs/performance.md, "Contact phases: an edge's slide
+         * from rest"). */
         if (pd_phase_forces_of(&p, &t, &F))
             return 0;
         least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
