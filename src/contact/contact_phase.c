@@ -684,6 +684,21 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
             return 0;
         least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
     }
+    for (int i = 0; i < nc && nc == 2 && !pivot && !(least > 0.0); i++) {
+        /* An edge one of whose contacts slides while the other's sticking
+         * force lies outside the cone (its margin alone not positive): that
+         * one slides from rest too, as a lone contact's would. */
+        int other_ok = 1;
+        for (int k = 0; k < NMARGIN; k++)
+            other_ok = other_ok && (k == 2 + i || g[k] > 0.0);
+        if (!other_ok || p.mode[i] != PD_PHASE_STICK)
+            continue;
+        pd_phase slid = p;
+        if (!pd_phase_slide_end_from_rest(&slid, &t, i, &accel) || pd_phase_forces_of(&slid, &t, &F))
+            continue;
+        p = slid;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+    }
     if (!(least > 0.0)) {
         /* An edge one of whose contacts would pull on the floor (its normal
          * force not positive) lifts off there: the other's phase, alone,

@@ -617,6 +617,23 @@ static int edge_residual_at(const edge_setup *e, const double th[2], double r[2]
     return edge_residual(e, c, sn, r, along, lambda);
 }
 
+/* What edge_residual needs of phase p (responses set) at state s. */
+static void edge_setup_of(const pd_phase *p, const pd_state *s, edge_setup *e)
+{
+    double R[3][3];
+    quat_to_matrix(s->q, R);
+    e->up = v3(R[2][0], R[2][1], R[2][2]), e->X = v3(R[0][0], R[0][1], R[0][2]);
+    e->Y = v3(R[1][0], R[1][1], R[1][2]), e->mu = p->mu;
+    for (int k = 0; k < 2; k++) {
+        e->af[k] = free_accel(p, s, e->up, k);
+        for (int j = 0; j < 2; j++) {
+            e->Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->up);
+            e->MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->X);
+            e->MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->Y);
+        }
+    }
+}
+
 /* Newton's method on the edge's two directions th[] (its Jacobian by
  * differences), to round-off of the residual (PD_TOL_PHASE_START_RESIDUAL
  * of g); r, along and lambda at the last th. 1 if converged. */
@@ -679,19 +696,8 @@ int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *acce
     if (!q.mapped)
         map_responses(&q);
     p = &q;
-    double R[3][3];
-    quat_to_matrix(s->q, R);
     edge_setup e;
-    e.up = v3(R[2][0], R[2][1], R[2][2]), e.X = v3(R[0][0], R[0][1], R[0][2]);
-    e.Y = v3(R[1][0], R[1][1], R[1][2]), e.mu = p->mu;
-    for (int k = 0; k < 2; k++) {
-        e.af[k] = free_accel(p, s, e.up, k);
-        for (int j = 0; j < 2; j++) {
-            e.Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.up);
-            e.MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.X);
-            e.MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.Y);
-        }
-    }
+    edge_setup_of(p, s, &e);
     /* A first start: each contact's direction of tangential acceleration
      * under its frictionless normal force, which a slide from rest keeps
      * where friction turns neither (an isotropic response: a lone contact
@@ -729,6 +735,75 @@ int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *acce
     if (!edge_newton(&e, p->g, th, r, along, lambda) || !edge_admissible(lambda, along))
         return 0;
     set_edge_slide(&q, th, out, accel, along);
+    return 1;
+}
+
+int pd_phase_slide_end_from_rest(pd_phase *p, const pd_state *s, int i, double *accel)
+{
+    int j = 1 - i;
+    if (p->nc != 2 || i < 0 || i > 1 || p->mode[i] != STICK || p->mode[j] != SLIDE ||
+        p->from_rest[j] || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    /* Contact j's friction is along its slip (world, horizontal). */
+    pd_vec3 vj = v3_add(s->v, quat_rotate(s->q, v3_cross(s->w, p->r[j])));
+    double sl = sqrt(vj.x * vj.x + vj.y * vj.y);
+    if (!(sl > 0.0))
+        return 0;
+    edge_setup e;
+    edge_setup_of(p, s, &e);
+    double c[2], sn[2], r[2], along[2], lambda[2];
+    c[j] = vj.x / sl, sn[j] = vj.y / sl;
+    /* Contact i's directions where its slip keeps its direction (its
+     * residual, t x a, zero) and grows, under positive normal forces:
+     * bracketed between neighbours of PD_PHASE_START_CELLS directions round
+     * the circle, each narrowed by regula falsi (Illinois) along the arc to
+     * round-off; the fastest growing taken, as for a lone contact. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS;
+    double best = 0.0, bt = 0.0, th0 = 0.0, f0 = 0.0;
+    int ok0 = 0;
+    for (int k = 0; k <= PD_PHASE_START_CELLS; k++) {
+        double th1 = step * k;
+        c[i] = cos(th1), sn[i] = sin(th1);
+        int ok1 = edge_residual(&e, c, sn, r, along, lambda);
+        double f1 = r[i];
+        if (ok0 && ok1 && (f0 <= 0.0) != (f1 <= 0.0)) {
+            double lo = th0, flo = f0, hi = th1, fhi = f1, m = lo;
+            int side = 0, ok = 1;
+            for (int it = 0; it < 60 && ok; it++) {
+                m = lo + flo / (flo - fhi) * (hi - lo);
+                if (!(m > lo && m < hi))
+                    break;
+                c[i] = cos(m), sn[i] = sin(m);
+                ok = edge_residual(&e, c, sn, r, along, lambda);
+                double fm = r[i];
+                if (fm == 0.0)
+                    break;
+                if ((fm <= 0.0) == (flo <= 0.0)) {
+                    lo = m, flo = fm;
+                    if (side == -1)
+                        fhi *= 0.5;
+                    side = -1;
+                } else {
+                    hi = m, fhi = fm;
+                    if (side == 1)
+                        flo *= 0.5;
+                    side = 1;
+                }
+            }
+            c[i] = cos(m), sn[i] = sin(m);
+            if (ok && edge_residual(&e, c, sn, r, along, lambda) && lambda[0] > 0.0 &&
+                lambda[1] > 0.0 && along[i] > best)
+                best = along[i], bt = m;
+        }
+        th0 = th1, f0 = f1, ok0 = ok1;
+    }
+    if (!(best > 0.0))
+        return 0;
+    p->mode[i] = SLIDE;
+    p->from_rest[i] = 1;
+    p->t0[i] = v3(cos(bt), sin(bt), 0.0);
+    p->drill[0] = p->drill[1] = 0.0;
+    *accel = best;
     return 1;
 }
 

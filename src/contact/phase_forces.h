@@ -90,6 +90,13 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
  * unchanged) if no such pair is found. */
 int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
+/* An edge whose contact i sticks with its force outside the friction cone
+ * while the other slides: contact i starts to slide from rest along a
+ * direction in which its slip then grows (as above), the other's friction
+ * along its slip. Sets p (mapped) so, contact i's slip acceleration into
+ * *accel, and returns 1; 0 (p unchanged) if there is none. */
+int pd_phase_slide_end_from_rest(pd_phase *p, const pd_state *s, int i, double *accel);
+
 /* The forces of state s (SI). 0, or 1 where the model does not hold (a
  * sliding contact with no slip to give friction a direction, a singular
  * system). */
