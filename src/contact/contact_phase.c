@@ -12,9 +12,11 @@
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
- * phase_forces.c solves it). A resting contact, or both contacts of a
- * resting edge, whose sticking force would leave the friction cone slide
- * from rest (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest):
+ * phase_forces.c solves it). A resting contact, both contacts of a
+ * resting edge, or the resting end of an edge whose other end slides, whose
+ * sticking force would leave the friction cone slide from rest
+ * (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest,
+ * pd_phase_slide_end_from_rest):
  * friction along the direction each slip then grows in, until the slip
  * reaches the start threshold, and along the slip from there, in the same
  * phase. A lone contact's slide is refused where another vertex is
