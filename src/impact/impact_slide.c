@@ -315,20 +315,32 @@ static int low_order_event_step(collision *c, pd_ode_fn fn, double e0, double e1
  * last term kept (taylor_step). */
 #define TAYLOR_SAFETY 0.9
 
-/* One step of the tau flow by its Taylor series at the current state, to
- * tau + min(t1 - tau, the series' own step). The coefficients follow from
- * the flow: p_t' = -mu u_t, pz' = s, W' = u_z s, u = u0 + K p (so u's
+/* The Taylor series of the tau flow at a state y (taylor_coefs) and the
+ * step it allows (h): kept across a step that overshot an event, which is
+ * retried from the same state with the same series and only a shorter h. */
+typedef struct {
+    double y[NSTATE]; /* the state it was built at */
+    int valid;
+    double P[3][TAYLOR_ORDER + 1], W[TAYLOR_ORDER + 1];
+    double h;
+} taylor_series;
+
+/* The series of the tau flow at the current state. The coefficients follow
+ * from the flow: p_t' = -mu u_t, pz' = s, W' = u_z s, u = u0 + K p (so u's
  * coefficients are K times p's), and s's from s^2 = u_x^2 + u_y^2:
  * 2 s_0 s_m = sum_{j=0..m} (x_j x_{m-j} + y_j y_{m-j}) - sum_{j=1..m-1} s_j s_{m-j}.
  * The step is the longest at which each of the last two terms stays within
  * the tolerance c->tol (1 + |y_i|) of every component, a tenth shorter:
  * the terms of a series of radius R fall as (h/R)^k, so the omitted tail is
- * below the last term once h is well inside R. *hnext is that step. */
-static void taylor_step(collision *c, double *tau, double t1, double *hnext)
+ * below the last term once h is well inside R. */
+static void taylor_coefs(const collision *c, taylor_series *T)
 {
     const int work = c->law == PD_IMPACT_ENERGETIC, N = TAYLOR_ORDER;
-    double P[3][TAYLOR_ORDER + 1], W[TAYLOR_ORDER + 1];
+    double (*P)[TAYLOR_ORDER + 1] = T->P, *W = T->W;
     double X[TAYLOR_ORDER + 1], Y[TAYLOR_ORDER + 1], Z[TAYLOR_ORDER + 1], S[TAYLOR_ORDER + 1];
+    for (int i = 0; i < NSTATE; i++)
+        T->y[i] = c->y[i];
+    T->valid = 1;
     for (int i = 0; i < 3; i++)
         P[i][0] = c->y[i];
     W[0] = c->y[PW];
@@ -366,14 +378,28 @@ static void taylor_step(collision *c, double *tau, double t1, double *hnext)
         r1 = fmax(r1, fabs(a[N - 1]) / tol);
         r0 = fmax(r0, fabs(a[N]) / tol);
     }
-    double h = TAYLOR_SAFETY * fmin(r1 > 0.0 ? pow(r1, -1.0 / (N - 1)) : HUGE_VAL,
-                          r0 > 0.0 ? pow(r0, -1.0 / N) : HUGE_VAL);
+    T->h = TAYLOR_SAFETY * fmin(r1 > 0.0 ? pow(r1, -1.0 / (N - 1)) : HUGE_VAL,
+                                r0 > 0.0 ? pow(r0, -1.0 / N) : HUGE_VAL);
+}
+
+/* One step of the tau flow by its Taylor series at the current state, to
+ * tau + min(t1 - tau, the series' own step), the series built unless T holds
+ * it for this state already. *hnext is the series' own step. */
+static void taylor_step(collision *c, taylor_series *T, double *tau, double t1, double *hnext)
+{
+    const int work = c->law == PD_IMPACT_ENERGETIC, N = TAYLOR_ORDER;
+    int same = T->valid;
+    for (int i = 0; i < NSTATE && same; i++)
+        same = T->y[i] == c->y[i];
+    if (!same)
+        taylor_coefs(c, T);
+    double h = T->h;
     *hnext = h;
     int last = !(h < t1 - *tau);
     if (last)
         h = t1 - *tau;
     for (int i = 0; i < (work ? NSTATE : NSTATE_P); i++) {
-        const double *a = i < 3 ? P[i] : W;
+        const double *a = i < 3 ? T->P[i] : T->W;
         double v = a[N];
         for (int k = N - 1; k >= 0; k--)
             v = v * h + a[k];
@@ -396,6 +422,8 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
     c->in.n = -1;  /* not looked for yet */
     pd_ray_series ser[PD_RAYS_MAX];
     c->ser = ser;
+    taylor_series T;
+    T.valid = 0;
     for (;;) {
         pd_vec3 u = coll_u(c, c->y);
         double s = sqrt(u.x * u.x + u.y * u.y);
@@ -478,7 +506,7 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
         /* The step is given the derivative at its start, evaluates none at
          * its end and keeps no history, so the jumps of the state between
          * steps (closed forms, retries) need no restart. */
-        taylor_step(c, &tau, t1, &h);
+        taylor_step(c, &T, &tau, t1, &h);
         ++*nsteps;
         cap = INFINITY;
         cap_event = EV_NONE;
