@@ -203,10 +203,11 @@ static int ode_objects_build(pd_engine_world *w)
     dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
                                          w->threading);
     dWorldSetGravity(w->world, 0.0, 0.0, -w->gravity);
-    /* The contacts carry their own erp/cfm; these only matter if a joint
-     * without them were ever added. */
+    /* The contacts' normal rows carry their own erp and cfm; every other
+     * row (friction, drilling) takes the world's cfm, which makes friction
+     * a damper of coefficient 1/cfm: see PD_ODE_FRICTION_CFM. */
     dWorldSetERP(w->world, w->erp);
-    dWorldSetCFM(w->world, w->cfm);
+    dWorldSetCFM(w->world, PD_ODE_FRICTION_CFM);
     /* A surface layer would let the part rest that far inside the floor;
      * heights must be the facet's. */
     dWorldSetContactSurfaceLayer(w->world, 0.0);

@@ -44,6 +44,21 @@
  * spring oscillation on top. */
 #define PD_ODE_DAMPING_RATIO 1.0
 
+/* ODE's constraint force mixing on the rows without a cfm of their own:
+ * the contacts' friction and drilling rows (ODE's world cfm, in ODE's
+ * units, where masses and times are of order 1: see engine_ode.c). A row
+ * with cfm c holds its velocity at -c times its force, so below mu N
+ * friction is a damper of coefficient 1/c, and a slip relaxes over about
+ * m_eff c instead of stopping. The contact spring's cfm, 1 / (h kp + kd),
+ * which the world had until 2026-11-28, is a relaxation time of a
+ * fraction of a millisecond for a centimetre part, of the order of an
+ * impact: friction could not stop a slip within it (measured in
+ * docs/engines-crosscheck.md). Why 1e-10 (ODE's own default): a slip then
+ * relaxes in 1e-10 time units, far inside any step, while the LCP stays
+ * regular where the kept contacts' rows are dependent (a face's eight
+ * corners); with 0 the dense solver failed. */
+#define PD_ODE_FRICTION_CFM 1e-10
+
 /* Bullet's collision margin, times the part's size L or its thickness if
  * that is less (a needle's margin at 1e-3 L was its whole thickness, and it
  * sank through the floor: 4 of 100 drops of a 1 m x 1 mm rod): its convex shapes are the hull inflated
