@@ -59,6 +59,19 @@
  * corners); with 0 the dense solver failed. */
 #define PD_ODE_FRICTION_CFM 1e-10
 
+/* A contact whose slip at the start of a step is faster than this many
+ * steps of friction under the part's weight (mu g dt) slides through the
+ * step: its friction acts along the slip alone (ODE: engine_ode.c, Bullet:
+ * friction_directions in engine_bullet.cpp). Why 1: the friction of a
+ * resting contact cannot stop a faster slip within the step, and a slower
+ * one (a contact sticking, or starting to) needs a second friction axis so
+ * that it does not creep sideways. The bound shrinks with the step, so
+ * converged results do not depend on it; an impact's larger normal force
+ * may stop a faster slip within one step, and the single axis then stops
+ * it along the slip (its row's limit is not reached), leaving the sideways
+ * drift of one step. */
+#define PD_ENGINE_SLIDE_STEPS 1.0
+
 /* Bullet's collision margin, times the part's size L or its thickness if
  * that is less (a needle's margin at 1e-3 L was its whole thickness, and it
  * sank through the floor: 4 of 100 drops of a 1 m x 1 mm rod): its convex shapes are the hull inflated

@@ -7,6 +7,7 @@
 #include <string.h>
 #include "check.h"
 #include "dynamics/body.h"
+#include "impact/impact.h"
 #include "engines/engine.h"
 #include "engines/engine_contact.h"
 #include "posedrop/posedrop.h"
@@ -333,6 +334,71 @@ static void test_corner_friction(void)
     pd_part_free(part);
 }
 
+/* A corner strike sliding throughout in 3-D: the cube turned 45 degrees
+ * about z, 30 about y and 30 about z again, so that the collision matrix
+ * couples the slip's two directions with each other and with the normal,
+ * and the slip turns during the impact; it strikes at (2, 0.5, -1) m/s,
+ * mu 0.3, e 0.3, contact_time 1e-4 s, no gravity. Coulomb's law gives a
+ * sliding contact a friction of exactly mu N against its slip and none
+ * across it, so the total impulse has |p_t| <= mu p_z, equal only if the
+ * slip kept its direction; the rigid law (pd_impact_solve, which the
+ * strike must not stick in) gives |p_t| = 0.9989 mu p_z. Each engine clamps
+ * its friction to mu times the normal impulse of the same solve, step by
+ * step, so the bound holds to the solvers' round-off (1e-6 taken); over
+ * p_z the slip follows the same path as in the rigid law (du = K dp, dp =
+ * (-mu s, 1) dp_z), to the engines' first order in the step, so the ratio
+ * is within 5 h / T below the rigid law's. Before 2026-11-28 both engines
+ * gave a sliding contact a second friction row across its slip, which held
+ * the slip's direction with up to mu N more: |p_t| = 1.05 mu p_z here. */
+static void test_sliding_turns(void)
+{
+    pd_part *part;
+    pd_body *b;
+    if (!cube(&part, &b))
+        return;
+    pd_quat q = quat_mul(quat_axis_angle(v3(0, 0, 1), M_PI / 6),
+                         quat_mul(quat_axis_angle(v3(0, 1, 0), M_PI / 6),
+                                  quat_mul(quat_axis_angle(v3(0, 0, 1), -M_PI / 4), b->frame)));
+    int c = pd_body_support_scan(b, quat_rotate_inv(q, v3(0, 0, 1)));
+    pd_vec3 r = quat_rotate(q, b->verts[c]);
+    twist in = {v3(2, 0.5, -1), v3(0, 0, 0)};
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.gravity = 0.0;
+    sc.contact_time = 1e-4;
+    double K[3][3], J[3][3];
+    for (int i = 0; i < 3; i++) {
+        pd_vec3 col = inv_inertia(b, q, v3(i == 0, i == 1, i == 2));
+        J[0][i] = col.x;
+        J[1][i] = col.y;
+        J[2][i] = col.z;
+    }
+    pd_impact_K(1.0 / b->mass, CONST_M3(J), r, K);
+    pd_impact_work *iw = pd_impact_work_alloc();
+    pd_impact_result rigid;
+    int ok = iw && pd_impact_solve(iw, CONST_M3(K), in.v, sc.mu, sc.restitution,
+                                   PD_IMPACT_POISSON, &rigid) == PD_OK;
+    pd_impact_work_free(iw);
+    CHECK(ok && !rigid.stuck);
+    double want = ok ? hypot(rigid.p.x, rigid.p.y) / (sc.mu * rigid.p.z) : 0.0;
+    const pd_engine *engines[2] = {&pd_engine_ode, &pd_engine_bullet};
+    for (int k = 0; ok && k < 2; k++)
+        for (int n = 200; n <= 400; n *= 2) {
+            twist got;
+            int struck = engine_strike(engines[k], b, part->hull, &sc, sc.contact_time / n, q, c,
+                                       in, &got);
+            CHECK(struck);
+            if (!struck)
+                continue;
+            pd_vec3 p = v3_scale(v3_sub(got.v, in.v), b->mass);
+            double ratio = hypot(p.x, p.y) / (sc.mu * p.z);
+            CHECK(ratio <= 1.0 + 1e-6);
+            CHECK_NEAR(ratio, want, 5.0 / n, "the rigid law's slip path, first order 5 h / T");
+        }
+    pd_body_free(b);
+    pd_part_free(part);
+}
+
 /* A contact shorter than PD_ENGINE_CONTACT_STEPS steps is the engine's
  * own: the strike at T / 2 per step gives the bytes the same strike gives
  * with contact_time 0. */
@@ -361,5 +427,6 @@ void suite_engine_contact(void)
     test_law();
     test_corner_impacts();
     test_corner_friction();
+    test_sliding_turns();
     test_unresolved();
 }
