@@ -142,45 +142,122 @@ pd_status pd_compliant_law_step(double chi, double e, double s_peak, double *ste
     return PD_OK;
 }
 
-pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law)
+/* One trial of chi: its contact, kept as the answer so far, and
+ * *f = e(chi) - e. */
+static pd_status trial(double x, double e, double *chi, double *eh, double *tau, double *s_peak,
+                       double *f)
+{
+    pd_status st = pd_compliant_law_contact(x, PD_COMPLIANT_LAW_TOL, eh, tau, s_peak);
+    *chi = x;
+    *f = *eh - e;
+    return st;
+}
+
+/* chi solves e(chi) = e, e(chi) falling from 1 at chi = 0 towards 0 and
+ * smooth: regula falsi in a bracket, the Illinois way (the value kept at an
+ * end that stays is halved, so that both ends close in, superlinearly),
+ * where bisection took some 45 contacts of the scaled law. The bracket is
+ * ratio (1 +- spread) (1 - e) / e, ratio a guess of chi e / (1 - e) (which
+ * lies between 1.01 and 1.5 for every e in range), moved until it holds
+ * the root. Each trial is a contact integrated to PD_COMPLIANT_LAW_TOL; the
+ * bracket closes to that tolerance as bisection's did, and chi is its last
+ * trial, within it. */
+static pd_status solve_chi(double e, double ratio, double spread, double *chi, double *eh,
+                           double *tau, double *s_peak)
+{
+    pd_status st;
+    double flo, fhi, fx;
+    if (e >= 1.0) /* no damping: the undamped oscillator rebounds with e = 1 */
+        return trial(0.0, e, chi, eh, tau, s_peak, &fx);
+    double lo = ratio * (1.0 - spread) * (1.0 - e) / e, hi = ratio * (1.0 + spread) * (1.0 - e) / e;
+    /* A bracket that misses the root moves past the end it missed by
+     * twice its width, which doubles each time. */
+    double width = hi - lo;
+    if ((st = trial(lo, e, chi, eh, tau, s_peak, &flo)) != PD_OK)
+        return st;
+    while (flo <= 0.0) {
+        /* e(lo) at or below e: the root is lower. */
+        hi = lo;
+        fhi = flo;
+        width *= 2.0;
+        lo = lo > width ? lo - width : 0.5 * lo;
+        if (lo < PD_COMPLIANT_LAW_TOL * PD_COMPLIANT_LAW_TOL)
+            return trial(0.0, e, chi, eh, tau, s_peak, &fx);
+        if ((st = trial(lo, e, chi, eh, tau, s_peak, &flo)) != PD_OK)
+            return st;
+    }
+    if ((st = trial(hi, e, chi, eh, tau, s_peak, &fhi)) != PD_OK)
+        return st;
+    while (fhi > 0.0) {
+        lo = hi;
+        flo = fhi;
+        width *= 2.0;
+        hi += width;
+        if (hi > PD_COMPLIANT_LAW_CHI_MAX)
+            return PD_ERR_NO_CONVERGENCE;
+        if ((st = trial(hi, e, chi, eh, tau, s_peak, &fhi)) != PD_OK)
+            return st;
+    }
+    /* flo > 0 >= fhi. */
+    int kept = 0; /* the end that stayed last time: -1 lo, +1 hi */
+    for (int k = 0; hi - lo > PD_COMPLIANT_LAW_TOL * hi; k++) {
+        if (k == PD_COMPLIANT_LAW_MAX_TRIALS)
+            return PD_ERR_NO_CONVERGENCE;
+        double x = hi - fhi * (hi - lo) / (fhi - flo);
+        /* Round-off can put the point on an end or outside: bisect. */
+        if (!(x > lo && x < hi))
+            x = 0.5 * (lo + hi);
+        if ((st = trial(x, e, chi, eh, tau, s_peak, &fx)) != PD_OK)
+            return st;
+        if (fx == 0.0)
+            break; /* on the root (a secant can land there exactly) */
+        if (fx > 0.0) {
+            lo = x;
+            flo = fx;
+            if (kept == 1)
+                fhi *= 0.5;
+            kept = 1;
+        } else {
+            hi = x;
+            fhi = fx;
+            if (kept == -1)
+                flo *= 0.5;
+            kept = -1;
+        }
+    }
+    return PD_OK;
+}
+
+static pd_status law_init(double e, double T, double ratio, double spread, pd_compliant_law *law)
 {
     if (!(e >= 0.0 && e <= 1.0) || !(T > 0.0 && isfinite(T)))
         return PD_ERR_RANGE;
     e = fmax(e, PD_COMPLIANT_E_MIN);
-    double lo = 0.0, hi = 1.0, eh, tau;
-    pd_status st;
-    /* e(chi) falls from 1 at chi = 0 towards 0: bracket, then halve. */
-    for (;;) {
-        if ((st = pd_compliant_law_contact(hi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
-            return st;
-        if (eh <= e)
-            break;
-        lo = hi;
-        hi *= 2.0;
-        if (hi > PD_COMPLIANT_LAW_CHI_MAX)
-            return PD_ERR_NO_CONVERGENCE;
-    }
-    for (int k = 0; k < PD_COMPLIANT_LAW_MAX_HALVINGS && hi - lo > PD_COMPLIANT_LAW_TOL * hi; k++) {
-        double mid = 0.5 * (lo + hi);
-        if ((st = pd_compliant_law_contact(mid, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
-            return st;
-        if (eh > e)
-            lo = mid;
-        else
-            hi = mid;
-    }
+    double eh, tau;
+    pd_status st = solve_chi(e, ratio, spread, &law->chi, &eh, &tau, &law->s_peak);
+    if (st != PD_OK)
+        return st;
     law->e = e;
     law->T = T;
-    law->chi = 0.5 * (lo + hi);
-    if ((st = pd_compliant_law_contact(law->chi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &law->s_peak)) != PD_OK)
-        return st;
     law->tau = tau;
     law->omega = tau / T;
     return pd_compliant_law_step(law->chi, eh, law->s_peak, &law->step);
 }
 
+/* A guess of chi e / (1 - e) (contact_tol.h, PD_COMPLIANT_LAW_CHI_GUESS). */
+static double chi_ratio_guess(double e)
+{
+    return 1.5 - 0.5 * pow(1.0 - fmin(e, 1.0), PD_COMPLIANT_LAW_CHI_GUESS);
+}
+
+pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law)
+{
+    return law_init(e, T, chi_ratio_guess(fmax(e, PD_COMPLIANT_E_MIN)), PD_COMPLIANT_LAW_CHI_SPREAD,
+                    law);
+}
+
 /* The table's nodes are even in log e (dense where chi changes fastest,
- * towards e = 0) and hold chi e / (1 - e), which stays near 1.6 over the
+ * towards e = 0) and hold chi e / (1 - e), which stays between 1.01 and 1.5 over the
  * whole range (chi itself goes as 1 / e towards 0 and as 1 - e towards 1),
  * log tau, s_peak (an estimate at step ends, which only bounds the
  * step) and the log of the step. */
@@ -196,7 +273,16 @@ pd_status pd_compliant_table_init(double e_lo, double e_hi, pd_compliant_table *
     for (int i = 0; i < t->n; i++) {
         pd_compliant_law law;
         double e = i == 0 ? e_lo : i + 1 == t->n ? e_hi : exp(t->x_lo + i * t->dx);
-        pd_status st = pd_compliant_law_init(e, 1.0, &law);
+        /* From the second node on, chi e / (1 - e) is guessed from the
+         * nodes below (extrapolated along the line through the last two),
+         * which puts the first bracket within PD_COMPLIANT_TABLE_SPREAD of
+         * it and saves about half of each law's contacts. */
+        double ratio = i == 0 ? chi_ratio_guess(e)
+                       : i == 1 ? t->y[0][0]
+                                : 2.0 * t->y[0][i - 1] - t->y[0][i - 2];
+        double spread = i == 0 ? PD_COMPLIANT_LAW_CHI_SPREAD : PD_COMPLIANT_TABLE_SPREAD;
+        pd_status st = ratio > 0.0 ? law_init(e, 1.0, ratio, spread, &law)
+                                   : pd_compliant_law_init(e, 1.0, &law);
         if (st != PD_OK)
             return st;
         t->one = law;

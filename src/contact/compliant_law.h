@@ -32,7 +32,7 @@ typedef struct pd_compliant_law {
 } pd_compliant_law;
 
 /* The law for restitution e in [0, 1] and contact duration T > 0 (s):
- * chi by bisection on e(chi), tau by integrating the scaled law to
+ * chi by regula falsi on e(chi) (compliant_law.c), tau by integrating the scaled law to
  * PD_COMPLIANT_LAW_TOL. PD_ERR_RANGE for e or T outside their ranges,
  * PD_ERR_NO_CONVERGENCE, PD_ERR_NOMEM. */
 pd_status pd_compliant_law_init(double e, double T, pd_compliant_law *law);
@@ -61,7 +61,7 @@ pd_status pd_compliant_law_step(double chi, double e, double s_peak, double *ste
 int pd_compliant_law_step_meets(double chi, double e, double h);
 
 /* The laws for the restitutions of a range [e_lo, e_hi], for runs whose
- * restitution each drop draws (a law costs ~0.7 ms, a drop of a small part
+ * restitution each drop draws (a law costs about 2M instructions, a drop of a small part
  * less): exact at PD_COMPLIANT_TABLE_NODES restitutions evenly spaced in
  * log e, cubic interpolation between them. */
 enum { PD_COMPLIANT_TABLE_NODES = 65 };

@@ -141,8 +141,9 @@
  * stops a failure. */
 #define PD_COMPLIANT_LAW_MAX_STEPS 100000
 
-/* Bisection halvings of chi's bracket: 200 reach round-off of any bracket. */
-#define PD_COMPLIANT_LAW_MAX_HALVINGS 200
+/* Trials of chi in its bracket (regula falsi, compliant_law.c), at most:
+ * about 10 reach PD_COMPLIANT_LAW_TOL; 200 only stop a failure. */
+#define PD_COMPLIANT_LAW_MAX_TRIALS 200
 
 /* The step with one contact is, going up from short steps, the last whose
  * rebound from a flat landing (the scaled law, pd_compliant_law_step) is within
@@ -225,5 +226,21 @@
 #define PD_COMPLIANT_LAW_HORIZON 1e3
 #define PD_COMPLIANT_LAW_HENON_STEPS 64
 #define PD_COMPLIANT_LAW_CHI_MAX 1e6
+
+/* The first bracket of chi: (1 +- PD_COMPLIANT_LAW_CHI_SPREAD) times a
+ * guess of chi e / (1 - e), times (1 - e) / e. chi e / (1 - e) is 1.010
+ * at e = 0.01, 1.111 at 0.1, 1.323 at 0.3, 1.433 at 0.5, 1.481 at 0.7 and
+ * 1.498 to 1.500 from 0.9 to 1 (chi goes as 1 / e towards 0 and as
+ * 1.5 (1 - e) towards 1); the guess 1.5 - 0.5 (1 - e)^2.7 is within 1.2% of
+ * it at every e (PD_COMPLIANT_LAW_CHI_GUESS the exponent), so a spread of
+ * 3% holds the root. A table of laws brackets each node's within
+ * PD_COMPLIANT_TABLE_SPREAD of the value extrapolated from the nodes below
+ * (65 nodes over 0.01 to 1 move it by under 2% a node, the extrapolation's
+ * error far less). Any bracket gives the same chi to PD_COMPLIANT_LAW_TOL
+ * (one that misses the root is moved past it, by widths that double);
+ * only the number of contacts integrated moves. */
+#define PD_COMPLIANT_LAW_CHI_GUESS 2.7
+#define PD_COMPLIANT_LAW_CHI_SPREAD 0.03
+#define PD_COMPLIANT_TABLE_SPREAD 1e-3
 
 #endif

@@ -147,6 +147,50 @@ static void test_law_closed_form(void)
                worst_e, worst_t);
 }
 
+/* chi is the root of e(chi) = e to PD_COMPLIANT_LAW_TOL, however it is
+ * searched: against plain bisection of the same contact integration from
+ * the bracket [0, 2^k] (the search the law used before regula falsi), and
+ * at a table's nodes, whose search starts from a bracket extrapolated from
+ * the nodes below, against the law made alone (interpolation at a node is
+ * the node's value, to round-off). 4 times the tolerance: each side's chi
+ * is within its final bracket of 1e-13, and e(chi) itself wavers by about
+ * that much with the integrator's steps. */
+static void test_law_chi_root(void)
+{
+    const double es[] = {0.01, 0.17, 0.3, 0.62, 0.9, 0.995};
+    for (size_t i = 0; i < sizeof es / sizeof *es; i++) {
+        double lo = 0.0, hi = 1.0, eh, tau, peak;
+        CHECK_STATUS(pd_compliant_law_contact(hi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &peak), PD_OK);
+        while (eh > es[i]) {
+            lo = hi;
+            hi *= 2.0;
+            CHECK_STATUS(pd_compliant_law_contact(hi, PD_COMPLIANT_LAW_TOL, &eh, &tau, &peak),
+                         PD_OK);
+        }
+        while (hi - lo > PD_COMPLIANT_LAW_TOL * hi) {
+            double mid = 0.5 * (lo + hi);
+            CHECK_STATUS(pd_compliant_law_contact(mid, PD_COMPLIANT_LAW_TOL, &eh, &tau, &peak),
+                         PD_OK);
+            *(eh > es[i] ? &lo : &hi) = mid;
+        }
+        pd_compliant_law law;
+        CHECK_STATUS(pd_compliant_law_init(es[i], 1e-3, &law), PD_OK);
+        CHECK_REL(law.chi, 0.5 * (lo + hi), 4.0 * PD_COMPLIANT_LAW_TOL,
+                  "chi by regula falsi is bisection's root");
+    }
+    pd_compliant_table t;
+    CHECK_STATUS(pd_compliant_table_init(0.04, 0.97, &t), PD_OK);
+    for (int i = 0; i < t.n; i++) {
+        double e = i == 0 ? 0.04 : i + 1 == t.n ? 0.97 : exp(t.x_lo + i * t.dx);
+        pd_compliant_law alone, node;
+        CHECK_STATUS(pd_compliant_law_init(e, 1e-3, &alone), PD_OK);
+        pd_compliant_table_law(&t, e, 1e-3, &node);
+        CHECK_REL(node.chi, alone.chi, 4.0 * PD_COMPLIANT_LAW_TOL + 1e-14,
+                  "a table node's chi, searched from the extrapolated bracket, is the law's");
+        CHECK_REL(node.tau, alone.tau, 4.0 * PD_COMPLIANT_LAW_TOL, "and so is its duration");
+    }
+}
+
 /* --- single impacts of random bodies ---------------------------------------- */
 
 /* A random state of body b touching the floor at one vertex (the lowest of
@@ -857,7 +901,7 @@ static void test_convergence(void)
 
 void suite_compliant(void)
 {
-    void (*tests[])(void) = {test_law_closed_form, test_energy_random_impacts, test_rigid_limit,
+    void (*tests[])(void) = {test_law_closed_form, test_law_chi_root, test_energy_random_impacts, test_rigid_limit,
                              test_rigid_limit_planar, test_flat_landings, test_housner, test_near_flat_cube,
                              test_convergence};
     for (size_t i = 0; i < sizeof tests / sizeof *tests; i++) {
