@@ -12,13 +12,16 @@
  * forces solve a small linear system (at most 6 unknowns); two sticking
  * contacts (a rotation about an edge) leave the squeeze along the edge
  * undetermined, and the system takes the solution without it (least norm;
- * phase_forces.c solves it). A resting contact, or both contacts of a
- * resting edge, whose sticking force would leave the friction cone slide
- * from rest (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest):
+ * phase_forces.c solves it). A resting contact, both contacts of a
+ * resting edge, or the resting end of an edge whose other end slides, whose
+ * sticking force would leave the friction cone slide from rest
+ * (pd_phase_slide_from_rest, pd_phase_slide_edge_from_rest,
+ * pd_phase_slide_end_from_rest):
  * friction along the direction each slip then grows in, until the slip
  * reaches the start threshold, and along the slip from there, in the same
- * phase; unless another vertex is predicted to land first (lands_first).
- * It slides from rest only while its sticking force stays outside the cone
+ * phase. A lone contact's slide is refused where another vertex is
+ * predicted to land first (lands_first); an edge's is not. It slides from
+ * rest only while its sticking force stays outside the cone
  * (else it would stick again). Where no direction is found for one contact
  * (just outside the cone's edge) or the part turns too fast for lands_first
  * to judge, it slips clipped (PD_PHASE_CLIP, phase_forces.h). A sticking
@@ -43,6 +46,7 @@
  * PD_TOL_PHASE_EVENT_REL sqrt(L/g) before it; and it ends the drop when the
  * energy test decides it. */
 #include <math.h>
+#include <stdint.h>
 #include <string.h>
 #include "contact/contact_phase.h"
 #include "contact/contact_pivot.h"
@@ -261,8 +265,12 @@ static double margins(const pd_phase *p, const pd_state *s, const pd_phase_force
 
 /* A point of the phase: its time, y and state, y's derivative, the angular
  * acceleration (body frame), the floor's contact, its margins and smallest
- * margin (-1 where the model fails) and, once asked for (rated), the force
- * margins' rates of change. */
+ * margin (-1 where the model fails), once asked for (rated), the force
+ * margins' rates of change and, once asked for (bit k of jets_set), the
+ * height jet of the contacts' k-th other neighbour (height_jet_of): the
+ * models of two successive steps share their middle point, and a point's
+ * jets were computed for the step before. */
+enum { NJETS = 64 };
 typedef struct {
     double tau, y[NY], dydt[NY];
     pd_state s;
@@ -270,12 +278,14 @@ typedef struct {
     int floor_v;
     double g[NMARGIN], dg[HEIGHT], least;
     int rated;
+    uint64_t jets_set;
+    double jet[NJETS][3];
 } point;
 
 static void point_at(const motion *mo, double slip_min, double tau, const double y[NY], point *a)
 {
     pd_phase_forces F;
-    a->tau = tau, a->rated = 0;
+    a->tau = tau, a->rated = 0, a->jets_set = 0;
     memcpy(a->y, y, sizeof a->y); /* fixed size, inlined; a pivot's y is a full buffer too */
     for (int k = 0; k < NMARGIN; k++)
         a->g[k] = HUGE_VAL;
@@ -319,6 +329,21 @@ static void height_jet(const pd_phase *p, const point *a, int w, double jet[3])
     pd_vec3 wr = v3_cross(a->s.w, r);
     jet[1] = v3_dot(a->up, wr) * p->T / p->L;
     jet[2] = (v3_dot(a->up_w, wr) + v3_dot(a->up, v3_cross(a->wdot, r))) * p->T * p->T / p->L;
+}
+
+/* height_jet of vertex w, the contacts' k-th neighbour other than
+ * themselves (in margins' order), at a: kept in a from its first use. */
+static const double *height_jet_of(const pd_phase *p, point *a, int k, int w, double tmp[3])
+{
+    if (k >= NJETS) {
+        height_jet(p, a, w, tmp);
+        return tmp;
+    }
+    if (!(a->jets_set >> k & 1)) {
+        height_jet(p, a, w, a->jet[k]);
+        a->jets_set |= (uint64_t)1 << k;
+    }
+    return a->jet[k];
 }
 
 /* The polynomial c[0] + c[1] s + ... + c[5] s^5, and its slope, at s. */
@@ -393,12 +418,11 @@ static double poly_zero(const double c[NCOEF], double s0, double s1, double g0, 
 /* The quintic in s (0 at a, 1 at b) of vertex w's height into c[0..NCOEF),
  * matching its value, slope and curvature at both ends (height_jet); the
  * height at b into c[NCOEF]; returns the height at a. */
-static double height_model(const pd_phase *p, const point *a, const point *b, int w,
+static double height_model(const pd_phase *p, point *a, point *b, int k, int w,
                            double c[NCOEF + 1])
 {
-    double len = b->tau - a->tau, ja[3], jb[3];
-    height_jet(p, a, w, ja);
-    height_jet(p, b, w, jb);
+    double len = b->tau - a->tau, ta[3], tb[3];
+    const double *ja = height_jet_of(p, a, k, w, ta), *jb = height_jet_of(p, b, k, w, tb);
     /* g0 + m0 s + c0/2 s^2 plus the cubic, quartic and quintic terms that
      * take up the misfits e0, e1, e2 of that quadratic's value, slope and
      * curvature at 1. */
@@ -448,12 +472,17 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
     }
     if (!(b->g[HEIGHT] <= 0.0))
         return len * frac;
+    int n = 0;
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
-            if (is_contact(p, w) || !(height_of(p, b->up, b->floor_v, w) <= 0.0))
+            if (is_contact(p, w))
                 continue;
-            double c[NCOEF + 1], g0 = height_model(p, a, b, w, c);
+            if (!(height_of(p, b->up, b->floor_v, w) <= 0.0)) {
+                n++;
+                continue;
+            }
+            double c[NCOEF + 1], g0 = height_model(p, a, b, n++, w, c);
             frac = fmin(frac, poly_zero(c, 0.0, 1.0, g0, c[NCOEF]));
         }
     return len * frac;
@@ -467,17 +496,18 @@ static double time_to_event(const motion *mo, double slip_min, point *a, point *
  * event predicted within the tolerance), it extrapolates by at most that
  * tolerance beyond b, which the quintic matches to the same order as
  * within. */
-static double predicted_event(const pd_phase *p, const point *a, const point *b, double horizon)
+static double predicted_event(const pd_phase *p, point *a, point *b, double horizon)
 {
     const pd_body *bd = p->b;
     double len = b->tau - a->tau, s1 = 1.0 + horizon / len, best = INFINITY;
+    int n = 0;
     for (int i = 0; i < p->nc; i++)
         for (int k = bd->adj_start[p->v[i]]; k < bd->adj_start[p->v[i] + 1]; k++) {
             int w = bd->adj[k];
             if (is_contact(p, w))
                 continue;
             double c[NCOEF + 1];
-            height_model(p, a, b, w, c);
+            height_model(p, a, b, n++, w, c);
             double g1 = poly(c, s1);
             if (!(g1 <= 0.0))
                 continue;
@@ -540,18 +570,6 @@ static int lands_first(const pd_phase *p, const pd_state *s, double slip_min, do
                 return 1;
         }
     return 0;
-}
-
-/* pd_phase_slide_edge_from_rest on a copy of pivot phase p (which has no
- * force solve set up), replacing p where it succeeds. */
-static int slide_edge(pd_phase *p, const pd_state *s, double *accel)
-{
-    pd_phase q = *p;
-    pd_phase_map(&q);
-    if (!pd_phase_slide_edge_from_rest(&q, s, accel))
-        return 0;
-    *p = q;
-    return 1;
 }
 
 int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
@@ -643,15 +661,18 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
             stuck_out = 0;
         }
     } else if (!(least > 0.0) && pivot && fmin(F.cone[0], F.cone[1]) <= 0.0 &&
-               slide_edge(&p, &t, &accel)) {
+               pd_phase_slide_edge_from_rest(&p, &t, &accel)) {
         /* An edge that cannot stick: both its contacts slide from rest,
-         * as one contact's would above, unless another vertex lands
-         * first. */
+         * as one contact's would above, but also where another vertex
+         * lands first. Refused there (lands_first), the edge went to
+         * microcollisions, each stopping the slip its rest step had grown,
+         * until the landing; unlike a lone contact's (parts/cap.off), the
+         * slip the phase leaves does not make the landing's microcollision
+         * dearer (docs/performance.md, "Contact phases: an edge's slide
+         * from rest"). */
         if (pd_phase_forces_of(&p, &t, &F))
             return 0;
         least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
-        if (least > 0.0 && lands_first(&p, &t, slip_min, 2.0 * slip_min / accel))
-            return 0;
     }
     if (stuck_out) {
         /* Outside the cone, but so near its edge that the slide from rest
@@ -663,6 +684,21 @@ int pd_contact_phase_start(const pd_settle *st, const pd_scene *sc, pd_state *s,
         p.mode[0] = PD_PHASE_CLIP;
         if (pd_phase_forces_of(&p, &t, &F))
             return 0;
+        least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
+    }
+    for (int i = 0; i < nc && nc == 2 && !pivot && !(least > 0.0); i++) {
+        /* An edge one of whose contacts slides while the other's sticking
+         * force lies outside the cone (its margin alone not positive): that
+         * one slides from rest too, as a lone contact's would. */
+        int other_ok = 1;
+        for (int k = 0; k < NMARGIN; k++)
+            other_ok = other_ok && (k == 2 + i || g[k] > 0.0);
+        if (!other_ok || p.mode[i] != PD_PHASE_STICK)
+            continue;
+        pd_phase slid = p;
+        if (!pd_phase_slide_end_from_rest(&slid, &t, i, &accel) || pd_phase_forces_of(&slid, &t, &F))
+            continue;
+        p = slid;
         least = margins(&p, &t, &F, slip_min, g, &floor_v, &up);
     }
     if (!(least > 0.0)) {

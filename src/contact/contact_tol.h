@@ -91,10 +91,11 @@
  * setting: every zero found is exact to round-off. */
 #define PD_PHASE_START_CELLS 36
 /* An edge whose two contacts start to slide from rest: their directions by
- * Newton's method from the best common one, at most this many iterations
- * (quadratic convergence takes a handful from a start within a cell; a
- * planar slide, the common case, starts on its answer); not converged, the
- * phase is refused as before. */
+ * Newton's method, from each contact's frictionless acceleration and, where
+ * that fails, from the best common direction, at most this many iterations
+ * each (quadratic convergence takes a handful from a start near the answer;
+ * a planar slide, the common case, starts on it); not converged, the phase
+ * is refused as before. */
 #define PD_PHASE_START_NEWTON 30
 /* ...converged when the two residuals (cross products of direction and
  * tangential acceleration, m/s^2) sum to at most this times g: the

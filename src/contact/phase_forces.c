@@ -240,7 +240,9 @@ void pd_phase_modes(pd_phase *p, const pd_body *b, double g, double mu, const pd
         p->v[1] = -1;
 }
 
-void pd_phase_map(pd_phase *p)
+/* The contacts' responses M, and mapped set, for phases that need no P
+ * (some contact slides). */
+static void map_responses(pd_phase *p)
 {
     const pd_body *b = p->b;
     int nc = p->nc;
@@ -255,6 +257,11 @@ void pd_phase_map(pd_phase *p)
                                    v3_cross(pd_body_inv_inertia(b, v3_cross(p->r[j], f)), p->r[i]));
                 p->M[i][j][0][k] = a.x, p->M[i][j][1][k] = a.y, p->M[i][j][2][k] = a.z;
             }
+}
+
+void pd_phase_map(pd_phase *p)
+{
+    map_responses(p);
     if (!all_stick(p))
         return;
     /* Every contact sticks: the rows and unknowns are the body axes, K is
@@ -610,54 +617,40 @@ static int edge_residual_at(const edge_setup *e, const double th[2], double r[2]
     return edge_residual(e, c, sn, r, along, lambda);
 }
 
-int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
+/* What edge_residual needs of phase p (responses set) at state s. */
+static void edge_setup_of(const pd_phase *p, const pd_state *s, edge_setup *e)
 {
-    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !p->mapped || !(p->mu > 0.0))
-        return 0;
     double R[3][3];
     quat_to_matrix(s->q, R);
-    edge_setup e;
-    e.up = v3(R[2][0], R[2][1], R[2][2]), e.X = v3(R[0][0], R[0][1], R[0][2]);
-    e.Y = v3(R[1][0], R[1][1], R[1][2]), e.mu = p->mu;
+    e->up = v3(R[2][0], R[2][1], R[2][2]), e->X = v3(R[0][0], R[0][1], R[0][2]);
+    e->Y = v3(R[1][0], R[1][1], R[1][2]), e->mu = p->mu;
     for (int k = 0; k < 2; k++) {
-        e.af[k] = free_accel(p, s, e.up, k);
+        e->af[k] = free_accel(p, s, e->up, k);
         for (int j = 0; j < 2; j++) {
-            e.Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.up);
-            e.MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.X);
-            e.MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e.Y);
+            e->Mu[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->up);
+            e->MX[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->X);
+            e->MY[k][j] = m3_vec(CONST_M3(p->M[k][j]), e->Y);
         }
     }
-    /* A start: the common direction, of PD_PHASE_START_CELLS round the
-     * circle (turned by one rotation each), where both slips grow under
-     * positive normal forces with the smallest residual; then Newton's
-     * method on both directions (its Jacobian by differences), to round-off
-     * of the residual. */
-    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
-    double th[2] = {0.0, 0.0}, r[2], along[2], lambda[2], best = HUGE_VAL, c = 1.0, sn = 0.0;
-    for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
-        const double cc[2] = {c, c}, ss[2] = {sn, sn};
-        if (edge_residual(&e, cc, ss, r, along, lambda) && lambda[0] > 0.0 && lambda[1] > 0.0 &&
-            along[0] > 0.0 && along[1] > 0.0 && r[0] * r[0] + r[1] * r[1] < best)
-            best = r[0] * r[0] + r[1] * r[1], th[0] = th[1] = step * k;
-        double c1 = c * cd - sn * sd;
-        sn = sn * cd + c * sd, c = c1;
-    }
-    if (!(best < HUGE_VAL))
-        return 0;
+}
+
+/* Newton's method on the edge's two directions th[] (its Jacobian by
+ * differences), to round-off of the residual (PD_TOL_PHASE_START_RESIDUAL
+ * of g); r, along and lambda at the last th. 1 if converged. */
+static int edge_newton(const edge_setup *e, double g, double th[2], double r[2], double along[2],
+                       double lambda[2])
+{
     double h = PD_PHASE_START_DIFF;
-    int converged = 0;
-    for (int it = 0; it < PD_PHASE_START_NEWTON && !converged; it++) {
-        if (!edge_residual_at(&e, th, r, along, lambda))
+    for (int it = 0; it < PD_PHASE_START_NEWTON; it++) {
+        if (!edge_residual_at(e, th, r, along, lambda))
             return 0;
-        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * p->g) {
-            converged = 1;
-            break;
-        }
+        if (fabs(r[0]) + fabs(r[1]) <= PD_TOL_PHASE_START_RESIDUAL * g)
+            return 1;
         double J[2][2], rh[2], ah[2], lh[2];
         for (int k = 0; k < 2; k++) {
             double tk[2] = {th[0], th[1]};
             tk[k] += h;
-            if (!edge_residual_at(&e, tk, rh, ah, lh))
+            if (!edge_residual_at(e, tk, rh, ah, lh))
                 return 0;
             J[0][k] = (rh[0] - r[0]) / h, J[1][k] = (rh[1] - r[1]) / h;
         }
@@ -667,16 +660,150 @@ int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel)
         th[0] -= (J[1][1] * r[0] - J[0][1] * r[1]) / det;
         th[1] -= (J[0][0] * r[1] - J[1][0] * r[0]) / det;
     }
-    if (!converged || !(lambda[0] > 0.0) || !(lambda[1] > 0.0) || !(along[0] > 0.0) ||
-        !(along[1] > 0.0))
-        return 0;
+    return 0;
+}
+
+/* Both normal forces positive and both slips growing. */
+static int edge_admissible(const double lambda[2], const double along[2])
+{
+    return lambda[0] > 0.0 && lambda[1] > 0.0 && along[0] > 0.0 && along[1] > 0.0;
+}
+
+/* q (a copy of the edge's phase) sliding from rest along th[] into *out,
+ * the slower slip's acceleration into *accel. */
+static void set_edge_slide(pd_phase *q, const double th[2], pd_phase *out, double *accel,
+                           const double along[2])
+{
     for (int k = 0; k < 2; k++) {
-        p->mode[k] = SLIDE;
-        p->from_rest[k] = 1;
-        p->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
-        p->drill[k] = 0.0;
+        q->mode[k] = SLIDE;
+        q->from_rest[k] = 1;
+        q->t0[k] = v3(cos(th[k]), sin(th[k]), 0.0);
+        q->drill[k] = 0.0;
     }
+    *out = *q;
     *accel = fmin(along[0], along[1]);
+}
+
+int pd_phase_slide_edge_from_rest(pd_phase *out, const pd_state *s, double *accel)
+{
+    const pd_phase *p = out;
+    if (p->nc != 2 || p->mode[0] != STICK || p->mode[1] != STICK || !(p->mu > 0.0))
+        return 0;
+    /* The responses alone: the sticking solve (P) is of no use to the
+     * search, nor to the sliding phase it sets. Into a copy, so that p is
+     * unchanged where the search fails. */
+    pd_phase q = *p;
+    if (!q.mapped)
+        map_responses(&q);
+    p = &q;
+    edge_setup e;
+    edge_setup_of(p, s, &e);
+    /* A first start: each contact's direction of tangential acceleration
+     * under its frictionless normal force, which a slide from rest keeps
+     * where friction turns neither (an isotropic response: a lone contact
+     * with equal moments) and which is near it otherwise; then Newton's
+     * method on both directions. Where that does not converge to an
+     * admissible pair, the common direction, of PD_PHASE_START_CELLS round
+     * the circle (turned by one rotation each), where both slips grow under
+     * positive normal forces with the smallest residual, and Newton's method
+     * from there. */
+    double th[2], r[2], along[2], lambda[2];
+    edge_setup e0 = e;
+    e0.mu = 0.0;
+    const double one[2] = {1.0, 1.0}, zero[2] = {0.0, 0.0};
+    if (edge_residual(&e0, one, zero, r, along, lambda)) {
+        /* along: each contact's acceleration along X, r: along Y. */
+        th[0] = atan2(r[0], along[0]), th[1] = atan2(r[1], along[1]);
+        if (edge_newton(&e, p->g, th, r, along, lambda) && edge_admissible(lambda, along)) {
+            set_edge_slide(&q, th, out, accel, along);
+            return 1;
+        }
+    }
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS, cd = cos(step), sd = sin(step);
+    double best = HUGE_VAL, c = 1.0, sn = 0.0;
+    th[0] = th[1] = 0.0;
+    for (int k = 0; k < PD_PHASE_START_CELLS; k++) {
+        const double cc[2] = {c, c}, ss[2] = {sn, sn};
+        if (edge_residual(&e, cc, ss, r, along, lambda) && edge_admissible(lambda, along) &&
+            r[0] * r[0] + r[1] * r[1] < best)
+            best = r[0] * r[0] + r[1] * r[1], th[0] = th[1] = step * k;
+        double c1 = c * cd - sn * sd;
+        sn = sn * cd + c * sd, c = c1;
+    }
+    if (!(best < HUGE_VAL))
+        return 0;
+    if (!edge_newton(&e, p->g, th, r, along, lambda) || !edge_admissible(lambda, along))
+        return 0;
+    set_edge_slide(&q, th, out, accel, along);
+    return 1;
+}
+
+int pd_phase_slide_end_from_rest(pd_phase *p, const pd_state *s, int i, double *accel)
+{
+    int j = 1 - i;
+    if (p->nc != 2 || i < 0 || i > 1 || p->mode[i] != STICK || p->mode[j] != SLIDE ||
+        p->from_rest[j] || !p->mapped || !(p->mu > 0.0))
+        return 0;
+    /* Contact j's friction is along its slip (world, horizontal). */
+    pd_vec3 vj = v3_add(s->v, quat_rotate(s->q, v3_cross(s->w, p->r[j])));
+    double sl = sqrt(vj.x * vj.x + vj.y * vj.y);
+    if (!(sl > 0.0))
+        return 0;
+    edge_setup e;
+    edge_setup_of(p, s, &e);
+    double c[2], sn[2], r[2], along[2], lambda[2];
+    c[j] = vj.x / sl, sn[j] = vj.y / sl;
+    /* Contact i's directions where its slip keeps its direction (its
+     * residual, t x a, zero) and grows, under positive normal forces:
+     * bracketed between neighbours of PD_PHASE_START_CELLS directions round
+     * the circle, each narrowed by regula falsi (Illinois) along the arc to
+     * round-off; the fastest growing taken, as for a lone contact. */
+    const double step = 2.0 * M_PI / PD_PHASE_START_CELLS;
+    double best = 0.0, bt = 0.0, th0 = 0.0, f0 = 0.0;
+    int ok0 = 0;
+    for (int k = 0; k <= PD_PHASE_START_CELLS; k++) {
+        double th1 = step * k;
+        c[i] = cos(th1), sn[i] = sin(th1);
+        int ok1 = edge_residual(&e, c, sn, r, along, lambda);
+        double f1 = r[i];
+        if (ok0 && ok1 && (f0 <= 0.0) != (f1 <= 0.0)) {
+            double lo = th0, flo = f0, hi = th1, fhi = f1, m = lo;
+            int side = 0, ok = 1;
+            for (int it = 0; it < 60 && ok; it++) {
+                m = lo + flo / (flo - fhi) * (hi - lo);
+                if (!(m > lo && m < hi))
+                    break;
+                c[i] = cos(m), sn[i] = sin(m);
+                ok = edge_residual(&e, c, sn, r, along, lambda);
+                double fm = r[i];
+                if (fm == 0.0)
+                    break;
+                if ((fm <= 0.0) == (flo <= 0.0)) {
+                    lo = m, flo = fm;
+                    if (side == -1)
+                        fhi *= 0.5;
+                    side = -1;
+                } else {
+                    hi = m, fhi = fm;
+                    if (side == 1)
+                        flo *= 0.5;
+                    side = 1;
+                }
+            }
+            c[i] = cos(m), sn[i] = sin(m);
+            if (ok && edge_residual(&e, c, sn, r, along, lambda) && lambda[0] > 0.0 &&
+                lambda[1] > 0.0 && along[i] > best)
+                best = along[i], bt = m;
+        }
+        th0 = th1, f0 = f1, ok0 = ok1;
+    }
+    if (!(best > 0.0))
+        return 0;
+    p->mode[i] = SLIDE;
+    p->from_rest[i] = 1;
+    p->t0[i] = v3(cos(bt), sin(bt), 0.0);
+    p->drill[0] = p->drill[1] = 0.0;
+    *accel = best;
     return 1;
 }
 

@@ -84,10 +84,18 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel);
 
 /* Both contacts of an edge, sticking (a pivot) where a force leaves the
  * friction cone, start to slide from rest: each along a direction in which
- * its slip then grows (as above), both found together. Sets p (mapped) so,
- * the slower slip's acceleration into *accel, and returns 1; 0 (p
+ * its slip then grows (as above), both found together. p need not be
+ * mapped (a pivot's start sets up no solve). Sets p so, mapped for the
+ * slide, the slower slip's acceleration into *accel, and returns 1; 0 (p
  * unchanged) if no such pair is found. */
 int pd_phase_slide_edge_from_rest(pd_phase *p, const pd_state *s, double *accel);
+
+/* An edge whose contact i sticks with its force outside the friction cone
+ * while the other slides: contact i starts to slide from rest along a
+ * direction in which its slip then grows (as above), the other's friction
+ * along its slip. Sets p (mapped) so, contact i's slip acceleration into
+ * *accel, and returns 1; 0 (p unchanged) if there is none. */
+int pd_phase_slide_end_from_rest(pd_phase *p, const pd_state *s, int i, double *accel);
 
 /* The forces of state s (SI). 0, or 1 where the model does not hold (a
  * sliding contact with no slip to give friction a direction, a singular

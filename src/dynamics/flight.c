@@ -176,7 +176,7 @@ static int principal_axis(pd_vec3 u, double tol)
 /* omega = a u + b axis (flight.h): a spherical top or a spin about a
  * principal axis (on_axis >= 0) turns about L alone; a symmetric top also
  * about its distinct axis. */
-static void set_axial(pd_flight *F, const double *I, const double *J, pd_vec3 u, int on_axis)
+static inline void set_axial(pd_flight *F, const double *I, const double *J, pd_vec3 u, int on_axis)
 {
     F->kind = PD_FLIGHT_AXIAL;
     if (I[0] == I[2] || on_axis >= 0) {
@@ -284,7 +284,7 @@ static pd_status plan_elliptic(pd_flight *F, pd_vec3 u, const double *J)
  * ends the other pairs give), and the round-off of the others, at most
  * ~1e-16 (2 E / I_min) / PD_FLIGHT_WMAX_PAIR_REL, is covered by adding
  * PD_FLIGHT_WMAX_ROUND times 2 E / I_min. Never above the classical bounds. */
-static double wmax_bound(const double *I, pd_vec3 w0, double L2)
+static inline double wmax_bound(const double *I, pd_vec3 w0, double L2)
 {
     double w[3] = {w0.x, w0.y, w0.z}, E2 = 0.0, best = 0.0, Imin = fmin(I[0], fmin(I[1], I[2]));
     for (int i = 0; i < 3; i++) {
@@ -304,7 +304,7 @@ static double wmax_bound(const double *I, pd_vec3 w0, double L2)
     return fmin(sqrt(fmin(w2, E2 / Imin)), sqrt(L2) / Imin);
 }
 
-pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
+pd_status pd_flight_plan_bounds(const pd_body *b, const pd_state *s0, double g, pd_flight *f)
 {
     if (!b || !s0 || !f || !(g >= 0.0))
         return PD_ERR_USAGE;
@@ -339,18 +339,30 @@ pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flig
         set_axial(F, I, J, u, on_axis);
         return PD_OK;
     }
-    pd_status st = plan_elliptic(F, u, J);
+    F->kind = PD_FLIGHT_BOUNDS; /* an asymmetric top: pd_flight_complete */
+    return PD_OK;
+}
+
+pd_status pd_flight_complete(const pd_body *b, pd_flight *f)
+{
+    if (!b || !f)
+        return PD_ERR_USAGE;
+    if (f->kind != PD_FLIGHT_BOUNDS)
+        return PD_OK;
+    pd_vec3 u = v3_scale(body_L(b, f->s0.w), 1.0 / f->lambda);
+    pd_status st = plan_elliptic(f, u, b->inv_moment);
     if (st != PD_OK) {
         /* Within PD_TOL_FLIGHT_NEAR_AXIS_REL of the separatrix's end, the
          * middle axis, the elliptic phase can overflow: a steady spin. */
         int near = principal_axis(u, PD_TOL_FLIGHT_NEAR_AXIS_REL);
-        if (near < 0)
+        if (near < 0) {
+            f->kind = PD_FLIGHT_BOUNDS; /* no flight: not to be evaluated */
             return st;
-        set_axial(F, I, J, u, near);
+        }
+        set_axial(f, b->moment, b->inv_moment, u, near);
     }
     return PD_OK;
 }
-
 
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
 {
@@ -395,6 +407,8 @@ pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out)
         for (int i = 0; i < 3; i++)
             wb[f->perm[i]] = f->wsc[i] * u[i];
         w = v3(wb[0], wb[1], wb[2]);
+    } else if (f->kind == PD_FLIGHT_BOUNDS) {
+        return PD_ERR_USAGE; /* pd_flight_complete first */
     }
     const pd_state *s0 = &f->s0;
     out->x = v3(s0->x.x + s0->v.x * t, s0->x.y + s0->v.y * t,

@@ -16,7 +16,10 @@ typedef enum pd_flight_kind {
     PD_FLIGHT_STILL,    /* no rotation */
     PD_FLIGHT_AXIAL,    /* spherical or symmetric top, or a steady spin about a
                            principal axis: two uniform rotations */
-    PD_FLIGHT_ELLIPTIC  /* asymmetric top: Jacobi elliptic functions */
+    PD_FLIGHT_ELLIPTIC, /* asymmetric top: Jacobi elliptic functions */
+    PD_FLIGHT_BOUNDS    /* an asymmetric top of which only the bounds are planned
+                           (pd_flight_plan_bounds): evaluable at t = 0 alone
+                           until pd_flight_complete */
 } pd_flight_kind;
 
 typedef struct pd_flight {
@@ -51,18 +54,37 @@ typedef struct pd_flight {
     pd_theta th;         /* last: pd_flight_plan zeroes only what precedes it */
 } pd_flight;
 
+/* pd_flight_plan (below) in two halves, the same flight bit for bit. The
+ * first plans all but an asymmetric top's rotation (s0, g, lambda, wmax,
+ * lhat, and the axial cases whole); an asymmetric top is then of kind
+ * PD_FLIGHT_BOUNDS, which pd_flight_eval evaluates at t = 0 only. The second
+ * solves that rotation (the elliptic plan, most of a plan's cost) and does
+ * nothing for a flight already complete. A drop plans after every collision,
+ * but a contact still touching afterwards leads straight to the next
+ * collision, and then the rotation was never needed: about a third of a
+ * box's plans (docs/performance.md). Statuses as pd_flight_plan's; after a
+ * failed pd_flight_complete the flight stays of kind PD_FLIGHT_BOUNDS. */
+pd_status pd_flight_plan_bounds(const pd_body *b, const pd_state *s0, double g, pd_flight *f);
+pd_status pd_flight_complete(const pd_body *b, pd_flight *f);
+
 /* Plans the flight of body b from state s0 under gravity g (m/s^2, >= 0).
  * PD_ERR_USAGE (NULL, g < 0), PD_ERR_NONFINITE (a non-finite state, or an
  * elliptic phase that overflows away from the middle axis). On failure *f
  * may be partly written (it is planned in place): it holds no flight and
  * must not be evaluated. */
-pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g, pd_flight *f);
+static inline pd_status pd_flight_plan(const pd_body *b, const pd_state *s0, double g,
+                                       pd_flight *f)
+{
+    pd_status st = pd_flight_plan_bounds(b, s0, g, f);
+    return st != PD_OK ? st : pd_flight_complete(b, f);
+}
 
 /* The state at time t (s, may be negative) after the start. The com is
  * exactly ballistic; the rotation is the closed-form torque-free motion.
  * PD_ERR_NONFINITE if an elliptic function fails (cannot happen for a planned
  * flight and finite t). */
 pd_status pd_flight_eval(const pd_flight *f, double t, pd_state *out);
+/* (PD_ERR_USAGE at t != 0 for a flight of kind PD_FLIGHT_BOUNDS.) */
 
 /* Plan and evaluate in one: advances *s by dt. */
 pd_status pd_flight_advance(const pd_body *b, pd_state *s, double g, double dt);
@@ -91,7 +113,7 @@ typedef struct pd_impact {
  * those within PD_TOL_CONTACT_REL * L of the floor and, with window > 0 (s),
  * those that would reach it within window at their present velocity.
  * PD_ERR_USAGE, PD_ERR_NO_CONVERGENCE (PD_CONTACT_MAX_STEPS), PD_ERR_NONFINITE. */
-pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
+pd_status pd_flight_impact(const pd_body *b, pd_flight *f, double t_max, double window,
                            int *contacts, int ncap, pd_impact *out);
 
 /* The same from time t0 of the flight on, at its state there (as
@@ -100,8 +122,10 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, d
  * plan). A flight stays valid until its next contact, so a caller that has
  * moved the state along it need not plan it again. The search for the lowest
  * vertex starts from vertex start (any index; one near the lowest at t0
- * saves the climb to it, pd_flight_impact starts from 0). */
-pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
+ * saves the climb to it, pd_flight_impact starts from 0). Both complete a
+ * flight planned by its bounds alone (pd_flight_complete) before they
+ * evaluate it, and only then: touching at t0 needs no rotation. */
+pd_status pd_flight_impact_from(const pd_body *b, pd_flight *f, double t0, const pd_state *at,
                                 int start, double t_max, double window, int *contacts, int ncap,
                                 pd_impact *out);
 

@@ -211,7 +211,7 @@ static int contact_set(const pd_body *b, const pd_state *s, pd_vec3 up, int lowe
     return n;
 }
 
-pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, double window,
+pd_status pd_flight_impact(const pd_body *b, pd_flight *f, double t_max, double window,
                            int *contacts, int ncap, pd_impact *out)
 {
     if (!f)
@@ -219,7 +219,7 @@ pd_status pd_flight_impact(const pd_body *b, const pd_flight *f, double t_max, d
     return pd_flight_impact_from(b, f, 0.0, &f->s0, 0, t_max, window, contacts, ncap, out);
 }
 
-pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0, const pd_state *at,
+pd_status pd_flight_impact_from(const pd_body *b, pd_flight *f, double t0, const pd_state *at,
                                 int start, double t_max, double window, int *contacts, int ncap,
                                 pd_impact *out)
 {
@@ -239,6 +239,8 @@ pd_status pd_flight_impact_from(const pd_body *b, const pd_flight *f, double t0,
     if (p.h <= tol) {
         r.kind = PD_IMPACT_NOW;
     } else {
+        if (f->kind == PD_FLIGHT_BOUNDS && (st = pd_flight_complete(b, f)) != PD_OK)
+            return st;
         for (;;) {
             if (r.steps++ >= PD_CONTACT_MAX_STEPS)
                 return PD_ERR_NO_CONVERGENCE;

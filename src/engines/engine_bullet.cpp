@@ -20,8 +20,9 @@
  *   not Bullet's support vertex and its probes;
  * - one fixed step per call, without interpolation;
  * - no deactivation: the drop loop decides rest by energy, never Bullet;
- * - the gyroscopic term by the adapter (gyroscopic_step) and two friction
- *   directions (bullet_world_alloc);
+ * - the gyroscopic term by the adapter (gyroscopic_step); two friction
+ *   directions, except in a step where every contact slides
+ *   (friction_directions);
  * - restitution threshold PD_BULLET_BOUNCE_STEPS * g dt instead of an
  *   absolute 0.2 m/s; penetration recovered by split impulse only, so
  *   pushing a sunk part out adds no kinetic energy that the rest test would
@@ -57,6 +58,11 @@ struct contact_law {
     bool on;
     double omega, zeta;
     double reach; /* the manifold's contact breaking threshold, m */
+    /* A contact slipping faster than this (m/s) slides through the step
+     * (slide_speed); the solver info whose friction directions
+     * processCollision sets for the step from that. */
+    double slide;
+    btContactSolverInfo *info;
 };
 
 class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
@@ -78,6 +84,33 @@ class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
             p.m_combinedContactDamping1 = btScalar(2.0 * law->zeta * m * law->omega);
             p.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
         }
+    }
+
+    /* Bullet's friction acts along the slip alone, or along it and across
+     * it (SOLVER_USE_2_FRICTION_DIRECTIONS), each row within mu times the
+     * normal impulse, for the whole step's solve. Across a sliding contact
+     * the second row holds the slip's direction fixed with up to mu N more
+     * (a sliding impact's friction up to sqrt(2) mu N, and the slip never
+     * turned); without it a resting part creeps sideways (see
+     * bullet_world_alloc). So the step has both rows when a contact slips
+     * slower than law->slide (it sticks, or may start to), and the slip's
+     * row alone when every contact slides, as this is solved after the
+     * collisions are found, in the same step. */
+    void friction_directions(const btRigidBody *body, const btVector3 &n)
+    {
+        bool slow = false;
+        for (int j = 0; j < manifold->getNumContacts(); j++) {
+            btManifoldPoint &p = manifold->getContactPoint(j);
+            btVector3 pa = manifold->getBody0() == body ? p.getPositionWorldOnA()
+                                                        : p.getPositionWorldOnB();
+            btVector3 v = body->getVelocityInLocalPoint(pa - body->getCenterOfMassPosition());
+            btVector3 t = v - n * n.dot(v);
+            slow = slow || double(t.length()) <= law->slide;
+        }
+        if (slow)
+            law->info->m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+        else
+            law->info->m_solverMode &= ~SOLVER_USE_2_FRICTION_DIRECTIONS;
     }
 
 public:
@@ -128,6 +161,8 @@ public:
         const btRigidBody *body = btRigidBody::upcast(hw->getCollisionObject());
         if (law->on && body)
             set_springs(body, n);
+        if (body)
+            friction_directions(body, n);
     }
 
     btScalar calculateTimeOfImpact(btCollisionObject *, btCollisionObject *,
@@ -265,6 +300,14 @@ static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
      * dashpot's alone (no restitution). */
     w->world.getSolverInfo().m_splitImpulse = law.on ? 0 : 1;
     w->body.setFriction(btScalar(scene->mu));
+    /* Sliding: PD_ENGINE_SLIDE_STEPS steps of friction under the part's
+     * weight (standard gravity's without gravity, as in ODE's adapter), and
+     * at least twice the slip below which Bullet does not turn the first
+     * friction row along the slip (its lateral speed squared within
+     * FLT_EPSILON, m^2/s^2). */
+    double g = scene->gravity != 0.0 ? fabs(scene->gravity) : 9.81;
+    law.slide = fmax(PD_ENGINE_SLIDE_STEPS * scene->mu * g * w->step_s,
+                     2.0 * sqrt(double(FLT_EPSILON)));
     w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
     return PD_OK;
 }
@@ -334,8 +377,11 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     /* Bullet's default friction acts along the sliding direction only; a
      * part resting on a face then creeps sideways at ~1e-4 m/s (measured on
      * a 1 x 2 x 3 cm box), a second, orthogonal direction holds it (2e-6 m
-     * in 1 s). */
+     * in 1 s). It is kept for every step in which a contact slips slowly,
+     * and left out while all slide (hull_floor_algorithm's
+     * friction_directions). */
     info.m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
+    w->hull_floor.law.info = &info;
 
     w->world.setGravity(btVector3(0, 0, btScalar(-scene->gravity)));
 

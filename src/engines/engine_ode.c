@@ -17,9 +17,14 @@
  * Friction: ODE has no exact Coulomb cone; dContactApprox1 gives a pyramid
  * whose limits are mu times the normal force of the same step (without it
  * ODE reads mu as a force in newtons). The pyramid's first axis is turned
- * along the sliding velocity, so a sliding contact meets exactly mu N against
- * its motion; only a sideways push on a sliding contact, or a stick broken
- * diagonally, sees the pyramid's up to sqrt(2) larger corner.
+ * along the sliding velocity. A contact that slides (PD_ENGINE_SLIDE_STEPS)
+ * has friction along that axis alone, so it meets exactly mu N against its
+ * motion and none across it; with the second axis too, that axis's row
+ * held the slip's direction fixed with up to mu N more across it (a sliding
+ * impact's friction up to sqrt(2) mu N, and the slip never turned). A
+ * contact that sticks or slips slower gets both axes, so that a resting
+ * part does not creep; only a stick broken diagonally sees the pyramid's up
+ * to sqrt(2) larger corner.
  *
  * Units: ODE is handed the part in units near its own size L, mass m and
  * time sqrt(L/g) (powers of two, so the conversions are exact), and every
@@ -88,6 +93,9 @@ struct pd_engine_world {
     double len, time, vel;
     double dt; /* in time units */
     double mu, restitution, bounce_vel;
+    /* A contact slipping faster than this slides through the step:
+     * PD_ENGINE_SLIDE_STEPS steps of friction under the part's weight. */
+    double slide_speed;
     double erp, cfm;
     /* contact_time > 0 and resolved by the step: each contact is the
      * scene's spring-dashpot (pd_engine_contact_law) for its effective mass,
@@ -203,10 +211,11 @@ static int ode_objects_build(pd_engine_world *w)
     dWorldSetStepThreadingImplementation(w->world, dThreadingImplementationGetFunctions(w->threading),
                                          w->threading);
     dWorldSetGravity(w->world, 0.0, 0.0, -w->gravity);
-    /* The contacts carry their own erp/cfm; these only matter if a joint
-     * without them were ever added. */
+    /* The contacts' normal rows carry their own erp and cfm; every other
+     * row (friction, drilling) takes the world's cfm, which makes friction
+     * a damper of coefficient 1/cfm: see PD_ODE_FRICTION_CFM. */
     dWorldSetERP(w->world, w->erp);
-    dWorldSetCFM(w->world, w->cfm);
+    dWorldSetCFM(w->world, PD_ODE_FRICTION_CFM);
     /* A surface layer would let the part rest that far inside the floor;
      * heights must be the facet's. */
     dWorldSetContactSurfaceLayer(w->world, 0.0);
@@ -404,6 +413,7 @@ static pd_status material(pd_engine_world *w, const pd_scene *scene)
                                                   w->width_m);
     }
     drilling_arm(w);
+    w->slide_speed = PD_ENGINE_SLIDE_STEPS * w->mu * w->gscale * w->dt;
     return PD_OK;
 }
 
@@ -591,14 +601,27 @@ static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
         dContact c;
         memset(&c, 0, sizeof c);
         c.geom = cg[i];
-        c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM;
+        /* Friction pyramid's first axis along the slip (see the top). The
+         * contact normal points from the floor into the part, +z. A
+         * sliding contact has friction along that axis only (mu2 = 0). */
+        dVector3 pv;
+        dBodyGetPointVel(w->body, cg[i].pos[0], cg[i].pos[1], cg[i].pos[2], pv);
+        double tx = pv[0], ty = pv[1];
+        double ts = sqrt(tx * tx + ty * ty);
+        c.surface.mode = dContactApprox1 | dContactSoftERP | dContactSoftCFM | dContactMu2;
         c.surface.mu = w->mu;
+        c.surface.mu2 = ts > w->slide_speed ? 0.0 : w->mu;
+        if (ts > 0.0) {
+            c.surface.mode |= dContactFDir1;
+            c.fdir1[0] = tx / ts;
+            c.fdir1[1] = ty / ts;
+            c.fdir1[2] = 0.0;
+        }
         if (w->drill > 0.0) {
             /* Spinning friction alone: rhoN is read only with the axes'
-             * own coefficients (dContactAxisDep, which also reads mu2),
-             * and no rolling resistance (rho = rho2 = 0). */
-            c.surface.mode |= dContactRolling | dContactAxisDep;
-            c.surface.mu2 = w->mu;
+             * own coefficients (dContactAxisDep, the same flag as
+             * dContactMu2), and no rolling resistance (rho = rho2 = 0). */
+            c.surface.mode |= dContactRolling;
             c.surface.rhoN = w->drill;
         }
         if (w->compliant) {
@@ -609,18 +632,6 @@ static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
             c.surface.bounce_vel = w->bounce_vel;
             c.surface.soft_erp = w->erp;
             c.surface.soft_cfm = w->cfm;
-        }
-        /* Friction pyramid's first axis along the slip (see the top). The
-         * contact normal points from the floor into the part, +z. */
-        dVector3 pv;
-        dBodyGetPointVel(w->body, cg[i].pos[0], cg[i].pos[1], cg[i].pos[2], pv);
-        double tx = pv[0], ty = pv[1];
-        double ts = sqrt(tx * tx + ty * ty);
-        if (ts > 0.0) {
-            c.surface.mode |= dContactFDir1;
-            c.fdir1[0] = tx / ts;
-            c.fdir1[1] = ty / ts;
-            c.fdir1[2] = 0.0;
         }
         dJointID j = dJointCreateContact(w->world, w->contacts, &c);
         if (!j) {

@@ -44,6 +44,37 @@
  * spring oscillation on top. */
 #define PD_ODE_DAMPING_RATIO 1.0
 
+/* ODE's constraint force mixing on the rows without a cfm of their own:
+ * the contacts' friction and drilling rows (ODE's world cfm, in ODE's
+ * units, where masses and times are of order 1: see engine_ode.c). A row
+ * with cfm c holds its velocity at -c times its force, so below mu N
+ * friction is a damper of coefficient 1/c, and a slip relaxes over about
+ * m_eff c instead of stopping. The contact spring's cfm, 1 / (h kp + kd),
+ * which the world had until 2026-11-28, is a relaxation time of a
+ * fraction of a millisecond for a centimetre part, of the order of an
+ * impact: friction could not stop a slip within it (measured in
+ * docs/engines-crosscheck.md). Why 1e-10 (ODE's own default): a slip then
+ * relaxes in 1e-10 time units, far inside any step, while the LCP stays
+ * regular where the kept contacts' rows are dependent (a face's eight
+ * corners); with 0 the dense solver failed. */
+#define PD_ODE_FRICTION_CFM 1e-10
+
+/* A contact whose slip at the start of a step is faster than this many
+ * steps of friction under the part's weight (mu g dt) slides through the
+ * step: its friction acts along the slip alone (ODE: engine_ode.c, Bullet:
+ * friction_directions in engine_bullet.cpp). A slower one (a contact
+ * sticking, or starting to) keeps a second friction axis so that it does
+ * not creep sideways. The bound shrinks with the step, so converged results
+ * do not depend on it; an impact's larger normal force may stop a faster
+ * slip within one step, and the single axis then stops it along the slip
+ * (its row's limit is not reached), leaving the sideways drift of one
+ * step. Why 10 and not 1 (the friction of a resting contact cannot stop a
+ * faster slip within the step): at 1, four of 100 ODE drops of a 1 mm cube
+ * spun at 3000 rad/s at the default 1 ms step ran to the time limit
+ * (tests/unit/test_hard_parts.c); at 10 none did. Why that happens at 1
+ * was not found. */
+#define PD_ENGINE_SLIDE_STEPS 10.0
+
 /* Bullet's collision margin, times the part's size L or its thickness if
  * that is less (a needle's margin at 1e-3 L was its whole thickness, and it
  * sank through the floor: 4 of 100 drops of a 1 m x 1 mm rod): its convex shapes are the hull inflated

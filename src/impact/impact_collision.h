@@ -33,6 +33,9 @@ typedef struct {
     pd_rays in;       /* the incoming rays */
     unsigned built;   /* bit k: ser[k] is built (once the slip comes near ray k) */
     pd_ray_series *ser; /* [PD_RAYS_MAX], the slide's: left out of the collision's zeroing */
+    pd_ray_out *out;    /* the diverging ray's series, the slide's likewise */
+    int out_built;      /* out is built (once the slip's direction comes near the ray) */
+    double out_refused; /* the angle at which out's tail was last refused (0: never) */
     int compressed;
     double pz_c, W_c, pz_end, W_end;
     int done;

@@ -48,4 +48,47 @@ void pd_ray_series_build(const double K[][3], double mu, double tx, double ty, i
 int pd_ray_series_tail(const double K[][3], double mu, const pd_ray_series *sr, pd_vec3 u,
                        double max_angle, double max_err, int with_work, pd_vec3 *dp, double *dw);
 
+/* The slide onto the diverging ray (impact_rays.h), exact up to the
+ * truncation of power series in the angle delta to it. There the slip's
+ * direction is attracted (b_1 < 0) while the slip grows (c_0 > 0), so no
+ * slide in its basin ends on it: it ends at a normal event, maximum
+ * compression or Poisson's end, somewhere along the way. Two series in
+ * delta give the way in closed form: H, the regular solution of
+ * b H' + c H = 1, so that pz - s H(phi) is constant along a trajectory, and
+ * R, with ln s + nu ln|delta| - R(delta) constant (nu = c_0 / |b_1|, the
+ * slip's growth against the direction's settling). Then the state at any
+ * angle delta_e further along is known, and the event is the root of one
+ * equation in ln|delta_e|, found by safeguarded Newton. Built once per
+ * collision, like the incoming rays' series. */
+/* Terms of the diverging ray's series: 12, as the incoming rays'; 16 and
+ * 20 took the same or more instructions on the recorded drops, the build
+ * growing as the square (impact_slide.c, OUT_ANGLE). */
+enum { PD_RAY_OUT_N = 12 };
+typedef struct pd_ray_out {
+    int ok;                        /* the ray attracts and the slip grows: the series exist */
+    double tx, ty;                 /* the ray's unit direction */
+    double nu;                     /* c_0 / |b_1| */
+    double h[PD_RAY_OUT_N + 1];    /* H */
+    double r[PD_RAY_OUT_N + 1];    /* R (r[0] = 0) */
+    double beta[PD_RAY_OUT_N + 1]; /* b / delta, < 0 wherever the series hold */
+    double wx, wy;                 /* K_tt^-1 K_tz */
+} pd_ray_out;
+
+/* Builds the series of the diverging ray (tx, ty) of K and mu (K as is). */
+void pd_ray_out_build(const double K[][3], double mu, double tx, double ty, pd_ray_out *o);
+
+enum { PD_RAY_OUT_COMPRESS, PD_RAY_OUT_PZ };
+
+/* The rest of the slide from the contact velocity u toward the ray of o, up
+ * to the event `target`: maximum compression (u_z rises to 0, within
+ * ev_tol of it; u.z < 0), or PD_RAY_OUT_PZ, a normal impulse of `goal` more
+ * (within ev_tol; goal > 0). Sets the impulse *dp and returns 1; returns 0
+ * (and sets nothing) unless u is within max_angle of the ray, delta within
+ * half the radius of convergence of every series, u_z rises all along the
+ * way (for compression: so the root is the first one), Newton converged,
+ * and the truncations' estimated error is at most max_err (units of the
+ * impulse). */
+int pd_ray_out_tail(const double K[][3], double mu, const pd_ray_out *o, pd_vec3 u, int target,
+                    double goal, double ev_tol, double max_angle, double max_err, pd_vec3 *dp);
+
 #endif

@@ -243,19 +243,25 @@ static double turn_step(const pd_body *b, const pd_state *s, double wmax, double
 }
 
 /* Plans the flight from s when *f_at < 0 (nothing planned since the motion
- * last changed) and sets *f_at to 0; 0 when the plan fails, the drop then
- * marked failed. */
+ * last changed) and sets *f_at to 0; with complete 0, only its bounds
+ * (pd_flight_plan_bounds): the impact search solves the rotation when it
+ * first needs it, and a search that finds a contact touching at once, which
+ * leads straight to the next collision, never does. 0 when the plan fails,
+ * the drop then marked failed. */
 static int plan_if_stale(const pd_body *b, const pd_state *s, double g, pd_flight *f, double *f_at,
-                         pd_trial *out)
+                         int complete, pd_trial *out)
 {
-    if (*f_at >= 0.0)
-        return 1;
-    pd_status st = pd_flight_plan(b, s, g, f);
+    pd_status st = PD_OK;
+    if (*f_at < 0.0) {
+        st = pd_flight_plan_bounds(b, s, g, f);
+        *f_at = 0.0;
+    }
+    if (st == PD_OK && complete && f->kind == PD_FLIGHT_BOUNDS)
+        st = pd_flight_complete(b, f);
     if (st != PD_OK) {
         pd_drop_failed(out, PD_STAGE_FLIGHT, st);
         return 0;
     }
-    *f_at = 0.0;
     return 1;
 }
 
@@ -326,7 +332,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         /* The flight from s: planned afresh after anything that changed the
          * motion, else the one s already lies on, at its time f_at. */
-        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, 0, out))
             break;
         if (!resolved) {
             pd_impact imp;
@@ -457,7 +463,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
          * lands meanwhile (a face's other corners after its first one
          * rebounds), which then starts below the floor. */
         phase_ok = 1;
-        if (!plan_if_stale(m->body, &s, g, &f, &f_at, out))
+        if (!plan_if_stale(m->body, &s, g, &f, &f_at, 1, out))
             break;
         double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
         if (rise > m->settle.v_rest)

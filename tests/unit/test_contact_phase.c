@@ -39,6 +39,45 @@ static pd_state on_edge(const pd_body *b, double tilt, int *contacts, int *nc)
     return s;
 }
 
+/* The 1 x 2 x 3 cm box with friction mu on its long edge (on_edge), leaning
+ * tilt past balance or, where face_gap > 0, until its side face is face_gap
+ * rad above the floor: its body and state, or NULL (torn down) where the
+ * setup or the edge fails. */
+static const pd_body *box_on_edge(drop_fixture *fx, pd_scene *sc, double mu, double tilt,
+                                  double face_gap, pd_state *s, int *contacts)
+{
+    const pd_body *b = drop_setup_box(fx, sc, mu);
+    if (!b)
+        return NULL;
+    int nc;
+    pd_vec3 h = half_extents(b);
+    if (face_gap > 0.0)
+        tilt = 0.5 * M_PI - face_gap - atan2(h.y, h.z);
+    *s = on_edge(b, tilt, contacts, &nc);
+    CHECK_INT(nc, 2);
+    if (nc != 2) {
+        drop_teardown(fx);
+        return NULL;
+    }
+    return b;
+}
+
+/* The edge phase started at s (contacts[0..2)): admitted, both ends
+ * sliding, the first from rest and the second too where both_rest. 1 if
+ * started. */
+static int edge_slide_starts(const drop_fixture *fx, const pd_scene *sc, pd_state *s,
+                             const int *contacts, pd_phase *phase, int both_rest)
+{
+    int started = pd_contact_phase_start(&fx->model->settle, sc, s, contacts, 2, phase);
+    CHECK(started);
+    if (!started)
+        return 0;
+    CHECK_INT(phase->nc, 2);
+    CHECK(phase->mode[0] == PD_PHASE_SLIDE && phase->mode[1] == PD_PHASE_SLIDE);
+    CHECK(phase->from_rest[0] && phase->from_rest[1] == both_rest);
+    return 1;
+}
+
 /* Sliding along the edge, balanced over it: friction mu m g brakes the box
  * along x and its pitching moment is carried by the two ends' normal forces
  * (mu h < X, so both stay positive); nothing turns. Closed form until the
@@ -681,6 +720,171 @@ static void test_edge_slide_from_rest(void)
     drop_teardown(&fx);
 }
 
+/* The 1 x 2 x 3 cm box on its long edge, leaning nearly onto a side face
+ * (1e-5 rad above the floor) and turning onto it: its edge cannot stick,
+ * and the face's far vertex lands before the slips reach a slide's speed
+ * (checked here to first order, as lands_first judges a lone contact).
+ * The edge's slide from rest is a phase all the same (it was refused, and
+ * microcollisions stopped the slip a rest step at a time until the
+ * landing); the phase slides the edge outward, ends before that vertex is
+ * below the floor by more than the event tolerance's travel, and friction
+ * only takes energy (to the phase's ODE error). */
+static void test_edge_slide_into_landing(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    pd_state s;
+    int contacts[8], nc = 2;
+    const pd_body *b = box_on_edge(&fx, &sc, 0.3, 0.0, 1e-5, &s, contacts);
+    if (!b)
+        return;
+    const double rate = 0.05 / sqrt(b->size / G);
+    /* The pivot's rate about the edge (body x), turning onto the face. */
+    pd_vec3 r0 = quat_rotate(s.q, b->verts[contacts[0]]);
+    s.w = v3(rate, 0.0, 0.0);
+    s.v = v3_neg(v3_cross(quat_rotate(s.q, s.w), r0));
+    /* The landing vertex: the lowest other one, and its first-order height
+     * at the slide's horizon. */
+    double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * b->size), accel = 0.0;
+    pd_phase p;
+    pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+    CHECK(pd_phase_slide_edge_from_rest(&p, &s, &accel));
+    int w = -1;
+    double hw = HUGE_VAL;
+    for (int i = 0; i < b->nverts; i++) {
+        double z = pd_body_vertex_world(b, &s, i).z;
+        if (i != contacts[0] && i != contacts[1] && z < hw)
+            hw = z, w = i;
+    }
+    pd_vec3 rw = quat_rotate(s.q, b->verts[w]);
+    double vz = s.v.z + v3_cross(quat_rotate(s.q, s.w), rw).z;
+    CHECK(hw + vz * slip_start / accel <= 0.0); /* lands first */
+    pd_phase phase;
+    pd_state t = s;
+    if (!edge_slide_starts(&fx, &sc, &t, contacts, &phase, 1)) {
+        drop_teardown(&fx);
+        return;
+    }
+    double E0 = total_energy(b, G, &t), dt = 0.0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &t, 1.0, &dt), PD_OK);
+    CHECK(dt > 0.0);
+    CHECK(pd_body_vertex_world(b, &t, w).z >= -PD_TOL_PHASE_EVENT_REL * sqrt(b->size / G) * fabs(vz));
+    CHECK(total_energy(b, G, &t) <= E0 + 1e-8 * b->mass * G * b->size);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* The 1 x 2 x 3 cm box on its long edge, leaning past balance, turning
+ * about the vertical through one end of the edge: that end at rest, the
+ * other sliding. With friction 0.05 the resting end's sticking force lies
+ * outside the cone, and it slides from rest too (it was refused, and
+ * microcollisions stopped its slip a rest step at a time): the start is
+ * admitted with both ends sliding, the resting one from rest along a
+ * direction in which its tangential acceleration under the phase's own
+ * force solve lies (to 1e-9 g: the narrowing's round-off with the solves'),
+ * outward, under positive normal forces; and the phase's energy only
+ * falls (to its ODE error). */
+static void test_edge_end_slides_from_rest(void)
+{
+    pd_scene sc;
+    drop_fixture fx;
+    pd_state s;
+    int contacts[8];
+    const pd_body *b = box_on_edge(&fx, &sc, 0.05, 0.2, 0.0, &s, contacts);
+    if (!b)
+        return;
+    pd_vec3 r0 = quat_rotate(s.q, b->verts[contacts[0]]), om = v3(0.0, 0.0, 2.0);
+    s.w = quat_rotate_inv(s.q, om);
+    s.v = v3_neg(v3_cross(om, r0));
+    pd_phase phase;
+    if (!edge_slide_starts(&fx, &sc, &s, contacts, &phase, 0)) {
+        drop_teardown(&fx);
+        return;
+    }
+    pd_phase_forces F;
+    CHECK(!pd_phase_forces_of(&phase, &s, &F));
+    pd_vec3 w = quat_rotate(s.q, s.w), alpha = quat_rotate(s.q, F.wdot);
+    pd_vec3 r = quat_rotate(s.q, b->verts[phase.v[0]]), t = phase.t0[0];
+    pd_vec3 a = v3_add(F.acc, v3_add(v3_cross(alpha, r), v3_cross(w, v3_cross(w, r))));
+    CHECK_NEAR(t.x * a.y - t.y * a.x, 0.0, 1e-9 * G, "slip grows along its direction");
+    CHECK(t.x * a.x + t.y * a.y > 0.0);
+    CHECK(F.fn[0] > 0.0 && F.fn[1] > 0.0);
+    double E0 = total_energy(b, G, &s), dt = 0.0;
+    pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
+    CHECK_STATUS(pd_contact_phase(&fx.model->settle, ode, pivot, &sc, &phase, &s, 1.0, &dt), PD_OK);
+    CHECK(dt > 0.0);
+    CHECK(total_energy(b, G, &s) <= E0 + 1e-8 * b->mass * G * b->size);
+    pd_ode_free(pivot);
+    pd_ode_free(ode);
+    drop_teardown(&fx);
+}
+
+/* A tetrahedron of vertices v[4] (A = v[0], B = v[1] on the plane z = 0),
+ * set up for scene sc, at rest in its own frame as the world's, A and B on
+ * the floor: its body, or NULL; its lowest vertices into contacts, *nc. */
+static const pd_body *tetra_on_edge(drop_fixture *fx, const pd_scene *sc, const pd_vec3 v[4],
+                                    pd_state *s, int *contacts, int *nc)
+{
+    if (!drop_setup(fx, convex_mesh(v, 4), sc))
+        return NULL;
+    const pd_body *b = fx->model->body;
+    *s = (pd_state){v3_add(fx->part->origin, b->com), b->frame, v3(0, 0, 0), v3(0, 0, 0)};
+    *nc = lowest_vertices(b, s->q, contacts);
+    return b;
+}
+
+/* A tetrahedron resting on its edge AB at rest, its centre of mass off
+ * the edge's middle and leaning past it, with too little friction to hold
+ * the edge: the weight's moment yaws it as it topples, so its two contacts'
+ * slides from rest part. Where a pair is found, each contact's tangential
+ * acceleration under the phase's own force solve (pd_phase_forces_of, not
+ * the search's residual) lies along its direction, outward, under a
+ * positive normal force. Tolerance: Newton's stop at 1e-12 g of the
+ * residual, with the solves' round-off. */
+static void test_edge_slide_apart(void)
+{
+    const double mus[3] = {0.02, 0.05, 0.1};
+    int found = 0;
+    for (int k = 0; k < 3; k++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        sc.mu = mus[k];
+        drop_fixture fx;
+        const pd_vec3 v[4] = {{0, 0, 0}, {0.01, 0, 0}, {0.002, 0.008, 0.008}, {0.003, -0.002, 0.009}};
+        pd_state s;
+        int contacts[8], nc;
+        const pd_body *b = tetra_on_edge(&fx, &sc, v, &s, contacts, &nc);
+        if (!b)
+            return;
+        CHECK_INT(nc, 2);
+        double slip_start = 2.0 * PD_TOL_PHASE_SLIP_REL * sqrt(G * b->size), accel = 0.0;
+        pd_phase p;
+        if (nc == 2) {
+            pd_phase_init(&p, b, G, sc.mu, &s, contacts, nc, slip_start);
+            CHECK(p.mode[0] == PD_PHASE_STICK && p.mode[1] == PD_PHASE_STICK);
+        }
+        if (nc == 2 && pd_phase_slide_edge_from_rest(&p, &s, &accel)) {
+            found++;
+            pd_phase_forces F;
+            CHECK(!pd_phase_forces_of(&p, &s, &F));
+            pd_vec3 alpha = quat_rotate(s.q, F.wdot);
+            for (int i = 0; i < 2; i++) {
+                pd_vec3 r = quat_rotate(s.q, b->verts[contacts[i]]), t = p.t0[i];
+                pd_vec3 a = v3_add(F.acc, v3_cross(alpha, r));
+                CHECK_NEAR(t.x * a.y - t.y * a.x, 0.0, 1e-9 * G, "slip grows along its direction");
+                CHECK(t.x * a.x + t.y * a.y > 0.0);
+                CHECK(F.fn[i] > 0.0);
+            }
+            /* the two directions differ: not a planar slide */
+            CHECK(fabs(p.t0[0].x * p.t0[1].y - p.t0[0].y * p.t0[1].x) > 1e-3);
+        }
+        drop_teardown(&fx);
+    }
+    CHECK(found > 0);
+}
+
 /* A tetrahedron resting on its edge AB, its centre of mass beyond A: the
  * weight's moment about A lifts B, whose normal force would be negative in
  * an edge phase. B lifts off, and the phase is A's alone (the edge's start
@@ -692,12 +896,11 @@ static void test_edge_lifts_one_end(void)
     sc.mu = 1.0; /* A sticks */
     drop_fixture fx;
     const pd_vec3 p[4] = {{0, 0, 0}, {0.01, 0, 0}, {-0.015, 0.005, 0.01}, {-0.015, -0.005, 0.01}};
-    if (!drop_setup(&fx, convex_mesh(p, 4), &sc))
+    pd_state s;
+    int contacts[8], nc;
+    const pd_body *b = tetra_on_edge(&fx, &sc, p, &s, contacts, &nc);
+    if (!b)
         return;
-    const pd_body *b = fx.model->body;
-    /* The part's own frame as the world's: A and B on the floor. */
-    pd_state s = {v3_add(fx.part->origin, b->com), b->frame, v3(0, 0, 0), v3(0, 0, 0)};
-    int contacts[8], nc = lowest_vertices(b, s.q, contacts);
     CHECK_INT(nc, 2);
     if (nc != 2)
         return;
@@ -847,5 +1050,8 @@ void suite_contact_phase(void)
     test_start_modes();
     test_slide_from_rest();
     test_edge_slide_from_rest();
+    test_edge_slide_apart();
+    test_edge_slide_into_landing();
+    test_edge_end_slides_from_rest();
     test_edge_lifts_one_end();
 }

@@ -3,6 +3,7 @@
  * precession), conservation laws, an independent fine-step RK4 integration of
  * q and omega, and brute-force scans (all vertices, fine time grids). */
 #include <stdlib.h>
+#include <string.h>
 #include "dynamics/body.h"
 #include "check.h"
 #include "dynamics/flight.h"
@@ -915,6 +916,63 @@ static void test_sincos(void)
  * inertia ratio is extreme: for a needle turning end over end the bound must
  * be within 1e-3 of the largest |w| sampled (the classical |L| / I_min was
  * 5e5 times it, and the impact search ran out of steps). */
+/* The plan in two halves (pd_flight_plan_bounds, then pd_flight_complete
+ * when the search first evaluates the flight) is the same flight: random
+ * spinning boxes, searched from a bounds-only plan and from a whole one,
+ * give the same contact to the bit and, evaluated anywhere, the same state;
+ * a search that finds the part touching at once leaves the rotation
+ * unsolved, and a bounds-only flight refuses evaluation away from t = 0. */
+static void test_plan_halves(void)
+{
+    pd_part *p = part_of_mesh(mesh_box(0.01, 0.02, 0.03));
+    pd_body *b = p ? body_of(p) : NULL;
+    if (!b) {
+        pd_part_free(p);
+        return;
+    }
+    test_rng r = {41};
+    int contacts[16], same = 1, trials = 0;
+    for (int trial = 0; trial < 40; trial++) {
+        pd_quat q = random_quat(&r);
+        pd_vec3 w = v3_scale(rng_unit_vector(&r), rng_range(&r, 1.0, 50.0));
+        pd_state st = {v3(0, 0, rng_range(&r, 0.02, 0.1)), q, v3(0.05, 0, -0.2), w};
+        pd_flight whole, half;
+        pd_impact a, c;
+        CHECK_STATUS(pd_flight_plan(b, &st, G, &whole), PD_OK);
+        CHECK_STATUS(pd_flight_plan_bounds(b, &st, G, &half), PD_OK);
+        CHECK_INT(half.kind, PD_FLIGHT_BOUNDS); /* the box's moments all differ */
+        pd_state at;
+        CHECK_STATUS(pd_flight_eval(&half, 1e-3, &at), PD_ERR_USAGE);
+        CHECK_STATUS(pd_flight_eval(&half, 0.0, &at), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &whole, 1.0, 0.0, contacts, 16, &a), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &half, 1.0, 0.0, contacts, 16, &c), PD_OK);
+        CHECK_INT(c.kind, PD_IMPACT_AT);
+        CHECK_INT(half.kind, whole.kind);
+        same &= a.kind == c.kind && a.t == c.t && a.vertex == c.vertex && a.height == c.height &&
+                a.steps == c.steps;
+        for (int i = 1; i <= 4; i++) {
+            pd_state x, y;
+            CHECK_STATUS(pd_flight_eval(&whole, a.t * i / 4.0, &x), PD_OK);
+            CHECK_STATUS(pd_flight_eval(&half, a.t * i / 4.0, &y), PD_OK);
+            same &= memcmp(&x, &y, sizeof x) == 0;
+        }
+        /* At its contact: touching now, and nothing solved. */
+        pd_state touch;
+        CHECK_STATUS(pd_flight_eval(&whole, a.t, &touch), PD_OK);
+        CHECK_STATUS(pd_flight_plan_bounds(b, &touch, G, &half), PD_OK);
+        CHECK_STATUS(pd_flight_impact(b, &half, 1.0, 0.0, contacts, 16, &c), PD_OK);
+        CHECK_INT(c.kind, PD_IMPACT_NOW);
+        CHECK_INT(half.kind, PD_FLIGHT_BOUNDS);
+        CHECK_STATUS(pd_flight_complete(b, &half), PD_OK);
+        CHECK_INT(half.kind, PD_FLIGHT_ELLIPTIC);
+        trials++;
+    }
+    CHECK(same); /* the same arithmetic in the same order: bit for bit */
+    CHECK_INT(trials, 40);
+    pd_body_free(b);
+    pd_part_free(p);
+}
+
 static void test_wmax(void)
 {
     test_rng r = {29};
@@ -972,6 +1030,7 @@ void suite_flight(void)
     test_flight();
     test_flight_reference();
     test_impact();
+    test_plan_halves();
     test_support();
     test_spin_accel();
     test_support_flat();

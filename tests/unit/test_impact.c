@@ -881,6 +881,64 @@ static void test_ray_tail(void)
            taken, tried, wide, worst, worst_w, worst_on);
 }
 
+/* The slide onto the diverging ray (impact_ray_series.c, pd_ray_out_tail)
+ * against RK4 in tau (steps of 1e-3, events by bisection) from states at an
+ * angle of 1e-4 to PD_TOL_IMPACT_SERIES_ANGLE from the ray, slips of 1e-3
+ * to 1 of the approach speed: the impulse at maximum compression, and at a
+ * normal impulse half as large again (Poisson's end at e = 0.5), within the
+ * bound the tail accepted (1e-9 or 1e-8 of |u0|) plus RK4's error (below
+ * 1e-11 at this step). */
+static void test_ray_out(void)
+{
+    test_rng rng = {31};
+    int taken = 0, tried = 0, wide = 0;
+    double worst = 0.0;
+    rk4_tau = 1;
+    for (int t = 0; t < 400 && tried < 120; t++) {
+        double K[3][3], tx, ty;
+        random_K_unit(&rng, K);
+        double mu = rng_range(&rng, 0.1, 1.5);
+        if (!pd_ray_diverging(CR(K), mu, &tx, &ty))
+            continue;
+        pd_ray_out o;
+        pd_ray_out_build(CR(K), mu, tx, ty, &o);
+        if (!o.ok)
+            continue;
+        double alpha = pow(10.0, rng_range(&rng, -3.0, 0.0));
+        double eps = pow(10.0, rng_range(&rng, -4.0, log10(PD_TOL_IMPACT_SERIES_ANGLE))) *
+                     (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+        pd_vec3 u = v3(alpha * (tx * cos(eps) - ty * sin(eps)), alpha * (ty * cos(eps) + tx * sin(eps)), -1.0);
+        const double max_err = tried % 2 ? 1e-8 : 1e-9, ev = 1e-11;
+        tried++;
+        pd_vec3 dc, de;
+        if (!pd_ray_out_tail(CR(K), mu, &o, u, PD_RAY_OUT_COMPRESS, 0.0, ev, PD_TOL_IMPACT_SERIES_ANGLE,
+                             max_err, &dc))
+            continue;
+        taken++;
+        wide += fabs(eps) > 0.1;
+        rk4_state c = rk4_until(CR(K), u, mu, (rk4_state){v3(0, 0, 0), 0.0}, 1e-3, 0, 0.0);
+        double err = v3_norm(v3_sub(dc, c.p));
+        worst = fmax(worst, err);
+        CHECK_NEAR(err, 0.0, max_err + 1e-11, "the bound the tail accepted, plus RK4's error");
+        /* u_z there: 0 within the event tolerance asked, to round-off */
+        CHECK_NEAR(u.z + K[2][0] * dc.x + K[2][1] * dc.y + K[2][2] * dc.z, 0.0, ev + 1e-14,
+                   "the compression the tail was asked for");
+        /* On to Poisson's end at e = 0.5, from the start (the goal counts from there). */
+        if (!pd_ray_out_tail(CR(K), mu, &o, u, PD_RAY_OUT_PZ, 1.5 * dc.z, ev * dc.z,
+                             PD_TOL_IMPACT_SERIES_ANGLE, max_err, &de))
+            continue;
+        rk4_state end = rk4_until(CR(K), u, mu, (rk4_state){v3(0, 0, 0), 0.0}, 1e-3, 2, 1.5 * dc.z);
+        err = v3_norm(v3_sub(de, end.p));
+        worst = fmax(worst, err);
+        CHECK_NEAR(err, 0.0, max_err + 1e-11, "the bound the tail accepted, plus RK4's error");
+    }
+    rk4_tau = 0;
+    CHECK(taken >= 40);  /* measured 55 of 65 */
+    CHECK(wide >= 5);    /* measured 10: tails from beyond 0.1 rad */
+    pd_note("impact: tails onto the diverging ray: %d of %d offered taken (%d beyond 0.1 rad), "
+            "impulse within %.2g of RK4's in tau\n", taken, tried, wide, worst);
+}
+
 static void test_incoming_rays(void)
 {
     test_rng rng = {17};
@@ -961,6 +1019,7 @@ void suite_impact(void)
     test_figure7_portrait();
     test_incoming_rays();
     test_ray_tail();
+    test_ray_out();
     test_marginal_stick();
     test_hard_cases();
     test_homogeneity();
