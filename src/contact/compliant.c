@@ -21,6 +21,7 @@ struct pd_compliant_work {
     double (*kt)[3];        /* the 2 x 2 tangential inverse mass, (xx, xy, yy) */
     pd_vec3 *armx, *army;   /* r x ex, r x ey: the slip along ex is v.x + w.(r x ex) */
     pd_vec3 *turnx, *turny; /* I^-1 (r x ex), I^-1 (r x ey): the turn per unit impulse */
+    double (*at)[2];        /* (r.ex, r.ey): the place in the floor's plane */
     int hint;
     const pd_cancel_flag *cancel; /* may be NULL */
 };
@@ -71,8 +72,9 @@ pd_compliant_work *pd_compliant_work_alloc(const pd_body *b)
     w->army = malloc(n * sizeof *w->army);
     w->turnx = malloc(n * sizeof *w->turnx);
     w->turny = malloc(n * sizeof *w->turny);
+    w->at = malloc(n * sizeof *w->at);
     if (!w->cand || !w->active || !w->k || !w->lam || !w->push || !w->pn || !w->ptx ||
-        !w->pty || !w->kt || !w->armx || !w->army || !w->turnx || !w->turny) {
+        !w->pty || !w->kt || !w->armx || !w->army || !w->turnx || !w->turny || !w->at) {
         pd_compliant_work_free(w);
         return NULL;
     }
@@ -96,6 +98,7 @@ void pd_compliant_work_free(pd_compliant_work *w)
     free(w->army);
     free(w->turnx);
     free(w->turny);
+    free(w->at);
     free(w);
 }
 
@@ -166,6 +169,269 @@ static double elastic_energy(const pd_compliant_work *w, const pd_body *b, const
             sum += 0.5 * w->k[i] * z * z;
     }
     return sum;
+}
+
+/* Contact j's tangential frame, for the friction solve: its arms (the slip
+ * along ex is v.x + w.(r x ex)), its turns (I^-1 of the arms: the spin per
+ * unit impulse), its 2 x 2 tangential inverse mass and its place in the
+ * floor's plane. */
+static void tangent_prepare(pd_compliant_work *w, const pd_body *b, int j, pd_vec3 r, pd_vec3 ex,
+                            pd_vec3 ey)
+{
+    w->armx[j] = v3_cross(r, ex);
+    w->army[j] = v3_cross(r, ey);
+    w->turnx[j] = pd_body_inv_inertia(b, w->armx[j]);
+    w->turny[j] = pd_body_inv_inertia(b, w->army[j]);
+    w->kt[j][0] = 1.0 / b->mass + v3_dot(w->armx[j], w->turnx[j]);
+    w->kt[j][1] = v3_dot(w->armx[j], w->turny[j]);
+    w->kt[j][2] = 1.0 / b->mass + v3_dot(w->army[j], w->turny[j]);
+    w->at[j][0] = v3_dot(r, ex);
+    w->at[j][1] = v3_dot(r, ey);
+}
+
+/* Adds the tangential impulse (dx, dy) at contact j to the body's motion. */
+static void push_tangent(const pd_compliant_work *w, int j, double m, double dx, double dy,
+                         pd_vec3 *v, pd_vec3 *wv)
+{
+    v->x += dx / m;
+    v->y += dy / m;
+    *wv = v3_add(*wv, v3_add(v3_scale(w->turnx[j], dx), v3_scale(w->turny[j], dy)));
+}
+
+/* Coulomb friction by Gauss-Seidel sweeps, the contacts coupled through the
+ * body: at each pushing contact the tangential impulse that stops its slip
+ * (the slip it would have without its own friction this step), if that lies
+ * within the cone; else the cone's impulse against the slip's direction, no
+ * larger than stops the slip along that direction. The direction matters:
+ * the cone's point nearest the stopping impulse is not against the slip
+ * where the tangential inverse mass is anisotropic, and that error does not
+ * shrink with the step (it moved a sliding impact's outgoing velocities by
+ * up to 2% of their size at any step). Stops when no impulse moved more than
+ * stop in a sweep; returns the sweeps made, or -1 if max_sweeps stopped
+ * them. */
+static int friction_sweeps(pd_compliant_work *w, int n, double m, double mu, double stop,
+                           int max_sweeps, int fresh, pd_vec3 *v, pd_vec3 *wv)
+{
+    if (fresh)
+        for (int j = 0; j < n; j++)
+            w->ptx[j] = w->pty[j] = 0.0;
+    for (int sweep = 0; sweep < max_sweeps; sweep++) {
+        double change = 0.0;
+        for (int j = 0; j < n; j++) {
+            double ux = v->x + v3_dot(*wv, w->armx[j]);
+            double uy = v->y + v3_dot(*wv, w->army[j]);
+            double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
+            double det = kxx * kyy - kxy * kxy;
+            double fx = ux - (kxx * w->ptx[j] + kxy * w->pty[j]);
+            double fy = uy - (kxy * w->ptx[j] + kyy * w->pty[j]);
+            double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
+            double cap = mu * w->pn[j];
+            if (px * px + py * py > cap * cap) {
+                /* hypot only where the squares underflow: it costs as much
+                 * as the rest of the sweep. */
+                double fn = sqrt(fx * fx + fy * fy);
+                if (!(fn > 0.0))
+                    fn = hypot(fx, fy);
+                double ax = fx / fn, ay = fy / fn;
+                double kaa = kxx * ax * ax + 2.0 * kxy * ax * ay + kyy * ay * ay;
+                double mag = fmin(cap, fn / kaa);
+                px = -mag * ax;
+                py = -mag * ay;
+            }
+            double ddx = px - w->ptx[j], ddy = py - w->pty[j];
+            w->ptx[j] = px;
+            w->pty[j] = py;
+            push_tangent(w, j, m, ddx, ddy, v, wv);
+            change = max2(change, max2(fabs(ddx), fabs(ddy)));
+        }
+        /* One contact: the slip without its own friction, which sets its
+         * impulse, does not depend on that impulse, so one sweep is
+         * converged and another would only re-derive it to round-off. */
+        if (change <= stop || n == 1)
+            return sweep + 1;
+    }
+    return -1;
+}
+
+/* The interval of s where |p + s d| <= cap (d != 0), intersected into
+ * [*lo, *hi]; 0 if it is empty. */
+static int cone_interval(double px, double py, double dx, double dy, double cap, double *lo,
+                         double *hi)
+{
+    double a = dx * dx + dy * dy, bh = px * dx + py * dy, c = px * px + py * py - cap * cap;
+    double disc = bh * bh - a * c;
+    if (!(disc >= 0.0) || !(a > 0.0))
+        return 0;
+    double root = sqrt(disc);
+    *lo = max2(*lo, (-bh - root) / a);
+    *hi = fmin(*hi, (-bh + root) / a);
+    return *lo <= *hi;
+}
+
+/* Solves A x = y in place for A symmetric positive definite 3 x 3, given
+ * by its Cholesky factor L (lower, row by row). */
+static void chol3_solve(double L[3][3], double x[3])
+{
+    for (int i = 0; i < 3; i++) {
+        for (int k = 0; k < i; k++)
+            x[i] -= L[i][k] * x[k];
+        x[i] /= L[i][i];
+    }
+    for (int i = 2; i >= 0; i--) {
+        for (int k = i + 1; k < 3; k++)
+            x[i] -= L[k][i] * x[k];
+        x[i] /= L[i][i];
+    }
+}
+
+/* Two contacts both sticking, in closed form. Their four slips are not
+ * independent: the segment between them lies in the floor's plane (to the
+ * depth they are pressed in), so a rigid body's two points move alike
+ * along it, and equal and opposite impulses along it (the squeeze) move
+ * the body not at all. So three slips are stopped, the common one along
+ * the segment and each one across it, by the least impulse that does
+ * (a 3 x 3 solve in the impulses orthogonal to the squeeze), and the
+ * squeeze is then free: the one nearest none that brings both impulses
+ * within their cones (each cone a quadratic in the squeeze, an interval).
+ * The squeeze is taken along the direction that leaves the three stopped
+ * slips stopped (the squeeze less its coupling to them), which is the
+ * squeeze itself when the contacts are at one depth. Returns 1 with the
+ * impulses applied to v and wv and left in ptx, pty; 0 if no squeeze
+ * brings both within their cones (a contact slides) or the contacts are at
+ * one point of the floor's plane, nothing changed. */
+static int friction_pair_stick(pd_compliant_work *w, double m, double mu, pd_vec3 *v,
+                               pd_vec3 *wv)
+{
+    double tx = w->at[0][0] - w->at[1][0], ty = w->at[0][1] - w->at[1][1];
+    double tn = sqrt(tx * tx + ty * ty);
+    if (!(tn > 0.0))
+        return 0;
+    tx /= tn;
+    ty /= tn;
+    const double h = sqrt(0.5);
+    /* The impulses (p0x, p0y, p1x, p1y) orthogonal to the squeeze q: along
+     * the segment at both, across it at one, across it at the other. */
+    const double B[4][3] = {{h * tx, -ty, 0.0}, {h * ty, tx, 0.0},
+                            {h * tx, 0.0, -ty}, {h * ty, 0.0, tx}};
+    const double q[4] = {h * tx, h * ty, -h * tx, -h * ty};
+    const pd_vec3 arm[4] = {w->armx[0], w->army[0], w->armx[1], w->army[1]};
+    const pd_vec3 turn[4] = {w->turnx[0], w->turny[0], w->turnx[1], w->turny[1]};
+    double K[4][4], u[4];
+    for (int a = 0; a < 4; a++) {
+        u[a] = ((a & 1) ? v->y : v->x) + v3_dot(*wv, arm[a]);
+        for (int c = a; c < 4; c++)
+            K[a][c] = K[c][a] = ((a & 1) == (c & 1) ? 1.0 / m : 0.0) + v3_dot(arm[a], turn[c]);
+    }
+    double KB[4][3], Kq[4], A[3][3], y[3], z[3];
+    for (int a = 0; a < 4; a++) {
+        Kq[a] = 0.0;
+        for (int c = 0; c < 4; c++)
+            Kq[a] += K[a][c] * q[c];
+        for (int i = 0; i < 3; i++) {
+            KB[a][i] = 0.0;
+            for (int c = 0; c < 4; c++)
+                KB[a][i] += K[a][c] * B[c][i];
+        }
+    }
+    for (int i = 0; i < 3; i++) {
+        y[i] = z[i] = 0.0;
+        for (int a = 0; a < 4; a++) {
+            y[i] -= B[a][i] * u[a];
+            z[i] += B[a][i] * Kq[a];
+        }
+        for (int k = 0; k < 3; k++) {
+            A[i][k] = 0.0;
+            for (int a = 0; a < 4; a++)
+                A[i][k] += B[a][i] * KB[a][k];
+        }
+    }
+    double L[3][3] = {{0}}, trace = A[0][0] + A[1][1] + A[2][2];
+    for (int i = 0; i < 3; i++) {
+        for (int k = 0; k <= i; k++) {
+            double sum = A[i][k];
+            for (int l = 0; l < k; l++)
+                sum -= L[i][l] * L[k][l];
+            if (k < i) {
+                L[i][k] = sum / L[k][k];
+            } else {
+                if (!(sum > PD_COMPLIANT_PAIR_PIVOT_REL * trace))
+                    return 0;
+                L[i][i] = sqrt(sum);
+            }
+        }
+    }
+    chol3_solve(L, y);
+    chol3_solve(L, z);
+    double p[4], d[4];
+    for (int a = 0; a < 4; a++) {
+        p[a] = d[a] = 0.0;
+        for (int i = 0; i < 3; i++) {
+            p[a] += B[a][i] * y[i];
+            d[a] -= B[a][i] * z[i];
+        }
+        d[a] += q[a];
+    }
+    double lo = -INFINITY, hi = INFINITY;
+    if (!cone_interval(p[0], p[1], d[0], d[1], mu * w->pn[0], &lo, &hi) ||
+        !cone_interval(p[2], p[3], d[2], d[3], mu * w->pn[1], &lo, &hi))
+        return 0;
+    double sq = lo > 0.0 ? lo : hi < 0.0 ? hi : 0.0;
+    for (int a = 0; a < 4; a++)
+        p[a] += sq * d[a];
+    for (int j = 0; j < 2; j++) {
+        w->ptx[j] = p[2 * j];
+        w->pty[j] = p[2 * j + 1];
+        push_tangent(w, j, m, p[2 * j], p[2 * j + 1], v, wv);
+    }
+    return 1;
+}
+
+/* The step's friction by the sweeps; with pair set, two contacts whose
+ * sweeps have not converged after PD_COMPLIANT_PAIR_AFTER are solved in
+ * closed form if both can stick, else their sweeps go on. Returns the
+ * sweeps made (0: the closed form), or -1 if max_sweeps stopped them.
+ * pair 2 tries the closed form first (for tests). */
+static int friction(pd_compliant_work *w, int n, double m, double mu, double stop, int max_sweeps,
+                    int pair, pd_vec3 *v, pd_vec3 *wv)
+{
+    if (pair == 2 && n == 2 && friction_pair_stick(w, m, mu, v, wv))
+        return 0;
+    if (pair != 1 || n != 2 || max_sweeps <= PD_COMPLIANT_PAIR_AFTER)
+        return friction_sweeps(w, n, m, mu, stop, max_sweeps, 1, v, wv);
+    pd_vec3 v0 = *v, w0 = *wv;
+    int made = friction_sweeps(w, n, m, mu, stop, PD_COMPLIANT_PAIR_AFTER, 1, v, wv);
+    if (made >= 0)
+        return made;
+    double kept[4] = {w->ptx[0], w->pty[0], w->ptx[1], w->pty[1]};
+    if (friction_pair_stick(w, m, mu, &v0, &w0)) {
+        *v = v0;
+        *wv = w0;
+        return 0;
+    }
+    w->ptx[0] = kept[0];
+    w->pty[0] = kept[1];
+    w->ptx[1] = kept[2];
+    w->pty[1] = kept[3];
+    made = friction_sweeps(w, n, m, mu, stop, max_sweeps - PD_COMPLIANT_PAIR_AFTER, 0, v, wv);
+    return made < 0 ? -1 : made + PD_COMPLIANT_PAIR_AFTER;
+}
+
+int pd_compliant_friction(pd_compliant_work *w, const pd_body *b, int n, const pd_vec3 *r,
+                          const double *pn, pd_vec3 ex, pd_vec3 ey, double mu, double tol,
+                          int sweeps, int pair, pd_vec3 *v, pd_vec3 *wv, double *p)
+{
+    double pn_max = 0.0;
+    for (int j = 0; j < n; j++) {
+        w->pn[j] = pn[j];
+        pn_max = max2(pn_max, pn[j]);
+        tangent_prepare(w, b, j, r[j], ex, ey);
+    }
+    int made = friction(w, n, b->mass, mu, tol * mu * pn_max, sweeps, pair, v, wv);
+    for (int j = 0; j < n; j++) {
+        p[2 * j] = w->ptx[j];
+        p[2 * j + 1] = w->pty[j];
+    }
+    return made;
 }
 
 pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd_settle *settle,
@@ -303,68 +569,12 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                                h * b->euler[2] * wo.x * wo.y));
         s->w = v3_add(s->w, pd_body_inv_inertia(b, dw));
 
-        /* Coulomb friction, the contacts coupled through the body (Gauss-
-         * Seidel sweeps): at each pushing contact the tangential impulse
-         * that stops its slip (the slip it would have without its own
-         * friction this step), if that lies within the cone; else the
-         * cone's impulse against the slip's direction, no larger than stops
-         * the slip along that direction. The direction matters: the cone's
-         * point nearest the stopping impulse is not against the slip where
-         * the tangential inverse mass is anisotropic, and that error does
-         * not shrink with the step (it moved a sliding impact's outgoing
-         * velocities by up to 2% of their size at any step). */
+        /* Coulomb friction at every pushing contact. */
         if (mu > 0.0 && npush > 0) {
-            for (int j = 0; j < npush; j++) {
-                pd_vec3 r_i = b->verts[w->push[j]];
-                w->ptx[j] = w->pty[j] = 0.0;
-                w->armx[j] = v3_cross(r_i, ex);
-                w->army[j] = v3_cross(r_i, ey);
-                w->turnx[j] = pd_body_inv_inertia(b, w->armx[j]);
-                w->turny[j] = pd_body_inv_inertia(b, w->army[j]);
-                w->kt[j][0] = 1.0 / m + v3_dot(w->armx[j], w->turnx[j]);
-                w->kt[j][1] = v3_dot(w->armx[j], w->turny[j]);
-                w->kt[j][2] = 1.0 / m + v3_dot(w->army[j], w->turny[j]);
-            }
-            double stop = c->sweep_tol * mu * pn_max;
-            for (int sweep = 0; sweep < PD_COMPLIANT_SWEEPS; sweep++) {
-                double change = 0.0;
-                for (int j = 0; j < npush; j++) {
-                    double ux = s->v.x + v3_dot(s->w, w->armx[j]);
-                    double uy = s->v.y + v3_dot(s->w, w->army[j]);
-                    double kxx = w->kt[j][0], kxy = w->kt[j][1], kyy = w->kt[j][2];
-                    double det = kxx * kyy - kxy * kxy;
-                    double fx = ux - (kxx * w->ptx[j] + kxy * w->pty[j]);
-                    double fy = uy - (kxy * w->ptx[j] + kyy * w->pty[j]);
-                    double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
-                    double cap = mu * w->pn[j];
-                    if (px * px + py * py > cap * cap) {
-                        /* hypot only where the squares underflow: it
-                         * costs as much as the rest of the sweep. */
-                        double fn = sqrt(fx * fx + fy * fy);
-                        if (!(fn > 0.0))
-                            fn = hypot(fx, fy);
-                        double ax = fx / fn, ay = fy / fn;
-                        double kaa = kxx * ax * ax + 2.0 * kxy * ax * ay + kyy * ay * ay;
-                        double mag = fmin(cap, fn / kaa);
-                        px = -mag * ax;
-                        py = -mag * ay;
-                    }
-                    double ddx = px - w->ptx[j], ddy = py - w->pty[j];
-                    w->ptx[j] = px;
-                    w->pty[j] = py;
-                    s->v.x += ddx / m;
-                    s->v.y += ddy / m;
-                    s->w = v3_add(s->w, v3_add(v3_scale(w->turnx[j], ddx),
-                                               v3_scale(w->turny[j], ddy)));
-                    change = max2(change, max2(fabs(ddx), fabs(ddy)));
-                }
-                /* One contact: the slip without its own friction, which
-                 * sets its impulse, does not depend on that impulse, so
-                 * one sweep is converged and another would only re-derive
-                 * it to round-off. */
-                if (change <= stop || npush == 1)
-                    break;
-            }
+            for (int j = 0; j < npush; j++)
+                tangent_prepare(w, b, j, b->verts[w->push[j]], ex, ey);
+            friction(w, npush, m, mu, c->sweep_tol * mu * pn_max, PD_COMPLIANT_SWEEPS, 1, &s->v,
+                     &s->w);
         }
 
         /* Positions from the new velocities (the symplectic half). */

@@ -92,4 +92,21 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
                            const pd_scene *scene, pd_state *s, double t_max,
                            pd_compliant_result *r);
 
+/* One step's friction, as a run solves it, exposed for tests: n pushing
+ * contacts (n at most the body's vertex count) at r[j] (body frame, from
+ * the centre of mass) with normal impulses pn[j] (N s), the world's x and y
+ * axes ex, ey in the body frame, friction mu. v (world frame) and wv (body
+ * frame) are changed by the friction impulses, which are written to p (x
+ * and y per contact, 2n). pair 1 solves two contacts that can both stick in
+ * closed form once PD_COMPLIANT_PAIR_AFTER sweeps have not converged them
+ * (as a run does), pair 2 tries that first, pair 0 never; else
+ * Gauss-Seidel sweeps, at most sweeps of
+ * them, stopped when no impulse moves by tol times mu times the largest
+ * normal impulse (a run: PD_COMPLIANT_SWEEPS, the model's sweep_tol).
+ * Returns the sweeps made, 0 for the closed form, -1 if the cap stopped
+ * them. */
+int pd_compliant_friction(pd_compliant_work *w, const pd_body *b, int n, const pd_vec3 *r,
+                          const double *pn, pd_vec3 ex, pd_vec3 ey, double mu, double tol,
+                          int sweeps, int pair, pd_vec3 *v, pd_vec3 *wv, double *p);
+
 #endif

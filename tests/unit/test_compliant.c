@@ -14,6 +14,7 @@
 #include "check.h"
 #include "drops_scale.h"
 #include "contact/compliant.h"
+#include "contact/contact_tol.h"
 #include "drop_fixture.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
@@ -899,11 +900,141 @@ static void test_convergence(void)
     }
 }
 
+/* --- friction of two contacts sticking ---------------------------------------- */
+
+/* A body of mass m and principal moments I (only these enter the friction
+ * solve), with room for n contacts. */
+static pd_body friction_body(double m, double ix, double iy, double iz, int n)
+{
+    pd_body b;
+    memset(&b, 0, sizeof b);
+    b.mass = m;
+    b.moment[0] = ix;
+    b.moment[1] = iy;
+    b.moment[2] = iz;
+    for (int k = 0; k < 3; k++)
+        b.inv_moment[k] = 1.0 / b.moment[k];
+    b.nverts = n;
+    return b;
+}
+
+/* The slip of contact r (body frame) along the world's x and y. */
+static void slip_at(pd_vec3 v, pd_vec3 wv, pd_vec3 r, pd_vec3 ex, pd_vec3 ey, double u[2])
+{
+    u[0] = v.x + v3_dot(wv, v3_cross(r, ex));
+    u[1] = v.y + v3_dot(wv, v3_cross(r, ey));
+}
+
+/* A block on two contacts at (+-a, 0, -c) below its centre of mass, the
+ * floor's axes the body's: pushed along their segment (x) with both
+ * sticking, the total impulse along x stops the slip, P = -v0 / (1/m +
+ * c^2 / I_y), and turns it about y by -c P / I_y; nothing moves across, and
+ * how the two share P (the squeeze) moves nothing. With the cones wide the
+ * closed form shares it evenly (the least impulse); with the first cone
+ * 0.3 |P| and the second 0.8 |P| only a squeeze keeps both within, and the
+ * nearest one leaves the first on its cone's edge. Spun about the normal
+ * instead, both sticking stop it whole: a couple of +-I_z w / (2a) across
+ * the segment. Tolerances: 1e-12 relative, a few solves' round-off. */
+static void test_friction_pair_closed_form(void)
+{
+    const double m = 2.0, ix = 0.3, iy = 0.5, iz = 0.7, a = 0.4, c = 0.25, v0 = 0.8, spin = 3.0;
+    pd_body b = friction_body(m, ix, iy, iz, 2);
+    pd_compliant_work *w = pd_compliant_work_alloc(&b);
+    CHECK(w != NULL);
+    if (!w)
+        return;
+    const pd_vec3 ex = v3(1, 0, 0), ey = v3(0, 1, 0);
+    const pd_vec3 r[2] = {v3(a, 0, -c), v3(-a, 0, -c)};
+    const double P = -v0 / (1.0 / m + c * c / iy);
+    const double wide[2] = {100.0, 100.0};
+    const double narrow[2] = {0.3 * fabs(P), 0.8 * fabs(P)};
+    for (int k = 0; k < 2; k++) {
+        pd_vec3 v = v3(v0, 0, 0), wv = v3(0, 0, 0);
+        double p[4], u[2];
+        int made = pd_compliant_friction(w, &b, 2, r, k == 0 ? wide : narrow, ex, ey, 1.0,
+                                         PD_COMPLIANT_SWEEP_TOL, PD_COMPLIANT_SWEEPS, 2, &v, &wv, p);
+        CHECK_INT(made, 0);
+        CHECK_REL(p[0] + p[2], P, 1e-12, "both stick: the total impulse stops the slip");
+        CHECK_NEAR(p[1], 0.0, 1e-12 * fabs(P), "nothing across the segment");
+        CHECK_NEAR(p[3], 0.0, 1e-12 * fabs(P), "nothing across the segment");
+        CHECK_REL(v.x, v0 + P / m, 1e-12, "the body's velocity from the total impulse");
+        CHECK_REL(wv.y, -c * P / iy, 1e-12, "the body's turn from the total impulse");
+        CHECK_NEAR(wv.x, 0.0, 1e-12 * fabs(wv.y), "no turn about x");
+        CHECK_NEAR(wv.z, 0.0, 1e-12 * fabs(wv.y), "no turn about z");
+        for (int j = 0; j < 2; j++) {
+            slip_at(v, wv, r[j], ex, ey, u);
+            CHECK_NEAR(u[0], 0.0, 1e-12 * v0, "sticking: no slip along");
+            CHECK_NEAR(u[1], 0.0, 1e-12 * v0, "sticking: no slip across");
+        }
+        if (k == 0) {
+            CHECK_REL(p[0], p[2], 1e-12, "wide cones: the least impulse shares evenly");
+        } else {
+            CHECK_REL(hypot(p[0], p[1]), narrow[0], 1e-12, "the nearest squeeze: first on its edge");
+            CHECK(hypot(p[2], p[3]) <= narrow[1]);
+        }
+    }
+    pd_vec3 v = v3(0, 0, 0), wv = v3(0, 0, spin);
+    double p[4];
+    int made = pd_compliant_friction(w, &b, 2, r, wide, ex, ey, 1.0, PD_COMPLIANT_SWEEP_TOL,
+                                     PD_COMPLIANT_SWEEPS, 2, &v, &wv, p);
+    CHECK_INT(made, 0);
+    CHECK_NEAR(v3_norm(v), 0.0, 1e-12 * spin * a, "a spin stopped: no velocity");
+    CHECK_NEAR(v3_norm(wv), 0.0, 1e-12 * spin, "a spin stopped: no turn");
+    CHECK_REL(p[1], -iz * spin / (2.0 * a), 1e-12, "a spin stopped by a couple across");
+    CHECK_REL(p[3], iz * spin / (2.0 * a), 1e-12, "a spin stopped by a couple across");
+    pd_compliant_work_free(w);
+}
+
+/* A coin (radius R, thickness t) tilted on two neighbouring rim vertices of
+ * a 32-gon, spinning and sliding, both able to stick: the run's solve
+ * against Gauss-Seidel sweeps run to convergence (1e5 sweeps at most, each
+ * stop 1e-14 of the cone). The sweeps converge by a factor of about 0.98
+ * a sweep here (the pair's coupling along its segment is nearly whole), so
+ * the run's cap of PD_COMPLIANT_SWEEPS stopped them half way; the closed
+ * form is the converged motion to round-off (1e-9 of the speed). And a
+ * pair that cannot both stick (a cone too narrow for any squeeze) is left
+ * to the sweeps, whose answer it then is. */
+static void test_friction_pair_converged(void)
+{
+    const double R = 0.01, t = 0.002, m = 1e-3, tilt = 0.6, dth = 2.0 * M_PI / 32.0;
+    pd_body b = friction_body(m, m * (3.0 * R * R + t * t) / 12.0, m * (3.0 * R * R + t * t) / 12.0,
+                              0.5 * m * R * R, 2);
+    pd_compliant_work *w = pd_compliant_work_alloc(&b);
+    CHECK(w != NULL);
+    if (!w)
+        return;
+    /* The segment between the contacts along the body's y, horizontal; the
+     * world's axes in the body frame tilted about it. */
+    const pd_vec3 r[2] = {v3(R * cos(0.5 * dth), R * sin(0.5 * dth), -0.5 * t),
+                          v3(R * cos(0.5 * dth), -R * sin(0.5 * dth), -0.5 * t)};
+    const pd_vec3 ex = v3(cos(tilt), 0, sin(tilt)), ey = v3(0, 1, 0);
+    const double pn[2][2] = {{1e-4, 1e-4}, {1e-4, 1e-9}};
+    for (int k = 0; k < 2; k++) {
+        pd_vec3 v = v3(0.05, 0.02, 0), wv = v3(3.0, -2.0, 5.0);
+        pd_vec3 vr = v, wr = wv;
+        double p[4], pr[4];
+        int made = pd_compliant_friction(w, &b, 2, r, pn[k], ex, ey, 0.5, PD_COMPLIANT_SWEEP_TOL,
+                                         PD_COMPLIANT_SWEEPS, 1, &v, &wv, p);
+        int ref = pd_compliant_friction(w, &b, 2, r, pn[k], ex, ey, 0.5, 1e-14, 100000, 0, &vr,
+                                        &wr, pr);
+        CHECK(ref > 0);
+        if (k == 0)
+            CHECK_INT(made, 0);
+        else
+            CHECK(made > 0);
+        double speed = 0.05 + R * 5.0;
+        CHECK_NEAR(v3_norm(v3_sub(v, vr)), 0.0, 1e-9 * speed, "the converged sweeps' velocity");
+        CHECK_NEAR(R * v3_norm(v3_sub(wv, wr)), 0.0, 1e-9 * speed, "the converged sweeps' turn");
+    }
+    pd_compliant_work_free(w);
+}
+
 void suite_compliant(void)
 {
     void (*tests[])(void) = {test_law_closed_form, test_law_chi_root, test_energy_random_impacts, test_rigid_limit,
                              test_rigid_limit_planar, test_flat_landings, test_housner, test_near_flat_cube,
-                             test_convergence};
+                             test_convergence, test_friction_pair_closed_form,
+                             test_friction_pair_converged};
     for (size_t i = 0; i < sizeof tests / sizeof *tests; i++) {
         clock_t c0 = clock();
         tests[i]();
