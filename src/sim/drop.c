@@ -147,8 +147,8 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
              * (docs/contact.md), an angular impulse about the normal of at
              * most (2/3) mu a times the normal impulse, against the spin
              * and never reversing it, so that it only takes energy. An
-             * impact keeps the rigid law (Poisson's), the compliant law's
-             * limit. */
+             * impact keeps the rigid law (Poisson's; the compliant law's
+             * limit but where friction turns or stops the slip). */
             double cap = 2.0 / 3.0 * sc->mu * m->settle.patch * res.p.z;
             double dl = fmax(-cap, fmin(cap, -ww.z / J[2][2]));
             ww = v3_add(ww, v3_scale(v3(J[0][2], J[1][2], J[2][2]), dl));
