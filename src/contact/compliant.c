@@ -208,15 +208,18 @@ static void push_tangent(const pd_compliant_work *w, int j, double m, double dx,
  * shrink with the step (it moved a sliding impact's outgoing velocities by
  * up to 2% of their size at any step). Stops when no impulse moved more than
  * stop in a sweep; returns the sweeps made, or -1 if max_sweeps stopped
- * them. */
+ * them. With stuck set, also stops after the first sweep that leaves every
+ * impulse within its cone without converging, returning -1 less the sweeps
+ * made. */
 static int friction_sweeps(pd_compliant_work *w, int n, double m, double mu, double stop,
-                           int max_sweeps, int fresh, pd_vec3 *v, pd_vec3 *wv)
+                           int max_sweeps, int fresh, int stuck, pd_vec3 *v, pd_vec3 *wv)
 {
     if (fresh)
         for (int j = 0; j < n; j++)
             w->ptx[j] = w->pty[j] = 0.0;
     for (int sweep = 0; sweep < max_sweeps; sweep++) {
         double change = 0.0;
+        int inside = 1;
         for (int j = 0; j < n; j++) {
             double ux = v->x + v3_dot(*wv, w->armx[j]);
             double uy = v->y + v3_dot(*wv, w->army[j]);
@@ -227,6 +230,7 @@ static int friction_sweeps(pd_compliant_work *w, int n, double m, double mu, dou
             double px = -(kyy * fx - kxy * fy) / det, py = -(kxx * fy - kxy * fx) / det;
             double cap = mu * w->pn[j];
             if (px * px + py * py > cap * cap) {
+                inside = 0;
                 /* hypot only where the squares underflow: it costs as much
                  * as the rest of the sweep. */
                 double fn = sqrt(fx * fx + fy * fy);
@@ -249,6 +253,8 @@ static int friction_sweeps(pd_compliant_work *w, int n, double m, double mu, dou
          * converged and another would only re-derive it to round-off. */
         if (change <= stop || n == 1)
             return sweep + 1;
+        if (stuck && inside)
+            return -2 - sweep;
     }
     return -1;
 }
@@ -387,21 +393,24 @@ static int friction_pair_stick(pd_compliant_work *w, double m, double mu, pd_vec
 }
 
 /* The step's friction by the sweeps; with pair set, two contacts whose
- * sweeps have not converged after PD_COMPLIANT_PAIR_AFTER are solved in
- * closed form if both can stick, else their sweeps go on. Returns the
- * sweeps made (0: the closed form), or -1 if max_sweeps stopped them.
- * pair 2 tries the closed form first (for tests). */
+ * sweeps have not converged by the first sweep that leaves both within
+ * their cones, or by PD_COMPLIANT_PAIR_AFTER sweeps, are solved in closed
+ * form if both can stick, else their sweeps go on. The closed form depends
+ * on the step's velocities alone, not on the sweeps so far, so it is tried
+ * once. Returns the sweeps made (0: the closed form), or -1 if max_sweeps
+ * stopped them. pair 2 tries the closed form first (for tests). */
 static int friction(pd_compliant_work *w, int n, double m, double mu, double stop, int max_sweeps,
                     int pair, pd_vec3 *v, pd_vec3 *wv)
 {
     if (pair == 2 && n == 2 && friction_pair_stick(w, m, mu, v, wv))
         return 0;
     if (pair != 1 || n != 2 || max_sweeps <= PD_COMPLIANT_PAIR_AFTER)
-        return friction_sweeps(w, n, m, mu, stop, max_sweeps, 1, v, wv);
+        return friction_sweeps(w, n, m, mu, stop, max_sweeps, 1, 0, v, wv);
     pd_vec3 v0 = *v, w0 = *wv;
-    int made = friction_sweeps(w, n, m, mu, stop, PD_COMPLIANT_PAIR_AFTER, 1, v, wv);
+    int made = friction_sweeps(w, n, m, mu, stop, PD_COMPLIANT_PAIR_AFTER, 1, 1, v, wv);
     if (made >= 0)
         return made;
+    int done = made == -1 ? PD_COMPLIANT_PAIR_AFTER : -1 - made;
     double kept[4] = {w->ptx[0], w->pty[0], w->ptx[1], w->pty[1]};
     if (friction_pair_stick(w, m, mu, &v0, &w0)) {
         *v = v0;
@@ -412,8 +421,8 @@ static int friction(pd_compliant_work *w, int n, double m, double mu, double sto
     w->pty[0] = kept[1];
     w->ptx[1] = kept[2];
     w->pty[1] = kept[3];
-    made = friction_sweeps(w, n, m, mu, stop, max_sweeps - PD_COMPLIANT_PAIR_AFTER, 0, v, wv);
-    return made < 0 ? -1 : made + PD_COMPLIANT_PAIR_AFTER;
+    made = friction_sweeps(w, n, m, mu, stop, max_sweeps - done, 0, 0, v, wv);
+    return made < 0 ? -1 : made + done;
 }
 
 int pd_compliant_friction(pd_compliant_work *w, const pd_body *b, int n, const pd_vec3 *r,

@@ -98,8 +98,9 @@ pd_status pd_compliant_run(const pd_compliant *c, pd_compliant_work *w, const pd
  * axes ex, ey in the body frame, friction mu. v (world frame) and wv (body
  * frame) are changed by the friction impulses, which are written to p (x
  * and y per contact, 2n). pair 1 solves two contacts that can both stick in
- * closed form once PD_COMPLIANT_PAIR_AFTER sweeps have not converged them
- * (as a run does), pair 2 tries that first, pair 0 never; else
+ * closed form once a sweep leaves both within their cones, or
+ * PD_COMPLIANT_PAIR_AFTER sweeps, have not converged them (as a run does),
+ * pair 2 tries that first, pair 0 never; else
  * Gauss-Seidel sweeps, at most sweeps of
  * them, stopped when no impulse moves by tol times mu times the largest
  * normal impulse (a run: PD_COMPLIANT_SWEEPS, the model's sweep_tol).

@@ -211,13 +211,14 @@
  * size, squared). */
 #define PD_COMPLIANT_PAIR_PIVOT_REL 1e-9
 
-/* The closed form for two sticking contacts is tried only once their
- * sweeps have run this many without converging: most pairs' sweeps
- * converge in 3 or 4 (a cube's or box's impacts), and trying it at every
- * pair's step cost 19-21% of the cube's and box's compliant runs. Either
- * way the motion is the same to the sweeps' own tolerance (both stop the
- * slips; they may share the free squeeze differently); only the cost
- * moves. */
+/* The closed form for two sticking contacts is tried only once a sweep
+ * leaves both impulses within their cones without converging, or once
+ * their sweeps have run this many without converging: most pairs slide
+ * and their sweeps converge in 3 or 4 (a cube's or box's impacts), and
+ * trying it at every pair's step cost 19-21% of the cube's and box's
+ * compliant runs. Either way the motion is the same to the sweeps' own
+ * tolerance (both stop the slips; they may share the free squeeze
+ * differently); only the cost moves. */
 #define PD_COMPLIANT_PAIR_AFTER 8
 
 /* A contact below the floor is resting, not in the middle of a bounce,

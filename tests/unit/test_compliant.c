@@ -1248,6 +1248,25 @@ static void test_friction_pair_closed_form(void)
             CHECK_REL(hypot(p[0], p[1]), narrow[0], 1e-12, "the nearest squeeze: first on its edge");
             CHECK(hypot(p[2], p[3]) <= narrow[1]);
         }
+        /* As a run solves it: with the wide cones the first sweep leaves
+         * both within them, unconverged, and hands the pair to the closed
+         * form, whose answer does not depend on when it is tried; with the
+         * narrow ones the first is on its cone's edge from the first sweep
+         * and the sweeps converge, to their stop (PD_COMPLIANT_SWEEP_TOL
+         * of the wider cone), on the same answer. */
+        pd_vec3 v1 = v3(v0, 0, 0), w1 = v3(0, 0, 0);
+        double p1[4];
+        made = pd_compliant_friction(w, &b, 2, r, k == 0 ? wide : narrow, ex, ey, 1.0,
+                                     PD_COMPLIANT_SWEEP_TOL, PD_COMPLIANT_SWEEPS, 1, &v1, &w1, p1);
+        const double tol = k == 0 ? 1e-12 : 10.0 * PD_COMPLIANT_SWEEP_TOL;
+        if (k == 0)
+            CHECK_INT(made, 0);
+        else
+            CHECK(made > 0);
+        for (int a4 = 0; a4 < 4; a4++)
+            CHECK_NEAR(p1[a4], p[a4], tol * fabs(P), "the run's answer is the closed form's");
+        CHECK_NEAR(v3_norm(v3_sub(v1, v)) + c * v3_norm(v3_sub(w1, wv)), 0.0, tol * v0,
+                   "the run's motion is the closed form's");
     }
     pd_vec3 v = v3(0, 0, 0), wv = v3(0, 0, spin);
     double p[4];
