@@ -178,7 +178,6 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
         linear_phase(&c, v3(0.0, 0.0, 1.0));
     } else {
         pd_status st = PD_OK;
-        c.have_ray = pd_ray_diverging(CONST_M3(c.K), mu, &c.rtx, &c.rty);
         if (hypot(c.u0.x, c.u0.y) > PD_TOL_IMPACT_EVENT_REL)
             st = pd_impact_slide(&c, law == PD_IMPACT_POISSON ? w->poisson : w->energetic, &r.nsteps);
         if (st != PD_OK)
@@ -189,7 +188,7 @@ pd_status pd_impact_solve(pd_impact_work *w, const double K[3][3], pd_vec3 u0, d
             if (!c.on_ray && stick_direction(CONST_M3(c.K), mu, &d)) {
                 r.stick_stable = 1;
             } else {
-                if (!c.have_ray)
+                if (!coll_have_ray(&c))
                     return PD_ERR_INTERNAL; /* unstable sticking always has its ray */
                 r.resumed = 1;
                 r.theta_e = atan2(c.rty, c.rtx);

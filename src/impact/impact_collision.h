@@ -27,6 +27,7 @@ typedef struct {
     pd_impact_law law;
     double tol;       /* the integrator's local error per step (absolute and relative) */
     double y[NSTATE]; /* p = (px, py, pz) and W so far */
+    int ray_known;    /* have_ray and (rtx, rty) are set (coll_have_ray) */
     int have_ray;     /* sticking is unstable: the diverging ray (rtx, rty) exists */
     double rtx, rty;
     int on_ray;       /* sliding stopped on that ray */
@@ -46,6 +47,19 @@ typedef struct {
 static inline pd_vec3 coll_u(const collision *c, const double y[])
 {
     return v3_add(c->u0, m3_vec(c->K, v3(y[PX], y[PY], y[PZ])));
+}
+
+/* Whether the diverging ray exists, found the first time it is asked: a
+ * collision whose slip never comes near an invariant ray and never sticks
+ * (most microcollisions of a sliding part: one step onto maximum
+ * compression) never needs it. */
+static inline int coll_have_ray(collision *c)
+{
+    if (!c->ray_known) {
+        c->have_ray = pd_ray_diverging(CONST_M3(c->K), c->mu, &c->rtx, &c->rty);
+        c->ray_known = 1;
+    }
+    return c->have_ray;
 }
 
 /* Marks maximum compression at the current state and sets the end target. */

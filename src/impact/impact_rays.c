@@ -5,6 +5,7 @@
 #include "base/gsl_adapter.h"
 #include "impact/impact.h"
 #include "impact/impact_rays.h"
+#include "impact/impact_tol.h"
 #include "base/vec3.h"
 
 /* --- the diverging ray ------------------------------------------------------- *
@@ -179,4 +180,45 @@ void pd_rays_incoming(const double K[][3], double mu, pd_rays *in)
         }
         flo = fhi;
     }
+}
+
+/* --- the diverging ray's basin ----------------------------------------------- *
+ * The slip's direction turns at the rate g above (in tau, impact_slide.c),
+ * whose roots are the invariant rays; between two roots it moves one way.
+ * At phi = phi_d + psi (phi_d the diverging ray's angle), with
+ * t = tan(psi / 2), (1 + t^2)^2 g = t Q(t) (g vanishes on the ray), Q a
+ * cubic with Q(0) = 2 g'(phi_d) < 0 since the ray attracts. The direction is in the basin when Q < 0 from 0 to its
+ * own t: at both ends and at Q's critical points between, each by
+ * PD_TOL_IMPACT_BASIN_REL of the size of Q's terms, so that round-off
+ * cannot pass a root. */
+int pd_ray_in_basin(const double K[][3], double mu, double rtx, double rty, pd_vec3 u, double s)
+{
+    const double A = K[1][2], C = -K[0][2], D = -mu * K[0][1],
+                 E = 0.5 * mu * (K[0][0] - K[1][1]);
+    const double c1 = rtx, s1 = rty, c2 = c1 * c1 - s1 * s1, s2 = 2.0 * s1 * c1;
+    const double Ar = A * c1 + C * s1, Cr = C * c1 - A * s1;
+    const double Dr = D * c2 + E * s2, Er = E * c2 - D * s2;
+    const double q[4] = {2.0 * Cr + 4.0 * Er, -6.0 * Dr, 2.0 * Cr - 4.0 * Er, Dr - Ar};
+    const double t0 = (rtx * u.y - rty * u.x) / (s + u.x * rtx + u.y * rty);
+    if (!isfinite(t0))
+        return 0;
+    double ts[4] = {0.0, t0, NAN, NAN};
+    /* Q' = q1 + 2 q2 t + 3 q3 t^2, its roots in the form that does not cancel */
+    const double disc = q[2] * q[2] - 3.0 * q[1] * q[3];
+    if (disc >= 0.0) {
+        const double qq = -(q[2] + copysign(sqrt(disc), q[2]));
+        ts[2] = qq / (3.0 * q[3]);
+        ts[3] = q[1] / qq;
+    }
+    const double lo = fmin(0.0, t0), hi = fmax(0.0, t0);
+    for (int i = 0; i < 4; i++) {
+        const double t = ts[i];
+        if (i >= 2 && !(t > lo && t < hi))
+            continue; /* outside, or none (NaN, infinite) */
+        const double val = ((q[3] * t + q[2]) * t + q[1]) * t + q[0];
+        const double size = ((fabs(q[3]) * fabs(t) + fabs(q[2])) * fabs(t) + fabs(q[1])) * fabs(t) + fabs(q[0]);
+        if (!(val < -PD_TOL_IMPACT_BASIN_REL * size))
+            return 0;
+    }
+    return 1;
 }

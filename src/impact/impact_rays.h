@@ -37,4 +37,13 @@ int pd_ray_diverging(const double K[][3], double mu, double *tx, double *ty);
  * ray is invariant and the flow needs no snapping). K is taken as is. */
 void pd_rays_incoming(const double K[][3], double mu, pd_rays *in);
 
+/* Whether the slip u (tangential part; s = |u_t| > 0) lies in the basin of
+ * the diverging ray (rtx, rty) of K and mu: no invariant ray lies between
+ * its direction and that ray, so the slip's direction turns onto the ray
+ * and meets no other (in the parameter tau of impact_slide.c the
+ * direction's flow is autonomous and one-dimensional). 0 where a ray may
+ * lie within round-off of that arc, or the direction is opposite the ray.
+ * K is taken as is. */
+int pd_ray_in_basin(const double K[][3], double mu, double rtx, double rty, pd_vec3 u, double s);
+
 #endif

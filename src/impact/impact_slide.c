@@ -499,13 +499,27 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
          * on it for good: the ray attracts nearby directions, and along it p'
          * is constant (closed form). Integrating instead is stiff: when the
          * ray's outward speed is small the direction relaxes onto the ray
-         * far faster than |u_t| grows (measured: > 1000 steps). */
-        if (c->have_ray && u.x * c->rtx + u.y * c->rty > 0.0 &&
+         * far faster than |u_t| grows (measured: > 1000 steps). The slip's
+         * direction can be that close to an invariant ray only where its
+         * turning rate b (u_t x u_t' = s^2 b in tau) is at most the angle,
+         * (pi/2) tols / s, times b's largest slope, |a| + mu (B's
+         * eigenvalues' spread) <= flow (PD_IMPACT_ON_RAY_MARGIN); elsewhere no ray is
+         * looked for on this account. */
+        const int near_ray =
+            !(fabs(u.x * (s * c->K[1][2] - c->mu * (c->K[1][0] * u.x + c->K[1][1] * u.y)) -
+                   u.y * (s * c->K[0][2] - c->mu * (c->K[0][0] * u.x + c->K[0][1] * u.y))) >
+              PD_IMPACT_ON_RAY_MARGIN * flow * tols * s);
+        if (near_ray && coll_have_ray(c) && u.x * c->rtx + u.y * c->rty > 0.0 &&
             fabs(c->rtx * u.y - c->rty * u.x) <= tols) {
             c->on_ray = 1;
             return PD_OK;
         }
-        if (c->in.n < 0 && s < RAYS_SLIP)
+        /* A slide bound for the diverging ray can reach no incoming one,
+         * nor come within the event tolerance of one away from the rays:
+         * their search is left until it could be used. */
+        if (c->in.n < 0 && s < RAYS_SLIP &&
+            (near_ray || !coll_have_ray(c) ||
+             !pd_ray_in_basin(CONST_M3(c->K), c->mu, c->rtx, c->rty, u, s)))
             pd_rays_incoming(CONST_M3(c->K), c->mu, &c->in);
         int ray = onto_incoming(c, u, s);
         if (ray != RAY_NONE) {
@@ -542,7 +556,7 @@ pd_status pd_impact_slide(collision *c, pd_ode *ode, int *nsteps)
 
         /* No step onto an event: the tail onto the diverging ray, where it
          * takes over, replaces the steps that would reach one. */
-        if (c->have_ray && !(hlim <= TAIL_AFTER * h) && onto_diverging(c, u)) {
+        if (!(hlim <= TAIL_AFTER * h) && coll_have_ray(c) && onto_diverging(c, u)) {
             ++*nsteps;
             cap = INFINITY;
             cap_event = EV_NONE;

@@ -68,6 +68,28 @@
  * slides integrated to the end, no change in results. */
 #define PD_TOL_IMPACT_TAIL_REL (0.1 * PD_TOL_IMPACT_EVENT_REL)
 
+/* The diverging ray is looked for (impact_slide.c) only where the slip's
+ * direction may lie within the event tolerance of an invariant ray: the
+ * turning rate b there (u_t x u_t' = s^2 b in tau) is at most the angle,
+ * (pi/2) PD_TOL_IMPACT_EVENT_REL / s, times b's largest slope, bounded by
+ * the flow's rate |a| + mu |B|. This factor stands for pi/2 with room for
+ * the round-off of the ray (1e-16 of the flow's rate) and of the test,
+ * against the 1e-9 of the tolerance: it decides where the ray is found,
+ * never a result (every direction it passes is one the on-ray test
+ * refuses). Larger: the ray found more often for nothing; below pi/2 the
+ * on-ray test could be skipped where it holds. */
+#define PD_IMPACT_ON_RAY_MARGIN 4.0
+
+/* A direction is taken to lie in the diverging ray's basin
+ * (pd_ray_in_basin) only when the cubic that vanishes at every other
+ * invariant ray stays below zero by this share of the size of its terms
+ * along the arc: its coefficients and values carry round-off of a few
+ * 1e-16 of that size, so no ray within round-off of the arc is missed. It
+ * decides only where the incoming rays are looked for (impact_slide.c),
+ * never a result: a direction that fails it has them looked for, as
+ * everywhere before. */
+#define PD_TOL_IMPACT_BASIN_REL 1e-12
+
 /* A collision "added energy" when its kinetic energy change p.(u0 + u1)/2
  * exceeds this fraction of |p| |u0| (the size of the work terms it is a sum
  * of). Why 1e-8: the energetic law's own bookkeeping error is the ODE's

@@ -362,6 +362,73 @@ static void test_figure7_portrait(void)
     CHECK_INT(stable, 2);
 }
 
+/* The diverging ray's basin (pd_ray_in_basin) against its definition,
+ * checked on the turning rate itself: g(phi) = n.v (v = flow_rate, n the
+ * normal of the direction), sampled on the arc from a direction to the ray.
+ * A direction placed in the basin must turn toward the ray at every sample
+ * (g of the sign that closes the angle: no invariant ray between); one at
+ * which every sample turns toward the ray by more than round-off must be
+ * placed in it; directions within 0.05 rad of the ray are in it (the ray
+ * attracts), so the check is not vacuous. */
+static double turning_rate(const double K[3][3], double mu, double phi)
+{
+    pd_vec3 v = flow_rate(K, mu, cos(phi), sin(phi));
+    return -sin(phi) * v.x + cos(phi) * v.y;
+}
+
+static void test_diverging_basin(void)
+{
+    test_rng rng = {31};
+    int found = 0, inside = 0, outside = 0;
+    for (int t = 0; t < 5000 && found < 8; t++) {
+        double K[3][3];
+        random_K(&rng, K);
+        double det = K[0][0] * K[1][1] - K[0][1] * K[0][1];
+        double al = (-K[0][2] * K[1][1] + K[1][2] * K[0][1]) / det;
+        double be = (-K[1][2] * K[0][0] + K[0][2] * K[0][1]) / det;
+        double lim = hypot(al, be), rtx, rty;
+        if (lim < 0.1)
+            continue;
+        double mu = rng_range(&rng, 0.1, 0.9) * lim;
+        CHECK(pd_ray_diverging(CR(K), mu, &rtx, &rty));
+        /* Half the flows with four invariant rays, where the basin is an
+         * arc between two of them and the other side holds an incoming
+         * ray's basin; most have two, the basin then all but one ray. */
+        pd_rays in;
+        pd_rays_incoming(CR(K), mu, &in);
+        if ((in.n >= 3) != (found % 2 == 0))
+            continue;
+        found++;
+        const double th = atan2(rty, rtx);
+        double gmax = 0.0;
+        for (int j = 0; j < 360; j++)
+            gmax = fmax(gmax, fabs(turning_rate(CR(K), mu, 2.0 * M_PI * j / 360)));
+        for (int k = 0; k < 90; k++) {
+            const double psi0 = -M_PI + 2.0 * M_PI * (k + 0.5) / 90, s = 0.3;
+            pd_vec3 u = v3(s * cos(th + psi0), s * sin(th + psi0), -1.0);
+            int inb = pd_ray_in_basin(CR(K), mu, rtx, rty, u, s);
+            /* the least of -sign(psi) g over the arc, relative to g's size */
+            double least = INFINITY;
+            for (int j = 1; j <= 2000; j++) {
+                double psi = psi0 * j / 2000;
+                least = fmin(least, -copysign(1.0, psi) * turning_rate(CR(K), mu, th + psi) / gmax);
+            }
+            if (inb) {
+                inside++;
+                CHECK(least > 0.0);
+            } else {
+                outside++;
+                CHECK(!(least > 1e-9));
+            }
+            if (fabs(psi0) < 0.05)
+                CHECK_INT(inb, 1);
+        }
+    }
+    CHECK_INT(found, 8);
+    CHECK(inside > 0 && outside > 0);
+    pd_note("impact: diverging ray's basin: %d of %d directions in it\n", inside, inside + outside);
+}
+
 /* Eq. 14 in pz with a fixed-step RK4, sharing no code with the library; for
  * slip that never stops, the impulses must agree. */
 static pd_vec3 rk4_rhs(const double K[3][3], pd_vec3 u0, double mu, pd_vec3 p)
@@ -1017,6 +1084,7 @@ void suite_impact(void)
     test_slow_slip_oracle();
     test_figure7();
     test_figure7_portrait();
+    test_diverging_basin();
     test_incoming_rays();
     test_ray_tail();
     test_ray_out();
