@@ -201,6 +201,12 @@ pd_status pd_ellint_Pcomp(double k, double n, double *result)
     gsl_sf_result r;
     return sf_value(gsl_sf_ellint_Pcomp_e(k, n, GSL_PREC_DOUBLE, &r), &r, result);
 }
+pd_status pd_ellint_RF(double x, double y, double z, double *result)
+{
+    gsl_set_error_handler_off();
+    gsl_sf_result r;
+    return sf_value(gsl_sf_ellint_RF_e(x, y, z, GSL_PREC_DOUBLE, &r), &r, result);
+}
 /* ==== end of elliptic functions ============================================= */
 /* --- ODE integration (see gsl_adapter.h) ------------------------------------ */
 

@@ -62,6 +62,10 @@ pd_status pd_ellint_P(double phi, double k, double n, double *result);
 /* Complete integrals K(k) = F(pi/2, k) and Pi(k, n) = P(pi/2, k, n); k < 1. */
 pd_status pd_ellint_Kcomp(double k, double *result);
 pd_status pd_ellint_Pcomp(double k, double n, double *result);
+
+/* Carlson's symmetric integral R_F(x, y, z) = (1/2) integral_0^inf dt /
+ * sqrt((t + x)(t + y)(t + z)), x, y, z >= 0, at most one of them 0. */
+pd_status pd_ellint_RF(double x, double y, double z, double *result);
 /* ==== end of elliptic functions ============================================= */
 /* --- ODE integration (used by impact.c and contact_phase.c) -----------------
  * One adaptive embedded Runge-Kutta integrator (GSL's rk8pd, Prince-Dormand

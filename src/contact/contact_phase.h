@@ -40,8 +40,10 @@ int pd_contact_phase_start(const pd_settle *settle, const pd_scene *scene, pd_st
 /* Runs phase (from pd_contact_phase_start) from s for at most t_max
  * seconds, or until the energy test decides the drop; s becomes the state
  * where it ended and *t_used the time it took. Two sticking contacts turn
- * about their edge by pivot_ode, or by ode in full where pivot_ode is NULL
- * (the reference the reduced motion is tested against). */
+ * about their edge in closed form where pivot_ode is given
+ * (pd_pivot_run; by pivot_ode where that declines), or by ode in full
+ * where pivot_ode is NULL (the reference the reduced motion is tested
+ * against). */
 pd_status pd_contact_phase(const pd_settle *settle, pd_ode *ode, pd_ode *pivot_ode,
                            const pd_scene *scene, const pd_phase *phase, pd_state *s,
                            double t_max, double *t_used);

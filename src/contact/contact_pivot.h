@@ -44,4 +44,15 @@ double pd_pivot_accel(const pd_pivot *pv, double a);
  * pd_pivot_accel, to the bit. */
 double pd_pivot_state(const pd_pivot *pv, double a, double w, pd_state *s, pd_phase_forces *F);
 
+/* The pivot from angle 0 turning at w0 (rad/s) in closed form (the energy
+ * gives the rate at every angle, an elliptic integral the time): to lead
+ * (s) before its first event (a contact's normal force or cone margin
+ * reaching 0, another neighbour of the contacts reaching the floor), or to
+ * t_max (s), whichever is sooner; the angle, rate and time there into *a,
+ * *w and *t (0 where the event is within lead of the start). 0 where it
+ * cannot (no turn to follow, a motion that turns back twice): the caller
+ * integrates. */
+int pd_pivot_run(const pd_pivot *pv, double w0, double t_max, double lead, double *a, double *w,
+                 double *t);
+
 #endif

@@ -123,6 +123,25 @@
  * 1986. */
 #define PD_PHASE_LANDS_TURN 1.0
 
+/* A pivot (two sticking contacts turning about their edge, contact_pivot.c)
+ * is run in closed form: its force margins, functions of the angle alone
+ * (trigonometric polynomials of degree 3 in it, and the cone's square root),
+ * are sampled every PD_PIVOT_CELL rad along the motion for the first that
+ * reaches zero. Why 0.02: a margin of amplitude M (its coefficients' sum)
+ * bends by at most 9 M per rad^2, so one positive at both ends of a cell h
+ * wide dips below zero inside it by at most 9 M h^2 / 8, 4.5e-4 M, over less
+ * than the cell; the integrated pivot it replaced saw its margins at its
+ * steps' ends alone, 0.015-0.03 rad apart (coin, cap, box: 0.0155, 0.0216,
+ * 0.032 rad a step, 400 drops each), so the sampled cell is no coarser.
+ * Every event found is then located to
+ * PD_TOL_PIVOT_ANGLE (rad): the part moves by that times L, a thousandth of
+ * the phase's tolerance per step, and the event's time by that over the
+ * rate, far inside the event tolerance (the time at an angle is Legendre's
+ * elliptic integral F, the angle at a time Jacobi's amplitude, both to
+ * round-off). */
+#define PD_PIVOT_CELL 0.02
+#define PD_TOL_PIVOT_ANGLE 1e-11
+
 
 /* --- compliant impacts (src/contact/compliant_law.c, compliant.c) ----------- */
 

@@ -133,21 +133,31 @@ static double topple_dt_da(double a, void *user)
 }
 
 /* Toppling about the edge: started 0.05 rad short of balance and turning
- * towards it with 1.5 times the energy it needs to pass, so the outcome is
- * open (a part leaning past balance from rest is decided at once, which ends
- * a phase), and friction enough to hold the edge. A rotation about a fixed
- * axis: the reaction does no work, the energy is conserved, the edge does not
- * move, the next face comes down, and then the box turns about the edge at
- * w = sqrt(w0^2 + 2 m g dh / I_e). */
+ * towards it with `excess` times the energy it needs to pass, and friction
+ * enough to hold the edge. A rotation about a fixed axis: the reaction
+ * does no work, the energy is conserved, the edge does not move, and the
+ * box turns about the edge at w = sqrt(w0^2 + 2 m g dh / I_e). With excess
+ * above 1 (1.5: the outcome open, a part leaning past balance from rest
+ * being decided at once, which ends an integrated phase) the next face
+ * comes down at a = pi/2; below 1 the box turns back short of balance and
+ * its own face comes down again at a = 0, by the quadrature of dt/da up to
+ * the turn and back (its 1 / sqrt singularity at the turn is QAGS's to
+ * take). The pivot (contact_pivot.c) runs it in closed form and must meet
+ * the exact solution to round-off: energy to 1e-12 m g L (measured 1e-16),
+ * the edge fixed to 1e-12 L (on its axis by construction), the rate the
+ * energy gives to 1e-10 of it (measured 6e-16) and the hand-over exactly
+ * half the event tolerance before the landing, to 1e-9 sqrt(L/g) (the
+ * elliptic integral's round-off and the landing's angle, located to
+ * PD_TOL_PIVOT_ANGLE; measured 3e-13). */
 static void edge_topple(const drop_fixture *fx, const pd_scene *sc, const pd_body *b,
-                        pd_ode *ode, pd_ode *pivot)
+                        pd_ode *ode, pd_ode *pivot, double lean, double excess)
 {
     int contacts[8], nc;
-    pd_state s = on_edge(b, -0.05, contacts, &nc);
+    pd_state s = on_edge(b, -lean, contacts, &nc);
     CHECK_INT(nc, 2);
     pd_vec3 h = half_extents(b);
-    double Ie = b->moment[0] + b->mass * (h.y * h.y + h.z * h.z), L = b->size;
-    double w0 = sqrt(1.5 * 2.0 * b->mass * G * (hypot(h.y, h.z) - s.x.z) / Ie);
+    double Ie = b->moment[0] + b->mass * (h.y * h.y + h.z * h.z), L = b->size, T = sqrt(L / G);
+    double w0 = sqrt(excess * 2.0 * b->mass * G * (hypot(h.y, h.z) - s.x.z) / Ie);
     pd_vec3 e0 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
     s.w = v3(w0, 0, 0);
     s.v = v3_cross(quat_rotate(s.q, s.w), v3_sub(s.x, e0)); /* the edge at rest */
@@ -158,32 +168,58 @@ static void edge_topple(const drop_fixture *fx, const pd_scene *sc, const pd_bod
     double t = 0.0;
     CHECK_STATUS(pd_contact_phase(&fx->model->settle, ode, pivot, sc, &phase, &s, 1.0, &t), PD_OK);
     CHECK(t > 0.0);
-    CHECK_NEAR(total_energy(b, G, &s), E0, 1e-8 * b->mass * G * L, "conservation: the ODE error alone, measured 3.7e-9 m g L at 1e-8 per step (pivot: 5e-10)");
+    double dE = fabs(total_energy(b, G, &s) - E0) / (b->mass * G * L);
+    CHECK_NEAR(dE, 0.0, 1e-8, "conservation: the ODE error alone, measured 3.7e-9 m g L at 1e-8 per step");
     pd_vec3 e1 = v3_add(s.x, quat_rotate(s.q, b->verts[contacts[0]]));
-    CHECK_NEAR(v3_norm(v3_sub(e1, e0)), 0.0, 1e-8 * L, "a sticking contact stays put: ODE error, measured 7.7e-9 L (pivot: on its axis, round-off)");
+    double moved = v3_norm(v3_sub(e1, e0)) / L;
+    CHECK_NEAR(moved, 0.0, 1e-8, "a sticking contact stays put: ODE error, measured 7.7e-9 L");
     /* It ends as the next face lands: some other vertex at the floor. */
     double low = 1e300;
     for (int i = 0; i < b->nverts; i++)
         if (i != contacts[0] && i != contacts[1])
             low = fmin(low, s.x.z + quat_rotate(s.q, b->verts[i]).z);
     CHECK_NEAR(low, 0.0, 1e-5 * L, "event located to 1e-6 sqrt(L/g), arriving at a few sqrt(g L): a few 1e-6 L");
-    /* The next face lands at a = pi/2 (its far edge reaches the floor): the
-     * time to it by quadrature of dt/da. The phase hands over at most the
-     * event tolerance early, late only by the ODE error. */
-    topple_rate rate = {w0 * w0, 2.0 * b->mass * G / Ie, h.y, h.z, atan2(h.y, h.z) - 0.05};
-    double t_land, T = sqrt(L / G);
-    CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, rate.a0, 0.5 * M_PI, 1e-13, &t_land), PD_OK);
+    /* The time to the landing by quadrature of dt/da. The phase hands over
+     * at most the event tolerance early, late only by the ODE error. */
+    topple_rate rate = {w0 * w0, 2.0 * b->mass * G / Ie, h.y, h.z, atan2(h.y, h.z) - lean};
+    double t_land;
+    if (excess > 1.0) {
+        CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, rate.a0, 0.5 * M_PI, 1e-13, &t_land), PD_OK);
+    } else {
+        /* The turn: zc = H sin(a + beta) reaches zc(a0) + w0^2 / k. */
+        double H = hypot(h.y, h.z), beta = atan2(h.z, h.y);
+        double zc0 = h.y * sin(rate.a0) + h.z * cos(rate.a0);
+        double a_turn = asin((zc0 + rate.w0sq / rate.k) / H) - beta, up, down;
+        CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, rate.a0, a_turn, 1e-13, &up), PD_OK);
+        CHECK_STATUS(pd_quad_integrate(topple_dt_da, &rate, 0.0, a_turn, 1e-13, &down), PD_OK);
+        t_land = up + down;
+    }
     CHECK(t <= t_land + 1e-8 * T);
     CHECK(t >= t_land - (PD_TOL_PHASE_EVENT_REL + 1e-8) * T);
     double w = sqrt(w0 * w0 + 2.0 * b->mass * G * (z0 - s.x.z) / Ie);
-    CHECK_NEAR(fabs(s.w.x), w, 1e-7 * w, "energy about a fixed axis: ODE error, measured 7.6e-8 w (pivot: 7.8e-9 w)");
+    CHECK_NEAR(fabs(s.w.x), w, 1e-7 * w, "energy about a fixed axis: ODE error, measured 7.6e-8 w");
     CHECK_NEAR(hypot(s.w.y, s.w.z), 0.0, 1e-7 * w, "the axis is the edge (pivot: by construction)");
+    if (pivot) {
+        CHECK_NEAR(dE, 0.0, 1e-12, "closed form: energy exact but for round-off");
+        CHECK_NEAR(moved, 0.0, 1e-12, "closed form: the edge is the axis");
+        CHECK_NEAR(fabs(s.w.x), w, 1e-10 * w, "closed form: the rate the energy gives");
+        CHECK_NEAR(t, t_land - 0.5 * PD_TOL_PHASE_EVENT_REL * T, 1e-9 * T,
+                   "closed form: half the event tolerance before the landing");
+        pd_note("contact_phase: pivot in closed form, excess %.1f: energy %.1e m g L, rate %.1e, "
+                "hand-over %.1e sqrt(L/g) off\n",
+                excess, dE, fabs(fabs(s.w.x) - w) / w,
+                fabs(t - (t_land - 0.5 * PD_TOL_PHASE_EVENT_REL * T)) / T);
+    }
 }
 
 /* Both ways the phase can run it: the full 13-unknown motion (no pivot
  * integrator), whose ODE error the tolerances above were measured on, and
  * the pivot (contact_pivot.c), which a drop takes for two sticking
- * contacts. */
+ * contacts; the pivot also where it turns back, 0.5 rad above its face
+ * with a fifth of the energy to balance (the integrated phase would end
+ * there as the energy test decides the drop), with friction 5: at 1 the
+ * edge starts to slip on the way down, which ends the phase before the
+ * landing. */
 static void test_edge_topple(void)
 {
     pd_scene sc;
@@ -192,8 +228,10 @@ static void test_edge_topple(void)
     if (!b)
         return;
     pd_ode *ode = pd_contact_phase_ode_alloc(), *pivot = pd_contact_pivot_ode_alloc();
-    edge_topple(&fx, &sc, b, ode, NULL);
-    edge_topple(&fx, &sc, b, ode, pivot);
+    edge_topple(&fx, &sc, b, ode, NULL, 0.05, 1.5);
+    edge_topple(&fx, &sc, b, ode, pivot, 0.05, 1.5);
+    sc.mu = 5.0;
+    edge_topple(&fx, &sc, b, ode, pivot, 0.5, 0.2);
     pd_ode_free(pivot);
     pd_ode_free(ode);
     drop_teardown(&fx);
