@@ -16,6 +16,7 @@
 #include "contact/contact_pivot.h"
 #include "contact/contact_tol.h"
 #include "base/gsl_adapter.h"
+#include "base/illinois.h"
 #include "base/quat.h"
 #include "base/vec3.h"
 
@@ -250,17 +251,11 @@ static double pend_force_event(const pend *pe, double sigma, double span)
             if (!(x > lo && x < hi))
                 x = 0.5 * (lo + hi);
             double f = pend_force_margin(pe, sigma * x);
-            if (f > 0.0) {
+            if (f > 0.0)
                 lo = x, flo = f;
-                if (side == -1)
-                    fhi *= 0.5;
-                side = -1;
-            } else {
+            else
                 hi = x, fhi = f;
-                if (side == 1)
-                    flo *= 0.5;
-                side = 1;
-            }
+            pd_illinois_moved(f > 0.0, &side, &flo, &fhi);
         }
         return lo;
     }

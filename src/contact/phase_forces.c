@@ -15,6 +15,7 @@
 #include "base/mat3.h"
 #include "contact/phase_forces.h"
 #include "contact/contact_tol.h"
+#include "base/illinois.h"
 #include "base/quat.h"
 #include "base/vec3.h"
 
@@ -540,17 +541,12 @@ int pd_phase_slide_from_rest(pd_phase *p, const pd_state *s, double *accel)
                     lc = mc, ls = ms;
                     break;
                 }
-                if ((fm <= 0.0) == (flo <= 0.0)) {
+                int moved_lo = (fm <= 0.0) == (flo <= 0.0);
+                if (moved_lo)
                     lc = mc, ls = ms, flo = fm;
-                    if (side == -1)
-                        fhi *= 0.5;
-                    side = -1;
-                } else {
+                else
                     hc = mc, hs = ms, fhi = fm;
-                    if (side == 1)
-                        flo *= 0.5;
-                    side = 1;
-                }
+                pd_illinois_moved(moved_lo, &side, &flo, &fhi);
             }
             double kk = f.k0 + f.k1 * lc + f.k2 * ls;
             double along = (lc * (f.p0 + f.p1 * lc + f.p2 * ls) + ls * (f.q0 + f.q1 * lc + f.q2 * ls)) / kk;
@@ -778,17 +774,12 @@ int pd_phase_slide_end_from_rest(pd_phase *p, const pd_state *s, int i, double *
                 double fm = r[i];
                 if (fm == 0.0)
                     break;
-                if ((fm <= 0.0) == (flo <= 0.0)) {
+                int moved_lo = (fm <= 0.0) == (flo <= 0.0);
+                if (moved_lo)
                     lo = m, flo = fm;
-                    if (side == -1)
-                        fhi *= 0.5;
-                    side = -1;
-                } else {
+                else
                     hi = m, fhi = fm;
-                    if (side == 1)
-                        flo *= 0.5;
-                    side = 1;
-                }
+                pd_illinois_moved(moved_lo, &side, &flo, &fhi);
             }
             c[i] = cos(m), sn[i] = sin(m);
             if (ok && edge_residual(&e, c, sn, r, along, lambda) && lambda[0] > 0.0 &&
