@@ -457,6 +457,50 @@ static void test_batch_short_forms(void)
     free(berr);
 }
 
+/* A batch that fails or is stopped keeps every earlier result: a part's
+ * DIR/<name>.csv until its new one is complete, all.csv until every part has
+ * one, with the parts that failed or did not run named on stderr; nothing
+ * temporary stays. SIGINT and SIGTERM reach the runs under way (10^6 drops
+ * of the cap take minutes, so the signal always comes first). */
+static void test_batch_keeps_results(void)
+{
+    char cmd[1024], *out, *err;
+    snprintf(cmd, sizeof cmd, "(set -e; D=%s/keep; scripts/posedrop-batch -o $D/out -n 20 -- "
+             "parts/cap.off parts/canonical/cube.off 2>/dev/null; cp -r $D/out $D/first)", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    static const struct {
+        const char *run;
+        int code;
+        const char *mention;
+    } cases[] = {
+        {"scripts/posedrop-batch -o $D/out -n 20 --com 5,5,5 -- parts/cap.off "
+         "parts/canonical/cube.off", 1, "parts/cap.off (failed), parts/canonical/cube.off (failed)"},
+        {"timeout --preserve-status -s INT 2 scripts/posedrop-batch -j1 -o $D/out -n 1000000 -- "
+         "parts/cap.off parts/canonical/cube.off", 130, "parts/canonical/cube.off (not run)"},
+        {"timeout --preserve-status -s TERM 2 scripts/posedrop-batch -j2 -o $D/out -n 1000000 -- "
+         "parts/cap.off parts/canonical/cube.off", 143, "(interrupted)"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        snprintf(cmd, sizeof cmd, "(D=%s/keep; %s)", tmpdir, cases[k].run);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), cases[k].code);
+        if (!strstr(err, cases[k].mention))
+            printf("     '%s' should say '%s':\n%s", cases[k].run, cases[k].mention, err);
+        CHECK(strstr(err, cases[k].mention) != NULL);
+        CHECK(strstr(err, "all.csv is left as it was") != NULL);
+        free(out);
+        free(err);
+        /* The first run's files, byte for byte; besides them only .err files. */
+        snprintf(cmd, sizeof cmd, "(set -e; D=%s/keep; for f in all cap cube; do cmp $D/first/$f.csv "
+                 "$D/out/$f.csv; done; test -z \"$(ls $D/out | grep -v -e '\\.csv$' -e '\\.err$')\")",
+                 tmpdir);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        free(out);
+        free(err);
+    }
+}
+
 /* Every script under scripts/ refuses a bad argument with one line on stderr
  * that names the script and what was wrong, exit status 2, nothing on
  * stdout, and nothing left in the directory it ran in (the issue's case:
@@ -471,6 +515,7 @@ static void test_script_refusals(void)
          "posedrop-batch: '-n' after --: options for posedrop go before --"},
         {"posedrop-batch -j x -- $R/parts/cap.off", "posedrop-batch: -j: expected a whole number"},
         {"posedrop-batch -o", "posedrop-batch: -o needs a value"},
+        {"posedrop-batch -j -1 -- $R/parts/cap.off", "posedrop-batch: -j: expected a whole number"},
         {"posedrop-batch -o results -- a.stl", "posedrop-batch: a.stl: no such readable file"},
         {"posedrop-batch -o results -- $R/parts/cap.off $R/parts/cap.off", "two parts named 'cap'"},
         /* posedrop's options in the forms it takes (a prefix, '=', a letter
@@ -550,6 +595,7 @@ void suite_batch(void)
     test_mpi();
     test_script_refusals();
     test_batch_short_forms();
+    test_batch_keeps_results();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)
