@@ -46,8 +46,13 @@ typedef struct pd_fit_param {
     int multiple;
 } pd_fit_param;
 
+/* The most measured drops a part's counts may add up to: far more than any
+ * feeder is observed for, far below where a sum of counts overflows. */
+#define PD_FIT_MAX_COUNT 1000000000000000L
+
 /* One part. count NULL: the part is not fitted, only predicted at the
- * fitted values (and averaged over the values the data allow). */
+ * fitted values (and averaged over the values the data allow). Its counts
+ * add up to at most PD_FIT_MAX_COUNT (PD_ERR_RANGE otherwise). */
 typedef struct pd_fit_part {
     const pd_part *part;
     const pd_static_result *poses; /* its stable poses (pd_static_estimate) */
@@ -71,6 +76,11 @@ typedef struct pd_fit_options {
                            >= 1; 0: 8 (d + 1) for d parameters */
     double alpha;       /* pseudo-count added to every class's simulated count
                            (Dirichlet smoothing), > 0; 0.5 (Jeffreys) */
+    pd_cancel_flag *cancel; /* may be NULL. Set non-zero (atomic_store, from any
+                           thread or a signal handler, as pd_sim_options' cancel)
+                           to stop the fit: the drops under way stop, and
+                           pd_fit_run returns PD_ERR_CANCELLED with no result.
+                           Only read, never reset; NULL by default */
 } pd_fit_options;
 
 PD_API void pd_fit_options_default(pd_fit_options *options);
@@ -126,7 +136,7 @@ typedef struct pd_fit_result {
  * probability alpha / (nsim + K alpha) instead of 0, so that no value makes
  * the likelihood minus infinity. PD_ERR_USAGE (a bad argument: the message
  * names it), PD_ERR_RANGE (a range outside its key's limits), PD_ERR_NOMEM,
- * and what pd_sim_run returns. On success *result is the caller's
+ * PD_ERR_CANCELLED (options->cancel set), and what pd_sim_run returns. On success *result is the caller's
  * (pd_fit_result_free). */
 PD_API pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
                             int nparams, const pd_scene *base, const pd_fit_options *options,

@@ -68,11 +68,18 @@ static pd_status scene_at(const model *m, const double *theta, pd_scene *sc, pd_
     return PD_OK;
 }
 
+static int cancelled(const pd_sim_options *o)
+{
+    return o->cancel && atomic_load(o->cancel) != 0;
+}
+
 static pd_status run_model(void *user, const double *theta, int all, double *const *p,
                            double *nsim, pd_diag *diag)
 {
     model *m = user;
     pd_scene sc;
+    if (cancelled(&m->sim))
+        return pd_fail(diag, PD_ERR_CANCELLED, "pd_fit_run: cancelled");
     pd_status st = scene_at(m, theta, &sc, diag);
     for (int i = 0; st == PD_OK && i < m->nparts; i++) {
         const pd_fit_part *fp = &m->parts[i];
@@ -83,6 +90,12 @@ static pd_status run_model(void *user, const double *theta, int all, double *con
         pd_sim_result *r = NULL;
         if ((st = pd_sim_run(fp->part, fp->poses, &sc, &o, &r, diag)) != PD_OK)
             break;
+        /* Stopped part way: its counts are not those of the fixed drops. */
+        if (r->partial) {
+            pd_sim_result_free(r);
+            st = pd_fail(diag, PD_ERR_CANCELLED, "pd_fit_run: cancelled");
+            break;
+        }
         m->drops += r->n;
         long settled = r->n - r->unsettled;
         int chain = r->transitions && r->closed_classes > 0;
@@ -138,6 +151,10 @@ static pd_status check_parts(const pd_fit_part *parts, int nparts, pd_diag *diag
             if (fp->count[c] < 0)
                 return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d has a negative "
                                "count (%ld)", i + 1, c + 1, fp->count[c]);
+            if (fp->count[c] > PD_FIT_MAX_COUNT - n)
+                return pd_fail(diag, PD_ERR_RANGE, "pd_fit_run: part %d: the counts add up to "
+                               "more than %.0e drops, more than were ever measured", i + 1,
+                               (double)PD_FIT_MAX_COUNT);
             n += fp->count[c];
         }
         if (n == 0)
@@ -294,6 +311,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     m.sim.seed = o.seed;
     m.sim.threads = o.threads;
     m.sim.engine = o.engine;
+    m.sim.cancel = o.cancel;
     m.ndrops = malloc(sizeof *m.ndrops * (size_t)nparts);
     m.pose_p = malloc(sizeof *m.pose_p * (size_t)maxposes);
     double lo[PD_FIT_MAX_PARAMS], hi[PD_FIT_MAX_PARAMS];

@@ -4,9 +4,12 @@
  * model with common random numbers, and the recovery of a scene value from
  * posedrop's own drops. PD_TEST_FULL=1 adds the coverage of the recovery
  * over repeats of posedrop's drops (minutes, not for every check). */
+#include <limits.h>
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include "check.h"
 #include "cli_run.h"
@@ -520,11 +523,58 @@ static void test_errors(const box_part *bp)
     pd_fit_part neg = fp;
     neg.count = negative;
     CHECK_STATUS(pd_fit_run(&neg, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
+    /* Counts whose sum overflows a long (signed overflow, then a fit that
+     * returned OK) or passes what anyone measures. */
+    long huge[8] = {LONG_MAX, LONG_MAX, 0};
+    pd_fit_part over = fp;
+    over.count = huge;
+    CHECK_STATUS(pd_fit_run(&over, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_RANGE);
+    CHECK(strstr(diag.message, "add up to more than") != NULL);
     pd_fit_part wrongk = fp;
     wrongk.nclasses = b.nclasses + 1;
     CHECK_STATUS(pd_fit_run(&wrongk, 1, &ok, 1, NULL, &fo, &fr, &diag), PD_ERR_USAGE);
     CHECK_STATUS(pd_fit_run(&fp, 1, &ok, 1, NULL, NULL, &fr, &diag), PD_ERR_USAGE);
     CHECK(strstr(diag.message, "options") != NULL);
+    CHECK(fr == NULL);
+}
+
+static void *cancel_soon(void *flag)
+{
+    struct timespec ts = {0, 50000000};
+    nanosleep(&ts, NULL);
+    atomic_store((pd_cancel_flag *)flag, 1);
+    return NULL;
+}
+
+/* The cancel flag: set before the call, the fit returns at once; set from
+ * another thread while it runs (a fit of 10^5 drops per evaluation, minutes
+ * of work), it stops with PD_ERR_CANCELLED and no result. */
+static void test_cancel(const box_part *bp)
+{
+    box_part b = *bp;
+    long count[8] = {10, 5, 1, 0, 0, 0, 0, 0};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_param mu = {"mu", 0.1, 0.5, 0, 0};
+    pd_fit_options fo;
+    pd_fit_options_default(&fo);
+    CHECK(fo.cancel == NULL);
+    pd_cancel_flag flag;
+    atomic_init(&flag, 1);
+    fo.cancel = &flag;
+    fo.ndrops = 100000;
+    pd_fit_result *fr = NULL;
+    pd_diag diag;
+    pd_diag_init(&diag);
+    CHECK_STATUS(pd_fit_run(&fp, 1, &mu, 1, NULL, &fo, &fr, &diag), PD_ERR_CANCELLED);
+    CHECK(fr == NULL && strstr(diag.message, "cancelled") != NULL);
+    atomic_store(&flag, 0);
+    pthread_t t;
+    if (pthread_create(&t, NULL, cancel_soon, &flag) != 0) {
+        CHECK(!"cannot start a thread");
+        return;
+    }
+    CHECK_STATUS(pd_fit_run(&fp, 1, &mu, 1, NULL, &fo, &fr, &diag), PD_ERR_CANCELLED);
+    pthread_join(t, NULL);
     CHECK(fr == NULL);
 }
 
@@ -537,6 +587,7 @@ static void test_box_fits(void)
         test_initial_choice(&b);
         test_contact_multiple(&b);
         test_errors(&b);
+        test_cancel(&b);
     }
     box_free(&b);
 }
