@@ -170,7 +170,12 @@ PD_API const char *pd_scene_param_name(pd_scene_param param);
 PD_API const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *buf,
                                    size_t size);
 
-/* Whether any parameter of scene is a range. */
+/* Whether parameter param of scene is a range of nonzero width, so that
+ * drops draw different values of it. A range of zero width is its one
+ * value: the drops run as with that value fixed, byte for byte. */
+PD_API int pd_scene_varies(const pd_scene *scene, pd_scene_param param);
+
+/* Whether any parameter of scene varies (pd_scene_varies). */
 PD_API int pd_scene_ranged(const pd_scene *scene);
 
 /* The values drop `drop` of a run seeded `seed` uses, one per parameter

@@ -244,7 +244,7 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
 {
     fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
     for (int k = 0; k < PD_NPARAMS; k++)
-        if (scene->range[k].kind != PD_DIST_FIXED)
+        if (pd_scene_varies(scene, (pd_scene_param)k))
             fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
     fputc('\n', f);
     for (long i = 0; i < sim->n; i++) {
@@ -257,7 +257,7 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
         for (int k = 0; k < PD_NPARAMS; k++)
-            if (scene->range[k].kind != PD_DIST_FIXED)
+            if (pd_scene_varies(scene, (pd_scene_param)k))
                 fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
         fputc('\n', f);
     }

@@ -341,7 +341,7 @@ pd_status pd_sim_sensitivity(const pd_sim_result *r, const pd_scene *sc, double 
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the sensitivity");
     s->nposes = k;
     for (int i = 0; i < PD_NPARAMS; i++)
-        if (sc->range[i].kind != PD_DIST_FIXED && sc->range[i].lo < sc->range[i].hi)
+        if (pd_scene_varies(sc, (pd_scene_param)i))
             s->param[s->nparams++] = (pd_scene_param)i;
     size_t nt = (size_t)(r->n > 0 ? r->n : 1);
     int *cat = malloc(sizeof *cat * nt);

@@ -135,6 +135,11 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         st = pd_fail(diag, PD_ERR_RANGE, "scene contact_time: the range reaches %g s for this "
                      "part: expected at most 1 s", ct_hi);
     m->compliant_any = !m->engine && ct_hi > 0.0;
+    /* A contact carrying the part's weight at the part's mass sinks
+     * g / omega^2 by the compliant law; a corner of radius R pressed that
+     * deep touches over a patch of radius sqrt(R g) / omega (Hertz's
+     * geometry, a^2 = R d). */
+    m->patch_omega = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity);
     if (st == PD_OK && m->compliant_any && m->material_ranged) {
         double e_lo = e->kind == PD_DIST_FIXED ? scene->restitution : e->lo;
         double e_hi = e->kind == PD_DIST_FIXED ? scene->restitution : e->hi;
@@ -150,13 +155,8 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         if (st != PD_OK)
             st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
                          "time %g s could not be set up", scene->restitution, m->contact_time);
-        /* A contact carrying the part's weight at the part's mass sinks
-         * g / omega^2 by the compliant law; a corner of radius R pressed
-         * that deep touches over a patch of radius sqrt(R g) / omega
-         * (Hertz's geometry, a^2 = R d). */
         else
-            m->settle.patch = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity) /
-                              m->compliant.law.omega;
+            m->settle.patch = m->patch_omega / m->compliant.law.omega;
     }
     if (st == PD_OK)
         m->top_time = top_spin_down(m->body, scene, m->settle.patch);
@@ -206,6 +206,8 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     w->contact_time = model->contact_time;
     w->compliant_on = model->compliant_on;
     w->compliant = model->compliant;
+    w->settle = model->settle;
+    w->top_time = model->top_time;
     return w;
 }
 
@@ -221,12 +223,18 @@ pd_status pd_drop_material(const pd_sim_model *m, pd_drop_work *w, const pd_scen
         resolved.contact_time = w->contact_time;
         return m->engine->material(w->world, &resolved);
     }
+    /* The patch and the top's spin-down follow the drop's own law and
+     * values, as a fixed run's follow its scene's: a zero-width range then
+     * gives the fixed run's bytes. */
     w->compliant_on = w->contact_time > 0.0;
+    w->settle.patch = 0.0;
     if (w->compliant_on) {
         pd_compliant_law law;
         pd_compliant_table_law(&m->table, drawn->restitution, w->contact_time, &law);
         pd_compliant_from_law(&law, m->body, m->tol_scale, &w->compliant);
+        w->settle.patch = m->patch_omega / w->compliant.law.omega;
     }
+    w->top_time = top_spin_down(m->body, drawn, w->settle.patch);
     return PD_OK;
 }
 

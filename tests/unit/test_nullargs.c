@@ -576,6 +576,14 @@ static void c_scene_ranged(const fixture *f, int k, outcome *o)
     o->st = pd_scene_ranged(P(0, &sc)) == 0 ? PD_OK : PD_ERR_INTERNAL;
 }
 
+static void c_scene_varies(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    o->st = pd_scene_varies(P(0, &sc), PD_PARAM_MU) == 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
 static void c_scene_draw(const fixture *f, int k, outcome *o)
 {
     pd_scene sc, drawn;
@@ -687,6 +695,7 @@ static const entry table[] = {
     {"pd_scene_param_name", "", c_scene_param_name},
     {"pd_scene_format", "?scene ?buf", c_scene_format},
     {"pd_scene_ranged", "?scene", c_scene_ranged},
+    {"pd_scene_varies", "?scene", c_scene_varies},
     {"pd_scene_draw", "?scene ?values ?drawn", c_scene_draw},
     {"pd_scene_quantile", "?scene", c_scene_quantile},
     {"pd_drop_stage_name", "", c_drop_stage_name},
