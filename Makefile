@@ -256,6 +256,7 @@ bench-mujoco: deps
 # docs/engines-crosscheck.md (scripts/referee-mujoco.py; about an hour of CPU).
 referee: deps
 	@$(MAKE) --no-print-directory $(CLI)
+	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) --law --doc docs/engines-crosscheck.md
 	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) -o results/referee \
 	    --doc docs/engines-crosscheck.md $(REFEREE)
 

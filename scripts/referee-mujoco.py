@@ -60,17 +60,16 @@ Needs the mujoco package (not a posedrop dependency; outside make check):
   python3 -m venv .venv && .venv/bin/pip install mujoco numpy
 """
 import argparse
-import csv
 import json
 import math
 import os
 import resource
-import subprocess
 import sys
 import time
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-ROOT = os.path.dirname(HERE)
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import script_util  # noqa: E402
+from script_util import ROOT, rows  # noqa: E402
 
 # PD_CORNER_RADIUS_REL (src/base/base_tol.h): the corner radius of a part of
 # size L that the automatic contact time assumes.
@@ -157,14 +156,7 @@ def read_mesh(path):
 
 
 def run(cmd):
-    p = subprocess.run(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    if p.returncode != 0:
-        sys.exit("referee-mujoco: %s failed: %s" % (" ".join(cmd), p.stderr.strip()))
-    return p.stdout
-
-
-def rows(text):
-    return list(csv.DictReader(text.splitlines()))
+    return script_util.run(cmd, "referee-mujoco")
 
 
 def child_cpu():
@@ -340,6 +332,40 @@ class Referee:
         return 0, d.time
 
 
+def law_check(mujoco, exe):
+    """The contact law as MuJoCo realises it: the 1 cm cube (its automatic
+    contact time T, e 0.3) striking the floor flat at 1 m/s without gravity,
+    at T / K for several K: the rebound over the approach speed and how long
+    the floor pushed, over T. Markdown."""
+    part = Part(exe, os.path.join(ROOT, "parts/canonical/cube.off"), "m", [])
+    T, e = part.scene["contact_time_s"], part.scene["restitution"]
+    out = ["The law as MuJoCo realises it here: the 1 cm cube (T = %.3g s, e = %g) striking "
+           "the floor flat at 1 m/s, gravity off, rebound speed over approach speed and the "
+           "time the floor pushed over T, at steps of T / K:\n\n" % (T, e),
+           "| K | 10 | 20 | 40 | 80 |\n", "|---|---|---|---|---|\n"]
+    got = []
+    for K in (10, 20, 40, 80):
+        ref = Referee(mujoco, part, T / K)
+        m, d = ref.model, ref.data
+        m.opt.gravity[2] = 0.0
+        mujoco.mj_resetData(m, d)
+        d.qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+        d.qpos[2] = 0.005 + 1e-4
+        d.qvel[2] = -1.0
+        t_in = t_out = None
+        while d.time < 20 * T and t_out is None:
+            mujoco.mj_step(m, d)
+            pushing = d.efc_force.size > 0 and d.efc_force.max() > 0
+            if pushing and t_in is None:
+                t_in = d.time
+            if t_in is not None and not pushing and d.qvel[2] > 0:
+                t_out = d.time
+        got.append((d.qvel[2], (t_out - t_in) / T if t_out else float("nan")))
+    out.append("| rebound / approach | %s |\n" % " | ".join("%.4f" % g[0] for g in got))
+    out.append("| duration / T | %s |\n" % " | ".join("%.3f" % g[1] for g in got))
+    return "".join(out)
+
+
 # --- statistics and the table -------------------------------------------------
 
 
@@ -369,12 +395,6 @@ def tv(a, b, n):
     return 0.5 * sum(abs(a.get(k, 0) - b.get(k, 0)) for k in keys) / n
 
 
-def git(*args):
-    p = subprocess.run(["git", "-C", ROOT] + list(args), stdout=subprocess.PIPE,
-                       stderr=subprocess.DEVNULL, text=True)
-    return p.stdout.strip()
-
-
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--posedrop", default=os.path.join(ROOT, "build/opt/posedrop"))
@@ -388,6 +408,9 @@ def main():
                     help="releases the finer steps run again (200)")
     ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
     ap.add_argument("--doc", help="Markdown file to put the table in, between the markers")
+    ap.add_argument("--law", action="store_true",
+                    help="only the contact law's check (a flat strike of the cube), into "
+                    "--doc between the referee-law markers")
     a = ap.parse_args()
     names = a.parts.split(",")
     why = ["unknown part %r (%s)" % (x, ", ".join(PARTS)) for x in names if x not in PARTS]
@@ -401,11 +424,19 @@ def main():
     if why:
         sys.stderr.write("".join("referee-mujoco: %s\n" % w for w in why))
         return 2
+    if a.law:
+        COMMIT[:] = script_util.commit_here()
+        text = ("Made by `scripts/referee-mujoco.py --law` on %s (commit %s%s); MuJoCo %s.\n\n"
+                % (time.strftime("%Y-%m-%d", time.gmtime()), COMMIT[0], COMMIT[1],
+                   mujoco.__version__) + law_check(mujoco, a.posedrop))
+        sys.stdout.write(text)
+        if a.doc:
+            script_util.put_between(a.doc, "referee-law", "\n" + text + "\n", "referee-mujoco")
+        return 0
     steps = [int(k) for k in a.steps.split(",")]
     # The code that ran: the commit at the start, and whether the tree
     # differed from it.
-    COMMIT[:] = [git("rev-parse", "--short", "HEAD"),
-                 ", with changes" if git("status", "--porcelain", "--untracked-files=no") else ""]
+    COMMIT[:] = script_util.commit_here()
     os.makedirs(a.o, exist_ok=True)
     out_rows, table = [], []
     for name in names:
@@ -464,7 +495,7 @@ def main():
     text = markdown(table, steps, a)
     sys.stdout.write(text)
     if a.doc:
-        put_in_doc(a.doc, text)
+        script_util.put_between(a.doc, "referee-mujoco", "\n" + text + "\n", "referee-mujoco")
     return 0
 
 
@@ -533,16 +564,6 @@ def markdown(table, steps, a):
             cells.append("TV %.3f, %.1f%% unchanged" % (tv(ca, cb, k), 100 * same))
         lines.append("| %s | %s |\n" % (name, " | ".join(cells)))
     return "".join(lines)
-
-
-def put_in_doc(path, text):
-    begin, end = "<!-- referee-mujoco begin -->\n", "<!-- referee-mujoco end -->\n"
-    doc = open(path).read()
-    i, j = doc.find(begin), doc.find(end)
-    if i < 0 or j < i:
-        sys.exit("referee-mujoco: %s has no '%s' ... '%s' lines" % (path, begin.strip(),
-                                                                     end.strip()))
-    open(path, "w").write(doc[:i + len(begin)] + "\n" + text + "\n" + doc[j:])
 
 
 if __name__ == "__main__":
