@@ -104,7 +104,7 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-full check-install test bench bench-mujoco demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+.PHONY: all check check-full check-install test bench bench-mujoco referee demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
         check-browser figures mpi
 .DEFAULT_GOAL := all
 
@@ -252,6 +252,14 @@ bench-mujoco: deps
 	@$(MAKE) --no-print-directory $(CLI)
 	$(MUJOCO_PY) scripts/bench-mujoco.py --posedrop $(CLI) $(BENCH_MUJOCO)
 
+# The cross-check corpus on the three engines and MuJoCo, its table put in
+# docs/engines-crosscheck.md (scripts/referee-mujoco.py; about an hour of CPU).
+referee: deps
+	@$(MAKE) --no-print-directory $(CLI)
+	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) --law --doc docs/engines-crosscheck.md
+	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) -o results/referee \
+	    --doc docs/engines-crosscheck.md $(REFEREE)
+
 # make fuzz: libFuzzer targets built with clang (installed on first use) for
 # the OFF, STL and OBJ readers, scene files, the part build (mesh in, part
 # model and static estimate out) and programs of library calls (api), each
@@ -329,6 +337,7 @@ help:
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make bench-mujoco  cost per drop against MuJoCo (pip install mujoco; see the script)"
+	@echo "make referee    the cross-check corpus on the three engines and MuJoCo, into docs"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
 	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"

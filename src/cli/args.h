@@ -29,6 +29,7 @@ typedef struct {
     pd_scene scene;
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
+    int crosscheck;                /* --crosscheck: every engine on the same releases */
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;
     const char *sensitivity;       /* --sensitivity FILE */

@@ -30,7 +30,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY, OPT_TIME_LIMIT };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -103,6 +103,14 @@ static const cli_option options[] = {
     {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
      "time step of ode (default 0.001) or bullet (1/960),\n"
      "above 0 and at most 0.01"},
+    {OPT_CROSSCHECK, "crosscheck", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "the same drops (the same releases) on all three engines;\n"
+     "p and its interval stay --engine's, and each row adds\n"
+     "p_impulse, p_ode, p_bullet, their lowest and highest,\n"
+     "p_engine_min and p_engine_max, and engines_disagree: 1\n"
+     "when two engines' 95% intervals are apart (the model, not\n"
+     "the sampling, limits that estimate); said on stderr too.\n"
+     "Costs the three runs together (docs/engines.md)"},
     {OPT_TIME_LIMIT, "time-limit", ARG_TEXT, "S", REAL("auto or a time in s", 0, 1e9, 1, 0), NULL, NULL,
      "simulated seconds a drop may take before it ends\n"
      "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
@@ -435,6 +443,7 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         break;
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
+    case OPT_CROSSCHECK: a->crosscheck = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
     case OPT_SVG: a->pictures[VIZ_GALLERY] = arg; break;
     case OPT_CHART: a->pictures[VIZ_CHART] = arg; break;
@@ -572,9 +581,12 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (optind != argc - 1)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
     note_file(a, NULL, argv[optind], 0);
-    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE)
+    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE && !a->crosscheck)
         return fail_usage("%s", "--dt sets the time step of the ode and bullet engines only; the "
                           "impulse engine (the default) has no step and would ignore it");
+    if (a->crosscheck && (!a->dynamic || a->sim.nshards))
+        return fail_usage("%s", "--crosscheck runs the drops on every engine: it needs -n or --ci, "
+                          "and does not go with --shard");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
     int stationary = a->scene.initial == PD_INITIAL_STATIONARY;

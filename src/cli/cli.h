@@ -60,8 +60,10 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
                        pd_diag *diag);
 
 /* json_out.c: one JSON document for the poses (or classes) and the run. */
+/* xe: --crosscheck's engines (NULL: none), their columns added to the rows. */
 void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_static_result *res,
-                const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s);
+                const pd_sim_result *sim, const int *class_of, int nclasses,
+                const viz_engines *xe, double wall_s);
 
 /* signals.c: signals_install, the first thing main does, catches SIGINT and
  * SIGTERM (and unblocks them). signals_catch makes them set options->cancel:

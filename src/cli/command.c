@@ -19,14 +19,40 @@ static void print_warning(void *user, const char *message)
     fprintf(stderr, "%s: warning: %s\n", prog, message);
 }
 
+/* --crosscheck's columns (xe NULL: none): each engine's p (empty for an
+ * engine an interruption kept from running), their lowest and highest, and
+ * whether two engines' intervals are apart. */
+static void print_spread_header(const viz_engines *xe)
+{
+    if (xe)
+        printf(",p_impulse,p_ode,p_bullet,p_engine_min,p_engine_max,engines_disagree");
+}
+
+static void print_spread(const viz_engines *xe, int row)
+{
+    if (!xe)
+        return;
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        const pd_sim_result *r = xe->sim[k];
+        if (r && r->n > 0)
+            printf(",%.10g", r->p[row]);
+        else
+            printf(",");
+    }
+    viz_spread x = viz_engine_spread(xe, row);
+    printf(",%.10g,%.10g,%d", x.lo, x.hi, x.apart);
+}
+
 /* A stationary shard adds the counts its merge needs to estimate the chain:
  * first (uniform drops settled in the row's pose) and to_J (drops started
  * resting on the row's pose that settled in pose J). */
-static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
+static void print_poses(const pd_static_result *res, const pd_sim_result *sim,
+                        const viz_engines *xe)
 {
     int chain = sim && sim->nshards > 0 && sim->transitions;
     printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s%s",
            sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "", chain ? ",first" : "");
+    print_spread_header(xe);
     for (int j = 0; chain && j < res->nposes; j++)
         printf(",to_%d", j + 1);
     printf("\n");
@@ -41,6 +67,7 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
         for (int j = -1; chain && j < res->nposes; j++)
             printf(",%ld", j < 0 ? sim->first_count[i]
                                  : sim->transitions[(size_t)i * (size_t)res->nposes + (size_t)j]);
+        print_spread(xe, i);
         printf("\n");
     }
 }
@@ -49,10 +76,11 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
  * probabilities summed (gsim holds the library's grouped counts and
  * intervals), and the members' pose numbers. */
 static void print_classes(const pd_static_result *res, const pd_sim_result *gsim,
-                          const int *class_of, int nclasses)
+                          const int *class_of, int nclasses, const viz_engines *xe)
 {
-    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s,members\n",
-           gsim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s", gsim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    print_spread_header(xe);
+    printf(",members\n");
     for (int c = 0; c < nclasses; c++) {
         int first = -1;
         double qs = 0.0, pqs = 0.0;
@@ -70,6 +98,7 @@ static void print_classes(const pd_static_result *res, const pd_sim_result *gsim
         if (gsim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", gsim->n, gsim->count[c], gsim->p[c],
                    gsim->ci_lo[c], gsim->ci_hi[c], gsim->unsettled, gsim->partial);
+        print_spread(xe, c);
         printf(",");
         for (int i = first, sep = 0; i < res->nposes; i++)
             if (class_of[i] == c) {
@@ -439,6 +468,77 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
+/* --crosscheck: the drops on the other engines, from the same seed, so that
+ * drop i starts from the same state on each; xsim[k] for engine k, the
+ * main run's own slot left NULL. A signal stops it: the engines not yet run
+ * stay NULL. ODE and Bullet take --dt when given; the impulse engine has no
+ * step. Only the main run keeps its drops' records (--trials,
+ * --sensitivity). */
+static pd_status crosscheck_run(const pd_part *part, const pd_static_result *res, cli_args *a,
+                                pd_sim_result *xsim[VIZ_ENGINES], pd_diag *diag)
+{
+    pd_sim_options main_run = a->sim;
+    pd_status st = PD_OK;
+    for (int k = 0; k < VIZ_ENGINES && st == PD_OK; k++) {
+        if (k == (int)main_run.engine)
+            continue;
+        if (cli_any(signals_caught()))
+            break;
+        a->sim.engine = (pd_engine_kind)k;
+        a->sim.dt = k == PD_ENGINE_IMPULSE ? 0.0 : main_run.dt;
+        a->sim.keep_trials = 0;
+        st = cli_simulate(part, res, a, &xsim[k], diag);
+    }
+    a->sim = main_run;
+    return st;
+}
+
+/* --crosscheck in words on stderr, always: whether the engines' 95%
+ * intervals are apart on any pose (class), and where. */
+static void print_crosscheck(const cli_args *a, const viz_engines *xe, int n, int grouped)
+{
+    const char *what = grouped ? "class" : "pose";
+    int apart = 0, ran = 0, widest = 0;
+    double wide = -1.0;
+    for (int k = 0; k < VIZ_ENGINES; k++)
+        ran += xe->sim[k] && xe->sim[k]->n > 0;
+    for (int i = 0; i < n; i++) {
+        viz_spread x = viz_engine_spread(xe, i);
+        apart += x.apart;
+        if (x.hi - x.lo > wide) {
+            wide = x.hi - x.lo;
+            widest = i;
+        }
+    }
+    if (ran < VIZ_ENGINES)
+        fprintf(stderr, "%s: %s: crosscheck: %d of %d engines ran before the interruption\n",
+                prog, a->path, ran, VIZ_ENGINES);
+    if (ran < 2)
+        return;
+    if (!apart) {
+        fprintf(stderr, "%s: %s: crosscheck: the engines agree within their 95%% intervals on "
+                        "every %s (widest range %.1f points, %s %d)\n", prog, a->path, what,
+                100.0 * wide, what, widest + 1);
+        return;
+    }
+    fprintf(stderr, "%s: %s: crosscheck: the engines disagree beyond their 95%% intervals on "
+                    "%d of %d %s%s:", prog, a->path, apart, n, what,
+            n == 1 ? "" : grouped ? "es" : "s");
+    for (int i = 0, sep = 0; i < n; i++) {
+        viz_spread x = viz_engine_spread(xe, i);
+        if (!x.apart)
+            continue;
+        fprintf(stderr, "%s %s %d (", sep++ ? ";" : "", what, i + 1);
+        for (int k = 0, c = 0; k < VIZ_ENGINES; k++)
+            if (xe->sim[k] && xe->sim[k]->n > 0)
+                fprintf(stderr, "%s%s %.1f%%", c++ ? ", " : "", viz_engine_label(k),
+                        100.0 * xe->sim[k]->p[i]);
+        fprintf(stderr, ")");
+    }
+    fprintf(stderr, "; there the contact model limits the estimate, not the number of drops "
+                    "(p_engine_min, p_engine_max)\n");
+}
+
 double cli_wall_seconds(void)
 {
     struct timespec ts;
@@ -491,6 +591,8 @@ int cli_run(cli_args *a)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
+    pd_sim_result *xsim[VIZ_ENGINES] = {NULL}, *xgsim[VIZ_ENGINES] = {NULL};
+    viz_engines xe_store, *xe = NULL;
     pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
@@ -512,6 +614,8 @@ int cli_run(cli_args *a)
     }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
+        if (st == PD_OK && a->crosscheck && !sim->partial)
+            st = crosscheck_run(part, res, a, xsim, &diag);
         t_sim = cli_wall_seconds() - t0 - t_static;
     }
     if (st == PD_OK && !cli_writer()) {
@@ -524,6 +628,23 @@ int cli_run(cli_args *a)
         st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
         if (st == PD_OK && sim)
             st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+        for (int k = 0; k < VIZ_ENGINES && st == PD_OK; k++)
+            if (xsim[k])
+                st = pd_sim_result_grouped(xsim[k], class_of, nclasses, &xgsim[k], &diag);
+    }
+    if (st == PD_OK && sim && a->crosscheck) {
+        /* An engine an interruption kept from running leaves the run partial. */
+        int partial = 0;
+        for (int k = 0; k < VIZ_ENGINES; k++) {
+            int mine = k == (int)a->sim.engine;
+            const pd_sim_result *r = mine ? (gsim ? gsim : sim) : xgsim[k] ? xgsim[k] : xsim[k];
+            xe_store.sim[k] = r;
+            partial |= !r || r->partial;
+        }
+        xe = &xe_store;
+        sim->partial |= partial;
+        if (gsim)
+            gsim->partial |= partial;
     }
     /* The report shows it when the drops' records were kept (not across
      * MPI ranks); --sensitivity needs them. */
@@ -533,7 +654,7 @@ int cli_run(cli_args *a)
                                 nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
+                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens, xe};
     if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -574,19 +695,21 @@ int cli_run(cli_args *a)
         print_summary(a, part, res);
     if (sim)
         print_sim_summary(a, sim);
+    if (xe)
+        print_crosscheck(a, xe, class_of ? nclasses : res->nposes, class_of != NULL);
     if (a->sim.nshards && !shard_write_identity(stdout, a, sim)) {
         code = EXIT_INTERNAL;
         goto done;
     }
     if (a->json)
-        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses,
+        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses, xe,
                    cli_wall_seconds() - t0);
     else if (a->facets)
         print_facets(part, res);
     else if (class_of)
-        print_classes(res, gsim, class_of, nclasses);
+        print_classes(res, gsim, class_of, nclasses, xe);
     else
-        print_poses(res, sim);
+        print_poses(res, sim, xe);
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
     if (code)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
@@ -609,6 +732,10 @@ done:
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        pd_sim_result_free(xgsim[k]);
+        pd_sim_result_free(xsim[k]);
+    }
     pd_static_result_free(res);
     pd_part_free(part);
     pd_mesh_free(mesh);

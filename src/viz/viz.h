@@ -24,6 +24,28 @@ typedef struct viz_measured {
 pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag);
 void viz_measured_free(viz_measured *m);
 
+/* --crosscheck: the same releases run on the three engines, each one's
+ * result per entry (grouped when class_of, like viz_input.sim), in
+ * pd_engine_kind's order (impulse, ODE, Bullet); NULL for an engine that did
+ * not run (an interrupted run). */
+enum { VIZ_ENGINES = 3 };
+typedef struct viz_engines {
+    const pd_sim_result *sim[VIZ_ENGINES];
+} viz_engines;
+
+/* An entry's spread across the engines that ran drops: the lowest and the
+ * highest p, and whether the engines disagree beyond their sampling
+ * intervals (the lowest 95% upper bound below the highest lower bound: two
+ * engines' intervals are apart). ran: how many engines count. */
+typedef struct viz_spread {
+    double lo, hi;
+    int apart, ran;
+} viz_spread;
+viz_spread viz_engine_spread(const viz_engines *x, int entry);
+
+/* "impulse", "ODE" or "Bullet": engine k's name in words. */
+const char *viz_engine_label(int k);
+
 /* What the pictures are made of. One entry per stable pose, or per class of
  * poses with class_of (as --group prints them), in the CSV's order. */
 typedef struct viz_input {
@@ -37,6 +59,7 @@ typedef struct viz_input {
     const pd_scene *scene;        /* the drops' scene (NULL without drops) */
     const viz_measured *measured; /* or NULL */
     const pd_sensitivity *sensitivity; /* of a run with ranges, or NULL */
+    const viz_engines *engines;   /* --crosscheck, or NULL */
 } viz_input;
 
 /* What the report says about the run besides the results. */

@@ -1085,6 +1085,136 @@ static void test_fifo_inputs(void)
     remove(fifo);
 }
 
+/* The value in column name of data row r (from 0) of a CSV text; NaN when
+ * the column or row is missing, or the field is empty. */
+static double cell(const char *csv, const char *name, int r)
+{
+    int k = csv ? column_index(csv, name) : -1;
+    const char *p = k >= 0 ? strchr(csv, '\n') : NULL;
+    for (int i = 0; i < r && p; i++)
+        p = strchr(p + 1, '\n');
+    if (!p || !p[1])
+        return nan("");
+    p++;
+    for (int i = 0; i < k && p; i++) {
+        p = strpbrk(p, ",\n");
+        p = p && *p == ',' ? p + 1 : NULL;
+    }
+    return p && *p != ',' && *p != '\n' ? strtod(p, NULL) : nan("");
+}
+
+static int data_rows(const char *csv)
+{
+    int rows = 0;
+    for (const char *p = strchr(csv, '\n'); p && p[1]; p = strchr(p + 1, '\n'))
+        rows++;
+    return rows;
+}
+
+/* --crosscheck: each engine's column is that engine's own run from the same
+ * seed (the same releases), exactly; the lowest and highest are theirs; the
+ * disagreement flag is the separate runs' 95% intervals apart; the bytes do
+ * not depend on -j; JSON and the report carry the same, and the options it
+ * refuses. The cap (engines apart on some classes) and the button (apart on
+ * none at 30 drops) between them exercise both words. */
+static void test_crosscheck(void)
+{
+    static const char *const engines[] = {"impulse", "ode", "bullet"};
+    static const char *const cols[] = {"p_impulse", "p_ode", "p_bullet"};
+    static const char *const parts[] = {"parts/cap.off", "parts/button.off"};
+    char args[512], *out, *err, *out2, *err2, *own[3], *own_err[3];
+    int saw_apart = 0, saw_agree = 0;
+    for (int part = 0; part < 2; part++) {
+        snprintf(args, sizeof args, "-n 30 -j 1 --group --crosscheck %s", parts[part]);
+        CHECK_INT(run(args, &out, &err), 0);
+        snprintf(args, sizeof args, "-n 30 -j 3 --group --crosscheck %s", parts[part]);
+        CHECK_INT(run(args, &out2, &err2), 0);
+        CHECK(strcmp(out, out2) == 0); /* any thread count, the same bytes */
+        free(out2);
+        free(err2);
+        for (int k = 0; k < 3; k++) {
+            snprintf(args, sizeof args, "-n 30 --group --engine %s %s", engines[k], parts[part]);
+            CHECK_INT(run(args, &own[k], &own_err[k]), 0);
+        }
+        CHECK(column_index(out, "members") > column_index(out, "engines_disagree"));
+        int rows = data_rows(out), apart_rows = 0;
+        CHECK(rows >= 2);
+        CHECK_INT(data_rows(own[0]), rows);
+        for (int r = 0; r < rows; r++) {
+            double lo = 2.0, hi = -1.0, min_hi = 2.0, max_lo = -1.0;
+            for (int k = 0; k < 3; k++) {
+                double p = cell(own[k], "p", r);
+                CHECK(cell(out, cols[k], r) == p); /* the same releases, the same outcomes */
+                lo = fmin(lo, p);
+                hi = fmax(hi, p);
+                min_hi = fmin(min_hi, cell(own[k], "ci_hi", r));
+                max_lo = fmax(max_lo, cell(own[k], "ci_lo", r));
+            }
+            CHECK(cell(out, "p", r) == cell(out, "p_impulse", r)); /* --engine's p stays */
+            CHECK(cell(out, "p_engine_min", r) == lo);
+            CHECK(cell(out, "p_engine_max", r) == hi);
+            int apart = min_hi < max_lo;
+            CHECK_INT((int)cell(out, "engines_disagree", r), apart);
+            apart_rows += apart;
+        }
+        CHECK(strstr(err, apart_rows ? "engines disagree beyond their 95% intervals on"
+                                     : "engines agree within their 95% intervals") != NULL);
+        saw_apart |= apart_rows > 0;
+        saw_agree |= apart_rows == 0;
+        for (int k = 0; k < 3; k++) {
+            free(own[k]);
+            free(own_err[k]);
+        }
+        free(out);
+        free(err);
+    }
+    CHECK(saw_apart && saw_agree);
+
+    /* Another --engine: p is its own, the columns the same; --dt reaches ODE
+     * and Bullet. */
+    CHECK_INT(run("-n 20 --engine ode --crosscheck parts/button.off", &out, &err), 0);
+    CHECK(cell(out, "p", 0) == cell(out, "p_ode", 0));
+    free(out);
+    free(err);
+    CHECK_INT(run("-n 20 --dt 0.0005 --crosscheck parts/cap.off", &out, &err), 0);
+    CHECK_INT(run("-n 20 --dt 0.0005 --engine bullet parts/cap.off", &out2, &err2), 0);
+    for (int r = 0; r < data_rows(out); r++)
+        CHECK(cell(out, "p_bullet", r) == cell(out2, "p", r));
+    free(out);
+    free(err);
+    free(out2);
+    free(err2);
+
+    /* JSON: the same keys in every row, and what each engine ran. */
+    CHECK_INT(run("-n 20 --crosscheck --group --format json parts/cap.off", &out, &err), 0);
+    const char *keys[] = {"\"p_impulse\": ", "\"p_ode\": ", "\"p_bullet\": ", "\"p_engine_min\": ",
+                          "\"p_engine_max\": ", "\"engines_disagree\": ", "\"crosscheck\": {"};
+    for (size_t i = 0; i < sizeof keys / sizeof keys[0]; i++)
+        CHECK(strstr(out, keys[i]) != NULL);
+    free(out);
+    free(err);
+
+    /* The report: the band in the chart, the section in words. */
+    char report[160];
+    snprintf(report, sizeof report, "%s/crosscheck.html", tmpdir);
+    snprintf(args, sizeof args, "-n 20 --crosscheck --group --report %s parts/cap.off", report);
+    CHECK_INT(run(args, &out, &err), 0);
+    char *html = slurp(report);
+    CHECK(html != NULL);
+    if (html) {
+        CHECK(strstr(html, "<section id=\"crosscheck\">") != NULL);
+        CHECK(strstr(html, "disagree beyond their sampling intervals") != NULL);
+        CHECK(strstr(html, "the range across the engines") != NULL);
+        CHECK(strstr(html, "stroke-dasharray=\"3 2\"") != NULL);
+    }
+    free(html);
+    free(out);
+    free(err);
+
+    expect_failure("--crosscheck parts/cap.off", 2, "--crosscheck");
+    expect_failure("--crosscheck -n 10 --shard 1/2 parts/cap.off", 2, "--crosscheck");
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -1112,6 +1242,7 @@ void suite_cli(void)
     test_scale_warnings();
     test_time_limit();
     test_fifo_inputs();
+    test_crosscheck();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

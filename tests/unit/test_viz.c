@@ -392,7 +392,7 @@ static void test_placement(void)
         if (!parts[k])
             continue;
         CHECK_STATUS(pd_static_estimate(parts[k], NULL, &res, NULL), PD_OK);
-        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL};
+        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL, NULL};
         CHECK_STATUS(viz_gallery(&in, 1, &b[k], NULL), PD_OK);
         CHECK_STATUS(viz_sphere(&in, 1, &b[k], NULL), PD_OK);
         pd_static_result_free(res);
@@ -770,7 +770,8 @@ static void test_layout_checker(void)
 
 /* The gallery, chart and sphere of 1 to 40 entries, static only under a
  * short part name, and with drops and a measured distribution whose labels
- * are as wide as they get (100.0%, <0.1%, long file names): no text over other text or over the scale bar, none cut
+ * are as wide as they get (100.0%, <0.1%, long file names, the engines'
+ * band and its marks): no text over other text or over the scale bar, none cut
  * by the picture's edge, by DejaVu Sans's advance widths (the font the
  * pictures name first) with no further tolerance. The entries are classes
  * of the insulator cap's 98 poses, the last class holding the rest. */
@@ -791,6 +792,15 @@ static void test_layout(void)
         hi[i] = 1.0;
     }
     pd_sim_result sim = {.n = 100000, .p = p, .ci_lo = lo, .ci_hi = hi};
+    /* --crosscheck's band: a second engine far from the first on every
+     * entry, its interval apart (labels marked !), a third not run. */
+    double p2[40], lo2[40], hi2[40];
+    for (int i = 0; i < 40; i++) {
+        p2[i] = 1.0 - p[i];
+        lo2[i] = hi2[i] = p2[i];
+    }
+    pd_sim_result sim2 = {.n = 100000, .p = p2, .ci_lo = lo2, .ci_hi = hi2};
+    viz_engines xe = {{&sim, &sim2, NULL}};
     char mpath[] = "parts/a_measured_distribution_of_long_name.csv";
     viz_measured meas = {.p = p, .lo = lo, .hi = hi, .n = 123456, .path = mpath};
     pd_scene scene;
@@ -800,12 +810,12 @@ static void test_layout(void)
     for (int n = 1; n <= 40 && class_of; n++) {
         for (int i = 0; i < np; i++)
             class_of[i] = i < n ? i : n - 1;
-        sim.nposes = meas.npose = n;
+        sim.nposes = sim2.nposes = meas.npose = n;
         for (int dyn = 0; dyn < 2; dyn++) { /* the long name with the long labels */
             viz_input in = {.name = names[dyn], .part = part, .res = res,
                             .sim = dyn ? &sim : NULL, .class_of = class_of, .nclasses = n,
                             .engine = "impulse", .scene = dyn ? &scene : NULL,
-                            .measured = dyn ? &meas : NULL};
+                            .measured = dyn ? &meas : NULL, .engines = dyn ? &xe : NULL};
             pd_status (*const draw[3])(const viz_input *, int, vbuf *, pd_diag *) = {
                 viz_gallery, viz_chart, viz_sphere};
             static const char *const kind[3] = {"gallery", "chart", "sphere"};
