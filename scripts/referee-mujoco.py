@@ -7,7 +7,8 @@ physical parameters, from the very releases posedrop drew, decided by the
 same rule and grouped into the same pose classes as posedrop's --group.
 
   .venv/bin/python scripts/referee-mujoco.py [-n DROPS] [--seed S]
-      [--parts a,b,...] [--steps K,...] [--check-n M] [-o DIR] [--doc FILE]
+      [--parts a,b,...] [--steps K,...] [--mj-n M] [--check-n M] [-o DIR]
+      [--doc FILE]
 
 The corpus (--parts picks some):
   bushing   flanged bushing: a stepped solid of revolution, 32-gon, mm:
@@ -40,6 +41,8 @@ velocity, no spin):
     posedrop's stepping engines have it (condim 4, torsional coefficient
     (2/3) a mu, a = sqrt(R d): a corner of radius R = PD_CORNER_RADIUS_REL L
     sunk d = g / omega^2);
+  - the first --mj-n releases (all by default; MuJoCo costs 10 to 100 times
+    posedrop's engines per drop);
   - the step T / K for the first K of --steps (default 20,40): the table's;
     each further (finer) step runs the first --check-n releases (200) again,
     and the total variation between successive steps on those, against
@@ -86,6 +89,8 @@ PARTS = {
     "cap": ("parts/insulator_cap.off", "m", "uniform"),
     "cube": ("parts/canonical/cube.off", "m", "resting"),
 }
+# Cheapest in MuJoCo first, so that a run stopped early has the most parts.
+ORDER = ["cube", "box", "bushing", "hexnut", "button", "cap"]
 ENGINES = ["impulse", "ode", "bullet"]
 PARTS_SEEN = {}
 COMMIT = ["?", ""]
@@ -390,6 +395,12 @@ def outcome_table(part, outcomes, resting, starts):
     return counts
 
 
+def tvn(a, na, b, nb):
+    """Total variation between two count tables of na and nb drops."""
+    keys = set(a) | set(b)
+    return 0.5 * sum(abs(a.get(k, 0) / na - b.get(k, 0) / nb) for k in keys)
+
+
 def tv(a, b, n):
     keys = set(a) | set(b)
     return 0.5 * sum(abs(a.get(k, 0) - b.get(k, 0)) for k in keys) / n
@@ -400,10 +411,13 @@ def main():
     ap.add_argument("--posedrop", default=os.path.join(ROOT, "build/opt/posedrop"))
     ap.add_argument("-n", type=int, default=1000, help="drops per engine and part (1000)")
     ap.add_argument("--seed", type=int, default=3)
-    ap.add_argument("--parts", default=",".join(PARTS))
+    ap.add_argument("--parts", default=",".join(ORDER))
     ap.add_argument("--steps", default="20,40",
                     help="MuJoCo's steps per contact time: the table's, then finer ones "
                     "for the convergence check (20,40)")
+    ap.add_argument("--mj-n", type=int,
+                    help="MuJoCo drops per part at the table's step: the first of the "
+                    "releases (default: all -n)")
     ap.add_argument("--check-n", type=int, default=200,
                     help="releases the finer steps run again (200)")
     ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
@@ -470,7 +484,7 @@ def main():
         for s, K in enumerate(steps):
             dt = part.scene["contact_time_s"] / K
             ref = Referee(mujoco, part, dt)
-            these = keep if s == 0 else keep[:a.check_n]
+            these = keep[:a.mj_n or len(keep)] if s == 0 else keep[:a.check_n]
             sys.stderr.write("referee-mujoco: %s on MuJoCo, dt = T/%d = %.3g s, %d drops\n"
                              % (name, K, dt, len(these)))
             outcomes = []
@@ -491,11 +505,13 @@ def main():
                 lo, hi = wilson(cnt, n_of[e])
                 out_rows.append([name, e, c, n_of[e], cnt, cnt / n_of[e], lo, hi, unsettled, ms])
         table.append((name, resting, classes, counts, results, n, st))
+        # After each part, so that a run stopped half way leaves what it did.
         write_csv(os.path.join(a.o, "referee.csv"), out_rows)
-    text = markdown(table, steps, a)
+        text = markdown(table, steps, a)
+        if a.doc:
+            script_util.put_between(a.doc, "referee-mujoco", "\n" + text + "\n",
+                                    "referee-mujoco")
     sys.stdout.write(text)
-    if a.doc:
-        script_util.put_between(a.doc, "referee-mujoco", "\n" + text + "\n", "referee-mujoco")
     return 0
 
 
@@ -518,22 +534,24 @@ def markdown(table, steps, a):
                     COMMIT[1], time.strftime("%H:%M", time.gmtime()),
                     __import__("mujoco").__version__))
     lines.append("Share of each pose class (posedrop's `--group` numbering) over %d drops "
-                 "per engine from the same releases (seed %d), with the 95%% Wilson "
+                 "per engine (MuJoCo: the first %d of them) from the same releases (seed %d), "
+                 "with the 95%% Wilson "
                  "interval's half-width; the cube: the share that ends on the face it "
                  "started resting on. TV: total variation from MuJoCo at T/%d. Unsettled "
-                 "drops are in no class.\n\n" % (a.n, a.seed, steps[0]))
+                 "drops are in no class.\n\n" % (a.n, a.mj_n or a.n, a.seed, steps[0]))
     lines.append("| part | class | " + " | ".join(label[c] for c in cols) + " |\n")
     lines.append("|---|---|" + "---|" * len(cols) + "\n")
     for name, resting, classes, counts, results, n, st in table:
         for c in classes:
             cells = []
             for e in cols:
-                k = counts[e].get(c, 0)
-                lo, hi = wilson(k, n)
-                cells.append("%.3f +- %.3f" % (k / n, (hi - lo) / 2))
+                k, ne = counts[e].get(c, 0), len(results[e][0])
+                lo, hi = wilson(k, ne)
+                cells.append("%.3f +- %.3f" % (k / ne, (hi - lo) / 2))
             lines.append("| %s | %s | %s |\n" % (name, "same face" if resting else c,
                                                   " | ".join(cells)))
-        tvs = ["%.3f" % tv(counts[e], counts[fine], n) for e in ENGINES] + ["-"]
+        nf = len(results[fine][0])
+        tvs = ["%.3f" % tvn(counts[e], n, counts[fine], nf) for e in ENGINES] + ["-"]
         uns = [str(sum(1 for x in results[e][0] if x == 0)) for e in cols]
         ms = ["%.3g" % results[e][1] for e in cols]
         lines.append("| %s | TV to MuJoCo | %s |\n" % (name, " | ".join(tvs)))

@@ -31,6 +31,7 @@ import argparse
 import os
 import sys
 import tempfile
+import textwrap
 import time
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -107,17 +108,16 @@ def main():
 
     apart = sum(r["apart"] for r in res)
     classes = sum(r["classes"] for r in res)
-    para = ("**How far to trust p.** Measured on the paper's four parts (%d drops, its belt; "
-            "`scripts/trust.py`, %s, commit %s%s): *sampling*, the 95%% intervals reach "
-            "%s points either side of p, and more drops narrow them; *the scene*, mu, "
-            "restitution, height and contact time over plausible ranges move a class by up "
-            "to %s points (`--sensitivity`, [docs/uncertainty.md](docs/uncertainty.md)); "
-            "*the model*, the three engines differ by up to %s points on a class, beyond "
-            "their intervals on %d of %d classes (`--crosscheck`); *measured*, the total "
-            "variation from the paper's physical tests is %s%% "
-            "([docs/validation.md](docs/validation.md)). A difference smaller than these "
-            "is not a finding.\n" % (a.n, when, commit, dirty, span("half"), span("shift"),
-                                     span("spread"), apart, classes, span("tv")))
+    para = ("**How far to trust p.** On the paper's four parts (`scripts/trust.py`, %s, "
+            "commit %s%s; %d drops, its belt): the 95%% intervals reach %s points either "
+            "side (more drops narrow them); the scene's plausible ranges move a class by up "
+            "to %s points (`--sensitivity`); the three engines differ by up to %s points, "
+            "beyond their intervals on %d of %d classes (`--crosscheck`); the physical tests "
+            "are %s%% away in total variation ([docs/validation.md](docs/validation.md)). "
+            "Differences below these are not findings.\n"
+            % (when, commit, dirty, a.n, span("half"), span("shift"), span("spread"), apart,
+               classes, span("tv")))
+    para = "\n".join(textwrap.wrap(para, 78, break_long_words=False, break_on_hyphens=False)) + "\n"
     sys.stdout.write("\n" + para)
     if a.doc:
         script_util.put_between(a.doc, "trust-table", table, "trust.py")
