@@ -54,7 +54,16 @@ typedef struct pd_fit_part {
     const int *class_of;  /* poses->nposes classes in [0, nclasses) (pd_pose_classes),
                              or NULL: every pose its own class */
     int nclasses;         /* with class_of NULL: poses->nposes */
-    const long *count;    /* nclasses measured counts (>= 0, not all 0), or NULL */
+    const long *count;    /* nclasses measured counts (>= 0, not all 0), or NULL; with
+                             cell_of, ncells counts */
+    /* Counts of sets of classes, for a label that stands for several poses
+     * (a die's face read as either of two facets, counts folded by mirror
+     * pairs): class c was counted in cell cell_of[c] (0 .. ncells - 1, each
+     * cell holding at least one class), and its likelihood is that of the
+     * cell, the sum of its classes' probabilities. NULL: every class its own
+     * cell (ncells is then ignored). */
+    const int *cell_of;
+    int ncells;
 } pd_fit_part;
 
 /* Where a fit stands, after each evaluation (and once before the first, with
@@ -125,7 +134,7 @@ typedef struct pd_fit_part_result {
                            parameters' spread and the simulation's own error */
     double loglik;      /* sum_k count_k log p_best_k (0 for a predicted part) */
     double chi2;        /* Pearson's X^2 of the counts against n p_best */
-    int df;             /* nclasses - 1 */
+    int df;             /* cells of counts (nclasses without cell_of) - 1 */
     double pvalue;      /* P(chi2_df > chi2) */
     double tv;          /* total variation between the counts and p_best: in-sample */
     pd_fit_quality fresh_best, fresh_mean; /* against fresh drops at the best

@@ -154,24 +154,27 @@ static int parse_spec(char *spec, pd_fit_param *params, int *nparams, int *fit_i
     return -1;
 }
 
-/* The measured file of a part, as counts per class (k of them). */
-static int read_counts(const char *path, const char *part, int k, long **count)
+/* The measured file of a part, as counts per class (k of them), or with
+ * sets of poses ("3|4") as counts per cell: every class not in a set its
+ * own cell, in class order, then the sets (*cell_of: k cells, *ncells). */
+static int read_counts(const char *path, const char *part, int k, long **count, int **cell_of,
+                       int *ncells)
 {
     viz_measured *m = NULL;
     pd_diag diag;
     pd_diag_init(&diag);
-    pd_status st = viz_measured_read(path, &m, &diag);
+    pd_status st = viz_measured_read_sets(path, &m, &diag);
     if (st != PD_OK) {
         fprintf(stderr, "%s: %s\n", prog, diag.message);
         return 0;
     }
-    int ok = 1;
+    int ok = 1, maxpose = m->npose;
     if (m->n <= 0) {
         fprintf(stderr, "%s: %s: the fit needs counts: columns pose,count, or pose,p,n\n", prog,
                 path);
         ok = 0;
-    } else if (m->npose > k) {
-        fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, m->npose, part, k,
+    } else if (maxpose > k) {
+        fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, maxpose, part, k,
                 k == 1 ? "" : "s");
         ok = 0;
     }
@@ -179,7 +182,31 @@ static int read_counts(const char *path, const char *part, int k, long **count)
         fprintf(stderr, "%s: out of memory\n", prog);
         ok = 0;
     }
-    for (int i = 0; ok && i < m->npose; i++)
+    if (ok && m->nsets && !(*cell_of = malloc(sizeof **cell_of * (size_t)k))) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        ok = 0;
+    }
+    if (ok && m->nsets) {
+        /* The sets' cells after the classes counted alone. */
+        for (int c = 0; c < k; c++)
+            (*cell_of)[c] = -1;
+        for (int s = 0, at = 0; s < m->nsets; at += m->set_size[s], s++)
+            for (int a = 0; a < m->set_size[s]; a++)
+                (*cell_of)[m->set_pose[at + a] - 1] = -2 - s;
+        int n = 0;
+        for (int c = 0; c < k; c++)
+            if ((*cell_of)[c] == -1) {
+                (*count)[n] = c < m->npose ? lround(m->p[c] * (double)m->n) : 0;
+                (*cell_of)[c] = n++;
+            }
+        for (int s = 0; s < m->nsets; s++)
+            (*count)[n + s] = lround(m->set_p[s] * (double)m->n);
+        for (int c = 0; c < k; c++)
+            if ((*cell_of)[c] <= -2)
+                (*cell_of)[c] = n - 2 - (*cell_of)[c];
+        *ncells = n + m->nsets;
+    }
+    for (int i = 0; ok && !m->nsets && i < m->npose; i++)
         (*count)[i] = lround(m->p[i] * (double)m->n);
     viz_measured_free(m);
     return ok;
@@ -192,6 +219,7 @@ typedef struct {
     pd_static_result *res;
     int *class_of, nclasses;
     long *count;
+    int *cell_of, ncells; /* with sets of poses measured; else NULL */
 } fit_input;
 
 static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
@@ -220,7 +248,8 @@ static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
             fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
         return 0;
     }
-    return !in->measured || read_counts(in->measured, in->path, in->nclasses, &in->count);
+    return !in->measured || read_counts(in->measured, in->path, in->nclasses, &in->count,
+                                                &in->cell_of, &in->ncells);
 }
 
 static const char *initial_name(pd_initial i)
@@ -294,16 +323,30 @@ static void write_gof(FILE *f, const pd_fit_result *r, const fit_input *in, int 
 
 static void print_table(const pd_fit_result *r, const fit_input *in, int nin)
 {
-    printf("part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n");
+    printf("part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi,set\n");
     for (int i = 0; i < nin; i++) {
         const pd_fit_part_result *q = &r->parts[i];
+        const int *of = in[i].cell_of;
         for (int c = 0; c < q->nclasses; c++) {
             printf("%s,%s,%d,", in[i].path, in[i].count ? "fitted" : "predicted", c + 1);
-            if (in[i].count)
-                printf("%ld,%.10g,", in[i].count[c], (double)in[i].count[c] / (double)q->n);
+            /* A set holds two poses or more. */
+            int cell = of ? of[c] : c, members = 0;
+            for (int e = 0; of && e < q->nclasses; e++)
+                members += of[e] == cell;
+            int in_set = members >= 2;
+            if (in[i].count && !in_set)
+                printf("%ld,%.10g,", in[i].count[cell], (double)in[i].count[cell] / (double)q->n);
             else
                 printf(",,");
-            printf("%.10g,%.10g,%.10g,%.10g\n", q->p_best[c], q->p[c], q->lo[c], q->hi[c]);
+            printf("%.10g,%.10g,%.10g,%.10g,", q->p_best[c], q->p[c], q->lo[c], q->hi[c]);
+            /* A set's count is its own row's in the measured file: the
+             * members name the set. */
+            for (int e = 0, first = 1; in_set && e < q->nclasses; e++)
+                if (of[e] == cell) {
+                    printf("%s%d", first ? "" : "|", e + 1);
+                    first = 0;
+                }
+            printf("\n");
         }
     }
 }
@@ -593,8 +636,8 @@ int cli_fit(int argc, char **argv)
     if (code < 0) {
         pd_fit_part parts[MAX_PARTS];
         for (int i = 0; i < nin; i++)
-            parts[i] = (pd_fit_part){in[i].part, in[i].res, in[i].class_of, in[i].nclasses,
-                                     in[i].count};
+            parts[i] = (pd_fit_part){in[i].part,  in[i].res,     in[i].class_of, in[i].nclasses,
+                                     in[i].count, in[i].cell_of, in[i].ncells};
         fo.fit_initial = fit_initial;
         double t0 = cli_wall_seconds(), c0 = cli_cpu_seconds();
         fit_clock clock = {t0, c0, 0.0};
@@ -631,6 +674,7 @@ int cli_fit(int argc, char **argv)
     pd_fit_result_free(r);
     for (int i = 0; i < nin; i++) {
         free(in[i].count);
+        free(in[i].cell_of);
         free(in[i].class_of);
         pd_static_result_free(in[i].res);
         pd_part_free(in[i].part);

@@ -176,8 +176,27 @@ static pd_status check_parts(const pd_fit_part *parts, int nparts, pd_diag *diag
         }
         if (!fp->count)
             continue;
+        int ncells = fp->cell_of ? fp->ncells : k;
+        if (fp->cell_of) {
+            if (ncells < 1 || ncells > k)
+                return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: %d cells of counts for "
+                               "%d classes: expected 1 to %d", i + 1, ncells, k, k);
+            for (int c = 0; c < k; c++)
+                if (fp->cell_of[c] < 0 || fp->cell_of[c] >= ncells)
+                    return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d counted in "
+                                   "cell %d, outside 1..%d", i + 1, c + 1, fp->cell_of[c] + 1,
+                                   ncells);
+            for (int j = 0; j < ncells; j++) {
+                int members = 0;
+                for (int c = 0; c < k; c++)
+                    members += fp->cell_of[c] == j;
+                if (!members)
+                    return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: cell %d of counts "
+                                   "has no class", i + 1, j + 1);
+            }
+        }
         long n = 0;
-        for (int c = 0; c < k; c++) {
+        for (int c = 0; c < ncells; c++) {
             if (fp->count[c] < 0)
                 return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d has a negative "
                                "count (%ld)", i + 1, c + 1, fp->count[c]);
@@ -307,23 +326,24 @@ static pd_fit_result *result_alloc(int d, const pd_fit_part *parts, int nparts)
     return r;
 }
 
-/* Pearson's X^2 of the 2 x K table of counts (n of them) and simulated
- * frequencies p of nsim drops, the classes neither reached left out; the TV
- * distance of their frequencies. */
-static pd_fit_quality quality(int k, const long *count, const double *p, double nsim)
+/* Pearson's X^2 of the 2 x K table of counts (n of them, per cell) and
+ * simulated frequencies p (per class) of nsim drops, the cells neither
+ * reached left out; the TV distance of their frequencies. */
+static pd_fit_quality quality(int k, const int *cell_of, int ncells, const long *count,
+                              const double *p, double nsim)
 {
     pd_fit_quality q = {0.0, -1, 1.0, 0.0};
     long n = 0;
-    for (int c = 0; c < k; c++)
+    for (int c = 0; c < ncells; c++)
         n += count[c];
     if (!(nsim > 0) || n <= 0) {
         q.df = 0;
         return q;
     }
     double tot = (double)n + nsim;
-    for (int c = 0; c < k; c++) {
-        double s = nsim * p[c], both = (double)count[c] + s;
-        q.tv += 0.5 * fabs((double)count[c] / (double)n - p[c]);
+    for (int c = 0; c < ncells; c++) {
+        double pc = fit_cell_p(k, cell_of, c, p), s = nsim * pc, both = (double)count[c] + s;
+        q.tv += 0.5 * fabs((double)count[c] / (double)n - pc);
         if (!(both > 0))
             continue;
         q.df++;
@@ -332,6 +352,12 @@ static pd_fit_quality quality(int k, const long *count, const double *p, double 
     }
     q.pvalue = q.df > 0 ? pd_gsl_chisq_q(q.chi2, q.df) : 1.0;
     return q;
+}
+
+/* Part i's cells of counts (its classes when it has no cell_of). */
+static int part_cells(const pd_fit_part *fp)
+{
+    return fp->cell_of ? fp->ncells : fp->nclasses;
 }
 
 /* Each fitted part's fresh-drop quality at theta (the problem's scale), and
@@ -354,9 +380,11 @@ static pd_status fresh(model *m, const fit_problem *pb, const double *theta, uin
     for (int i = 0; i < m->nparts; i++) {
         if (!pb->count[i])
             continue;
-        pd_fit_quality q = quality(pb->k[i], pb->count[i], p[i], nsim[i]);
+        const pd_fit_part *fp = &m->parts[i];
+        pd_fit_quality q = quality(pb->k[i], fp->cell_of, part_cells(fp), pb->count[i], p[i],
+                                   nsim[i]);
         long n = 0;
-        for (int c = 0; c < pb->k[i]; c++)
+        for (int c = 0; c < part_cells(fp); c++)
             n += pb->count[i][c];
         all.chi2 += q.chi2;
         all.df += q.df;
@@ -421,6 +449,8 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     int *kk = malloc(sizeof *kk * (size_t)nparts);
     const long **count = malloc(sizeof *count * (size_t)nparts);
     const long **one = malloc(sizeof *one * (size_t)nparts);
+    const int **cell_of = malloc(sizeof *cell_of * (size_t)nparts);
+    int *ncells = malloc(sizeof *ncells * (size_t)nparts);
     pd_fit_result *r = result_alloc(d, parts, nparts);
     double **pb_best = malloc(sizeof *pb_best * (size_t)nparts);
     double **pp = malloc(sizeof *pp * (size_t)nparts), **plo = malloc(sizeof *plo * (size_t)nparts);
@@ -432,7 +462,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     for (int i = 0; i < nparts; i++)
         ksum += (size_t)parts[i].nclasses;
     double *pbuf = malloc(sizeof *pbuf * ksum);
-    if (!m.ndrops || !m.pose_p || !kk || !count || !one || !r || !pb_best || !pp || !plo || !phi ||
+    if (!m.ndrops || !m.pose_p || !kk || !count || !one || !cell_of || !ncells || !r || !pb_best || !pp || !plo || !phi ||
         !nsim || !ps || !ns || !pbuf) {
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
         goto done;
@@ -445,13 +475,16 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     for (int i = 0; i < nparts; i++) {
         kk[i] = parts[i].nclasses;
         count[i] = parts[i].count;
+        cell_of[i] = parts[i].cell_of;
+        ncells[i] = part_cells(&parts[i]);
         pb_best[i] = r->parts[i].p_best;
         pp[i] = r->parts[i].p;
         plo[i] = r->parts[i].lo;
         phi[i] = r->parts[i].hi;
         ps[i] = i ? ps[i - 1] + kk[i - 1] : pbuf;
     }
-    fit_problem pb = {d, lo, hi, nparts, kk, count, o.alpha, run_model, &m, note, &m};
+    fit_problem pb = {d,      lo,      hi,        nparts,    kk,   count, cell_of,
+                      ncells, o.alpha, run_model, &m, note, &m};
     fit_settings set = {o.max_evals, o.npoints ? o.npoints : 8 * (d + 1)};
     double theta[PD_FIT_MAX_PARAMS], best_theta[PD_FIT_MAX_PARAMS], best = -HUGE_VAL;
     pd_initial modes[3] = {PD_INITIAL_UNIFORM, PD_INITIAL_BOOTSTRAP, PD_INITIAL_STATIONARY};
@@ -502,7 +535,8 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
             if (st == PD_OK) {
                 r->evaluations++;
                 note(&m, "prediction", 0, 0.0);
-                score += pd_fit_loglik_dm(kk[j], parts[j].count, ps[j], ns[j], o.alpha);
+                score += fit_loglik_cells(kk[j], cell_of[j], ncells[j], parts[j].count, ps[j],
+                                          ns[j], o.alpha);
             }
         }
         m.prog.held_out = 0;
@@ -543,17 +577,18 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         for (int i = 0; i < nparts; i++) {
             pd_fit_part_result *q = &r->parts[i];
             q->nsim = (long)nsim[i];
-            q->df = q->nclasses - 1;
+            q->df = ncells[i] - 1;
             if (!parts[i].count)
                 continue;
-            for (int c = 0; c < q->nclasses; c++) {
+            for (int c = 0; c < ncells[i]; c++)
                 q->n += parts[i].count[c];
+            for (int c = 0; c < ncells[i]; c++) {
+                double pc = fit_cell_p(kk[i], cell_of[i], c, q->p_best);
                 if (parts[i].count[c] > 0)
-                    q->loglik += (double)parts[i].count[c] * log(q->p_best[c]);
+                    q->loglik += (double)parts[i].count[c] * log(pc);
+                q->tv += 0.5 * fabs((double)parts[i].count[c] / (double)q->n - pc);
             }
-            for (int c = 0; c < q->nclasses; c++)
-                q->tv += 0.5 * fabs((double)parts[i].count[c] / (double)q->n - q->p_best[c]);
-            q->chi2 = fit_chi2(q->nclasses, parts[i].count, q->p_best);
+            q->chi2 = fit_chi2_cells(kk[i], cell_of[i], ncells[i], parts[i].count, q->p_best);
             q->pvalue = q->df > 0 ? pd_gsl_chisq_q(q->chi2, q->df) : 1.0;
             r->loglik += q->loglik;
             r->chi2 += q->chi2;
@@ -597,6 +632,8 @@ done:
     free(kk);
     free(count);
     free(one);
+    free(cell_of);
+    free(ncells);
     if (st == PD_OK)
         *result = r;
     else

@@ -45,6 +45,14 @@ typedef struct {
     int round;
 } ctx;
 
+/* Part i's cells of counts. */
+static const int *cells(const fit_problem *pb, int i, int *ncells)
+{
+    const int *of = pb->cell_of ? pb->cell_of[i] : NULL;
+    *ncells = of && pb->ncells ? pb->ncells[i] : pb->k[i];
+    return of;
+}
+
 static void to_theta(const fit_problem *pb, const double *z, double *theta)
 {
     for (int i = 0; i < pb->d; i++)
@@ -64,8 +72,11 @@ static pd_status evaluate(ctx *c, const double *z, int all, double *loglik)
         return st;
     double l = 0.0;
     for (int i = 0; all != 2 && i < pb->nparts; i++)
-        if (pb->count[i])
-            l += pd_fit_loglik_dm(pb->k[i], pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+        if (pb->count[i]) {
+            int nc;
+            const int *of = cells(pb, i, &nc);
+            l += fit_loglik_cells(pb->k[i], of, nc, pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+        }
     *loglik = l;
     if (pb->note)
         pb->note(pb->note_user, c->stage, c->round, l);
@@ -279,11 +290,13 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             if (!pb->count[i])
                 continue;
             long n = 0;
-            for (int j = 0; j < pb->k[i]; j++)
+            int nc;
+            const int *of = cells(pb, i, &nc);
+            for (int j = 0; j < nc; j++)
                 n += pb->count[i][j];
-            x2 += fit_chi2(pb->k[i], pb->count[i], out->p_best[i]);
-            expect += (double)(pb->k[i] - 1) * (1.0 + (double)n / nsim[i]);
-            df += pb->k[i] - 1;
+            x2 += fit_chi2_cells(pb->k[i], of, nc, pb->count[i], out->p_best[i]);
+            expect += (double)(nc - 1) * (1.0 + (double)n / nsim[i]);
+            df += nc - 1;
         }
         /* Without a degree of freedom left, X^2 says nothing of the fit. */
         expect *= df > 0 ? (double)df / (double)(df + d) : 0.0;

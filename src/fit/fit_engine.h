@@ -20,7 +20,10 @@ typedef struct fit_problem {
     const double *lo, *hi;    /* the box, lo < hi */
     int nparts;
     const int *k;             /* classes per part */
-    const long *const *count; /* per part; NULL: predicted only */
+    const long *const *count; /* per part, one per cell; NULL: predicted only */
+    const int *const *cell_of; /* per part: each class's cell of counts, or NULL (or
+                                  cell_of NULL): every class its own cell */
+    const int *ncells;        /* per part, with cell_of; NULL: k */
     double alpha;             /* the smoothing pseudo-count */
     fit_model_fn model;
     void *user;
@@ -79,6 +82,15 @@ double fit_halton(long i, int j);
 
 /* Pearson's X^2 of counts (k) against n p. */
 double fit_chi2(int k, const long *count, const double *p);
+
+/* With counts of cells of classes: class i of k in cell cell_of[i] (cell_of
+ * NULL: every class its own cell, ncells = k); count has ncells entries.
+ * The Dirichlet-multinomial log-likelihood, Pearson's X^2, and the
+ * probability of cell j. */
+double fit_loglik_cells(int k, const int *cell_of, int ncells, const long *count,
+                        const double *p_sim, double nsim, double alpha);
+double fit_chi2_cells(int k, const int *cell_of, int ncells, const long *count, const double *p);
+double fit_cell_p(int k, const int *cell_of, int j, const double *p);
 
 /* The q-quantile of a mixture of Beta(a_j, b_j) with weights w_j (n terms,
  * summing to 1), by bisection to 1e-9. */

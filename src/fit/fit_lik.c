@@ -40,31 +40,71 @@ static double lnpoch(double a, double x)
            (1.0 / (b * b * b) - 1.0 / (a * a * a)) / 360.0;
 }
 
-double pd_fit_loglik_dm(int k, const long *count, const double *p_sim, double nsim, double alpha)
+/* The probability of cell j of counts: the sum over its classes (cell_of
+ * NULL: class j alone); *members receives their number. */
+static double cell_p(int k, const int *cell_of, int j, const double *p, int *members)
+{
+    if (!cell_of) {
+        *members = 1;
+        return p[j];
+    }
+    double s = 0.0;
+    *members = 0;
+    for (int i = 0; i < k; i++)
+        if (cell_of[i] == j) {
+            s += p[i];
+            (*members)++;
+        }
+    return s;
+}
+
+double fit_loglik_cells(int k, const int *cell_of, int ncells, const long *count,
+                        const double *p_sim, double nsim, double alpha)
 {
     if (!count || !p_sim)
         return 0.0;
     double l = 0.0;
     long n = 0;
-    for (int i = 0; i < k; i++)
-        if (count[i] > 0) {
-            l += lnpoch(nsim * p_sim[i] + alpha, (double)count[i]);
-            n += count[i];
+    /* A Dirichlet's sums over disjoint cells are Dirichlet with the summed
+     * parameters: a cell of m classes has s + m alpha. */
+    for (int j = 0; j < ncells; j++)
+        if (count[j] > 0) {
+            int m;
+            double s = nsim * cell_p(k, cell_of, j, p_sim, &m);
+            l += lnpoch(s + (double)m * alpha, (double)count[j]);
+            n += count[j];
         }
     return l - lnpoch(nsim + (double)k * alpha, (double)n);
 }
 
-double fit_chi2(int k, const long *count, const double *p)
+double pd_fit_loglik_dm(int k, const long *count, const double *p_sim, double nsim, double alpha)
+{
+    return fit_loglik_cells(k, NULL, k, count, p_sim, nsim, alpha);
+}
+
+double fit_chi2_cells(int k, const int *cell_of, int ncells, const long *count, const double *p)
 {
     long n = 0;
-    for (int i = 0; i < k; i++)
-        n += count[i];
+    for (int j = 0; j < ncells; j++)
+        n += count[j];
     double x2 = 0.0;
-    for (int i = 0; i < k; i++) {
-        double e = (double)n * p[i];
-        x2 += ((double)count[i] - e) * ((double)count[i] - e) / e;
+    for (int j = 0; j < ncells; j++) {
+        int m;
+        double e = (double)n * cell_p(k, cell_of, j, p, &m);
+        x2 += ((double)count[j] - e) * ((double)count[j] - e) / e;
     }
     return x2;
+}
+
+double fit_chi2(int k, const long *count, const double *p)
+{
+    return fit_chi2_cells(k, NULL, k, count, p);
+}
+
+double fit_cell_p(int k, const int *cell_of, int j, const double *p)
+{
+    int m;
+    return cell_p(k, cell_of, j, p, &m);
 }
 
 double fit_halton(long i, int j)

@@ -63,6 +63,19 @@ static void test_likelihood_hand(void)
                "200 logs of order 7 summed: round-off 1e-13 each");
     CHECK_NEAR(pd_fit_loglik_dm(2, c46, pr, 1e12, 0.5), 40 * log(0.4) + 60 * log(0.6), 1e-8,
                "the plug-in limit: the DM's excess is of order n^2 / nsim = 1e-8");
+    /* Classes 1 and 3 counted as one set: the Dirichlet's sum over them is
+     * Beta(s + 2 alpha, ...): a = 3 against A = 7/2, two counts give
+     * (3)(4) / ((7/2)(9/2)). */
+    const int cell_of[] = {0, 1, 0};
+    const long c2set[] = {2, 0};
+    CHECK_NEAR(fit_loglik_cells(3, cell_of, 2, c2set, p, 2.0, 0.5), log(12.0 / 15.75), ROUND,
+               "hand: the set's Gamma ratio");
+    CHECK_NEAR(fit_cell_p(3, cell_of, 0, p), 1.0, ROUND, "the set's probability: 0.5 + 0.5");
+    /* X^2 of the set's 2 counts against 2 * 1 expected, the other cell's 0
+     * against 0 + ... : (2 - 2)^2 / 2 + (0 - 0.2)^2 / 0.2 with p = (0.4, 0.1, 0.5). */
+    const double p415[] = {0.4, 0.1, 0.5};
+    CHECK_NEAR(fit_chi2_cells(3, cell_of, 2, c2set, p415), 0.04 / 0.2 + 0.04 / 1.8, ROUND,
+               "hand: expected 1.8 and 0.2");
     /* Pearson's X^2: n = 6, expected 1.2, 1.8, 3: 0.04/1.2 + 0.04/1.8 + 0. */
     CHECK_NEAR(fit_chi2(3, c2, q), 0.04 / 1.2 + 0.04 / 1.8, ROUND, "hand");
 }
@@ -104,7 +117,7 @@ static void test_search_closed_form(void)
     const int k[] = {2, 2};
     const double lo[] = {0.05, 0.05}, hi[] = {0.95, 0.95};
     int nparts = 2, evals = 0;
-    fit_problem pb = {2, lo, hi, 2, k, count, 0.5, exact_model, &nparts, NULL, NULL};
+    fit_problem pb = {2, lo, hi, 2, k, count, NULL, NULL, 0.5, exact_model, &nparts, NULL, NULL};
     fit_settings s = {200, 32};
     double theta[2], l;
     pd_diag diag;
@@ -158,7 +171,7 @@ static void test_dispersion(void)
     const long *count[] = {c};
     const int k[] = {3};
     const double lo[] = {0.05}, hi[] = {0.95};
-    fit_problem pb = {1, lo, hi, 1, k, count, 0.5, misfit_model, NULL, NULL, NULL};
+    fit_problem pb = {1, lo, hi, 1, k, count, NULL, NULL, 0.5, misfit_model, NULL, NULL, NULL};
     fit_settings s = {200, 32};
     double theta[1], l, wlo[1], whi[1], wmean[1], pb0[3], p0[3], l0[3], h0[3], nsb[1];
     double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
@@ -218,7 +231,7 @@ static void crn_fit(test_rng *rng, double truth, long n, int S, double *lo, doub
     const long *count[] = {c};
     const int k[] = {2};
     const double plo_[] = {0.05}, phi_[] = {0.95};
-    fit_problem pb = {1, plo_, phi_, 1, k, count, 0.5, crn_sim, &m, NULL, NULL};
+    fit_problem pb = {1, plo_, phi_, 1, k, count, NULL, NULL, 0.5, crn_sim, &m, NULL, NULL};
     fit_settings s = {150, 16};
     double theta[1], l, wmean[1], pb0[2], p0[2], l0[2], h0[2], nsb[1];
     double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
@@ -304,7 +317,7 @@ static const pd_fit_param box_e = {"restitution", 0.05, 0.7, 0, 0};
 static pd_status box_fit(const box_part *b, const long *count, pd_fit_param prm, long nsim,
                          int max_evals, int npoints, pd_fit_result **fr)
 {
-    pd_fit_part fp = {b->part, b->res, b->class_of, b->nclasses, count};
+    pd_fit_part fp = {b->part, b->res, b->class_of, b->nclasses, count, NULL, 0};
     pd_fit_options o;
     pd_fit_options_default(&o);
     o.ndrops = nsim;
@@ -357,7 +370,7 @@ static void test_recovery(void)
         for (int r = 0; r < R; r++) {
             CHECK(box_counts(&b, truth, 300, 2000 + (uint64_t)r, count));
             fr = NULL;
-            pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+            pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count, NULL, 0};
             pd_fit_param prm = {"restitution", 0.05, 0.7, 0, 0};
             pd_fit_options o;
             pd_fit_options_default(&o);
@@ -453,7 +466,7 @@ static void test_initial_choice(const box_part *bp)
 {
     box_part b = *bp;
     long count[8] = {240, 48, 12, 0, 0, 0, 0, 0};
-    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count, NULL, 0};
     pd_fit_param prm = {"restitution", 0.05, 0.7, 0, 0};
     pd_fit_options o;
     pd_fit_options_default(&o);
@@ -493,7 +506,7 @@ static void test_errors(const box_part *bp)
 {
     box_part b = *bp;
     long count[8] = {10, 5, 1, 0, 0, 0, 0, 0};
-    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count, NULL, 0};
     pd_fit_result *fr = NULL;
     pd_fit_options fo;
     pd_fit_options_default(&fo);
@@ -597,6 +610,17 @@ static void test_command(void)
     write_file(many, "pose,count\n1,1\n9,2\n");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
     expect_failure(args, 2, "pose 9");
+    /* Sets of poses: one pose in two rows is refused, and so is a set given
+     * to a plain run, which has no likelihood to put it in. */
+    write_file(many, "pose,count\n1|2,5\n2,3\n");
+    snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
+    expect_failure(args, 2, "pose 2 given twice");
+    write_file(many, "pose,count\n1|1,5\n");
+    expect_failure(args, 2, "3|4");
+    write_file(many, "pose,count\n1|2,5\n3,3\n");
+    snprintf(args, sizeof args, "--measured %s --chart %s/c.svg parts/canonical/box_1x2x3.off",
+             many, tmpdir);
+    expect_failure(args, 2, "posedrop fit");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 -n 5 %s --measured %s", box, counts);
     expect_failure(args, 2, "number of drops");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s/no/dir/x", box,
@@ -619,7 +643,8 @@ static void test_command(void)
              "--scene %s", box, counts, scene, params, base);
     char *out = NULL, *err = NULL;
     CHECK_INT(run(args, &out, &err), 0);
-    CHECK(out && strncmp(out, "part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n", 53) == 0);
+    CHECK(out &&
+          strncmp(out, "part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi,set\n", 57) == 0);
     double sum[2] = {0, 0};
     int rows = 0;
     for (const char *line = out ? strchr(out, '\n') : NULL; line && line[1]; line = strchr(line + 1, '\n')) {
@@ -642,6 +667,18 @@ static void test_command(void)
     CHECK_NEAR(sum[0], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
     CHECK_NEAR(sum[1], 1.0, 1e-6, "averaged probabilities sum to 1; quantile bisection aside");
     CHECK(err && strstr(err, "restitution = ") != NULL);
+    free(out);
+    free(err);
+    /* Sets of poses: posedrop's poses of the box counted in mirror pairs,
+     * each pair one row, and its members named by the set column. */
+    char pairs[128];
+    snprintf(pairs, sizeof pairs, "%s/pairs.csv", tmpdir);
+    write_file(pairs, "pose,count\n1|2,200\n3|4,70\n5|6,30\n");
+    snprintf(args, sizeof args, "fit --no-group --fit restitution=0.05:0.7 -n 100 --max-evals 5 "
+             "--points 2 %s --measured %s", box, pairs);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(out && strstr(out, ",fitted,1,,,") && strstr(out, ",1|2\n") &&
+          strstr(out, ",5|6\n"));
     free(out);
     free(err);
     /* The scene file is one --scene reads. */
@@ -744,9 +781,10 @@ static void coverage_case(const char *what, double mu, int *covered, int *all_co
     for (int r = 0; r < DATASETS; r++) {
         CHECK(scene_counts(&fit[0], &truth, MEASURED, 10000 + (uint64_t)r, c0));
         CHECK(scene_counts(&fit[1], &truth, MEASURED, 20000 + (uint64_t)r, c1));
-        pd_fit_part fp[3] = {{fit[0].part, fit[0].res, fit[0].class_of, fit[0].nclasses, c0},
-                             {fit[1].part, fit[1].res, fit[1].class_of, fit[1].nclasses, c1},
-                             {held.part, held.res, held.class_of, held.nclasses, NULL}};
+        pd_fit_part fp[3] = {
+            {fit[0].part, fit[0].res, fit[0].class_of, fit[0].nclasses, c0, NULL, 0},
+            {fit[1].part, fit[1].res, fit[1].class_of, fit[1].nclasses, c1, NULL, 0},
+            {held.part, held.res, held.class_of, held.nclasses, NULL, NULL, 0}};
         pd_fit_param prm = {"restitution", 0.05, 0.7, 0, 0};
         pd_fit_options o;
         pd_fit_options_default(&o);

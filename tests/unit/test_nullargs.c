@@ -454,7 +454,7 @@ DEFAULTS(fit_options_default, pd_fit_options)
 static pd_status cube_fit(const fixture *f, int k, pd_fit_result **r, pd_diag *diag)
 {
     static const long count[1] = {10};
-    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count};
+    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count, NULL, 0};
     pd_fit_param param = {"restitution", 0.1, 0.5, 0, 0};
     pd_fit_options fo;
     pd_fit_options_default(&fo);
