@@ -16,12 +16,21 @@ typedef struct viz_measured {
     double *lo, *hi; /* 95% Wilson interval when counts (or n) were given, else NULL */
     long n;          /* observations (sum of counts, or the n column), 0 if unknown */
     char *path;
+    /* Rows whose pose is a set of poses, "3|4" (viz_measured_read_sets
+     * only): a label that stands for any of them. */
+    int nsets;
+    int *set_size;   /* [nsets] poses in each set */
+    int *set_pose;   /* the sets' pose numbers, one set after another */
+    double *set_p;   /* [nsets] each set's probability, as p */
 } viz_measured;
 
 /* Reads a CSV with a header naming the columns pose and count, or pose and
  * p (and optionally n, the observations behind p, for an interval). Errors
  * name the file and line: PD_ERR_IO, PD_ERR_PARSE, PD_ERR_RANGE. */
 pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag);
+/* The same, where a pose may also be a set of two or more poses, "3|4", each
+ * pose counted in one row at most. */
+pd_status viz_measured_read_sets(const char *path, viz_measured **out, pd_diag *diag);
 void viz_measured_free(viz_measured *m);
 
 /* --crosscheck: the same releases run on the three engines, each one's

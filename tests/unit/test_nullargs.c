@@ -454,7 +454,7 @@ DEFAULTS(fit_options_default, pd_fit_options)
 static pd_status cube_fit(const fixture *f, int k, pd_fit_result **r, pd_diag *diag)
 {
     static const long count[1] = {10};
-    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count};
+    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count, NULL, 0};
     pd_fit_param param = {"restitution", 0.1, 0.5, 0, 0};
     pd_fit_options fo;
     pd_fit_options_default(&fo);
@@ -496,6 +496,15 @@ static void c_fit_loglik(const fixture *f, int k, outcome *o)
     const double p[2] = {0.5, 0.5};
     const long c[2] = {1, 1};
     double l = pd_fit_loglik(2, P(0, c), P(1, p), 10, 0.5);
+    o->st = (k < 0 ? l < 0 : l == 0) ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_fit_loglik_dm(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    const double p[2] = {0.5, 0.5};
+    const long c[2] = {1, 1};
+    double l = pd_fit_loglik_dm(2, P(0, c), P(1, p), 10, 0.5);
     o->st = (k < 0 ? l < 0 : l == 0) ? PD_OK : PD_ERR_INTERNAL;
 }
 
@@ -689,6 +698,7 @@ static const entry table[] = {
     {"pd_fit_result_free", "?result", c_fit_result_free},
     {"pd_fit_smooth", "?p_sim ?out", c_fit_smooth},
     {"pd_fit_loglik", "?count ?p_sim", c_fit_loglik},
+    {"pd_fit_loglik_dm", "?count ?p_sim", c_fit_loglik_dm},
     {"pd_first_order_index", "x y index lo hi ?diag", c_first_order_index},
     {"pd_sim_sensitivity", "result scene ?class_of out ?diag", c_sim_sensitivity},
     {"pd_sensitivity_free", "?sensitivity", c_sensitivity_free},
