@@ -35,3 +35,64 @@ args_files() {
         [ -f "$f" ] && [ -r "$f" ] || args_die "$f: no such readable file"
     done
 }
+
+# POSEDROP WORD...: posedrop's options among the words, in every form it
+# accepts (getopt_long's): a long name or any prefix that starts no other
+# name (an exact name first), with its value as the next word or after '=';
+# a letter, with its value as the next word or glued to it (-n100). The
+# names are those POSEDROP --help lists, a value shown by an upper-case word
+# after the name ("--units U", "-n N"). Sets opt_names[i] and opt_values[i]
+# (each option by its full name, and its value, "" for a flag), opt_words
+# (the words that make the options, as given) and other_words (the rest:
+# part files, or words posedrop will say what it makes of).
+args_posedrop() {
+    local bin=$1 name meta w v i
+    shift
+    local -a words=("$@")
+    declare -gA takes=()
+    while read -r name meta; do
+        case "$meta" in [A-Z]*) takes[$name]=1 ;; *) takes[$name]=0 ;; esac
+    done < <("$bin" --help 2>/dev/null | sed -n 's/^  \(-[-a-zA-Z0-9]*\) *\([^ ]*\).*/\1 \2/p')
+    [ ${#takes[@]} -gt 0 ] || args_die "$bin --help lists no options"
+    opt_names=() opt_values=() opt_words=() other_words=()
+    for ((i = 0; i < ${#words[@]}; i++)); do
+        w=${words[$i]}
+        case "$w" in
+            --?*=*) args_resolve "${w%%=*}"; v=${w#*=}
+                [ "${takes[$name]}" = 1 ] || args_die "option '$name' takes no value"
+                opt_words+=("$w") ;;
+            --?*) args_resolve "$w"; v=""; opt_words+=("$w")
+                if [ "${takes[$name]}" = 1 ]; then
+                    [ $((i + 1)) -lt ${#words[@]} ] || args_die "option '$name' needs a value"
+                    i=$((i + 1)); v=${words[$i]}; opt_words+=("$v")
+                fi ;;
+            -[!-]?*) args_resolve "${w:0:2}"; v=${w:2}
+                [ "${takes[$name]}" = 1 ] || args_die "option '$name' takes no value"
+                opt_words+=("$w") ;;
+            -[!-]) args_resolve "$w"; v=""; opt_words+=("$w")
+                if [ "${takes[$name]}" = 1 ]; then
+                    [ $((i + 1)) -lt ${#words[@]} ] || args_die "option '$name' needs a value"
+                    i=$((i + 1)); v=${words[$i]}; opt_words+=("$v")
+                fi ;;
+            *) other_words+=("$w"); continue ;;
+        esac
+        opt_names+=("$name"); opt_values+=("$v")
+    done
+}
+
+# WORD -> sets name: the option of posedrop's (args_posedrop's takes) it names.
+args_resolve() {
+    local w=$1 c m=()
+    if [ -n "${takes[$w]+x}" ]; then name=$w; return; fi
+    case "$w" in
+        --?*)
+            for c in "${!takes[@]}"; do
+                case "$c" in "$w"*) m+=("$c") ;; esac
+            done
+            [ ${#m[@]} -gt 0 ] || args_die "unknown option '$w' for posedrop"
+            [ ${#m[@]} -eq 1 ] ||
+                args_die "option '$w' is the start of more than one of posedrop's options' names"
+            name=${m[0]} ;;
+        *) args_die "unknown option '$w' for posedrop" ;;
+    esac
+}

@@ -11,7 +11,8 @@
 # between their distributions and a chi-square test of homogeneity (is the
 # difference larger than sampling noise explains?), and the fraction of
 # drops, started from identical states, that end in the same pose on both.
-# Options after -- go to posedrop unchanged (e.g. --units mm, --mu 0.5).
+# Options after -- go to posedrop unchanged (e.g. --units mm, --mu 0.5,
+# --group), in any form posedrop takes, the part files among or after them.
 set -u
 . "$(dirname "$0")/args.sh"
 n=500
@@ -20,23 +21,26 @@ opts=()
 parts=()
 while [ $# -gt 0 ]; do
     case "$1" in
+        --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
-        --) shift
-            while [ $# -gt 0 ] && [ "${1#-}" != "$1" ]; do
-                [ $# -ge 2 ] || args_die "$1 after -- needs a value (posedrop's options there take one each)"
-                opts+=("$1" "$2"); shift 2
-            done ;;
+        --) shift; opts=("$@"); break ;;
         -*) args_die "unknown option '$1' (options for posedrop go after --)" ;;
-        --help) sed -n '2,13p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) parts+=("$1"); shift ;;
     esac
 done
-[ ${#parts[@]} -gt 0 ] || args_die "no part files given"
-args_files "${parts[@]}"
 here=$(cd "$(dirname "$0")/.." && pwd)
 bin=$(ls -t "$here"/build/*/posedrop 2>/dev/null | head -n 1)
 [ -n "$bin" ] || { echo "crosscheck.sh: posedrop not built (run make)" >&2; exit 2; }
+# After --, posedrop's options as posedrop reads them (a flag takes no
+# value), and the part files among them.
+if [ ${#opts[@]} -gt 0 ]; then
+    args_posedrop "$bin" "${opts[@]}"
+    opts=("${opt_words[@]}")
+    parts+=("${other_words[@]}")
+fi
+[ ${#parts[@]} -gt 0 ] || args_die "no part files given"
+args_files "${parts[@]}"
 mkdir -p "$outdir" || exit 2
 csv="$outdir/crosscheck.csv"
 echo "part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled" > "$csv"

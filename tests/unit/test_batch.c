@@ -455,6 +455,20 @@ static void test_batch_short_forms(void)
     free(err);
     free(bout);
     free(berr);
+
+    /* A part that succeeds with a warning (a file in millimetres read as
+     * metres) says so on the batch's stderr, and leaves no .err file:
+     * those are for failures. */
+    snprintf(cmd, sizeof cmd, "scripts/posedrop-batch -j1 -o %s/warn -- parts/block.stl", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &bout, &berr), 0);
+    CHECK(strstr(berr, "block.stl: the part is 45.8 m across; if the file is in millimetres, "
+                       "add --units mm") != NULL);
+    snprintf(path, sizeof path, "%s/warn/block.err", tmpdir);
+    CHECK(access(path, F_OK) != 0);
+    snprintf(path, sizeof path, "%s/warn/block.csv", tmpdir);
+    CHECK(access(path, F_OK) == 0);
+    free(bout);
+    free(berr);
 }
 
 /* A batch that fails or is stopped keeps every earlier result: a part's
@@ -535,7 +549,12 @@ static void test_script_refusals(void)
         {"cost-accuracy.sh -s 0", "cost-accuracy.sh: -s: expected a whole number"},
         {"cost-accuracy.sh -o", "cost-accuracy.sh: -o needs a value"},
         {"crosscheck.sh -n x $R/parts/cap.off", "crosscheck.sh: -n: expected a whole number"},
-        {"crosscheck.sh -- --units", "crosscheck.sh: --units after -- needs a value"},
+        {"crosscheck.sh -- --units", "crosscheck.sh: option '--units' needs a value"},
+        /* After --, posedrop's flags take no value and the part files may
+         * come among the options. */
+        {"crosscheck.sh -- --group --units mm nofile.stl", "crosscheck.sh: nofile.stl: no such"},
+        {"crosscheck.sh -- --units mm --group", "crosscheck.sh: no part files given"},
+        {"crosscheck.sh -- --bogus 3 $R/parts/cap.off", "unknown option '--bogus' for posedrop"},
         {"crosscheck.sh -o out nofile.stl", "crosscheck.sh: nofile.stl: no such readable file"},
         {"figures.sh --x", "figures.sh: unknown argument '--x'"},
         {"paper.sh -i foo", "paper.sh: posedrop: --initial: initial: expected uniform, bootstrap"},

@@ -304,8 +304,13 @@ static void test_dynamic(void)
     /* The cross-check script: one CSV for the three engines, a verdict per
      * pair, drop-by-drop agreement. */
     char cmd[512];
-    snprintf(cmd, sizeof cmd, "scripts/crosscheck.sh -n 40 -o %s/xc -- --units mm parts/block.stl",
-             tmpdir);
+    CHECK_INT(run_cmd("scripts/crosscheck.sh --help", 1, &out, &err), 0);
+    CHECK(strstr(out, "scripts/crosscheck.sh [-n DROPS] [-o DIR]") != NULL && err[0] == '\0');
+    free(out);
+    free(err);
+    /* A flag of posedrop's before a valued option, the part after them. */
+    snprintf(cmd, sizeof cmd,
+             "scripts/crosscheck.sh -n 40 -o %s/xc -- --group --units mm parts/block.stl", tmpdir);
     CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
     CHECK(strstr(out, "impulse vs ode: total variation") != NULL);
     CHECK(strstr(out, "ode vs bullet:") != NULL && strstr(out, "same pose") != NULL);
