@@ -549,6 +549,43 @@ static void c_sensitivity_free(const fixture *f, int k, outcome *o)
     pd_sim_result_free(r);
 }
 
+static const pd_change cube_change = {PD_CHANGE_SCALE, 2, 0, 0.0, 0.0, 0.5, 2.0};
+
+static void c_design_axes(const fixture *f, int k, outcome *o)
+{
+    pd_vec3 axes[3] = {{-7, -7, -7}, {-7, -7, -7}, {-7, -7, -7}};
+    o->st = pd_design_axes(P(0, f->part), P(1, axes), P(2, &o->diag));
+    o->touched = o->st != PD_OK && axes[0].x != -7;
+}
+
+static void c_design_apply(const fixture *f, int k, outcome *o)
+{
+    double v = 1.5;
+    pd_part *p = SENTINEL;
+    o->st = pd_design_apply(P(0, f->part), P(1, &cube_change), 1, P(2, &v), P(3, &p),
+                            P(4, &o->diag));
+    settle_output(o, p, pd_part_free);
+}
+
+static void c_design_sensitivity(const fixture *f, int k, outcome *o)
+{
+    pd_sim_options so;
+    few_drops(&so);
+    pd_design_sens *s = SENTINEL;
+    o->st = pd_design_sensitivity(P(0, f->part), P(1, f->res), P(2, (const pd_static_options *)NULL),
+                                  P(3, &cube_change), 1, P(4, f->class_of), f->nclasses,
+                                  P(5, (const pd_scene *)NULL), P(6, &so), P(7, &s), P(8, &o->diag));
+    settle_output(o, s, pd_design_sens_free);
+}
+
+static void c_design_sens_free(const fixture *f, int k, outcome *o)
+{
+    pd_design_sens *s = NULL;
+    o->st = pd_design_sensitivity(f->part, f->res, NULL, &cube_change, 1, NULL, 0, NULL, NULL, &s,
+                                  NULL);
+    free_unless_null(k, s, pd_design_sens_free);
+}
+
 static void c_scene_param_name(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -684,6 +721,11 @@ static const entry table[] = {
     {"pd_first_order_index", "x y index lo hi ?diag", c_first_order_index},
     {"pd_sim_sensitivity", "result scene ?class_of out ?diag", c_sim_sensitivity},
     {"pd_sensitivity_free", "?sensitivity", c_sensitivity_free},
+    {"pd_design_axes", "part axes ?diag", c_design_axes},
+    {"pd_design_apply", "part changes value changed ?diag", c_design_apply},
+    {"pd_design_sensitivity", "part res ?options changes ?class_of ?scene ?sim out ?diag",
+     c_design_sensitivity},
+    {"pd_design_sens_free", "?sensitivity", c_design_sens_free},
     {"pd_scene_param_name", "", c_scene_param_name},
     {"pd_scene_format", "?scene ?buf", c_scene_format},
     {"pd_scene_ranged", "?scene", c_scene_ranged},
