@@ -127,6 +127,95 @@ PD_API pd_status pd_design_sensitivity(const pd_part *part, const pd_static_resu
 
 PD_API void pd_design_sens_free(pd_design_sens *sensitivity);
 
+typedef enum pd_design_goal {
+    PD_GOAL_TARGET = 0, /* each named pose at its probability: least squares */
+    PD_GOAL_MAXIMISE,   /* the named poses' summed probability as high as can be */
+    PD_GOAL_EQUALISE    /* the named poses equally likely: least squares of
+                           each against their mean */
+} pd_design_goal;
+
+typedef enum pd_design_model { PD_DESIGN_QS = 0, PD_DESIGN_PQS } pd_design_model;
+
+/* A pose named by the outward normal of its resting facet in the part's
+ * (file's) frame, as posedrop prints it: the hull facet of the part as
+ * given whose normal is nearest, within 5 degrees; followed through the
+ * changes by its vertices. */
+typedef struct pd_design_target {
+    pd_vec3 normal;
+    double p;           /* PD_GOAL_TARGET: the probability wanted, 0..1 */
+} pd_design_target;
+
+typedef struct pd_design_options {
+    pd_static_options statics; /* pd_static_options_default */
+    pd_design_model model;     /* which static estimate the first stage
+                                  searches: PD_DESIGN_PQS */
+    int group;                 /* 1: a target names its pose's class (the
+                                  poses a rotation of the changed part maps
+                                  onto it), summed; 0 */
+    pd_scene scene;            /* the drops' scene: pd_scene_default */
+    pd_sim_options sim;        /* the refinement's drops: ndrops per
+                                  evaluation (0: no refinement), seed (the
+                                  same at every evaluation), threads,
+                                  engine; 20000 */
+    int max_evals;             /* drop evaluations of the refinement, >= 1; 12 */
+    long check_drops;          /* fresh drops of the result, 0: none; 20000 */
+    uint64_t check_seed;       /* their seed, another than sim.seed's; 2 */
+    /* Called after each stage's steps (stage "scan", "static", "drops",
+     * "check"), may be NULL. */
+    void (*progress)(void *user, const char *stage, int evals, double objective);
+    void *progress_user;
+} pd_design_options;
+
+PD_API void pd_design_options_default(pd_design_options *options);
+
+typedef struct pd_design_target_result {
+    double p_target;           /* PD_GOAL_TARGET: the target; else the mean
+                                  reached (equalise) or 1 (maximise) */
+    double qs_before, pqs_before;  /* the part as given */
+    double qs_static, pqs_static;  /* at the static stage's optimum */
+    double qs_after, pqs_after;    /* at the result */
+    double p_refine;           /* the refinement drops' estimate at the
+                                  result (its seed), 0 without */
+    double p_after, lo, hi;    /* fresh drops of the result, 95% Wilson */
+    int vanished;              /* 1: the named facet is no resting pose of
+                                  the result (it toppled, or merged into
+                                  another facet) */
+    int appeared;              /* 1: the named facet was no resting pose of
+                                  the part as given */
+    pd_vec3 normal_after;      /* the facet's normal on the result */
+} pd_design_target_result;
+
+typedef struct pd_design_result {
+    int nchanges;
+    double value_before[PD_DESIGN_MAX_CHANGES]; /* 1 or 0 (clamped into range) */
+    double value_static[PD_DESIGN_MAX_CHANGES];  /* the static stage's optimum */
+    double value[PD_DESIGN_MAX_CHANGES];         /* the result */
+    int ntargets;
+    pd_design_target_result *targets;
+    double objective_static;   /* the static model's objective at its optimum */
+    double objective_refine;   /* the refinement drops' at the result */
+    double objective_after;    /* the fresh drops' */
+    int static_evals;          /* static evaluations (each QS + PQS + Jacobian) */
+    int drop_evals;            /* refinement evaluations */
+    long drops;                /* drops in all, refinement and check */
+    int poses_before, poses_after; /* stable poses of the part as given, of the result */
+    pd_part *part;             /* the result, the caller's through
+                                  pd_design_result_free */
+} pd_design_result;
+
+/* Designs: searches changes (nchanges in 1..PD_DESIGN_MAX_CHANGES) for the
+ * goal over targets (ntargets >= 1; PD_GOAL_EQUALISE >= 2), on part with
+ * options (required; pd_design_options_default fills them). On success
+ * *result is the caller's. PD_ERR_USAGE (a bad argument or a normal no
+ * facet has: the message names it), PD_ERR_NOMEM, and what the drops
+ * return. */
+PD_API pd_status pd_design_run(const pd_part *part, const pd_change *changes, int nchanges,
+                               pd_design_goal goal, const pd_design_target *targets,
+                               int ntargets, const pd_design_options *options,
+                               pd_design_result **result, pd_diag *diag);
+
+PD_API void pd_design_result_free(pd_design_result *result);
+
 #ifdef __cplusplus
 }
 #endif

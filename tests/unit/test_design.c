@@ -4,7 +4,9 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "check.h"
+#include "cli_run.h"
 #include "posedrop/design.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
@@ -47,6 +49,10 @@ static pd_mesh *mesh_stepped(int n, double r1, double t1, double r2, double t2)
     }
     return m;
 }
+
+/* An address no failed call may write through: the result stays it. */
+static char sentinel_byte;
+#define SENTINEL_RESULT ((pd_design_result *)(void *)&sentinel_byte)
 
 static pd_part *part_from(pd_mesh *m, const pd_vec3 *com)
 {
@@ -304,8 +310,180 @@ static void test_drop_differences(void)
     pd_part_free(cube);
 }
 
+
+/* The static design against parts built independently at its answer: a
+ * target met to the least-squares solver's precision (objective 1e-20,
+ * residuals 1e-10; 1e-8 allowed), an equalisation whose answer is known in
+ * closed form (the six faces of a box equally likely: a cube), a maximum
+ * on a range's bound. */
+static pd_design_options static_only(pd_design_model model)
+{
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.model = model;
+    o.sim.ndrops = 0;
+    o.check_drops = 0;
+    return o;
+}
+
+static void test_static_design(void)
+{
+    double a = 0.01;
+    pd_part *cube = part_from(mesh_box(a, a, a), NULL);
+    pd_change ch = {PD_CHANGE_SCALE, 2, 0, 0, 0, 0.1, 3.0};
+    pd_design_target t[6] = {{{0, 0, 1}, 1.0 / 3}, {{0, 0, -1}, 1.0 / 3}, {{1, 0, 0}, 1.0 / 12},
+                             {{-1, 0, 0}, 1.0 / 12}, {{0, 1, 0}, 1.0 / 12}, {{0, -1, 0}, 1.0 / 12}};
+    for (int model = 0; model < 2 && cube; model++) {
+        pd_design_options o = static_only((pd_design_model)model);
+        pd_design_result *r = NULL;
+        CHECK_STATUS(pd_design_run(cube, &ch, 1, PD_GOAL_TARGET, t, 6, &o, &r, NULL), PD_OK);
+        if (!r)
+            continue;
+        pd_part *box = part_from(mesh_box(a, a, a * r->value[0]), NULL);
+        pd_static_result *res = NULL;
+        if (box)
+            CHECK_STATUS(pd_static_estimate(box, NULL, &res, NULL), PD_OK);
+        for (int i = 0; res && i < res->nposes; i++)
+            if (fabs(res->poses[i].normal.z) > 0.5)
+                CHECK_NEAR(model ? res->poses[i].p_pqs : res->poses[i].p_qs, 1.0 / 3, 1e-8,
+                           "least squares converged: residual ~1e-10");
+        CHECK_NEAR(r->targets[0].pqs_after, model ? 1.0 / 3 : r->targets[0].pqs_after, 1e-8,
+                   "the model searched meets the target");
+        CHECK(r->value[0] < 1.0 && r->targets[0].vanished == 0 && r->poses_after == 6);
+        pd_note("design: three-sided die, %s: scale_z %.6f, %d static evaluations\n",
+                model ? "PQS" : "QS", r->value[0], r->static_evals);
+        pd_static_result_free(res);
+        pd_part_free(box);
+        pd_design_result_free(r);
+    }
+    /* Equalise a 1 x 1.3 x 1.7 box's six faces by stretching y and z: a
+     * cube, y by 1/1.3 and z by 1/1.7. */
+    pd_part *box = part_from(mesh_box(a, 1.3 * a, 1.7 * a), NULL);
+    pd_change yz[2] = {{PD_CHANGE_SCALE, 1, 0, 0, 0, 0.3, 2.0}, {PD_CHANGE_SCALE, 2, 0, 0, 0, 0.3, 2.0}};
+    pd_design_options o = static_only(PD_DESIGN_QS);
+    pd_design_result *r = NULL;
+    if (box)
+        CHECK_STATUS(pd_design_run(box, yz, 2, PD_GOAL_EQUALISE, t, 6, &o, &r, NULL), PD_OK);
+    if (r) {
+        CHECK_NEAR(r->value[0], 1.0 / 1.3, 1e-6, "closed form (a cube); solver's precision");
+        CHECK_NEAR(r->value[1], 1.0 / 1.7, 1e-6, "closed form (a cube); solver's precision");
+        CHECK_NEAR(r->targets[5].qs_after, 1.0 / 6, 1e-9, "a cube's faces");
+    }
+    pd_design_result_free(r);
+    /* The bottom face's share grows as the centre of mass sinks toward it:
+     * the maximum lies at the range's lower end. */
+    pd_change low = {PD_CHANGE_COM, 2, 0, 0, 0, -0.3 * a, 0.2 * a};
+    r = NULL;
+    if (cube)
+        CHECK_STATUS(pd_design_run(cube, &low, 1, PD_GOAL_MAXIMISE, t + 1, 1, &o, &r, NULL),
+                     PD_OK);
+    if (r) {
+        CHECK_NEAR(r->value[0], -0.3 * a, 1e-12 * a, "a monotone share: the range's bound");
+        CHECK(r->targets[0].qs_after > r->targets[0].qs_before);
+    }
+    pd_design_result_free(r);
+    /* A normal no facet has, and two targets of one facet, are refused. */
+    pd_design_target bad[2] = {{{1, 1, 0}, 0.5}, {{0, 0, 1}, 0.5}};
+    r = SENTINEL_RESULT;
+    CHECK_STATUS(pd_design_run(cube, &ch, 1, PD_GOAL_TARGET, bad, 1, &o, &r, NULL), PD_ERR_USAGE);
+    pd_design_target twice[2] = {{{0, 0, 1}, 0.5}, {{0, 0.01, 1}, 0.5}};
+    CHECK_STATUS(pd_design_run(cube, &ch, 1, PD_GOAL_TARGET, twice, 2, &o, &r, NULL),
+                 PD_ERR_USAGE);
+    CHECK(r == SENTINEL_RESULT);
+    pd_part_free(box);
+    pd_part_free(cube);
+}
+
+/* Drops: a short refinement and check whose numbers hang together (the
+ * fresh estimate inside its interval, every drop counted). */
+static void test_drop_design(void)
+{
+    double a = 0.01;
+    pd_part *cube = part_from(mesh_box(a, a, a), NULL);
+    pd_change ch = {PD_CHANGE_SCALE, 2, 0, 0, 0, 0.1, 3.0};
+    pd_design_target t[2] = {{{0, 0, 1}, 2.0 / 3}, {{1, 0, 0}, 1.0 / 3}};
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.group = 1;
+    o.sim.ndrops = 300;
+    o.sim.threads = 1;
+    o.max_evals = 3;
+    o.check_drops = 300;
+    pd_design_result *r = NULL;
+    if (cube)
+        CHECK_STATUS(pd_design_run(cube, &ch, 1, PD_GOAL_TARGET, t, 2, &o, &r, NULL), PD_OK);
+    if (r) {
+        CHECK(r->drop_evals >= 1 && r->drop_evals <= 3);
+        CHECK_INT(r->drops, 300L * (r->drop_evals + 1));
+        for (int i = 0; i < 2; i++)
+            CHECK(r->targets[i].lo <= r->targets[i].p_after &&
+                  r->targets[i].p_after <= r->targets[i].hi);
+        /* Grouped: the caps are one class, the four sides another. */
+        CHECK_NEAR(r->targets[0].pqs_after + r->targets[1].pqs_after, 1.0, 1e-12,
+                   "two classes hold every pose");
+    }
+    pd_design_result_free(r);
+    pd_part_free(cube);
+}
+
+/* The command: a design written and read back, and bad input refused with
+ * file and line. */
+static void test_command(void)
+{
+    snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-design-XXXXXX");
+    if (!mkdtemp(tmpdir)) {
+        CHECK(!"no scratch directory");
+        return;
+    }
+    char target[160], off[160], sens[160], cmd[1024], *out = NULL, *err = NULL;
+    snprintf(target, sizeof target, "%s/t.csv", tmpdir);
+    snprintf(off, sizeof off, "%s/d.off", tmpdir);
+    snprintf(sens, sizeof sens, "%s/s.csv", tmpdir);
+    write_file(target, "nx,ny,nz,p\n0,0,1,0.6666666667\n1,0,0,0.3333333333\n");
+    snprintf(cmd, sizeof cmd, "design --group --vary scale_z=0.1:3 --target %s -n 0 --check 0 "
+             "--out %s --sensitivity %s --sensitivity-drops 0 parts/canonical/cube.off", target,
+             off, sens);
+    CHECK_INT(run(cmd, &out, &err), 0);
+    CHECK(out && strncmp(out, "pose,nx,ny,nz,p_target,", 23) == 0 && !strstr(out, "nan"));
+    CHECK(err && strstr(err, "scale_z = ") && strstr(err, "shortened"));
+    char *s = slurp(sens);
+    const char *head = "pose,nx,ny,nz,parameter,d_p_qs,d_p_pqs,d_p,ci_lo,ci_hi,";
+    CHECK(s && strncmp(s, head, strlen(head)) == 0);
+    free(s);
+    free(out);
+    free(err);
+    /* The written part, estimated by the plain command: PQS meets the
+     * target (caps 2/3, sides 1/3). */
+    snprintf(cmd, sizeof cmd, "--group %s", off);
+    CHECK_INT(run(cmd, &out, &err), 0);
+    CHECK(out && strstr(out, ",0.6666666") && strstr(out, ",0.3333333"));
+    free(out);
+    free(err);
+    /* With classes, naming the two caps of the box apart asks one class's
+     * probability twice. */
+    write_file(target, "nx,ny,nz,p\n0,0,1,0.3\n0,0,-1,0.3\n");
+    snprintf(cmd, sizeof cmd, "design --group --vary scale_z=0.1:3 --target %s -n 0 --check 0 "
+             "--out %s parts/canonical/cube.off", target, off);
+    expect_failure(cmd, 2, "name one pose class");
+    write_file(target, "nx,ny,nz,p\n0,0,1,0.5\n0,0,x,0.5\n");
+    snprintf(cmd, sizeof cmd, "design --vary scale_z=0.1:3 --target %s --out %s "
+             "parts/canonical/cube.off", target, off);
+    expect_failure(cmd, 2, "t.csv:3: column nz");
+    expect_failure("design --vary scale_q=1:2 --target x.csv --out y.off parts/canonical/cube.off",
+                   2, "unknown change");
+    expect_failure("design --vary scale_z=2:1 --sensitivity y.csv parts/canonical/cube.off", 2,
+                   "LO < HI");
+    expect_failure("design --vary scale_z=0.5:2 parts/canonical/cube.off", 2, "give a goal");
+    snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
+    if (system(cmd) != 0)
+        printf("     could not remove %s\n", tmpdir);
+}
+
 void suite_design(void)
 {
+    test_command();
+    test_static_design();
+    test_drop_design();
     test_triangle_derivative();
     test_closed_forms();
     test_static_sensitivities();

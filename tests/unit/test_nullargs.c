@@ -586,6 +586,33 @@ static void c_design_sens_free(const fixture *f, int k, outcome *o)
     free_unless_null(k, s, pd_design_sens_free);
 }
 
+DEFAULTS(design_options_default, pd_design_options)
+
+static pd_status cube_design(const fixture *f, int k, pd_design_result **r, pd_diag *diag)
+{
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.sim.ndrops = 0;
+    o.check_drops = 0;
+    pd_design_target t = {{0, 0, 1}, 0.3};
+    return pd_design_run(P(0, f->part), P(1, &cube_change), 1, PD_GOAL_TARGET, P(2, &t), 1,
+                         P(3, &o), P(4, r), P(5, diag));
+}
+
+static void c_design_run(const fixture *f, int k, outcome *o)
+{
+    pd_design_result *r = SENTINEL;
+    o->st = cube_design(f, k, &r, &o->diag);
+    settle_output(o, r, pd_design_result_free);
+}
+
+static void c_design_result_free(const fixture *f, int k, outcome *o)
+{
+    pd_design_result *r = NULL;
+    o->st = cube_design(f, -1, &r, NULL);
+    free_unless_null(k, r, pd_design_result_free);
+}
+
 static void c_scene_param_name(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -726,6 +753,9 @@ static const entry table[] = {
     {"pd_design_sensitivity", "part res ?options changes ?class_of ?scene ?sim out ?diag",
      c_design_sensitivity},
     {"pd_design_sens_free", "?sensitivity", c_design_sens_free},
+    {"pd_design_options_default", "?options", c_design_options_default},
+    {"pd_design_run", "part changes targets options result ?diag", c_design_run},
+    {"pd_design_result_free", "?result", c_design_result_free},
     {"pd_scene_param_name", "", c_scene_param_name},
     {"pd_scene_format", "?scene ?buf", c_scene_format},
     {"pd_scene_ranged", "?scene", c_scene_ranged},
