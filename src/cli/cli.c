@@ -257,6 +257,8 @@ static void usage(FILE *out)
         "       %s merge [options] SHARD...   (sums shards: see 'posedrop merge --help')\n"
         "       %s fit [options] --fit SPEC --part PART --measured CSV ...\n"
         "                             (calibrates the scene: see 'posedrop fit --help')\n"
+        "       %s design [options] --vary SPEC --target CSV --out OFF PART\n"
+        "                             (changes the part to a target: see 'posedrop design --help')\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
         "flat surface and prints one CSV row per stable pose:\n"
@@ -272,7 +274,7 @@ static void usage(FILE *out)
         "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
-        "\n", prog, prog, prog);
+        "\n", prog, prog, prog, prog);
     for (int i = 0; i < NOPTIONS; i++) {
         const cli_option *o = &options[i];
         if (o->kind == ARG_HEADING) {
@@ -645,6 +647,8 @@ int main(int argc, char **argv)
         return cli_end(cli_merge(argc - 1, argv + 1));
     if (argc > 1 && strcmp(argv[1], "fit") == 0)
         return cli_end(cli_fit(argc - 1, argv + 1));
+    if (argc > 1 && strcmp(argv[1], "design") == 0)
+        return cli_end(cli_design(argc - 1, argv + 1));
     cli_args a;
     int code = parse_args(argc, argv, &a);
     if (code < 0)

@@ -47,6 +47,9 @@ void out_abort(out_file *o);
 /* fit_cmd.c: the fit subcommand (parses its own options). */
 int cli_fit(int argc, char **argv);
 
+/* design_cmd.c: the design subcommand (parses its own options). */
+int cli_design(int argc, char **argv);
+
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;
  * the shards of a merge read and checked into a->scene, a->sim and the
  * part's path and SHA-256 (shard_load; shard_unload frees them), and summed
