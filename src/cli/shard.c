@@ -607,6 +607,10 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
         s.count = f->count;
         s.first_count = f->first;
         s.transitions = f->to;
+        s.nshards = f->n;
+        s.shard = f->k - 1;
+        s.added = NULL;
+        s.added_nshards = 0;
         st = pd_sim_result_add(*sum, &s, diag);
     }
     if (st == PD_OK)
