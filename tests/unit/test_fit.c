@@ -644,7 +644,7 @@ static void test_command(void)
     snprintf(many, sizeof many, "%s/many.csv", tmpdir);
     write_file(many, "pose,count\n1,1\n9,2\n");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
-    expect_failure(args, 2, "pose 9");
+    expect_failure(args, 2, "pose class 9, but");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 -n 5 %s --measured %s", box, counts);
     expect_failure(args, 2, "number of drops");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s --out %s/no/dir/x", box,
