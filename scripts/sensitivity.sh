@@ -71,7 +71,7 @@ awk -F, -v OFS=, -v initial="$initial" -v k="$k" -v n="$n" '
     NR == 1 {
         for (i = 1; i <= NF; i++) c[$i] = i
         np = 0
-        for (i = c["end"] + 1; i <= NF; i++) if ($i != "member") param[++np] = $i
+        for (i = c["end"] + 1; i <= NF; i++) if ($i != "member" && $i != "partial") param[++np] = $i
         next
     }
     {

@@ -183,6 +183,8 @@ typedef struct pd_fit_result {
     long drops;         /* drops simulated in all */
     int nparts;
     pd_fit_part_result *parts; /* in the order given */
+    long failed;        /* of the drops simulated, those that failed (a solver
+                           could not go on): in no count, as in pd_sim_run */
 } pd_fit_result;
 
 /* Fits params (nparams in 1..PD_FIT_MAX_PARAMS, distinct keys) to the parts
@@ -194,7 +196,8 @@ typedef struct pd_fit_result {
  * probability alpha / (nsim + K alpha) instead of 0, so that no value makes
  * the likelihood minus infinity. PD_ERR_USAGE (a bad argument: the message
  * names it), PD_ERR_RANGE (a range outside its key's limits), PD_ERR_NOMEM,
- * PD_ERR_CANCELLED (options->cancel set), and what pd_sim_run returns. On success *result is the caller's
+ * PD_ERR_CANCELLED (options->cancel set), PD_ERR_NO_CONVERGENCE when every
+ * drop of a part at one evaluation failed, and what pd_sim_run returns. On success *result is the caller's
  * (pd_fit_result_free). */
 PD_API pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
                             int nparams, const pd_scene *base, const pd_fit_options *options,

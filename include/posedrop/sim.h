@@ -407,6 +407,13 @@ typedef struct pd_sim_result {
                                the options that change outcomes (not threads,
                                keep_trials or the shard); pd_sim_result_add
                                refuses a shard whose own differs */
+    /* A sum (pd_sim_result_new): the split of the shards added (their
+     * nshards, 1 for whole runs; 0 before the first) and which of them were
+     * added, so that pd_sim_result_add refuses a shard added twice or one of
+     * another split, either of which would count drops twice. The library's
+     * bookkeeping: read it, never write it. NULL in any other result. */
+    int added_nshards;
+    unsigned char *added;
 } pd_sim_result;
 
 /* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
@@ -467,8 +474,9 @@ PD_API void pd_sim_result_free(pd_sim_result *result);
  * give the unsharded run's result, byte for byte (trials aside: none are
  * kept). scene and options may be NULL (defaults). PD_ERR_USAGE for a NULL
  * static_result, result, sum or shard, or a shard of another run (its
- * run_fingerprint: another part, pose table, scene, seed or drop count),
- * PD_ERR_NOMEM. */
+ * run_fingerprint: another part, pose table, scene, seed or drop count), a
+ * shard added before, one of another split (another nshards) or sum itself
+ * (each would count drops twice), PD_ERR_NOMEM. */
 PD_API pd_status pd_sim_result_new(const pd_static_result *static_result,
                                    const pd_scene *scene, const pd_sim_options *options,
                                    pd_sim_result **result, pd_diag *diag);

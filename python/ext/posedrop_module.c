@@ -789,6 +789,20 @@ static int wait_slice(run_ctx *c)
     return finished;
 }
 
+/* Ctrl-C reaches only the main thread's Python code: the module's SIGINT
+ * handler (posedrop/__init__.py) counts it here, and a run waiting on any
+ * other thread that sees the count move stops as the main thread's would,
+ * raising KeyboardInterrupt there too. */
+static atomic_long interrupts;
+
+static PyObject *mod_interrupt(PyObject *mod, PyObject *unused)
+{
+    (void)mod;
+    (void)unused;
+    atomic_fetch_add(&interrupts, 1);
+    Py_RETURN_NONE;
+}
+
 /* The caller's cancel event: 1 if set, 0 if not, -1 on an error. */
 static int cancel_requested(PyObject *event)
 {
@@ -824,8 +838,8 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
         pthread_mutex_destroy(&c->lock);
         return -1;
     }
-    int failed = 0, finished = 0;
-    long reported = -1;
+    int failed = 0, finished = 0, interrupted = 0;
+    long reported = -1, seen = atomic_load(&interrupts);
     while (!finished) {
         Py_BEGIN_ALLOW_THREADS
         finished = wait_slice(c);
@@ -833,6 +847,10 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
         if (finished)
             break;
         int set = PyErr_CheckSignals() < 0 ? -1 : cancel_requested(event);
+        if (set == 0 && atomic_load(&interrupts) != seen) {
+            interrupted = 1;
+            set = -1;
+        }
         if (set == 0 && progress != Py_None && atomic_load(&c->done) != reported) {
             reported = atomic_load(&c->done);
             PyObject *r = PyObject_CallFunction(progress, "ll", reported, atomic_load(&c->total));
@@ -852,6 +870,8 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
     Py_END_ALLOW_THREADS
     pthread_cond_destroy(&c->finished_cv);
     pthread_mutex_destroy(&c->lock);
+    if (interrupted)
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
     return failed ? -1 : 0;
 }
 
@@ -968,6 +988,17 @@ static PyObject *Poses_drop(PosesObject *self, PyObject *args, PyObject *kw)
         return NULL;
     if (progress != Py_None && !PyCallable_Check(progress)) {
         PyErr_SetString(PyExc_TypeError, "progress must be callable");
+        return NULL;
+    }
+    /* Checked now, not when the first slice asks it (cancel=5 ran until
+     * then). */
+    PyObject *is_set = event == Py_None ? NULL : PyObject_GetAttrString(event, "is_set");
+    int callable = is_set && PyCallable_Check(is_set);
+    Py_XDECREF(is_set);
+    if (event != Py_None && !callable) {
+        PyErr_Clear();
+        PyErr_SetString(PyExc_TypeError, "cancel must have an is_set() method, as "
+                                         "threading.Event has");
         return NULL;
     }
     run_ctx *c = calloc(1, sizeof *c);
@@ -1340,6 +1371,7 @@ static PyMethodDef module_methods[] = {
      METH_VARARGS | METH_KEYWORDS, "pd_part_build from (n, 3) float64 and (m, 3) int32 buffers"},
     {"version", mod_version, METH_NOARGS, "pd_version()"},
     {"statuses", mod_statuses, METH_NOARGS, "the pd_status names and values"},
+    {"interrupt", mod_interrupt, METH_NOARGS, "stop the runs waiting on other threads (Ctrl-C)"},
     {"engine_available", mod_engine_available, METH_O, "pd_engine_available"},
     {"names", mod_names, METH_NOARGS, "(stage names, status strings, parameter names)"},
     {NULL, NULL, 0, NULL}};

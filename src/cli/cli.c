@@ -185,11 +185,13 @@ static const cli_option options[] = {
      "number of the output and a last column member the pose\n"
      "within it, numbered as without --group; then one column\n"
      "per ranged scene parameter, named by its key, the value\n"
-     "the drop drew (vibration in degrees)"},
+     "the drop drew (vibration in degrees); last partial, 1 in\n"
+     "every row of an interrupted run"},
     {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with ranges, what each ranged parameter moves, as CSV:\n"
      "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
-     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi: the\n"
+     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,\n"
+     "partial: the\n"
      "pose's probability in the lower and upper third of the\n"
      "range (95% Wilson) and the first-order index, the share\n"
      "of the pose's variance the parameter explains (95%\n"

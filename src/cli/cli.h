@@ -31,9 +31,11 @@ double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 double cli_wall_seconds(void); /* a monotonic clock, s, for timings (command.c) */
 
 /* A side file written to a temporary beside its path and renamed onto it
- * once complete (command.c): out_open makes it ready before any work (0 and a
- * message when it cannot be written), out_commit puts it in place (0 and a
- * message on a write error), out_abort drops it. */
+ * once the run's every output is complete (command.c): out_open makes it
+ * ready before any work (0 and a message when it cannot be written),
+ * out_close closes it (0 and a message on a write error, the file then
+ * dropped), out_place puts a closed file in place, out_place_all each of n
+ * that was opened (after stdout is written in full), out_abort drops it. */
 typedef struct {
     const char *path;
     char *target; /* where the temporary is renamed to (a symbolic link resolved) */
@@ -41,7 +43,9 @@ typedef struct {
     FILE *f;
 } out_file;
 int out_open(out_file *o, const char *path);
-int out_commit(out_file *o);
+int out_close(out_file *o);
+int out_place(out_file *o);
+int out_place_all(out_file *const *files, int n);
 void out_abort(out_file *o);
 
 /* fit_cmd.c: the fit subcommand (parses its own options). */
@@ -75,6 +79,7 @@ void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_stat
  * signals_caught: whether one arrived in this process. */
 void signals_install(void);
 void signals_catch(pd_sim_options *options);
+void signals_catch_fit(pd_fit_options *options);
 int signals_caught(void);
 
 /* progress.c: when stderr is a terminal, options->progress draws a line. */

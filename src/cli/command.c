@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include "cli/cli.h"
@@ -180,6 +181,23 @@ int out_open(out_file *o, const char *path)
     int exists = stat(path, &sb) == 0;
     if (exists && S_ISDIR(sb.st_mode))
         return out_fail(path, "is a directory");
+    if (exists && S_ISFIFO(sb.st_mode)) {
+        /* open(2) of a named pipe waits for a reader, for ever if none
+         * comes, and no signal then stops the run as it should: one with
+         * no reader yet is refused at once. */
+        int fd = open(path, O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0)
+            return out_fail(path, errno == ENXIO ? "a named pipe that no program is reading"
+                                                 : strerror(errno));
+        int flags = fcntl(fd, F_GETFL);
+        if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 ||
+            !(o->f = fdopen(fd, "w"))) {
+            int err = errno;
+            close(fd);
+            return out_fail(path, strerror(err));
+        }
+        return 1;
+    }
     if (exists && !S_ISREG(sb.st_mode)) {
         if (!(o->f = fopen(path, "w")))
             return out_fail(path, strerror(errno));
@@ -243,20 +261,35 @@ void out_abort(out_file *o)
     memset(o, 0, sizeof *o);
 }
 
-/* Closes with every write error caught, then puts the file in place. */
-int out_commit(out_file *o)
+/* Closes with every write error caught; the temporary stays until
+ * out_place (or out_abort). Does nothing when the file is closed already. */
+int out_close(out_file *o)
 {
+    if (!o->f)
+        return 1;
+    errno = 0;
     int ok = fflush(o->f) == 0 && !ferror(o->f);
     int err = errno;
-    ok &= fclose(o->f) == 0;
-    o->f = NULL;
-    if (ok && o->tmp && rename(o->tmp, o->target) != 0) {
-        err = errno;
+    if (fclose(o->f) != 0 && ok) {
         ok = 0;
+        err = errno;
     }
-    if (!ok)
+    o->f = NULL;
+    if (!ok) {
         fprintf(stderr, "%s: %s: write error: %s\n", prog, o->path, strerror(err ? err : EIO));
-    if (ok) {
+        out_abort(o);
+    }
+    return ok;
+}
+
+/* Puts a closed file in place. */
+int out_place(out_file *o)
+{
+    int ok = 1;
+    if (o->tmp && rename(o->tmp, o->target) != 0) {
+        fprintf(stderr, "%s: %s: cannot put it in place: %s\n", prog, o->path, strerror(errno));
+        ok = 0;
+    } else {
         free(o->tmp);
         o->tmp = NULL;
     }
@@ -264,18 +297,29 @@ int out_commit(out_file *o)
     return ok;
 }
 
+int out_place_all(out_file *const *files, int n)
+{
+    int ok = 1;
+    for (int i = 0; i < n; i++)
+        if (files[i]->path)
+            ok &= out_place(files[i]);
+    return ok;
+}
+
 /* One row per drop. With --group (class_of not NULL) the pose column holds
  * the class number, as in the main output, so the two files join on it; the
- * pose within the class follows in a last column, member. An unsettled drop
- * has pose (and member) 0. */
+ * pose within the class follows in a column member. An unsettled drop has
+ * pose (and member) 0. The last column, partial, is 1 in every row of an
+ * interrupted run (its file holds only the drops done), as in the main
+ * output. */
 static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
-                         const pd_scene *scene)
+                         const pd_scene *scene, int partial)
 {
     fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
     for (int k = 0; k < PD_NPARAMS; k++)
         if (pd_scene_varies(scene, (pd_scene_param)k))
             fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
-    fputc('\n', f);
+    fprintf(f, ",partial\n");
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
@@ -288,7 +332,7 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
         for (int k = 0; k < PD_NPARAMS; k++)
             if (pd_scene_varies(scene, (pd_scene_param)k))
                 fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
-        fputc('\n', f);
+        fprintf(f, ",%d\n", partial);
     }
 }
 
@@ -311,17 +355,17 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
 }
 
 /* --sensitivity: one row per pose (class with --group) and ranged
- * parameter, numbered as in the output. */
-static void write_sensitivity(FILE *f, const pd_sensitivity *s)
+ * parameter, numbered as in the output; partial as in --trials. */
+static void write_sensitivity(FILE *f, const pd_sensitivity *s, int partial)
 {
     fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
-               "index,index_lo,index_hi\n");
+               "index,index_lo,index_hi,partial\n");
     for (int i = 0; i < s->nposes * s->nparams; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
+        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g,%d\n",
                 r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
                 r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
-                r->index_lo, r->index_hi);
+                r->index_lo, r->index_hi, partial);
     }
 }
 
@@ -664,16 +708,17 @@ int cli_run(cli_args *a)
         goto done;
     }
     /* The side files before stdout: if one cannot be written in full (a
-     * full disk, /dev/full), the run fails with nothing on stdout. */
+     * full disk, /dev/full), the run fails with nothing on stdout. None is
+     * put in place before stdout is written in full too: a failed run
+     * leaves every earlier file as it was. */
+    int partial = sim && sim->partial;
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of, &a->scene);
+        write_trials(trials_out.f, sim, class_of, &a->scene, partial);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
     if (sens_out.f)
-        write_sensitivity(sens_out.f, sens);
-    if ((trials_out.f && !out_commit(&trials_out)) ||
-        (transitions_out.f && !out_commit(&transitions_out)) ||
-        (sens_out.f && !out_commit(&sens_out))) {
+        write_sensitivity(sens_out.f, sens, partial);
+    if (!out_close(&trials_out) || !out_close(&transitions_out) || !out_close(&sens_out)) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -686,7 +731,7 @@ int cli_run(cli_args *a)
             code = fail_status(st, &diag, NULL);
             goto done;
         }
-        if (!out_commit(&pic_out[k])) {
+        if (!out_close(&pic_out[k])) {
             code = EXIT_INTERNAL;
             goto done;
         }
@@ -711,8 +756,15 @@ int cli_run(cli_args *a)
     else
         print_poses(res, sim, xe);
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
-    if (code)
+    if (code) {
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
+        goto done;
+    }
+    out_file *const outs[] = {&trials_out, &transitions_out, &sens_out, &pic_out[0], &pic_out[1],
+                              &pic_out[2], &pic_out[3]};
+    _Static_assert(VIZ_KINDS == 4, "every picture is put in place");
+    if (!out_place_all(outs, (int)(sizeof outs / sizeof outs[0])))
+        code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
         code = cli_interrupt_code();
     else if (code == 0 && sim && sim->n > 0 && sim->failed == sim->n) {

@@ -1,5 +1,6 @@
 /* fit_cmd.c: posedrop fit, the scene calibrated to measured drops
  * (pd_fit_run; docs/calibration.md). */
+#include <errno.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -154,11 +155,12 @@ static int parse_spec(char *spec, pd_fit_param *params, int *nparams, int *fit_i
     return -1;
 }
 
-/* The measured file of a part, as counts per class (k of them), or with
- * sets of poses ("3|4") as counts per cell: every class not in a set its
- * own cell, in class order, then the sets (*cell_of: k cells, *ncells). */
-static int read_counts(const char *path, const char *part, int k, long **count, int **cell_of,
-                       int *ncells)
+/* The measured file of a part, as counts per class (k of them; poses with
+ * --no-group), or with sets of poses ("3|4") as counts per cell: every class
+ * not in a set its own cell, in class order, then the sets (*cell_of: k
+ * cells, *ncells). */
+static int read_counts(const char *path, const char *part, int k, int group, long **count,
+                       int **cell_of, int *ncells)
 {
     viz_measured *m = NULL;
     pd_diag diag;
@@ -174,8 +176,13 @@ static int read_counts(const char *path, const char *part, int k, long **count, 
                 path);
         ok = 0;
     } else if (maxpose > k) {
-        fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, maxpose, part, k,
-                k == 1 ? "" : "s");
+        if (group)
+            fprintf(stderr, "%s: %s: pose class %d, but %s has %d pose class%s (numbered as "
+                    "'posedrop --group' numbers them; --no-group for its poses)\n", prog, path,
+                    maxpose, part, k, k == 1 ? "" : "es");
+        else
+            fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, maxpose,
+                    part, k, k == 1 ? "" : "s");
         ok = 0;
     }
     if (ok && !(*count = calloc((size_t)k, sizeof **count))) {
@@ -248,8 +255,8 @@ static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
             fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
         return 0;
     }
-    return !in->measured || read_counts(in->measured, in->path, in->nclasses, &in->count,
-                                                &in->cell_of, &in->ncells);
+    return !in->measured || read_counts(in->measured, in->path, in->nclasses, group,
+                                        &in->count, &in->cell_of, &in->ncells);
 }
 
 static const char *initial_name(pd_initial i)
@@ -409,6 +416,9 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
     print_quality("all parts: fresh drops at the weighted means", &r->fresh_mean);
     fprintf(stderr, "%s: fit: all parts in-sample (a diagnostic): X^2 = %.2f, log-likelihood "
             "%.2f\n", prog, r->chi2, r->loglik);
+    if (r->failed)
+        fprintf(stderr, "%s: fit: warning: %ld of the %ld simulated drops failed (a solver could "
+                "not go on) and are in no count\n", prog, r->failed, r->drops);
     if (r->dispersion > 1.0)
         fprintf(stderr, "%s: fit: X^2 is %.3g times what the noise explains: the intervals are "
                 "widened by its square root for the model's misfit\n", prog, r->dispersion);
@@ -557,7 +567,8 @@ int cli_fit(int argc, char **argv)
             int outcome = pd_num_read(&rule, optarg, NULL, &v);
             if (outcome != PD_NUM_OK) {
                 char msg[256];
-                code = fit_fail("%s: %s", argv[optind - 1],
+                code = fit_fail("%s: %s", c == 'n' ? "-n" : c == 'j' ? "-j" : c == F_SEED
+                                ? "--seed" : c == F_MAXEVALS ? "--max-evals" : "--points",
                                 pd_num_message(msg, sizeof msg, &rule, optarg, outcome));
                 break;
             }
@@ -632,6 +643,9 @@ int cli_fit(int argc, char **argv)
     for (int i = 0; code < 0 && i < nin; i++)
         if (!load_part(&in[i], &read, group))
             code = EXIT_USAGE;
+    /* A signal before the fit ends the run here, nothing written. */
+    if (code < 0 && signals_caught())
+        code = cli_interrupt_code();
     pd_fit_result *r = NULL;
     if (code < 0) {
         pd_fit_part parts[MAX_PARTS];
@@ -639,12 +653,17 @@ int cli_fit(int argc, char **argv)
             parts[i] = (pd_fit_part){in[i].part,  in[i].res,     in[i].class_of, in[i].nclasses,
                                      in[i].count, in[i].cell_of, in[i].ncells};
         fo.fit_initial = fit_initial;
+        signals_catch_fit(&fo);
         double t0 = cli_wall_seconds(), c0 = cli_cpu_seconds();
         fit_clock clock = {t0, c0, 0.0};
         fo.progress = fit_progress;
         fo.progress_user = &clock;
         pd_status st = pd_fit_run(parts, nin, params, nparams, &scene, &fo, &r, &diag);
-        if (st != PD_OK) {
+        if (st == PD_ERR_CANCELLED) {
+            fprintf(stderr, "%s: fit: interrupted: nothing written (a fit stopped part way has no "
+                    "result; earlier files are as they were)\n", prog);
+            code = cli_interrupt_code();
+        } else if (st != PD_OK) {
             fprintf(stderr, "%s: fit: %s\n", prog, diag.message[0] ? diag.message
                                                                     : pd_status_str(st));
             code = pd_status_is_input_error(st) || st == PD_ERR_USAGE ? EXIT_USAGE
@@ -657,16 +676,24 @@ int cli_fit(int argc, char **argv)
                 write_params(outs[1].f, r, params);
             if (outs[2].f)
                 write_gof(outs[2].f, r, in, nin);
+            /* The files are put in place together, once stdout is written
+             * too: a failed run leaves every earlier file as it was. */
             code = 0;
             for (int k = 0; k < 3; k++)
-                if (outs[k].f && !out_commit(&outs[k]))
+                if (!out_close(&outs[k]))
                     code = EXIT_INTERNAL;
             if (code == 0) {
                 print_summary(r, params, in, nin, fit_initial, wall, cpu);
                 print_table(r, in, nin);
-                if (fflush(stdout) != 0 || ferror(stdout))
+                if (fflush(stdout) != 0 || ferror(stdout)) {
+                    fprintf(stderr, "%s: fit: error writing the output: %s\n", prog,
+                            strerror(errno));
                     code = EXIT_INTERNAL;
+                }
             }
+            out_file *const placed[3] = {&outs[0], &outs[1], &outs[2]};
+            if (code == 0 && !out_place_all(placed, 3))
+                code = EXIT_INTERNAL;
         }
     }
     for (int k = 0; k < 3; k++)

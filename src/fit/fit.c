@@ -40,6 +40,7 @@ typedef struct {
     pd_sim_options sim;
     long *ndrops;  /* per part */
     long drops;    /* simulated so far */
+    long failed;   /* of them, drops that failed */
     double *pose_p; /* scratch, the largest part's poses */
     pd_fit_progress_fn progress;
     void *progress_user;
@@ -140,6 +141,18 @@ static pd_status run_model(void *user, const double *theta, int all, double *con
             break;
         }
         m->drops += r->n;
+        m->failed += r->failed;
+        /* No drop ran to an end the model defines: the likelihood would be
+         * the smoothing's alone, flat, and its optimum meaningless. */
+        if (r->n > 0 && r->failed == r->n) {
+            char st_name[64];
+            snprintf(st_name, sizeof st_name, "%s", pd_status_str(r->failed_status));
+            st = pd_fail(diag, PD_ERR_NO_CONVERGENCE, "every one of the %ld simulated drops of "
+                         "part %d failed (the first at stage %s: %s): no likelihood to fit", r->n,
+                         i + 1, pd_drop_stage_name(r->failed_stage), st_name);
+            pd_sim_result_free(r);
+            break;
+        }
         long settled = r->n - r->unsettled;
         int chain = r->transitions && r->closed_classes > 0;
         for (int j = 0; j < r->nposes; j++)
@@ -635,6 +648,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         }
         st = scene_at(&m, best_theta, &r->scene, diag);
         r->drops = m.drops;
+        r->failed = m.failed;
     }
 done:
     free(pb_best);

@@ -127,6 +127,7 @@ void pd_sim_result_free(pd_sim_result *r)
     free(r->trials);
     free(r->first_count);
     free(r->transitions);
+    free(r->added);
     free(r);
 }
 
@@ -603,6 +604,23 @@ pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag 
                        "(%d poses, seed %llu; the run: %d poses, seed %llu; or another part, "
                        "scene or drop count)", s->nposes, (unsigned long long)s->seed,
                        sum->nposes, (unsigned long long)sum->seed);
+    /* Every drop of the run in one shard only: the shards of one split,
+     * each once. */
+    int split = s->nshards > 0 ? s->nshards : 1, which = s->nshards > 0 ? s->shard : 0;
+    if (s == sum || (sum->added_nshards && split != sum->added_nshards) || which < 0 ||
+        which >= split || (sum->added && sum->added[which]))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: %s", s == sum
+                       ? "the sum added to itself"
+                       : sum->added_nshards && split != sum->added_nshards
+                           ? "a shard of another split than the shards added (its drops would "
+                             "count twice)"
+                           : "this shard was added already (its drops would count twice)");
+    if (!sum->added) {
+        if (!(sum->added = calloc((size_t)split, 1)))
+            return pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+        sum->added_nshards = split;
+    }
+    sum->added[which] = 1;
     size_t k = (size_t)sum->nposes;
     sum->n += s->n;
     sum->unsettled += s->unsettled;

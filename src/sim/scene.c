@@ -138,8 +138,12 @@ static double *field(pd_scene *s, const numeric_key *k)
     return (double *)(void *)((char *)s + k->field);
 }
 
+/* The key of a pd_scene_param; NULL for any other number (gravity's -1,
+ * which marks a key that takes no range, included). */
 static const numeric_key *param_key(int param)
 {
+    if (param < 0 || param >= PD_NPARAMS)
+        return NULL;
     for (int i = 0; i < NNUMERIC; i++)
         if (keys[i].param == param)
             return &keys[i];

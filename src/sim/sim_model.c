@@ -97,6 +97,15 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
                        options->engine == PD_ENGINE_BULLET ? "Bullet" : "ODE", limit / dt, dt,
                        limit, part->size, PD_STEPS_MAX);
     }
+    const pd_dist *hr = &scene->range[PD_PARAM_HEIGHT];
+    double h_hi = hr->kind == PD_DIST_FIXED ? scene->height : hr->hi;
+    if (h_hi > PD_HEIGHT_SIZES_MAX * part->size) {
+        free(m);
+        return pd_fail(diag, PD_ERR_RANGE, "a drop height of %g m is %.3g times the part's size "
+                       "(%.3g m), more than the %g at which a drop can be simulated (it would "
+                       "bounce for hours of CPU, or fail): a part or height in the wrong unit?",
+                       h_hi, h_hi / part->size, part->size, PD_HEIGHT_SIZES_MAX);
+    }
     m->hull = part->hull;
     m->com = part->com;
     m->poses = poses;

@@ -110,8 +110,10 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     int legend_rows = nser + has_xc;
     double legend_h = legend_rows * LEGEND_LINE + 8;
     char title[512], legend[5][256];
-    snprintf(title, sizeof title, "Pose probabilities of %s%s", viz_base_name(in->name),
-             in->class_of ? ", by class" : "");
+    /* An interrupted run's chart says so where it is seen, as its CSV does. */
+    snprintf(title, sizeof title, "Pose probabilities of %s%s%s", viz_base_name(in->name),
+             in->class_of ? ", by class" : "",
+             in->sim && in->sim->partial ? " (interrupted: partial)" : "");
     const char *whiskers = has_dyn || (has_meas && e[0].meas_ci) ? "whiskers: 95% intervals" : "";
     const char *caption = in->class_of
                               ? "pose class (as numbered by --group), drawn as in the gallery"

@@ -57,6 +57,37 @@ static int number(const char *s, double *out)
     return pd_parse_double(s, strlen(s), out) == PD_NUM_OK;
 }
 
+/* Half a unit in the last digit the text of a number gives (0.333: 5e-4,
+ * 1.5e-2: 5e-4), the most by which it may differ from what it was rounded
+ * from. */
+static double half_last_digit(const char *s)
+{
+    const char *dot = strchr(s, '.'), *e = strpbrk(s, "eE");
+    int decimals = 0;
+    for (const char *c = dot ? dot + 1 : s + strlen(s); *c >= '0' && *c <= '9'; c++)
+        decimals++;
+    long exponent = e ? strtol(e + 1, NULL, 10) : 0;
+    return 0.5 * pow(10.0, (double)(exponent - decimals));
+}
+
+/* One line into line (size bytes): 1, 0 at the end of the file, -1 for a
+ * line too long, -2 for a NUL byte (no text file holds one). */
+static int read_line(FILE *f, char *line, int size)
+{
+    int n = 0, c;
+    while ((c = getc(f)) != EOF) {
+        if (c == '\0')
+            return -2;
+        if (n == size - 1)
+            return -1;
+        line[n++] = (char)c;
+        if (c == '\n')
+            break;
+    }
+    line[n] = '\0';
+    return n > 0 ? 1 : 0;
+}
+
 typedef struct {
     int pose;      /* 0 for a set */
     int first, nm; /* a set: its poses are members[first .. first + nm) */
@@ -129,14 +160,20 @@ static pd_status measured_read(const char *path, int sets, viz_measured **out, p
     row *rows = NULL;
     int nrows = 0, cap = 0, maxpose = 0, *members = NULL, nmembers = 0, mcap = 0, nsets = 0;
     pd_status st = PD_OK;
-    while (st == PD_OK && fgets(line, sizeof line, f)) {
+    int got;
+    while (st == PD_OK && (got = read_line(f, line, sizeof line)) != 0) {
         lineno++;
-        if (!strchr(line, '\n') && !feof(f)) {
-            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: line longer than %d characters", path,
-                         lineno, LINE_MAX_LEN - 2);
+        if (got < 0) {
+            st = got == -2 ? pd_fail(diag, PD_ERR_PARSE, "%s:%ld: a NUL byte: binary data, not a "
+                                     "CSV table", path, lineno)
+                           : pd_fail(diag, PD_ERR_PARSE, "%s:%ld: line longer than %d "
+                                     "characters", path, lineno, LINE_MAX_LEN - 2);
             break;
         }
         char *p = line;
+        /* A UTF-8 byte order mark, as spreadsheets write one, is no text. */
+        if (lineno == 1 && strncmp(p, "\xEF\xBB\xBF", 3) == 0)
+            memmove(p, p + 3, strlen(p + 3) + 1);
         while (*p == ' ' || *p == '\t')
             p++;
         if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
@@ -190,6 +227,15 @@ static pd_status measured_read(const char *path, int sets, viz_measured **out, p
                 break;
             }
             n_given = nv;
+            /* p of n drops is a whole number of drops, to p's last digit:
+             * 0.333 of 10 is no count, and would be rounded silently. */
+            double drops = v * nv;
+            if (fabs(drops - nearbyint(drops)) > nv * half_last_digit(vtext) + 1e-9 * nv) {
+                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: p %s of n %s drops is %.6g drops, not a "
+                             "whole number: give p to enough digits, or the counts (pose,count)",
+                             path, lineno, vtext, field[col_n], drops);
+                break;
+            }
         }
         /* Every pose in one row at most, alone or in a set. */
         const int *mine = nm ? members + nmembers - nm : &pose;
@@ -237,6 +283,9 @@ static pd_status measured_read(const char *path, int sets, viz_measured **out, p
                      ncols ? "rows after the header" : "header (pose,count or pose,p)");
     else if (st == PD_OK && col_count >= 0 && !(total > 0))
         st = pd_fail(diag, PD_ERR_RANGE, "%s: the counts add up to 0", path);
+    else if (st == PD_OK && col_count >= 0 && total > 1e15)
+        st = pd_fail(diag, PD_ERR_RANGE, "%s: the counts add up to %.6g, more than the 1e15 "
+                     "drops a count may be", path, total);
     else if (st == PD_OK && col_p >= 0 && fabs(total - 1.0) > VIZ_MEASURED_SUM_TOL)
         st = pd_fail(diag, PD_ERR_RANGE, "%s: the p column adds up to %.6g, expected 1 (within %g)",
                      path, total, VIZ_MEASURED_SUM_TOL);

@@ -283,7 +283,7 @@ static void test_dynamic(void)
     for (char *c = t; c && *c; c++)
         rows += *c == '\n';
     CHECK_INT(rows, 26);
-    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end\n", 42) == 0);
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,partial\n", 50) == 0);
     free(t);
     free(out);
     free(err);
@@ -767,8 +767,8 @@ static void test_group_trials(void)
     snprintf(args, sizeof args, "-n %d --group --trials %s parts/cap.off", N, gpath);
     CHECK_INT(run(args, &gout, &gerr), 0);
     char *t = slurp(tpath), *g = slurp(gpath);
-    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end\n", 42) == 0);
-    const char *ghead = "drop,qw,qx,qy,qz,pose,collisions,time,end,member\n";
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,partial\n", 50) == 0);
+    const char *ghead = "drop,qw,qx,qy,qz,pose,collisions,time,end,member,partial\n";
     CHECK(g && strncmp(g, ghead, strlen(ghead)) == 0);
 
     /* Each file against its own main output: row r of the output is pose
@@ -1043,7 +1043,7 @@ static void test_time_limit(void)
     CHECK(err && strstr(err, "4 of 4 drops did not settle") &&
           strstr(err, "4 at the time limit (0.05 s simulated"));
     char *t = slurp(trials);
-    CHECK_INT(rows_ending(t, ",time_limit"), 4);
+    CHECK_INT(rows_ending(t, ",time_limit,0"), 4);
     free(t);
     free(out);
     free(err);
@@ -1220,6 +1220,117 @@ static void test_crosscheck(void)
     expect_failure("--crosscheck -n 10 --shard 1/2 parts/cap.off", 2, "--crosscheck");
 }
 
+/* Nothing lost: a run that fails (stdout on a full disk) or is stopped
+ * leaves every file it would have replaced as it was, or, interrupted,
+ * writes its side files marked partial in their own content; posedrop fit
+ * stops within the drops in flight of SIGINT/SIGTERM (130/143) and writes
+ * nothing; an output naming a named pipe that no program reads is refused
+ * at once instead of waiting in open(); merge of an endless binary input
+ * stops at its first NUL byte, and of an endless line at 16 MiB. Each
+ * script exits with the command's status, or 99 when a file was harmed
+ * (the runs of 10^6 drops take minutes: the signal always comes first). */
+typedef struct {
+    const char *script;
+    int code;
+    const char *mention;
+} script_case;
+
+/* Each script run in a directory of its own with B the command, P the cap,
+ * M a measured table of three classes: its exit status and a mention in
+ * its stderr. */
+static void run_scripts(const char *tag, const script_case *cases, size_t n)
+{
+    for (size_t k = 0; k < n; k++) {
+        char cmd[2048], *out, *err;
+        snprintf(cmd, sizeof cmd, "(R=$PWD; B=$R/" PD_CLI_PATH "; P=$R/parts/cap.off; D=%s/%s%zu; "
+                 "mkdir -p $D && cd $D && printf 'pose,count\\n1,30\\n2,20\\n3,10\\n' >m.csv && "
+                 "M=$D/m.csv && %s)", tmpdir, tag, k, cases[k].script);
+        int rc = run_cmd(cmd, 1, &out, &err);
+        if (rc != cases[k].code || !strstr(err, cases[k].mention))
+            printf("     %s case %zu: exit %d, expected %d with '%s':\n%s", tag, k, rc,
+                   cases[k].code, cases[k].mention, err);
+        CHECK_INT(rc, cases[k].code);
+        CHECK(strstr(err, cases[k].mention) != NULL);
+        free(out);
+        free(err);
+    }
+}
+
+static void test_nothing_lost(void)
+{
+    static const script_case cases[] = {
+        {"echo OLD >t.csv; echo OLD >s.svg; $B -n 20 --trials t.csv --svg s.svg $P >/dev/full; "
+         "r=$?; test \"$(cat t.csv)$(cat s.svg)\" = OLDOLD || exit 99; exit $r", 1,
+         "error writing the output"},
+        {"X=$R/parts/canonical/box_1x2x3.off; $B -n 140 --initial stationary --shard 1/2 $X >s1; "
+         "$B -n 140 --initial stationary --shard 2/2 $X >s2; "
+         "echo OLD >tr.csv; "
+         "$B merge --transitions tr.csv s1 s2 >/dev/full; r=$?; "
+         "test \"$(cat tr.csv)\" = OLD || exit 99; exit $r", 1, "error writing the output"},
+        {"echo OLD >o.scene; echo OLD >p.csv; echo OLD >g.csv; $B fit --fit mu=0.2:0.6 -n 10 "
+         "--max-evals 1 --points 2 --part $P --measured $M --out o.scene --params p.csv "
+         "--gof g.csv >/dev/full; r=$?; test \"$(cat o.scene p.csv g.csv)\" = \"$(printf "
+         "'OLD\\nOLD\\nOLD')\" || exit 99; exit $r", 1, "fit: error writing the output"},
+        {"timeout --preserve-status -s INT 2 $B -n 1000000 -j 2 --trials t.csv --sensitivity "
+         "se.csv --chart c.svg --mu 0.2:0.6 $P >/dev/null; r=$?; tail -n 1 t.csv | grep -q ',1$' "
+         "&& tail -n 1 se.csv | grep -q ',1$' && grep -q 'interrupted: partial' c.svg || exit 99; "
+         "exit $r", 130, "results are partial"},
+        {"echo OLD >p.csv; timeout --preserve-status -s INT 2 $B fit --fit mu=0.2:0.6 -n 1000000 "
+         "--part $P --measured $M --params p.csv; r=$?; test \"$(cat p.csv)\" = OLD && "
+         "test -z \"$(ls -a | grep posedrop-)\" || exit 99; exit $r", 130,
+         "fit: interrupted: nothing written"},
+        {"timeout --preserve-status -s TERM 2 $B fit --fit mu=0.2:0.6 -n 1000000 --part $P "
+         "--measured $M >out.csv; r=$?; test ! -s out.csv || exit 99; exit $r", 143,
+         "fit: interrupted"},
+        {"mkfifo f1; timeout -s KILL 20 $B -n 5 --trials f1 $P", 2,
+         "f1: cannot write: a named pipe that no program is reading"},
+        {"mkfifo f2; timeout -s KILL 20 $B fit --fit mu=0.2:0.6 --part $P --measured $M --gof f2", 2,
+         "f2: cannot write: a named pipe that no program is reading"},
+        {"mkfifo f3; cat f3 >got & $B -n 5 --trials f3 $P >/dev/null; r=$?; wait; "
+         "test \"$(wc -l <got)\" = 6 || exit 99; exit $r", 0, ""},
+        {"ulimit -v 4000000; $B merge /dev/zero", 2, "/dev/zero:1: not a shard: a NUL byte"},
+        {"head -c 17000000 /dev/zero | tr '\\000' x >long; $B merge long", 2,
+         "long:1: not a shard: a line longer than 16777216 bytes"},
+    };
+    run_scripts("lost", cases, sizeof cases / sizeof *cases);
+}
+
+/* posedrop fit's failures and messages: a part too small for its drop
+ * height (a 1e-12 m cube from 0.12 m, whose every drop failed while the fit
+ * printed an optimum of the smoothing alone and exited 0) is an input
+ * error naming the ratio, for the fit and the main command alike; option
+ * errors name the option; a measured
+ * class beyond the part's is called a class; a one-class fit says there is
+ * nothing to test instead of "df -1, p = 1"; a measured table with p not a
+ * whole number of its n drops is refused. */
+static void test_fit_messages(void)
+{
+    static const script_case cases[] = {
+        {"awk '/^#/||/^OFF/{print;next} !h{print;h=1;next} NF==3{printf \"%.17g %.17g %.17g\\n\", "
+         "$1*1e-10,$2*1e-10,$3*1e-10;next} {print}' $R/parts/canonical/cube.off >tiny.off; "
+         "printf 'pose,count\\n1,5\\n' >one.csv; $B fit --fit mu=0.2:0.6 -n 10 --max-evals 2 "
+         "--points 2 --part tiny.off --measured one.csv >out.csv; r=$?; test ! -s out.csv || "
+         "exit 99; $B -n 5 tiny.off >>out.csv && exit 98; test ! -s out.csv || exit 99; exit $r",
+         2, "is 6.93e+10 times the part's size (1.73e-12 m), more than the 1e+06"},
+        {"$B fit -n 0 --fit mu=0.2:0.6 --part $P --measured $M", 2,
+         "fit: -n: expected a number of drops"},
+        {"$B fit --seed x --fit mu=0.2:0.6 --part $P --measured $M", 2, "fit: --seed: expected"},
+        {"printf 'pose,count\\n1,5\\n2,3\\n' >two.csv; $B fit --fit mu=0.2:0.6 --part "
+         "$R/parts/canonical/cube.off --measured two.csv", 2,
+         "has 1 pose class (numbered as 'posedrop --group' numbers them"},
+        {"printf 'pose,count\\n1,5\\n' >one.csv; $B fit --fit mu=0.2:0.6 -n 10 --max-evals 2 "
+         "--points 2 --part $R/parts/canonical/cube.off --measured one.csv >/dev/null", 0,
+         "1 class: nothing to test the fit against"},
+        {"printf 'pose,p,n\\n1,0.333,10\\n2,0.667,10\\n' >pn.csv; $B fit --fit mu=0.2:0.6 "
+         "--part $P --measured pn.csv", 2, "p 0.333 of n 10 drops is 3.33 drops"},
+        /* A tumble that spins a 1 cm cube's corners at 87 m/s, 56 times its
+         * landing speed, is said before a run of minutes a drop. */
+        {"$B -n 1 --tumble 10000 --time-limit 0.01 $R/parts/canonical/cube.off >/dev/null", 0,
+         "--tumble 10000 rad/s turns the part's corners at 86.6 m/s, 56 times"},
+    };
+    run_scripts("fitmsg", cases, sizeof cases / sizeof *cases);
+}
+
 void suite_cli(void)
 {
     snprintf(tmpdir, sizeof tmpdir, "/tmp/posedrop-cli-XXXXXX");
@@ -1248,6 +1359,8 @@ void suite_cli(void)
     test_time_limit();
     test_fifo_inputs();
     test_crosscheck();
+    test_nothing_lost();
+    test_fit_messages();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

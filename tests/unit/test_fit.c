@@ -660,7 +660,7 @@ static void test_command(void)
     snprintf(many, sizeof many, "%s/many.csv", tmpdir);
     write_file(many, "pose,count\n1,1\n9,2\n");
     snprintf(args, sizeof args, "fit --fit mu=0.1:0.5 %s --measured %s", box, many);
-    expect_failure(args, 2, "pose 9");
+    expect_failure(args, 2, "pose class 9, but");
     /* Sets of poses: one pose in two rows is refused, and so is a set given
      * to a plain run, which has no likelihood to put it in. */
     write_file(many, "pose,count\n1|2,5\n2,3\n");

@@ -317,7 +317,7 @@ static void test_command(void)
     snprintf(cmd, sizeof cmd, "-n 5 --mu 0.2:0.6 --contact-time 0.3x:3x --trials %s " BOX, path);
     CHECK_INT(run(cmd, &out, &err), 0);
     char *t = slurp(path);
-    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,mu,contact_time\n", 58) == 0);
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,mu,contact_time,partial\n", 66) == 0);
     free(t);
     free(out);
     free(err);

@@ -228,7 +228,7 @@ static void test_command(void)
     CHECK_INT(run(cmd, &out, &err), 0);
     char *c = slurp(csv), *r = slurp(html);
     const char *head = "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,"
-                       "p_high_hi,index,index_lo,index_hi\n";
+                       "p_high_hi,index,index_lo,index_hi,partial\n";
     CHECK(c && strncmp(c, head, strlen(head)) == 0);
     int rows = 0;
     for (char *p = c; p && *p; p++)

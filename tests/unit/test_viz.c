@@ -494,6 +494,40 @@ static void test_measured(void)
     expect_measured_error("pose,count\n0,2\n", ":2: expected a pose number");
     expect_measured_error("pose,count\n1,2,3\n", ":2: expected 2 fields");
     expect_measured_error("pose,count\n", "no rows");
+    /* p of n drops that is no whole number of drops, to p's digits: 0.333
+     * of 10 is 3.33 drops (was rounded to 3 silently); 0.46 of 1036 is
+     * 476.56, within 1036 x 0.005 of 477, as the paper's rounded p are. */
+    expect_measured_error("pose,p,n\n1,0.333,10\n2,0.667,10\n", ":2: p 0.333 of n 10 drops is 3.33");
+    CHECK_STATUS(viz_measured_read(write_tmp("pn.csv", "pose,p,n\n1,0.46,1036\n2,0.54,1036\n"), &m,
+                                   NULL), PD_OK);
+    viz_measured_free(m);
+    m = NULL;
+    /* Counts whose sum passes 1e15 (10^4 rows of 1e15 overflowed n). */
+    char *many = malloc(10000 * 24 + 16);
+    if (many) {
+        int len = sprintf(many, "pose,count\n");
+        for (int i = 1; i <= 10000; i++)
+            len += sprintf(many + len, "%d,1e15\n", i);
+        expect_measured_error(many, "the counts add up to 1e+19, more than");
+        free(many);
+    }
+    /* A byte order mark before the header is skipped, as the other
+     * readers skip it; a NUL byte is binary data, not a long line. */
+    CHECK_STATUS(viz_measured_read(write_tmp("bom.csv", "\xEF\xBB\xBFpose,count\n1,3\n"), &m, NULL),
+                 PD_OK);
+    CHECK(m && m->n == 3);
+    viz_measured_free(m);
+    const char *nul = write_tmp("nul.csv", "pose,count\n1,3\n");
+    FILE *f = fopen(nul, "ab");
+    if (f) {
+        fwrite("2\0003\n", 1, 4, f);
+        fclose(f);
+    }
+    pd_diag d;
+    pd_diag_init(&d);
+    m = NULL;
+    CHECK(viz_measured_read(nul, &m, &d) == PD_ERR_PARSE && m == NULL);
+    CHECK(strstr(d.message, ":3: a NUL byte") != NULL);
 }
 
 /* Every file the command writes is well-formed (SVGs of SVG 1.1 elements

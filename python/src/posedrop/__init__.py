@@ -16,6 +16,8 @@ same part, options and seed.
 See docs/python.md in the repository.
 """
 import enum as _enum
+import signal as _signal
+import threading as _threading
 
 from . import _posedrop
 from ._api import (END_NAMES, PARAM_NAMES, Drops, Facets, Part, PoseClasses, Sensitivity,
@@ -28,6 +30,21 @@ Status = _enum.IntEnum("Status", _posedrop.statuses())
 
 #: The version of the C library the module runs (``pd_version()``).
 __version__ = _posedrop.version()
+
+
+def _on_sigint(signum, frame):
+    """Ctrl-C: drops running on any thread stop (raising KeyboardInterrupt
+    there), not only those the main thread waits for; then the usual
+    KeyboardInterrupt in the main thread."""
+    _posedrop.interrupt()
+    _signal.default_int_handler(signum, frame)
+
+
+# Only in place of Python's own handler, and only from the main thread (the
+# only one that may set a handler): a program's own handler is left alone.
+if (_threading.current_thread() is _threading.main_thread()
+        and _signal.getsignal(_signal.SIGINT) is _signal.default_int_handler):
+    _signal.signal(_signal.SIGINT, _on_sigint)
 
 
 def engine_available(engine):

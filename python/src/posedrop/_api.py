@@ -379,7 +379,11 @@ class StablePoses:
         ------
         KeyboardInterrupt
             On Ctrl-C: the drops under way finish, no new one starts, and
-            the interrupt propagates (use ``cancel`` for a partial result).
+            the interrupt propagates (use ``cancel`` for a partial result);
+            on a thread other than the main one too, as long as Python's
+            own SIGINT handler was in place when posedrop was imported.
+        TypeError
+            ``cancel`` without an ``is_set()`` method.
         InputError
             A scene value or option the library refuses.
         """
