@@ -282,17 +282,27 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
 }
 
 /* --sensitivity: one row per pose (class with --group) and ranged
- * parameter, numbered as in the output. */
+ * parameter, numbered as in the output: the effect first, then the thirds
+ * it comes from, the index, and an interaction where one is flagged (its
+ * columns empty where none is). */
 static void write_sensitivity(FILE *f, const pd_sensitivity *s)
 {
-    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
-               "index,index_lo,index_hi\n");
+    fprintf(f, "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,p_low_lo,p_low_hi,n_high,"
+               "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,interacts,effect_in_low,"
+               "effect_in_middle,effect_in_high,interaction,interaction_lo,interaction_hi\n");
     for (int i = 0; i < s->nposes * s->nparams; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
-                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
-                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
-                r->index_lo, r->index_hi);
+        fprintf(f, "%d,%s,%.6g,%.6g,%.6g,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,"
+                   "%.6g,", r->pose + 1, pd_scene_param_name(r->param), r->effect, r->effect_lo,
+                r->effect_hi, r->n_low, r->p_low, r->p_low_lo, r->p_low_hi, r->n_high, r->p_high,
+                r->p_high_lo, r->p_high_hi, r->index, r->index_lo, r->index_hi);
+        if (r->interacts >= 0)
+            fprintf(f, "%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g\n",
+                    pd_scene_param_name((pd_scene_param)r->interacts), r->effect_in[0],
+                    r->effect_in[1], r->effect_in[2], r->interaction, r->interaction_lo,
+                    r->interaction_hi);
+        else
+            fputs(",,,,,,\n", f);
     }
 }
 
@@ -510,6 +520,14 @@ int cli_run(cli_args *a)
         code = cli_interrupt_code();
         goto done;
     }
+    /* A shard prints its poses' own counts; its merge groups them. */
+    if (st == PD_OK && a->group && !a->sim.nshards) {
+        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
+        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
+        /* --effect resolves the effects the output shows, the classes'. */
+        a->sim.effect_class_of = class_of;
+        a->sim.effect_nclasses = nclasses;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
         t_sim = cli_wall_seconds() - t0 - t_static;
@@ -518,13 +536,8 @@ int cli_run(cli_args *a)
         code = 0;
         goto done;
     }
-    /* A shard prints its poses' own counts; its merge groups them. */
-    if (st == PD_OK && a->group && !a->sim.nshards) {
-        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
-        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
-        if (st == PD_OK && sim)
-            st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
-    }
+    if (st == PD_OK && class_of && sim)
+        st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
     /* The report shows it when the drops' records were kept (not across
      * MPI ranks); --sensitivity needs them. */
     if (st == PD_OK && sim && pd_scene_ranged(&a->scene) &&
@@ -548,8 +561,15 @@ int cli_run(cli_args *a)
         write_trials(trials_out.f, sim, class_of, &a->scene);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
-    if (sens_out.f)
+    if (sens_out.f) {
         write_sensitivity(sens_out.f, sens);
+        /* What the effects can tell apart, said whether or not it was
+         * asked for: an effect inside it is no evidence of none. */
+        if (sens->nparams > 0)
+            fprintf(stderr, "%s: %s: these %ld drops resolve an effect to %.1f points (the "
+                    "widest half of an effect's 95%% interval); four times the drops halve "
+                    "it\n", prog, a->path, sens->n, 100 * sens->resolution);
+    }
     if ((trials_out.f && !out_commit(&trials_out)) ||
         (transitions_out.f && !out_commit(&transitions_out)) ||
         (sens_out.f && !out_commit(&sens_out))) {
