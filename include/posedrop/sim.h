@@ -285,6 +285,16 @@ typedef struct pd_sim_options {
                                with the drops done so far (of the shard) and
                                those planned; must return quickly */
     void *progress_user;
+    double effect_halfwidth; /* in (0, 0.5): with a scene parameter that
+                               varies and keep_trials, keep dropping (after
+                               ndrops, in rounds sized from the widest
+                               interval so far, up to max_drops) until every
+                               effect's 95% interval (pd_sim_sensitivity, per
+                               pose) is at most this wide on each side; 0 */
+    const int *effect_class_of; /* NULL, or with effect_halfwidth the effects
+                               are those of effect_nclasses classes of poses
+                               (pd_pose_classes' class_of, one per pose) */
+    int effect_nclasses;
 } pd_sim_options;
 
 /* Cancelling a run: point options->cancel at an atomic_int holding 0 and

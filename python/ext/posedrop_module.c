@@ -1207,25 +1207,36 @@ static PyObject *Drops_sensitivity(DropsObject *self, PyObject *args)
     size_t m = (size_t)s->nposes * (size_t)s->nparams;
     PyObject *d = PyDict_New(), *params = d ? PyList_New(0) : NULL;
     int bad = !d || put(d, "params", params) || put(d, "n", PyLong_FromLong(s->n)) ||
-              put(d, "nposes", PyLong_FromLong(s->nposes));
+              put(d, "nposes", PyLong_FromLong(s->nposes)) ||
+              put(d, "resolution", PyFloat_FromDouble(s->resolution)) ||
+              put(d, "interaction_tests", PyLong_FromLong(s->interaction_tests));
     for (int k = 0; !bad && k < s->nparams; k++) {
         PyObject *name = PyUnicode_FromString(pd_scene_param_name(s->param[k]));
         bad = !name || PyList_Append(params, name) < 0;
         Py_XDECREF(name);
     }
     void *pose = NULL, *nlow = NULL, *nhigh = NULL, *v = NULL;
+    PyObject *with = bad ? NULL : PyList_New(0);
     bad = bad || put(d, "pose", new_buffer(m, sizeof(int32_t), &pose)) ||
           put(d, "n_low", new_buffer(m, sizeof(int64_t), &nlow)) ||
           put(d, "n_high", new_buffer(m, sizeof(int64_t), &nhigh)) ||
-          put(d, "values", new_buffer(9 * m, sizeof(double), &v));
+          put(d, "interacts", with) ||
+          put(d, "values", new_buffer(18 * m, sizeof(double), &v));
     for (size_t i = 0; !bad && i < m; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        const double row[9] = {r->p_low,  r->p_low_lo,  r->p_low_hi, r->p_high,  r->p_high_lo,
-                               r->p_high_hi, r->index, r->index_lo, r->index_hi};
+        const double row[18] = {r->effect, r->effect_lo, r->effect_hi, r->p_low, r->p_low_lo,
+                                r->p_low_hi, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
+                                r->index_lo, r->index_hi, r->effect_in[0], r->effect_in[1],
+                                r->effect_in[2], r->interaction, r->interaction_lo,
+                                r->interaction_hi};
         ((int32_t *)pose)[i] = r->pose;
         ((int64_t *)nlow)[i] = r->n_low;
         ((int64_t *)nhigh)[i] = r->n_high;
-        memcpy((double *)v + 9 * i, row, sizeof row);
+        PyObject *name = PyUnicode_FromString(
+            r->interacts >= 0 ? pd_scene_param_name((pd_scene_param)r->interacts) : "");
+        bad = !name || PyList_Append(with, name) < 0;
+        Py_XDECREF(name);
+        memcpy((double *)v + 18 * i, row, sizeof row);
     }
     pd_sensitivity_free(s);
     if (bad) {

@@ -30,7 +30,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -122,6 +122,10 @@ static const cli_option options[] = {
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},
+    {OPT_EFFECT, "effect", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
+     "with a range, drop (from -n, in rounds) until every\n"
+     "effect's 95% interval is within DELTA (0.03: 3 points\n"
+     "each side; --sensitivity, docs/uncertainty.md)"},
     {OPT_SEED, "seed", ARG_WHOLE, "S", WHOLE("a seed", 0, LLONG_MAX), NULL, NULL,
      "random seed, 0..2^63-1 (default 1); same seed, same bytes"},
     {'j', NULL, ARG_WHOLE, "THREADS", WHOLE("a number of threads", 1, 256), NULL, NULL,
@@ -189,13 +193,14 @@ static const cli_option options[] = {
      "every row of an interrupted run"},
     {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with ranges, what each ranged parameter moves, as CSV:\n"
-     "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
-     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,\n"
-     "partial: the\n"
-     "pose's probability in the lower and upper third of the\n"
-     "range (95% Wilson) and the first-order index, the share\n"
-     "of the pose's variance the parameter explains (95%\n"
-     "bootstrap interval; docs/uncertainty.md)"},
+     "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,...,\n"
+     "index,index_lo,index_hi,interacts,...: the effect, how far\n"
+     "the pose's probability moves from the range's lower third\n"
+     "to its upper (95% bootstrap interval), the thirds' p (95%\n"
+     "Wilson), the first-order index, and the parameter across\n"
+     "whose thirds the effect changes, if any; stderr says what\n"
+     "effect the drops resolve; last partial, 1 in every row\n"
+     "of an interrupted run (docs/uncertainty.md)"},
     {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -415,6 +420,11 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.ci_halfwidth = x;
         a->dynamic = 1;
         break;
+    case OPT_EFFECT:
+        a->sim.effect_halfwidth = x;
+        a->sim.keep_trials = 1;
+        a->dynamic = 1;
+        break;
     case OPT_SEED: a->sim.seed = (uint64_t)n; break;
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
@@ -599,6 +609,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (stationary && a->sim.ci_halfwidth > 0)
         return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
                           "number of drops over the poses in advance: give -n");
+    if (a->sim.effect_halfwidth > 0 && (!pd_scene_ranged(&a->scene) || a->sim.nshards ||
+                                        a->scene.initial != PD_INITIAL_UNIFORM))
+        return fail_usage("%s", "--effect needs a scene with a range (such as --mu 0.2:0.5) and "
+                          "the uniform start, and does not go with --shard (the drops' number "
+                          "comes from their effects)");
     if (a->sensitivity && (!a->dynamic || !pd_scene_ranged(&a->scene) || a->sim.nshards))
         return fail_usage("%s", "--sensitivity needs drops (-n or --ci) of a scene with a range "
                           "(such as --mu 0.2:0.5), and does not go with --shard");

@@ -355,17 +355,27 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
 }
 
 /* --sensitivity: one row per pose (class with --group) and ranged
- * parameter, numbered as in the output; partial as in --trials. */
+ * parameter, numbered as in the output: the effect first, then the thirds
+ * it comes from, the index, and an interaction where one is flagged (its
+ * columns empty where none is); partial as in --trials. */
 static void write_sensitivity(FILE *f, const pd_sensitivity *s, int partial)
 {
-    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
-               "index,index_lo,index_hi,partial\n");
+    fprintf(f, "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,p_low_lo,p_low_hi,n_high,"
+               "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,interacts,effect_in_low,"
+               "effect_in_middle,effect_in_high,interaction,interaction_lo,interaction_hi,partial\n");
     for (int i = 0; i < s->nposes * s->nparams; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g,%d\n",
-                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
-                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
-                r->index_lo, r->index_hi, partial);
+        fprintf(f, "%d,%s,%.6g,%.6g,%.6g,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,"
+                   "%.6g,", r->pose + 1, pd_scene_param_name(r->param), r->effect, r->effect_lo,
+                r->effect_hi, r->n_low, r->p_low, r->p_low_lo, r->p_low_hi, r->n_high, r->p_high,
+                r->p_high_lo, r->p_high_hi, r->index, r->index_lo, r->index_hi);
+        if (r->interacts >= 0)
+            fprintf(f, "%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n",
+                    pd_scene_param_name((pd_scene_param)r->interacts), r->effect_in[0],
+                    r->effect_in[1], r->effect_in[2], r->interaction, r->interaction_lo,
+                    r->interaction_hi, partial);
+        else
+            fprintf(f, ",,,,,,,%d\n", partial);
     }
 }
 
@@ -656,6 +666,14 @@ int cli_run(cli_args *a)
         code = cli_interrupt_code();
         goto done;
     }
+    /* A shard prints its poses' own counts; its merge groups them. */
+    if (st == PD_OK && a->group && !a->sim.nshards) {
+        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
+        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
+        /* --effect resolves the effects the output shows, the classes'. */
+        a->sim.effect_class_of = class_of;
+        a->sim.effect_nclasses = nclasses;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
         if (st == PD_OK && a->crosscheck && !sim->partial)
@@ -666,16 +684,11 @@ int cli_run(cli_args *a)
         code = 0;
         goto done;
     }
-    /* A shard prints its poses' own counts; its merge groups them. */
-    if (st == PD_OK && a->group && !a->sim.nshards) {
-        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
-        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
-        if (st == PD_OK && sim)
-            st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
-        for (int k = 0; k < VIZ_ENGINES && st == PD_OK; k++)
-            if (xsim[k])
-                st = pd_sim_result_grouped(xsim[k], class_of, nclasses, &xgsim[k], &diag);
-    }
+    if (st == PD_OK && class_of && sim)
+        st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+    for (int k = 0; k < VIZ_ENGINES && st == PD_OK && class_of; k++)
+        if (xsim[k])
+            st = pd_sim_result_grouped(xsim[k], class_of, nclasses, &xgsim[k], &diag);
     if (st == PD_OK && sim && a->crosscheck) {
         /* An engine an interruption kept from running leaves the run partial. */
         int partial = 0;
@@ -716,8 +729,15 @@ int cli_run(cli_args *a)
         write_trials(trials_out.f, sim, class_of, &a->scene, partial);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
-    if (sens_out.f)
+    if (sens_out.f) {
         write_sensitivity(sens_out.f, sens, partial);
+        /* What the effects can tell apart, said whether or not it was
+         * asked for: an effect inside it is no evidence of none. */
+        if (sens->nparams > 0)
+            fprintf(stderr, "%s: %s: these %ld drops resolve an effect to %.1f points (the "
+                    "widest half of an effect's 95%% interval); four times the drops halve "
+                    "it\n", prog, a->path, sens->n, 100 * sens->resolution);
+    }
     if (!out_close(&trials_out) || !out_close(&transitions_out) || !out_close(&sens_out)) {
         code = EXIT_INTERNAL;
         goto done;

@@ -556,10 +556,18 @@ class Sensitivity:
     params : list of str
         The ranged parameters, in ``pd_scene_param`` order; empty for a
         scene without a range of nonzero width.
+    resolution : float
+        The widest half-width of an effect's interval: what the drops
+        resolve.
+    interaction_tests : int
+        Pose and ordered parameter pairs tested for an interaction.
     pose : (rows,) int32
         The pose (or class) index, from 0 (the file's ``pose`` less 1).
     parameter : (rows,) str
         The parameter's name.
+    effect, effect_lo, effect_hi : (rows,)
+        ``p_high - p_low``, how far the pose moves across the range, and its
+        95% bootstrap interval.
     n_low, n_high : (rows,) int64
         Settled drops whose value fell in the lower, upper third of the
         range (thirds of the logarithm for a log-uniform range).
@@ -567,10 +575,18 @@ class Sensitivity:
         The pose's share of those and its 95% Wilson interval.
     index, index_lo, index_hi : (rows,)
         The first-order index S_i and its 95% bootstrap interval.
+    interacts : (rows,) str
+        The parameter across whose thirds the effect changes, or "".
+    effect_in_low, effect_in_middle, effect_in_high : (rows,)
+        With ``interacts``: the effect in that parameter's thirds.
+    interaction, interaction_lo, interaction_hi : (rows,)
+        With ``interacts``: the largest change of those and its interval.
     """
 
-    _COLUMNS = ("p_low", "p_low_lo", "p_low_hi", "p_high", "p_high_lo", "p_high_hi",
-                "index", "index_lo", "index_hi")
+    _COLUMNS = ("effect", "effect_lo", "effect_hi", "p_low", "p_low_lo", "p_low_hi", "p_high",
+                "p_high_lo", "p_high_hi", "index", "index_lo", "index_hi", "effect_in_low",
+                "effect_in_middle", "effect_in_high", "interaction", "interaction_lo",
+                "interaction_hi")
 
     def __init__(self, d):
         self.n = d["n"]
@@ -580,6 +596,9 @@ class Sensitivity:
         self.parameter = np.array(self.params * self.nposes, dtype=str)
         self.n_low = _i64(d["n_low"])
         self.n_high = _i64(d["n_high"])
+        self.resolution = d["resolution"]
+        self.interaction_tests = d["interaction_tests"]
+        self.interacts = np.array(list(d["interacts"]), dtype=str)
         values = _f64(d["values"], -1, len(self._COLUMNS))
         for k, name in enumerate(self._COLUMNS):
             setattr(self, name, values[:, k])
