@@ -239,6 +239,18 @@ int out_commit(out_file *o)
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a last column, member. An unsettled drop
  * has pose (and member) 0. */
+/* --trace: one row per state of the traced drop, in full precision; called
+ * from the thread that runs that drop, the only writer of the file while
+ * the drops run. */
+static void write_trace_row(void *user, const pd_trace_row *r)
+{
+    fprintf((FILE *)user,
+            "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+            "%.17g,%.17g,%d,%s\n",
+            r->t, r->x[0], r->x[1], r->x[2], r->q[0], r->q[1], r->q[2], r->q[3], r->v[0], r->v[1],
+            r->v[2], r->w[0], r->w[1], r->w[2], r->energy, r->depth, r->contacts, r->event);
+}
+
 static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
                          const pd_scene *scene)
 {
@@ -465,8 +477,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, trace_out = {0},
+             pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
+                 (!a->trace || out_open(&trace_out, a->trace)) &&
                  (!a->transitions || out_open(&transitions_out, a->transitions)) &&
                  (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
@@ -480,6 +494,7 @@ int cli_run(cli_args *a)
     }
     if (!opened) {
         out_abort(&trials_out);
+        out_abort(&trace_out);
         out_abort(&transitions_out);
         out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
@@ -509,6 +524,11 @@ int cli_run(cli_args *a)
     if (st == PD_OK && cli_any(signals_caught())) {
         code = cli_interrupt_code();
         goto done;
+    }
+    if (st == PD_OK && a->dynamic && trace_out.f) {
+        fprintf(trace_out.f, "t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,energy,depth,contacts,event\n");
+        a->sim.trace = write_trace_row;
+        a->sim.trace_user = trace_out.f;
     }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
@@ -550,7 +570,7 @@ int cli_run(cli_args *a)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
     if (sens_out.f)
         write_sensitivity(sens_out.f, sens);
-    if ((trials_out.f && !out_commit(&trials_out)) ||
+    if ((trials_out.f && !out_commit(&trials_out)) || (trace_out.f && !out_commit(&trace_out)) ||
         (transitions_out.f && !out_commit(&transitions_out)) ||
         (sens_out.f && !out_commit(&sens_out))) {
         code = EXIT_INTERNAL;
@@ -600,6 +620,7 @@ int cli_run(cli_args *a)
     }
 done:
     out_abort(&trials_out);
+    out_abort(&trace_out);
     out_abort(&transitions_out);
     out_abort(&sens_out);
     pd_sensitivity_free(sens);

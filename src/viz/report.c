@@ -203,7 +203,7 @@ static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
             snprintf(v, sizeof v, "%s; seed %llu", engines[so->engine], (unsigned long long)so->seed);
         else
             snprintf(v, sizeof v, "%s, time step %s; seed %llu", engines[so->engine],
-                     so->dt > 0 ? "as given" : "the engine's default", (unsigned long long)so->seed);
+                     so->dt > 0 ? "as given" : "automatic, from the scene", (unsigned long long)so->seed);
         row(b, "engine", v);
         snprintf(v, sizeof v, "%ld drops, %ld unsettled (in no count)%s", sim->n, sim->unsettled,
                  sim->partial ? "; interrupted: partial" : "");
