@@ -249,12 +249,38 @@ typedef enum pd_engine_kind {
     PD_ENGINE_BULLET       /* Bullet Physics, fixed step */
 } pd_engine_kind;
 
+/* One state of a traced drop (pd_sim_options.trace), the same fields for
+ * every engine, so that two engines' runs of the same drop can be laid side
+ * by side. The orientation is that of the part's principal frame (the
+ * engines' body frame), whose origin is the centre of mass. */
+typedef struct pd_trace_row {
+    double t;          /* s since the release */
+    double x[3];       /* centre of mass, world, m (z up, the floor at 0) */
+    double q[4];       /* principal frame -> world, w x y z */
+    double v[3];       /* centre of mass velocity, m/s */
+    double w[3];       /* angular velocity, world frame, rad/s */
+    double energy;     /* kinetic plus potential energy over the weight: the
+                          height the centre of mass could reach, m */
+    double depth;      /* the lowest hull vertex's depth below the floor, m
+                          (negative: its height above it) */
+    int contacts;      /* hull vertices below the floor or within
+                          PD_TOL_REST_FALL_REL of the size above it (the
+                          depth a soft contact lets a resting part sink) */
+    const char *event; /* what the state follows: "release", "step" (a
+                          stepping engine's), "flight" (the impulse engine's
+                          closed-form flight or rest step), "impact",
+                          "compliant" (a compliant impact's end), "phase" (a
+                          contact phase's end), "end" */
+} pd_trace_row;
+
 /* Defaults after the field's meaning; pd_sim_run refuses values outside the
  * stated ranges. */
 typedef struct pd_sim_options {
     pd_engine_kind engine;  /* PD_ENGINE_IMPULSE */
-    double dt;              /* s, fixed step of ODE and Bullet, at most 0.01; 0 picks
-                               each engine's default (ODE 1 ms, Bullet 1/960 s) */
+    double dt;              /* s, fixed step of ODE and Bullet, at most 0.01; 0
+                               (automatic): 20 steps per contact time, at most
+                               a tenth of the thickness travelled per step
+                               (docs/engines.md) */
     long ndrops;            /* drops to run (with ci_halfwidth: at least these), >= 0; 2000 */
     uint64_t seed;          /* 1 */
     int threads;            /* 0: all cores; at most 256 are used */
@@ -295,6 +321,13 @@ typedef struct pd_sim_options {
                                are those of effect_nclasses classes of poses
                                (pd_pose_classes' class_of, one per pose) */
     int effect_nclasses;
+    /* May be NULL. Else drop trace_drop (numbered as in the run, >= 0) calls
+     * it with every state it passes through, in order, from the thread
+     * running that drop: a stepping engine's after every step, the impulse
+     * engine's at every event (docs/engines.md, "Tracing a drop"). */
+    void (*trace)(void *user, const pd_trace_row *row);
+    void *trace_user;
+    long trace_drop;        /* 0 */
 } pd_sim_options;
 
 /* Cancelling a run: point options->cancel at an atomic_int holding 0 and

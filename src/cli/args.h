@@ -22,7 +22,7 @@ typedef struct {
 } cli_file;
 
 typedef struct {
-    const char *path, *trials, *transitions, *com_text;
+    const char *path, *trials, *transitions, *trace, *com_text;
     pd_mesh_read_options read;
     pd_part_options part;
     pd_static_options estimate;

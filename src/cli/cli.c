@@ -30,7 +30,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT, OPT_TRACE, OPT_TRACE_DROP };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -100,9 +100,11 @@ static const cli_option options[] = {
     {OPT_ENGINE, "engine", ARG_CHOICE, "E", NO_RULE, engine_names, NULL,
      "impulse (default): posedrop's own simulator; ode or\n"
      "bullet: the same drops on a stepping engine, to cross-check"},
-    {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
-     "time step of ode (default 0.001) or bullet (1/960),\n"
-     "above 0 and at most 0.01"},
+    {OPT_DT, "dt", ARG_TEXT, "S", REAL("auto or a time step in s", 0, 0.01, 1, 0), NULL, NULL,
+     "time step of ode and bullet, above 0 and at most 0.01,\n"
+     "or auto (default): 20 steps per contact time (the\n"
+     "shortest the scene draws), each corner travelling at\n"
+     "most a tenth of the part's thickness per step"},
     {OPT_CROSSCHECK, "crosscheck", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
      "the same drops (the same releases) on all three engines;\n"
      "p and its interval stay --engine's, and each row adds\n"
@@ -191,6 +193,15 @@ static const cli_option options[] = {
      "per ranged scene parameter, named by its key, the value\n"
      "the drop drew (vibration in degrees); last partial, 1 in\n"
      "every row of an interrupted run"},
+    {OPT_TRACE, "trace", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
+     "one drop's motion as CSV, the same columns on every\n"
+     "engine: t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,energy,\n"
+     "depth,contacts,event (docs/engines.md, \"Tracing a drop\");\n"
+     "a stepping engine's every step, the impulse engine's\n"
+     "every event"},
+    {OPT_TRACE_DROP, "trace-drop", ARG_WHOLE, "I", WHOLE("a drop number", 0, LONG_MAX), NULL, NULL,
+     "the drop --trace records, numbered from 0 (default 0):\n"
+     "the same I starts from the same state on every engine"},
     {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with ranges, what each ranged parameter moves, as CSV:\n"
      "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,...,\n"
@@ -428,7 +439,13 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case OPT_SEED: a->sim.seed = (uint64_t)n; break;
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
-    case OPT_DT: a->sim.dt = x; break;
+    case OPT_DT: {
+        int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        a->sim.dt = strcmp(arg, "auto") == 0 ? 0.0 : x;
+        break;
+    }
     case OPT_TIME_LIMIT: {
         int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
         if (rc != PD_NUM_OK)
@@ -451,6 +468,8 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.keep_trials = 1;
         break;
     case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_TRACE: a->trace = arg; break;
+    case OPT_TRACE_DROP: a->sim.trace_drop = (long)n; break;
     case OPT_SENSITIVITY:
         a->sensitivity = arg;
         a->sim.keep_trials = 1;
@@ -603,6 +622,8 @@ static int parse_args(int argc, char **argv, cli_args *a)
                           "and does not go with --shard");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
+    if (a->trace && !a->dynamic)
+        return fail_usage("%s", "--trace needs drops to record (-n or --ci)");
     int stationary = a->scene.initial == PD_INITIAL_STATIONARY;
     if (a->transitions && (!stationary || !a->dynamic))
         return fail_usage("%s", "--transitions needs the drops of --initial stationary and -n");

@@ -306,6 +306,18 @@ int out_place_all(out_file *const *files, int n)
     return ok;
 }
 
+/* --trace: one row per state of the traced drop, in full precision; called
+ * from the thread that runs that drop, the only writer of the file while
+ * the drops run. */
+static void write_trace_row(void *user, const pd_trace_row *r)
+{
+    fprintf((FILE *)user,
+            "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+            "%.17g,%.17g,%d,%s\n",
+            r->t, r->x[0], r->x[1], r->x[2], r->q[0], r->q[1], r->q[2], r->q[3], r->v[0], r->v[1],
+            r->v[2], r->w[0], r->w[1], r->w[2], r->energy, r->depth, r->contacts, r->event);
+}
+
 /* One row per drop. With --group (class_of not NULL) the pose column holds
  * the class number, as in the main output, so the two files join on it; the
  * pose within the class follows in a column member. An unsettled drop has
@@ -541,6 +553,8 @@ static pd_status crosscheck_run(const pd_part *part, const pd_static_result *res
         a->sim.engine = (pd_engine_kind)k;
         a->sim.dt = k == PD_ENGINE_IMPULSE ? 0.0 : main_run.dt;
         a->sim.keep_trials = 0;
+        /* --trace records --engine's drop only. */
+        a->sim.trace = NULL;
         st = cli_simulate(part, res, a, &xsim[k], diag);
     }
     a->sim = main_run;
@@ -619,8 +633,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, trace_out = {0},
+             pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
+                 (!a->trace || out_open(&trace_out, a->trace)) &&
                  (!a->transitions || out_open(&transitions_out, a->transitions)) &&
                  (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
@@ -634,6 +650,7 @@ int cli_run(cli_args *a)
     }
     if (!opened) {
         out_abort(&trials_out);
+        out_abort(&trace_out);
         out_abort(&transitions_out);
         out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
@@ -673,6 +690,11 @@ int cli_run(cli_args *a)
         /* --effect resolves the effects the output shows, the classes'. */
         a->sim.effect_class_of = class_of;
         a->sim.effect_nclasses = nclasses;
+    }
+    if (st == PD_OK && a->dynamic && trace_out.f) {
+        fprintf(trace_out.f, "t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,energy,depth,contacts,event\n");
+        a->sim.trace = write_trace_row;
+        a->sim.trace_user = trace_out.f;
     }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
@@ -738,7 +760,8 @@ int cli_run(cli_args *a)
                     "widest half of an effect's 95%% interval); four times the drops halve "
                     "it\n", prog, a->path, sens->n, 100 * sens->resolution);
     }
-    if (!out_close(&trials_out) || !out_close(&transitions_out) || !out_close(&sens_out)) {
+    if (!out_close(&trials_out) || !out_close(&trace_out) || !out_close(&transitions_out) ||
+        !out_close(&sens_out)) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -780,8 +803,8 @@ int cli_run(cli_args *a)
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
         goto done;
     }
-    out_file *const outs[] = {&trials_out, &transitions_out, &sens_out, &pic_out[0], &pic_out[1],
-                              &pic_out[2], &pic_out[3]};
+    out_file *const outs[] = {&trials_out,  &trace_out,  &transitions_out, &sens_out,
+                              &pic_out[0], &pic_out[1], &pic_out[2],      &pic_out[3]};
     _Static_assert(VIZ_KINDS == 4, "every picture is put in place");
     if (!out_place_all(outs, (int)(sizeof outs / sizeof outs[0])))
         code = EXIT_INTERNAL;
@@ -795,6 +818,7 @@ int cli_run(cli_args *a)
     }
 done:
     out_abort(&trials_out);
+    out_abort(&trace_out);
     out_abort(&transitions_out);
     out_abort(&sens_out);
     pd_sensitivity_free(sens);

@@ -286,6 +286,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     }
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
+    pd_drop_trace_state(m, o, sc->gravity, index, 0.0, &s, "release");
     if (w->compliant_work)
         pd_compliant_work_watch(w->compliant_work, o->cancel);
     w->rest_depth = 0.0;
@@ -365,6 +366,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 }
                 t += imp.t - f_at;
                 f_at = imp.t;
+                pd_drop_trace_state(m, o, g, index, t, &s, "flight");
             }
             rest_from = -HUGE_VAL;
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
@@ -390,6 +392,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                     *energy_gain += cr.energy_gain;
                     w->rest_depth = fmax(w->rest_depth, cr.rest_depth);
                     t += cr.time;
+                    pd_drop_trace_state(m, o, g, index, t, &s, "compliant");
                     f_at = -1.0;
                     phase_ok = 1;
                     if (cr.end == PD_COMPLIANT_CANCELLED) {
@@ -418,6 +421,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 break;
             }
             if (out->collisions != before) {
+                pd_drop_trace_state(m, o, g, index, t, &s, "impact");
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
                 resolved = out->collisions - before < PD_MAX_ROUNDS && w->contact_time == 0.0;
@@ -448,6 +452,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 run.time_limit += spun;
             }
             t += dt;
+            pd_drop_trace_state(m, o, g, index, t, &s, "phase");
             phase_ok = 0;
             if (t >= o->time_limit) {
                 out->end = PD_END_TIME_LIMIT;
@@ -486,10 +491,13 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             break;
         }
         t += dt;
+        pd_drop_trace_state(m, o, g, index, t, &s, "flight");
         if (t >= o->time_limit) {
             out->end = PD_END_TIME_LIMIT;
             break;
         }
     }
     out->time = t;
+    if (out->end == PD_END_SETTLED)
+        pd_drop_trace_state(m, o, g, index, t, &s, "end");
 }

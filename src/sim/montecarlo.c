@@ -22,6 +22,7 @@
 #include "sim/markov.h"
 #include "sim/scene.h"
 #include "posedrop/sensitivity.h"
+#include "sim/sim_tol.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
 #include "static/static_check.h"
@@ -33,10 +34,6 @@ enum { BOOTSTRAP_FIRST = 20, BOOTSTRAP_ROUND = 100 };
 /* --ci: drops between checks of the stopping rule. Plain runs go in batches
  * of at most BATCH_MAX, so the outcome buffer stays small for any -n. */
 enum { CI_BATCH = 1000, BATCH_MAX = 65536 };
-/* The coarsest fixed step a stepping engine is given, the CLI's --dt limit:
- * a part of 1 cm dropped 0.12 m meets the floor at 1.5 m/s and crosses its
- * own size in under 7 ms, so a longer step would pass through contacts. */
-static const double PD_SIM_DT_MAX = 0.01;
 /* Two-sided 95% normal quantile for the Wilson intervals. */
 static const double Z95 = PD_Z95;
 
@@ -60,6 +57,9 @@ void pd_sim_options_default(pd_sim_options *o)
     o->shard = 0;
     o->progress = NULL;
     o->progress_user = NULL;
+    o->trace = NULL;
+    o->trace_user = NULL;
+    o->trace_drop = 0;
 }
 
 double pd_time_limit_auto(double size, const pd_scene *scene)
@@ -699,10 +699,13 @@ pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
         return pd_fail(diag, PD_ERR_USAGE, "option engine is %d: expected PD_ENGINE_IMPULSE, "
                        "PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
     if (o->dt < 0 || o->dt > PD_SIM_DT_MAX)
-        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (the engine's "
-                       "default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
+        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (automatic, "
+                       "from the scene) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
     if (o->ndrops < 0)
         return pd_fail(diag, PD_ERR_USAGE, "option ndrops is %ld: expected 0 or more", o->ndrops);
+    if (o->trace_drop < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "option trace_drop is %ld: expected 0 or more",
+                       o->trace_drop);
     if (o->threads < 0)
         return pd_fail(diag, PD_ERR_USAGE, "option threads is %d: expected 0 (all cores) or "
                        "more", o->threads);

@@ -120,6 +120,12 @@ void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
                      const pd_sim_options *options, long index, const double *init_cdf,
                      pd_state *s, pd_trial *out);
 
+/* Hands drop `index`'s state s at time t, after `event`, to options->trace
+ * if that drop is traced (pd_trace_row, its energy under gravity);
+ * nothing otherwise. */
+void pd_drop_trace_state(const pd_sim_model *model, const pd_sim_options *options, double gravity,
+                         long index, double t, const pd_state *s, const char *event);
+
 /* Marks the drop's record failed at that stage with that status. */
 static inline void pd_drop_failed(pd_trial *out, pd_drop_stage stage, pd_status status)
 {

@@ -267,11 +267,12 @@ static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
             snprintf(v, sizeof v, "%s; seed %llu", engines[so->engine], (unsigned long long)so->seed);
         else
             snprintf(v, sizeof v, "%s, time step %s; seed %llu", engines[so->engine],
-                     so->dt > 0 ? "as given" : "the engine's default", (unsigned long long)so->seed);
+                     so->dt > 0 ? "as given" : "automatic, from the scene",
+                     (unsigned long long)so->seed);
         if (crosscheck)
             snprintf(v + strlen(v), sizeof v - strlen(v), "; the same releases on every engine "
                      "(--crosscheck), ODE and Bullet at %s", so->dt > 0 ? "the step given"
-                                                                   : "their default steps");
+                                                                   : "their automatic steps");
         row(b, "engine", v);
         snprintf(v, sizeof v, "%ld drops, %ld unsettled (in no count)%s", sim->n, sim->unsettled,
                  sim->partial ? "; interrupted: partial" : "");

@@ -52,7 +52,7 @@ static void test_merge_equals_run(void)
     }
     /* Grouping happens at the merge, from the shards' per-pose counts. */
     check_shards_merge("grp", "-n 140 --initial stationary --group " BOX, 3);
-    check_shards_merge("eng", "-n 40 --engine ode --mu 0.5 --units mm parts/block.stl", 3);
+    check_shards_merge("eng", "-n 40 --engine ode --dt 0.001 --mu 0.5 --units mm parts/block.stl", 3);
 }
 
 /* The side files: merge --transitions writes the unsharded run's chain; the
@@ -378,7 +378,7 @@ static void test_mpi(void)
     static const char *const runs[] = {
         "-n 200 --seed 4 parts/cap.off",
         "-n 140 --initial stationary --group " BOX,
-        "-n 30 --engine ode --units mm parts/block.stl",
+        "-n 30 --engine ode --dt 0.001 --units mm parts/block.stl",
     };
     for (int i = 0; i < 3; i++) {
         char cmd[512], *one, *two, *err;

@@ -289,7 +289,7 @@ static void test_dynamic(void)
     free(err);
 
     /* The stepping engines: same columns, same scene; bad choices refused. */
-    CHECK_INT(run("-n 40 --engine ode --units mm parts/block.stl", &out, &err), 0);
+    CHECK_INT(run("-n 40 --engine ode --dt 0.001 --units mm parts/block.stl", &out, &err), 0);
     const char *cols = "pose,nx,ny,nz,area,height,p_qs,p_pqs,n,count,p,";
     CHECK(strncmp(out, cols, strlen(cols)) == 0);
     free(out);
@@ -310,7 +310,7 @@ static void test_dynamic(void)
     free(err);
     /* A flag of posedrop's before a valued option, the part after them. */
     snprintf(cmd, sizeof cmd,
-             "scripts/crosscheck.sh -n 40 -o %s/xc -- --group --units mm parts/block.stl", tmpdir);
+             "scripts/crosscheck.sh -n 12 -o %s/xc -- --group --units mm parts/block.stl", tmpdir);
     CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
     CHECK(strstr(out, "impulse vs ode: total variation") != NULL);
     CHECK(strstr(out, "ode vs bullet:") != NULL && strstr(out, "same pose") != NULL);
@@ -319,7 +319,7 @@ static void test_dynamic(void)
     snprintf(path, sizeof path, "%s/xc/crosscheck.csv", tmpdir);
     char *x = slurp(path);
     CHECK(x && strncmp(x, "part,pose,engine,n,p,ci_lo,ci_hi,ms_per_drop,unsettled\n", 55) == 0);
-    CHECK(x && strstr(x, "\nblock,1,bullet,40,") != NULL);
+    CHECK(x && strstr(x, "\nblock,1,bullet,12,") != NULL);
     free(x);
 
     /* A bad scene file names its line and prints nothing. */
@@ -1055,8 +1055,15 @@ static void test_time_limit(void)
     write_file(path, "OFF\n8 6 0\n0 0 0\n1e29 0 0\n1e29 1e29 0\n0 1e29 0\n0 0 1e29\n"
                      "1e29 0 1e29\n1e29 1e29 1e29\n0 1e29 1e29\n4 0 3 2 1\n4 4 5 6 7\n"
                      "4 0 1 5 4\n4 1 2 6 5\n4 2 3 7 6\n4 3 0 4 7\n");
-    snprintf(args, sizeof args, "--engine ode -n 2 %s", path);
+    snprintf(args, sizeof args, "--engine ode --dt 0.001 -n 2 %s", path);
     expect_failure(args, 2, "steps of 0.001 s per drop");
+    /* The automatic step is never refused: it is not taken shorter than
+     * the time limit over PD_STEPS_MAX. */
+    snprintf(args, sizeof args, "--engine ode -n 2 %s", path);
+    CHECK_INT(run(args, &out, &err), 0);
+    CHECK(out && strstr(out, ",2,") != NULL);
+    free(out);
+    free(err);
 }
 
 /* --scene and --measured naming a named pipe that no program writes to:

@@ -7,6 +7,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "cli_run.h"
 #include "drop_fixture.h"
 #include "base/quat.h"
@@ -28,6 +29,7 @@ static pd_sim_result *sim_run(const fixture *f, const pd_scene *sc, pd_engine_ki
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.ndrops = n;
     o.threads = threads;
     o.keep_trials = 1;
