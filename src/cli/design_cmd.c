@@ -675,7 +675,7 @@ int cli_design(int argc, char **argv)
             say_sensitivity(s, res, class_of, in.changes, unit, unames[in.read.units]);
             fprintf(stderr, "%s: design: sensitivities: %.2f s CPU\n", prog,
                     cli_cpu_seconds() - c0);
-            if (!out_commit(&outs[1]))
+            if (!(out_close(&outs[1]) && out_place(&outs[1])))
                 code = EXIT_INTERNAL;
         }
         pd_design_sens_free(s);
@@ -696,7 +696,8 @@ int cli_design(int argc, char **argv)
             int com_moved = in.po.com_given;
             for (int k = 0; k < in.nchanges; k++)
                 com_moved |= in.changes[k].kind == PD_CHANGE_COM;
-            if (!write_off(outs[0].f, r->part, unit, in.path, com_moved) || !out_commit(&outs[0]))
+            if (!write_off(outs[0].f, r->part, unit, in.path, com_moved) ||
+                !(out_close(&outs[0]) && out_place(&outs[0])))
                 code = EXIT_INTERNAL;
             else {
                 print_summary(&in, r, targets, cli_cpu_seconds() - c0);

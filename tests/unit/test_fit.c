@@ -569,7 +569,7 @@ static void test_cancel(const box_part *bp)
 {
     box_part b = *bp;
     long count[8] = {10, 5, 1, 0, 0, 0, 0, 0};
-    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count};
+    pd_fit_part fp = {b.part, b.res, b.class_of, b.nclasses, count, NULL, 0};
     pd_fit_param mu = {"mu", 0.1, 0.5, 0, 0};
     pd_fit_options fo;
     pd_fit_options_default(&fo);
