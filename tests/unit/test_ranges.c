@@ -327,7 +327,7 @@ static void test_command(void)
     snprintf(cmd, sizeof cmd, "-n 5 --mu 0.4:0.4 --restitution 0.2:0.5 --trials %s " BOX, path);
     CHECK_INT(run(cmd, &out, &err), 0);
     t = slurp(path);
-    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,restitution\n", 54) == 0);
+    CHECK(t && strncmp(t, "drop,qw,qx,qy,qz,pose,collisions,time,end,restitution,partial\n", 62) == 0);
     free(t);
     free(out);
     free(err);
