@@ -173,7 +173,8 @@ $(BUILD)/mpi/%.o: src/cli/%.c Makefile
 $(CLI_MPI): $(CLI_MPI_OBJS) $(BUILD)/src/base/number.o $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
 	OMPI_CC=$(CXX) $(MPICC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET) -lstdc++
 
-$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
+# The tests (the fuzz targets' replay) read shards as posedrop merge does.
+$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(BUILD)/src/cli/shard_read.o $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 $(BENCH_BIN): $(BENCH_OBJS) $(LIB_BULLET) $(LIB)
@@ -262,19 +263,20 @@ referee: deps
 
 # make fuzz: libFuzzer targets built with clang (installed on first use) for
 # the OFF, STL and OBJ readers, scene files, the part build (mesh in, part
-# model and static estimate out) and programs of library calls (api), each
+# model and static estimate out), programs of library calls (api), and the
+# command's readers of measured counts (measured) and of shards (shard), each
 # run for FUZZ_SECONDS from the seeds in parts/ and tests/fuzz/
 # (scripts/fuzz.sh). The C library is built with address and
 # undefined-behaviour sanitizers (Bullet, C++, is left out: not registered).
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := off stl obj scene part api
+FUZZ_TARGETS := off stl obj scene part api measured shard
 FUZZ_BUILD   := build/fuzz
 FUZZ_CC      ?= clang
 FUZZ_CFLAGS  := -std=c11 -g -O1 -pthread -fsanitize=fuzzer-no-link,address,undefined \
                 -fno-sanitize-recover=undefined -fno-omit-frame-pointer -ffp-contract=off \
                 -D_DEFAULT_SOURCE -Iinclude -Isrc -Itests/support \
                 $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null)
-FUZZ_SRCS    := $(LIB_SRCS) tests/support/fuzz_targets.c
+FUZZ_SRCS    := $(LIB_SRCS) src/viz/measured.c src/cli/shard_read.c tests/support/fuzz_targets.c
 FUZZ_OBJS    := $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/%.o)
 # Kept between runs: make would otherwise delete them as intermediate files
 # of the pattern rule below and compile them all again next time.

@@ -400,6 +400,30 @@ static void test_mpi(void)
     CHECK(out[0] == '\0' && strstr(err, "--ci") != NULL);
     free(out);
     free(err);
+    /* The command's rules over ranks: an output on a named pipe that no
+     * program reads is refused at once (each rank waited in open(2)). A
+     * stdout that fails is mpirun's to see, not the ranks' (it forwards
+     * their output), so that rule is checked on posedrop alone. */
+    static const struct {
+        const char *script;
+        int code;
+        const char *mention;
+    } rules[] = {
+        {"mkfifo f; timeout -s KILL 60 $M $B -n 5 --chart f $P", 2,
+         "f: cannot write: a named pipe that no program is reading"},
+    };
+    for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
+        char cmd[1024];
+        snprintf(cmd, sizeof cmd, "(R=$PWD; M='" MPIRUN_2 "'; B=$R/" PD_CLI_MPI_PATH "; "
+                 "P=$R/parts/cap.off; D=%s/mpirule%zu; mkdir -p $D && cd $D && %s)", tmpdir, k,
+                 rules[k].script);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), rules[k].code);
+        if (!strstr(err, rules[k].mention))
+            printf("     posedrop-mpi case %zu should say '%s':\n%s", k, rules[k].mention, err);
+        CHECK(strstr(err, rules[k].mention) != NULL);
+        free(out);
+        free(err);
+    }
 }
 
 /* The part's SHA-256 (shards, JSON) against coreutils' sha256sum, for files
