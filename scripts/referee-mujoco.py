@@ -422,6 +422,8 @@ def main():
                     help="releases the finer steps run again (200)")
     ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
     ap.add_argument("--doc", help="Markdown file to put the table in, between the markers")
+    ap.add_argument("--doc-tag", default="referee-mujoco",
+                    help="the markers' name (referee-mujoco): several runs, several tables")
     ap.add_argument("--law", action="store_true",
                     help="only the contact law's check (a flat strike of the cube), into "
                     "--doc between the referee-law markers")
@@ -509,8 +511,7 @@ def main():
         write_csv(os.path.join(a.o, "referee.csv"), out_rows)
         text = markdown(table, steps, a)
         if a.doc:
-            script_util.put_between(a.doc, "referee-mujoco", "\n" + text + "\n",
-                                    "referee-mujoco")
+            script_util.put_between(a.doc, a.doc_tag, "\n" + text + "\n", "referee-mujoco")
     sys.stdout.write(text)
     return 0
 
