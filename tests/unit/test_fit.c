@@ -501,6 +501,24 @@ static void test_initial_choice(const box_part *bp)
             ps[c] = (q->p_best[c] * ((double)q->nsim + ka) - o.alpha) / (double)q->nsim;
         CHECK_NEAR(pd_fit_loglik_dm(q->nclasses, count, ps, (double)q->nsim, o.alpha), best,
                    1e-9 * fabs(best), "the same drops, round-off of sums");
+        CHECK_INT(fr->initial_untested, 1);
+    }
+    pd_fit_result_free(fr);
+    /* Two parts: each mode scored by the parts predicted from fits to the
+     * other, the best scorer kept, and the untested flag down. */
+    long other[8] = {200, 70, 30, 0, 0, 0, 0, 0};
+    pd_fit_part two[2] = {fp, fp};
+    two[1].count = other;
+    fr = NULL;
+    CHECK_STATUS(pd_fit_run(two, 2, &prm, 1, NULL, &o, &fr, &diag), PD_OK);
+    if (fr) {
+        int arg = 0;
+        for (int i = 0; i < 3; i++) {
+            CHECK(isfinite(fr->loglik_initial[i]) && fr->loglik_initial[i] < 0);
+            arg = fr->loglik_initial[i] > fr->loglik_initial[arg] ? i : arg;
+        }
+        CHECK_INT((int)fr->initial, arg);
+        CHECK_INT(fr->initial_untested, 0);
     }
     pd_fit_result_free(fr);
 }
