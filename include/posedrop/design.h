@@ -201,6 +201,10 @@ typedef struct pd_design_result {
     int poses_before, poses_after; /* stable poses of the part as given, of the result */
     pd_part *part;             /* the result, the caller's through
                                   pd_design_result_free */
+    int partial;               /* 1: the drops were cancelled (options.sim's
+                                  cancel flag): the result is the best point
+                                  found before, not refined further and not
+                                  checked (p_after, lo, hi 0) */
 } pd_design_result;
 
 /* Designs: searches changes (nchanges in 1..PD_DESIGN_MAX_CHANGES) for the

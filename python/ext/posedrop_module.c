@@ -1246,6 +1246,233 @@ static PyObject *Drops_sensitivity(DropsObject *self, PyObject *args)
     return d;
 }
 
+/* --- design ------------------------------------------------------------ */
+
+/* changes: a sequence of (kind, axis, lo, hi) tuples, kind "scale" or
+ * "com", or ("stretch", axis, lo, hi, from, to) for a slab; metres. */
+static int read_changes(PyObject *seq, pd_change *ch, int *n)
+{
+    PyObject *fast = PySequence_Fast(seq, "changes: expected a sequence of tuples");
+    if (!fast)
+        return -1;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(fast);
+    int rc = 0;
+    if (m < 1 || m > PD_DESIGN_MAX_CHANGES) {
+        PyErr_Format(PyExc_ValueError, "changes: expected 1 to %d, got %zd",
+                     PD_DESIGN_MAX_CHANGES, m);
+        rc = -1;
+    }
+    for (Py_ssize_t i = 0; rc == 0 && i < m; i++) {
+        const char *kind;
+        int axis;
+        double lo, hi, from = 0.0, to = 0.0;
+        PyObject *item = PySequence_Fast_GET_ITEM(fast, i);
+        if (!PyTuple_Check(item) ||
+            !PyArg_ParseTuple(item, "sidd|dd", &kind, &axis, &lo, &hi, &from, &to)) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_ValueError, "changes[%zd]: expected (kind, axis, lo, hi) or "
+                         "('stretch', axis, lo, hi, from, to)", i);
+            rc = -1;
+            break;
+        }
+        memset(&ch[i], 0, sizeof ch[i]);
+        ch[i].axis = axis;
+        ch[i].lo = lo;
+        ch[i].hi = hi;
+        if (strcmp(kind, "scale") == 0 && PyTuple_GET_SIZE(item) == 4)
+            ch[i].kind = PD_CHANGE_SCALE;
+        else if (strcmp(kind, "com") == 0 && PyTuple_GET_SIZE(item) == 4)
+            ch[i].kind = PD_CHANGE_COM;
+        else if (strcmp(kind, "stretch") == 0 && PyTuple_GET_SIZE(item) == 6) {
+            ch[i].kind = PD_CHANGE_SCALE;
+            ch[i].slab = 1;
+            ch[i].from = from;
+            ch[i].to = to;
+        } else {
+            PyErr_Format(PyExc_ValueError, "changes[%zd]: kind '%s': expected 'scale' or 'com' "
+                         "(4 items) or 'stretch' (6 items)", i, kind);
+            rc = -1;
+        }
+    }
+    *n = (int)m;
+    Py_DECREF(fast);
+    return rc;
+}
+
+static PyObject *Poses_design_sensitivity(PosesObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"changes", "classes", "nclasses", "drops", "seed", "threads", NULL};
+    PyObject *changes, *classes = Py_None;
+    int nclasses = 0, threads = 0;
+    long drops = 0;
+    unsigned long long seed = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OilKi", kwlist, &changes, &classes, &nclasses,
+                                     &drops, &seed, &threads))
+        return NULL;
+    pd_change ch[PD_DESIGN_MAX_CHANGES];
+    int n = 0;
+    if (read_changes(changes, ch, &n) < 0)
+        return NULL;
+    Py_buffer view = {0};
+    if (classes != Py_None) {
+        if (PyObject_GetBuffer(classes, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+            return NULL;
+        if (view.itemsize != sizeof(int) ||
+            view.len != (Py_ssize_t)(sizeof(int) * (size_t)self->res->nposes)) {
+            PyBuffer_Release(&view);
+            PyErr_SetString(PyExc_ValueError, "classes: expected one C int per pose");
+            return NULL;
+        }
+    }
+    pd_sim_options so;
+    pd_sim_options_default(&so);
+    so.ndrops = drops;
+    so.seed = (uint64_t)seed;
+    so.threads = threads;
+    warn_box w;
+    pd_diag diag;
+    diag_start(&diag, &w);
+    pd_design_sens *s = NULL;
+    pd_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = pd_design_sensitivity(self->part->part, self->res, NULL, ch, n,
+                               classes != Py_None ? view.buf : NULL, nclasses, NULL,
+                               drops > 0 ? &so : NULL, &s, &diag);
+    Py_END_ALLOW_THREADS
+    if (classes != Py_None)
+        PyBuffer_Release(&view);
+    if (st != PD_OK)
+        return fail(st, &diag, &w);
+    if (diag_finish(&w) < 0) {
+        pd_design_sens_free(s);
+        return NULL;
+    }
+    size_t m = (size_t)s->nposes * (size_t)s->nchanges;
+    PyObject *d = PyDict_New();
+    void *pose = NULL, *v = NULL;
+    int bad = !d || put(d, "nposes", PyLong_FromLong(s->nposes)) ||
+              put(d, "ndrops", PyLong_FromLong(s->ndrops)) ||
+              put_doubles(d, "step", s->step, (size_t)s->nchanges) ||
+              put(d, "pose", new_buffer(m, sizeof(int32_t), &pose)) ||
+              put(d, "values", new_buffer(7 * m, sizeof(double), &v));
+    for (size_t i = 0; !bad && i < m; i++) {
+        const pd_design_sens_row *r = &s->rows[i];
+        const double row[7] = {r->d_qs, r->d_pqs, r->d_p, r->lo, r->hi, r->qs_kink, r->pqs_kink};
+        ((int32_t *)pose)[i] = r->pose;
+        memcpy((double *)v + 7 * i, row, sizeof row);
+    }
+    pd_design_sens_free(s);
+    if (bad) {
+        Py_XDECREF(d);
+        return NULL;
+    }
+    return d;
+}
+
+static const char *const goal_names[] = {"target", "maximise", "equalise", NULL};
+static const char *const model_names[] = {"qs", "pqs", NULL};
+
+static PyObject *Part_design(PartObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"changes", "goal", "normals", "p", "model", "group", "n",
+                             "max_evals", "check", "seed", "threads", NULL};
+    PyObject *changes, *goal = Py_None, *normals, *probs = Py_None, *model = Py_None;
+    int group = 0, max_evals = 12, threads = 0;
+    long ndrops = 20000, check = 20000;
+    unsigned long long seed = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|OOplilKi", kwlist, &changes, &goal, &normals,
+                                     &probs, &model, &group, &ndrops, &max_evals, &check, &seed,
+                                     &threads))
+        return NULL;
+    pd_change ch[PD_DESIGN_MAX_CHANGES];
+    int n = 0, g = 0, mdl = PD_DESIGN_PQS;
+    if (read_changes(changes, ch, &n) < 0 || choose("goal", goal_names, goal, &g) < 0 ||
+        choose("model", model_names, model, &mdl) < 0)
+        return NULL;
+    enum { MAXT = 64 };
+    pd_design_target t[MAXT];
+    PyObject *fn = PySequence_Fast(normals, "normals: expected a sequence of (nx, ny, nz)");
+    if (!fn)
+        return NULL;
+    Py_ssize_t nt = PySequence_Fast_GET_SIZE(fn);
+    PyObject *fp = probs != Py_None ? PySequence_Fast(probs, "p: expected a sequence") : NULL;
+    int rc = probs != Py_None && !fp ? -1 : 0;
+    if (rc == 0 && (nt < 1 || nt > MAXT || (fp && PySequence_Fast_GET_SIZE(fp) != nt))) {
+        PyErr_Format(PyExc_ValueError, "normals: expected 1 to %d, and as many p", MAXT);
+        rc = -1;
+    }
+    for (Py_ssize_t i = 0; rc == 0 && i < nt; i++) {
+        double x, y, z;
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fn, i), "ddd", &x, &y, &z)) {
+            rc = -1;
+            break;
+        }
+        t[i].normal = (pd_vec3){x, y, z};
+        t[i].p = fp ? PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fp, i)) : 0.0;
+        if (PyErr_Occurred())
+            rc = -1;
+    }
+    Py_DECREF(fn);
+    Py_XDECREF(fp);
+    if (rc < 0)
+        return NULL;
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.model = (pd_design_model)mdl;
+    o.group = group;
+    o.sim.ndrops = ndrops;
+    o.sim.seed = (uint64_t)seed;
+    o.sim.threads = threads;
+    o.max_evals = max_evals;
+    o.check_drops = check;
+    o.check_seed = (uint64_t)seed + 1;
+    warn_box w;
+    pd_diag diag;
+    diag_start(&diag, &w);
+    pd_design_result *r = NULL;
+    pd_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = pd_design_run(self->part, ch, n, (pd_design_goal)g, t, (int)nt, &o, &r, &diag);
+    Py_END_ALLOW_THREADS
+    if (st != PD_OK)
+        return fail(st, &diag, &w);
+    if (diag_finish(&w) < 0) {
+        pd_design_result_free(r);
+        return NULL;
+    }
+    PyObject *d = PyDict_New();
+    void *v = NULL;
+    int bad = !d || put_doubles(d, "value_before", r->value_before, (size_t)n) ||
+              put_doubles(d, "value_static", r->value_static, (size_t)n) ||
+              put_doubles(d, "value", r->value, (size_t)n) ||
+              put(d, "objective_static", PyFloat_FromDouble(r->objective_static)) ||
+              put(d, "objective_refine", PyFloat_FromDouble(r->objective_refine)) ||
+              put(d, "objective_after", PyFloat_FromDouble(r->objective_after)) ||
+              put(d, "static_evals", PyLong_FromLong(r->static_evals)) ||
+              put(d, "drop_evals", PyLong_FromLong(r->drop_evals)) ||
+              put(d, "drops", PyLong_FromLong(r->drops)) ||
+              put(d, "poses_before", PyLong_FromLong(r->poses_before)) ||
+              put(d, "poses_after", PyLong_FromLong(r->poses_after)) ||
+              put(d, "targets", new_buffer(14 * (size_t)nt, sizeof(double), &v));
+    for (Py_ssize_t i = 0; !bad && i < nt; i++) {
+        const pd_design_target_result *q = &r->targets[i];
+        const double row[14] = {q->p_target, q->qs_before, q->pqs_before, q->qs_static,
+                                q->pqs_static, q->qs_after, q->pqs_after, q->p_refine,
+                                q->p_after, q->lo, q->hi, q->vanished, q->appeared, 0.0};
+        memcpy((double *)v + 14 * i, row, sizeof row);
+    }
+    if (!bad) {
+        bad = put(d, "part", part_new(r->part));
+        r->part = NULL; /* the new Part owns it (part_new frees it on failure) */
+    }
+    pd_design_result_free(r);
+    if (bad) {
+        Py_XDECREF(d);
+        return NULL;
+    }
+    return d;
+}
+
 /* --- module ------------------------------------------------------------ */
 
 static PyObject *mod_version(PyObject *mod, PyObject *unused)
@@ -1323,6 +1550,8 @@ static PyMethodDef Part_methods[] = {
     {"info", (PyCFunction)Part_info, METH_NOARGS, "the part's properties as a dict"},
     {"mesh", (PyCFunction)Part_mesh, METH_NOARGS, "(vertices, faces) buffers of the welded mesh"},
     {"hull", (PyCFunction)Part_hull, METH_NOARGS, "the convex hull as a dict of buffers"},
+    {"design", (PyCFunction)(void (*)(void))Part_design, METH_VARARGS | METH_KEYWORDS,
+     "pd_design_run"},
     {"estimate", (PyCFunction)(void (*)(void))Part_estimate, METH_VARARGS | METH_KEYWORDS,
      "pd_static_estimate"},
     {NULL, NULL, 0, NULL}};
@@ -1332,6 +1561,8 @@ static PyMethodDef Poses_methods[] = {
     {"facets", (PyCFunction)Poses_facets, METH_NOARGS, "the hull facets as a dict of buffers"},
     {"classes", (PyCFunction)Poses_classes, METH_NOARGS, "pd_pose_classes: (buffer, nclasses)"},
     {"drop", (PyCFunction)(void (*)(void))Poses_drop, METH_VARARGS | METH_KEYWORDS, "pd_sim_run"},
+    {"design_sensitivity", (PyCFunction)(void (*)(void))Poses_design_sensitivity,
+     METH_VARARGS | METH_KEYWORDS, "pd_design_sensitivity"},
     {NULL, NULL, 0, NULL}};
 
 static PyMethodDef Drops_methods[] = {

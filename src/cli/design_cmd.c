@@ -27,11 +27,12 @@ static void design_usage(FILE *out)
         "Writes the changed part (OFF, in the input's units) and prints one CSV row per\n"
         "named pose:\n"
         "  pose,nx,ny,nz,p_target,p_qs_before,p_pqs_before,p_qs_after,p_pqs_after,\n"
-        "  p_refine,p_after,ci_lo,ci_hi,met,vanished\n"
+        "  p_refine,p_after,ci_lo,ci_hi,met,vanished,partial\n"
         "p_refine: the search's own drops at the result; p_after, ci_lo, ci_hi: the\n"
         "fresh drops and their 95%% Wilson interval; met: 1 when the target lies in it\n"
         "(targets only); vanished: 1 when the pose's facet no longer rests (it topples,\n"
-        "or merged into another). stderr: progress, the change in words, the cost.\n"
+        "or merged into another); partial: 1 when a signal stopped the drops (the best\n"
+        "part found so far, unchecked). stderr: progress, the change in words, the cost.\n"
         "\n"
         "  --vary SPEC      the changes, comma-separated, each KEY=LO:HI:\n"
         "                   scale_x, scale_y, scale_z: stretch the part by a factor\n"
@@ -238,10 +239,14 @@ static void progress_line(void *user, const char *stage, int evals, double objec
             evals == 1 ? "" : "s", objective);
 }
 
-static const char *change_name(const pd_change *c, char *buf, size_t size)
+/* The change as --vary names it (a slab's planes in file units). */
+static const char *change_name(const pd_change *c, double unit, char *buf, size_t size)
 {
-    snprintf(buf, size, "%s_%c", c->kind == PD_CHANGE_COM ? "com" : c->slab ? "stretch" : "scale",
-             axis_names[c->axis]);
+    if (c->slab)
+        snprintf(buf, size, "stretch_%c@%g:%g", axis_names[c->axis], c->from / unit, c->to / unit);
+    else
+        snprintf(buf, size, "%s_%c", c->kind == PD_CHANGE_COM ? "com" : "scale",
+                 axis_names[c->axis]);
     return buf;
 }
 
@@ -249,22 +254,29 @@ static const char *change_name(const pd_change *c, char *buf, size_t size)
 static void say_change(const pd_change *c, double before, double after, double unit,
                        const char *uname)
 {
-    char name[32];
-    change_name(c, name, sizeof name);
+    char name[64];
+    change_name(c, unit, name, sizeof name);
     if (c->kind == PD_CHANGE_COM)
-        fprintf(stderr, "%s: design: %s = %.6g %s: the centre of mass moved %.4g %s toward %c%c "
+        fprintf(stderr, "%s: design: %s = %.10g %s: the centre of mass moved %.4g %s toward %c%c "
                 "(range %g:%g)\n", prog, name, after / unit, uname, fabs(after - before) / unit,
                 uname, after >= before ? '+' : '-', axis_names[c->axis], c->lo / unit,
                 c->hi / unit);
     else if (c->slab)
-        fprintf(stderr, "%s: design: %s = %.6g: the slab %g to %g %s along %c %s %.4g%% "
+        fprintf(stderr, "%s: design: %s = %.10g: the slab %g to %g %s along %c %s %.4g%% "
                 "(range %g:%g)\n", prog, name, after, c->from / unit, c->to / unit, uname,
                 axis_names[c->axis], after >= 1.0 ? "thickened by" : "thinned by",
                 100.0 * fabs(after - 1.0), c->lo, c->hi);
     else
-        fprintf(stderr, "%s: design: %s = %.6g: the part %s %.4g%% along its axis %c (range "
+        fprintf(stderr, "%s: design: %s = %.10g: the part %s %.4g%% along its axis %c (range "
                 "%g:%g)\n", prog, name, after, after >= 1.0 ? "stretched by" : "shortened by",
                 100.0 * fabs(after - 1.0), axis_names[c->axis], c->lo, c->hi);
+}
+
+/* The library's message, once prefixed with the subcommand. */
+static void say_failure(const pd_diag *diag, pd_status st)
+{
+    const char *m = diag->message[0] ? diag->message : pd_status_str(st);
+    fprintf(stderr, "%s: %s%s\n", prog, strncmp(m, "design:", 7) == 0 ? "" : "design: ", m);
 }
 
 static int write_off(FILE *f, const pd_part *p, double unit, const char *src, int com_given)
@@ -302,9 +314,9 @@ static void write_sensitivity(FILE *f, const pd_design_sens *s, const pd_static_
         for (int k = 0; k < s->nchanges; k++) {
             const pd_design_sens_row *r = &s->rows[i * s->nchanges + k];
             double per = ch[k].kind == PD_CHANGE_COM ? unit : 1.0; /* per file unit */
-            char name[32];
+            char name[64];
             fprintf(f, "%d,%.10g,%.10g,%.10g,%s,%.10g,%.10g,", i + 1, cli_clean(n.x),
-                    cli_clean(n.y), cli_clean(n.z), change_name(&ch[k], name, sizeof name),
+                    cli_clean(n.y), cli_clean(n.z), change_name(&ch[k], unit, name, sizeof name),
                     r->d_qs * per, r->d_pqs * per);
             if (s->ndrops > 0)
                 fprintf(f, "%.10g,%.10g,%.10g,%.10g", r->d_p * per, r->lo * per, r->hi * per,
@@ -516,7 +528,7 @@ static int load(design_in *in, pd_mesh **mesh, pd_part **part, pd_static_result 
 static void print_result(const pd_design_result *r, const pd_design_target *t, pd_design_goal goal)
 {
     printf("pose,nx,ny,nz,p_target,p_qs_before,p_pqs_before,p_qs_after,p_pqs_after,p_refine,"
-           "p_after,ci_lo,ci_hi,met,vanished\n");
+           "p_after,ci_lo,ci_hi,met,vanished,partial\n");
     for (int i = 0; i < r->ntargets; i++) {
         const pd_design_target_result *q = &r->targets[i];
         printf("%d,%.10g,%.10g,%.10g,", i + 1, cli_clean(t[i].normal.x), cli_clean(t[i].normal.y),
@@ -531,7 +543,7 @@ static void print_result(const pd_design_result *r, const pd_design_target *t, p
             printf(",");
         else
             printf("%d,", q->p_target >= q->lo && q->p_target <= q->hi);
-        printf("%d\n", q->vanished);
+        printf("%d,%d\n", q->vanished, r->partial);
     }
 }
 
@@ -544,9 +556,9 @@ static void print_summary(const design_in *in, const pd_design_result *r,
         say_change(&in->changes[k], r->value_before[k], r->value[k], unit,
                    unames[in->read.units]);
     for (int k = 0; k < r->nchanges; k++) {
-        char name[32];
+        char name[64];
         fprintf(stderr, "%s: design: %s: %.6g at the %s optimum, %.6g after the drops\n", prog,
-                change_name(&in->changes[k], name, sizeof name),
+                change_name(&in->changes[k], unit, name, sizeof name),
                 in->changes[k].kind == PD_CHANGE_COM ? r->value_static[k] / unit
                                                      : r->value_static[k],
                 in->o.model == PD_DESIGN_QS ? "QS" : "PQS",
@@ -589,9 +601,12 @@ static void say_sensitivity(const pd_design_sens *s, const pd_static_result *res
             if (ch[k].kind == PD_CHANGE_COM)
                 snprintf(what, sizeof what, "moving the centre of mass 1 %s toward +%c", uname,
                          axis_names[ch[k].axis]);
+            else if (ch[k].slab)
+                snprintf(what, sizeof what, "stretching the slab %g to %g %s along %c by 10%%",
+                         ch[k].from / unit, ch[k].to / unit, uname, axis_names[ch[k].axis]);
             else
-                snprintf(what, sizeof what, "stretching %s %c by 10%%",
-                         ch[k].slab ? "the slab along" : "the part along", axis_names[ch[k].axis]);
+                snprintf(what, sizeof what, "stretching the part along %c by 10%%",
+                         axis_names[ch[k].axis]);
             fprintf(stderr, "%s: design: pose %d (%.3g, %.3g, %.3g): %s moves it %+.2f points "
                     "(QS), %+.2f (PQS)", prog, i + 1, cli_clean(n.x), cli_clean(n.y),
                     cli_clean(n.z), what, 100 * r->d_qs * per, 100 * r->d_pqs * per);
@@ -667,8 +682,7 @@ int cli_design(int argc, char **argv)
                                              class_of, nclasses, &in.o.scene,
                                              in.sens_drops > 0 ? &so : NULL, &s, &diag);
         if (st != PD_OK) {
-            fprintf(stderr, "%s: design: %s\n", prog, diag.message[0] ? diag.message
-                                                                       : pd_status_str(st));
+            say_failure(&diag, st);
             code = st == PD_ERR_USAGE ? EXIT_USAGE : EXIT_INTERNAL;
         } else {
             write_sensitivity(outs[1].f, s, res, class_of, in.changes, unit);
@@ -688,8 +702,7 @@ int cli_design(int argc, char **argv)
         pd_status st = pd_design_run(part, in.changes, in.nchanges, in.goal, targets, nt, &in.o,
                                      &r, &diag);
         if (st != PD_OK) {
-            fprintf(stderr, "%s: design: %s\n", prog, diag.message[0] ? diag.message
-                                                                       : pd_status_str(st));
+            say_failure(&diag, st);
             code = st == PD_ERR_USAGE || pd_status_is_input_error(st) ? EXIT_USAGE
                                                                       : EXIT_INTERNAL;
         } else {
@@ -707,6 +720,10 @@ int cli_design(int argc, char **argv)
                             (r->part->com.x + r->part->origin.x) / unit,
                             (r->part->com.y + r->part->origin.y) / unit,
                             (r->part->com.z + r->part->origin.z) / unit);
+                if (r->partial)
+                    fprintf(stderr, "%s: design: interrupted: %s holds the best part found "
+                            "before the signal, neither refined further nor checked\n", prog,
+                            in.out_path);
                 print_result(r, targets, in.goal);
                 if (fflush(stdout) != 0 || ferror(stdout))
                     code = EXIT_INTERNAL;

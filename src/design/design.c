@@ -70,6 +70,7 @@ typedef struct run {
     long drops;
     pd_diag *diag;
     pd_status st;               /* the first hard failure */
+    int partial;                /* the drops were cancelled (options.sim.cancel) */
 } run;
 
 /* One evaluated point: the changed part, its static estimate, and each
@@ -427,6 +428,7 @@ static double drop_eval(run *R, const double *x, long n, uint64_t seed, double *
         return HUGE_VAL;
     }
     R->drops += s->n;
+    R->partial |= s->partial;
     int np = p.res->nposes;
     for (int t = 0; t < R->nt; t++) {
         long c = 0;
@@ -464,8 +466,8 @@ static double nm_fn(const double *x, void *user)
     }
     R->drop_evals++;
     double f = drop_eval(R, y, R->o->sim.ndrops, R->o->sim.seed, pt, NULL, NULL, NULL);
-    if (R->st != PD_OK)
-        return NAN;
+    if (R->st != PD_OK || R->partial)
+        return NAN; /* stops the simplex */
     if (!isfinite(f))
         f = 4.0;
     if (f < u->best_f) {
@@ -477,6 +479,15 @@ static double nm_fn(const double *x, void *user)
     return f + out;
 }
 
+/* The objective that sampling error alone leaves at the answer. */
+static double noise_floor(const run *R, const double *p)
+{
+    double v = 0.0;
+    for (int t = 0; t < R->nt; t++)
+        v += p[t] * (1.0 - p[t]);
+    return v / (double)R->o->sim.ndrops;
+}
+
 /* Stage 3 from x (overwritten by the best point the drops found); the
  * drops' objective there, and the targets' probabilities into best_p. J0
  * is the static Jacobian at x. */
@@ -485,15 +496,34 @@ static double drop_stage(run *R, double *x, const double *J0, int m, double *bes
     int d = R->d;
     double pt[MAX_TARGETS], r[MAX_TARGETS];
     if (R->goal == PD_GOAL_MAXIMISE) {
+        /* The static model can be far from the drops (a flange's share
+         * under PQS is a fifth of the drops'), so the simplex starts from
+         * the best on drops of the static optimum, the range's middle and,
+         * for up to three changes, its corners; its first steps span a
+         * quarter of the range. */
         nm_user u = {R, HUGE_VAL, {0}, {0}};
-        double step[PD_DESIGN_MAX_CHANGES], fmin;
+        double step[PD_DESIGN_MAX_CHANGES], fmin, y[PD_DESIGN_MAX_CHANGES];
+        nm_fn(x, &u);
+        int ncorners = d <= 3 ? 1 << d : 0;
+        for (int c = -1; c < ncorners && R->st == PD_OK && !R->partial &&
+                         R->drop_evals < R->o->max_evals; c++) {
+            for (int k = 0; k < d; k++)
+                y[k] = c < 0 ? 0.5 : (c >> k) & 1;
+            nm_fn(y, &u);
+        }
+        if (R->st != PD_OK || R->partial || !isfinite(u.best_f))
+            return u.best_f;
+        memcpy(x, u.best_x, sizeof(double) * (size_t)d);
         for (int k = 0; k < d; k++)
-            step[k] = 0.1;
-        int evals = 0;
-        pd_status st = pd_gsl_nelder_mead(nm_fn, &u, d, x, step, 1e-3, R->o->max_evals, &evals,
-                                          &fmin);
-        if (st != PD_OK && R->st == PD_OK)
-            R->st = st == PD_ERR_INTERNAL ? PD_OK : st;
+            step[k] = x[k] > 0.5 ? -0.25 : 0.25;
+        int evals = 0, left = R->o->max_evals - R->drop_evals;
+        pd_status st = left > d ? pd_gsl_nelder_mead(nm_fn, &u, d, x, step, 1e-3, left, &evals,
+                                                     &fmin)
+                                : PD_OK;
+        /* A stop asked for by nm_fn, or a first simplex that could not be
+         * set, leaves the best point found; only memory is fatal. */
+        if (st == PD_ERR_NOMEM && R->st == PD_OK)
+            R->st = pd_fail(R->diag, st, "design: out of memory");
         if (isfinite(u.best_f))
             memcpy(x, u.best_x, sizeof(double) * (size_t)d);
         memcpy(best_p, u.best_p, sizeof u.best_p);
@@ -509,10 +539,12 @@ static double drop_stage(run *R, double *x, const double *J0, int m, double *bes
     progress(R, "drops", R->drop_evals, f);
     double lambda = 1e-6;
     int misses = 0;
-    /* Three steps in a row that do not lower the objective: the drops'
-     * answer is as good as their own resolution lets it be. */
-    while (R->drop_evals < R->o->max_evals && isfinite(f) && f > 0.0 && R->st == PD_OK &&
-           misses < 3) {
+    /* Three steps in a row that do not lower the objective, or an
+     * objective below what the drops' own sampling error gives at the
+     * answer (sum_t p_t (1 - p_t) / n): the drops' answer is as good as
+     * their resolution lets it be. */
+    while (R->drop_evals < R->o->max_evals && isfinite(f) && f > noise_floor(R, best_p) &&
+           R->st == PD_OK && !R->partial && misses < 3) {
         double x1[PD_DESIGN_MAX_CHANGES], r1[MAX_TARGETS], dx[PD_DESIGN_MAX_CHANGES];
         lm_step(x, r, J, m, d, lambda, x1);
         double dd = 0.0;
@@ -524,6 +556,8 @@ static double drop_stage(run *R, double *x, const double *J0, int m, double *bes
             break;
         R->drop_evals++;
         double f1 = drop_eval(R, x1, R->o->sim.ndrops, R->o->sim.seed, pt, NULL, r1, &m);
+        if (R->partial)
+            break; /* a cancelled evaluation's drops are fewer: not comparable */
         if (!isfinite(f1)) {
             lambda = lambda * 10.0 + 1e-3;
             continue;
@@ -732,7 +766,7 @@ pd_status pd_design_run(const pd_part *part, const pd_change *changes, int nchan
             res->targets[t].vanished = !stable[t];
         }
     }
-    if (R.st == PD_OK && options->check_drops > 0) {
+    if (R.st == PD_OK && options->check_drops > 0 && !R.partial) {
         double pt[MAX_TARGETS], r[MAX_TARGETS];
         long count[MAX_TARGETS];
         int m;
@@ -766,6 +800,7 @@ pd_status pd_design_run(const pd_part *part, const pd_change *changes, int nchan
     res->static_evals = R.static_evals;
     res->drop_evals = R.drop_evals;
     res->drops = R.drops;
+    res->partial = R.partial;
     free(R.mark);
     if (R.st != PD_OK) {
         pd_design_result_free(res);

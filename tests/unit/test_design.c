@@ -423,6 +423,19 @@ static void test_drop_design(void)
                    "two classes hold every pose");
     }
     pd_design_result_free(r);
+    /* Cancelled before the first drop: the static answer comes back, marked
+     * partial and unchecked. */
+    pd_cancel_flag stop = 1;
+    o.sim.cancel = &stop;
+    r = NULL;
+    if (cube)
+        CHECK_STATUS(pd_design_run(cube, &ch, 1, PD_GOAL_TARGET, t, 2, &o, &r, NULL), PD_OK);
+    if (r) {
+        CHECK_INT(r->partial, 1);
+        CHECK_INT(r->drop_evals, 1);
+        CHECK(r->targets[0].p_after == 0.0 && r->value[0] == r->value_static[0]);
+    }
+    pd_design_result_free(r);
     pd_part_free(cube);
 }
 

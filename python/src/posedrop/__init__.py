@@ -20,8 +20,8 @@ import signal as _signal
 import threading as _threading
 
 from . import _posedrop
-from ._api import (END_NAMES, PARAM_NAMES, Drops, Facets, Part, PoseClasses, Sensitivity,
-                   StablePoses, Trials)
+from ._api import (END_NAMES, PARAM_NAMES, Design, DesignSensitivity, Drops, Facets, Part,
+                   PoseClasses, Sensitivity, StablePoses, Trials)
 from ._errors import InputError, InternalError, PosedropError, PosedropWarning
 from ._trimesh import compute_stable_poses
 
@@ -53,6 +53,7 @@ def engine_available(engine):
 
 
 __all__ = ["Part", "StablePoses", "Facets", "PoseClasses", "Drops", "Trials", "Sensitivity",
+           "Design", "DesignSensitivity",
            "END_NAMES", "PARAM_NAMES",
            "compute_stable_poses", "PosedropError", "InputError", "InternalError",
            "PosedropWarning", "Status", "engine_available", "__version__"]
