@@ -226,13 +226,16 @@ check-browser: deps
 # The insulator cap's gallery, chart against the paper's physical tests and
 # gauss-sphere map, and the cost-accuracy chart, into docs/figures/
 # (docs/figures.md); the table of docs/uncertainty.md, ranged runs beside
-# sweeps (docs/figures/uncertainty/). CHART_ONLY=1 redraws the
+# sweeps (docs/figures/uncertainty/); make paper's tables, whose eq. (16)
+# errors README quotes (docs/figures/paper.txt). CHART_ONLY=1 redraws the
 # cost-accuracy chart from its kept CSV instead of rerunning its several
 # minutes of drops.
 figures: deps
 	@$(MAKE) --no-print-directory all
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
 	POSEDROP=$(CLI) scripts/uncertainty.sh
+	{ echo "# scripts/paper.sh (POSEDROP=$(CLI); make figures), commit $$(git rev-parse --short HEAD), $$(date -u +%F)"; \
+	  POSEDROP=$(CLI) scripts/paper.sh; } > docs/figures/paper.txt
 
 # The cheap measured files behind docs/ rerun: fails when a number moved
 # beyond its drops' noise (make check-full runs it).
