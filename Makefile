@@ -105,7 +105,7 @@ BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
 .PHONY: all check check-full check-install test bench bench-mujoco referee demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
-        check-browser figures mpi
+        check-browser figures check-figures mpi
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
@@ -212,6 +212,7 @@ check check-full: deps lint
 	@$(MAKE) --no-print-directory $(if $(filter -j%,$(MAKEFLAGS)),,-j2) all $(TEST_BIN)
 	@$(MAKE) --no-print-directory check-install
 	@$(MAKE) --no-print-directory test $(if $(filter check-full,$@),TEST_FULL=1)
+	$(if $(filter check-full,$@),@$(MAKE) --no-print-directory check-figures)
 
 demo: deps
 	@$(MAKE) --no-print-directory all
@@ -225,11 +226,23 @@ check-browser: deps
 
 # The insulator cap's gallery, chart against the paper's physical tests and
 # gauss-sphere map, and the cost-accuracy chart, into docs/figures/
-# (docs/figures.md). CHART_ONLY=1 redraws the cost-accuracy chart from its
-# kept CSV instead of rerunning its several minutes of drops.
+# (docs/figures.md); the table of docs/uncertainty.md, ranged runs beside
+# sweeps (docs/figures/uncertainty/); make paper's tables, whose eq. (16)
+# errors README quotes (docs/figures/paper.txt). CHART_ONLY=1 redraws the
+# cost-accuracy chart from its kept CSV instead of rerunning its several
+# minutes of drops.
 figures: deps
 	@$(MAKE) --no-print-directory all
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
+	POSEDROP=$(CLI) scripts/uncertainty.sh
+	{ echo "# scripts/paper.sh (POSEDROP=$(CLI); make figures), commit $$(git rev-parse --short HEAD), $$(date -u +%F)"; \
+	  POSEDROP=$(CLI) scripts/paper.sh; } > docs/figures/paper.txt
+
+# The cheap measured files behind docs/ rerun: fails when a number moved
+# beyond its drops' noise (make check-full runs it).
+check-figures:
+	@$(MAKE) --no-print-directory $(CLI)
+	python3 scripts/check_figures.py -b $(CLI) docs/figures/uncertainty/*-ranged.csv
 
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
@@ -342,7 +355,7 @@ help:
 	@echo "make referee    the cross-check corpus on the three engines and MuJoCo, into docs"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
-	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"
+	@echo "make figures    the cap's pictures, the cost-accuracy chart and the uncertainty table in docs/"
 	@echo "make check-install  install to a temporary prefix, build the library example"
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make MPI=1      also build posedrop-mpi with OpenMPI (scripts/install-deps.sh mpi)"
