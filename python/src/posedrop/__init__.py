@@ -20,7 +20,7 @@ import enum as _enum
 from . import _posedrop
 from ._api import (END_NAMES, PARAM_NAMES, Drops, Facets, Part, PoseClasses, Sensitivity,
                    StablePoses, Trials)
-from ._errors import InputError, InternalError, PosedropError, PosedropWarning
+from ._errors import InputError, InternalError, PosedropError, PosedropWarning, UnitsWarning
 from ._trimesh import compute_stable_poses
 
 #: The library's statuses (``pd_status``), e.g. ``Status.ERR_PARSE``.
@@ -38,4 +38,4 @@ def engine_available(engine):
 __all__ = ["Part", "StablePoses", "Facets", "PoseClasses", "Drops", "Trials", "Sensitivity",
            "END_NAMES", "PARAM_NAMES",
            "compute_stable_poses", "PosedropError", "InputError", "InternalError",
-           "PosedropWarning", "Status", "engine_available", "__version__"]
+           "PosedropWarning", "UnitsWarning", "Status", "engine_available", "__version__"]
