@@ -105,7 +105,7 @@ BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
 .PHONY: all check check-full check-install test bench bench-mujoco referee demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
-        check-browser figures check-figures mpi
+        check-browser check-readme figures check-figures mpi
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
@@ -223,6 +223,12 @@ demo: deps
 check-browser: deps
 	@$(MAKE) --no-print-directory $(CLI)
 	POSEDROP=$(CLI) tests/browser/check.sh
+
+# Every command README.md gives, as written: CI's own checked to be in
+# .ci/run, the others run from a scratch directory (tests/readme/check.sh).
+check-readme: deps
+	@$(MAKE) --no-print-directory all
+	tests/readme/check.sh
 
 # The insulator cap's gallery, chart against the paper's physical tests and
 # gauss-sphere map, and the cost-accuracy chart, into docs/figures/
@@ -355,6 +361,7 @@ help:
 	@echo "make referee    the cross-check corpus on the three engines and MuJoCo, into docs"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
+	@echo "make check-readme   every command README.md gives, run as written"
 	@echo "make figures    the cap's pictures, the cost-accuracy chart and the uncertainty table in docs/"
 	@echo "make check-install  install to a temporary prefix, build the library example"
 	@echo "                with plain pkg-config, compare it with the command"

@@ -30,6 +30,15 @@ typedef enum pd_units { PD_UNITS_M = 0, PD_UNITS_CM, PD_UNITS_MM, PD_UNITS_IN } 
 PD_API double pd_units_scale(pd_units units);
 /* "m", "cm", "mm", "in" -> units. PD_ERR_USAGE for anything else. */
 PD_API pd_status pd_units_parse(const char *text, pd_units *units);
+/* Whether a part of this size (bounding-box diagonal, m) read in these
+ * units is one dropped on a feeder, a belt or a bin: 0.5 mm to 2 m across
+ * (a file in millimetres read as metres is a thousand times too large).
+ * 1 if so, or if size is not a number; 0 if not, with *suggest (NULL
+ * allowed) the unit that, given instead, would make the file's numbers a
+ * plausible part (millimetres first for a part too large), or units itself
+ * when none would. The command, posedrop fit and the Python binding warn
+ * with it; the library itself accepts any size. */
+PD_API int pd_units_plausible(double size, pd_units units, pd_units *suggest);
 
 typedef struct pd_mesh {
     int nverts;

@@ -165,8 +165,8 @@ PD_API pd_status pd_scene_set(pd_scene *scene, const char *key, const char *valu
 PD_API const char *pd_scene_param_name(pd_scene_param param);
 
 /* A parameter's setting as text pd_scene_set reads, in its text's unit
- * (degrees for vibration), numbers with %.6g: "0.3", "0.2:0.5",
- * "0.3x:3x log", "auto". Returns buf. */
+ * (degrees for vibration), each number the shortest text that reads back
+ * to the same value: "0.3", "0.2:0.5", "0.3x:3x log", "auto". Returns buf. */
 PD_API const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *buf,
                                    size_t size);
 

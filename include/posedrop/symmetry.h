@@ -50,8 +50,9 @@ PD_API void pd_symmetry_free(pd_symmetry *symmetry);
  * i's resting facet onto pose j's, corner onto corner, and their centre of
  * mass heights agree within PD_TOL_SYMMETRY_REL of the size. class_of (room
  * for res->nposes entries) receives each pose's class; classes are numbered
- * 0.. in order of first appearance in the pose table, so class 0 holds pose
- * 0. *nclasses receives their number. Returns PD_ERR_USAGE (a NULL argument,
+ * 0.. by decreasing QS probability summed over their members (sums within
+ * PD_TOL_PROB_TIE_REL in order of first appearance in the pose table), as
+ * the poses are. *nclasses receives their number. Returns PD_ERR_USAGE (a NULL argument,
  * a pose whose facet is not a facet of part's hull), PD_ERR_NOMEM. */
 PD_API pd_status pd_pose_classes(const pd_part *part, const pd_static_result *res, int *class_of,
                                  int *nclasses, pd_diag *diag);

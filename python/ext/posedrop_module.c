@@ -875,6 +875,19 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
     return failed ? -1 : 0;
 }
 
+/* The progress callback's last call: (n, n) for a finished run, so that
+ * a bar ends full (the slices report only what was done when they woke);
+ * (n, total) for one cancelled early. */
+static int final_progress(run_ctx *c, PyObject *progress)
+{
+    if (progress == Py_None)
+        return 0;
+    long total = c->sim->partial ? atomic_load(&c->total) : c->sim->n;
+    PyObject *r = PyObject_CallFunction(progress, "ll", c->sim->n, total);
+    Py_XDECREF(r);
+    return r ? 0 : -1;
+}
+
 static const char *const engine_names[] = {"impulse", "ode", "bullet", NULL};
 
 /* Sets option *field from value unless it is None. */
@@ -1042,7 +1055,7 @@ static PyObject *Poses_drop(PosesObject *self, PyObject *args, PyObject *kw)
         diag_discard(&w);
     } else if (c->st != PD_OK) {
         fail(c->st, &c->diag, &w);
-    } else if (diag_finish(&w) < 0) {
+    } else if (diag_finish(&w) < 0 || final_progress(c, progress) < 0) {
         pd_sim_result_free(c->sim);
     } else {
         result = drops_new(c->sim, &c->scene, pd_contact_time_auto_size(c->part));
@@ -1546,6 +1559,22 @@ static PyObject *mod_engine_available(PyObject *mod, PyObject *arg)
     return PyBool_FromLong(pd_engine_available((pd_engine_kind)e));
 }
 
+/* (size, units) -> None if plausible, else the unit to suggest ("" for none):
+ * pd_units_plausible. */
+static PyObject *mod_units_plausible(PyObject *mod, PyObject *args)
+{
+    (void)mod;
+    double size;
+    PyObject *units;
+    pd_units u = PD_UNITS_M, suggest;
+    if (!PyArg_ParseTuple(args, "dO", &size, &units) || read_units(units, &u) < 0)
+        return NULL;
+    if (pd_units_plausible(size, u, &suggest))
+        Py_RETURN_NONE;
+    static const char *const names[] = {"m", "cm", "mm", "in"};
+    return PyUnicode_FromString(suggest == u ? "" : names[suggest]);
+}
+
 static PyMethodDef Part_methods[] = {
     {"info", (PyCFunction)Part_info, METH_NOARGS, "the part's properties as a dict"},
     {"mesh", (PyCFunction)Part_mesh, METH_NOARGS, "(vertices, faces) buffers of the welded mesh"},
@@ -1615,6 +1644,7 @@ static PyMethodDef module_methods[] = {
     {"statuses", mod_statuses, METH_NOARGS, "the pd_status names and values"},
     {"interrupt", mod_interrupt, METH_NOARGS, "stop the runs waiting on other threads (Ctrl-C)"},
     {"engine_available", mod_engine_available, METH_O, "pd_engine_available"},
+    {"units_plausible", mod_units_plausible, METH_VARARGS, "pd_units_plausible"},
     {"names", mod_names, METH_NOARGS, "(stage names, status strings, parameter names)"},
     {NULL, NULL, 0, NULL}};
 

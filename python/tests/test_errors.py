@@ -36,7 +36,9 @@ def test_bad_files_raise_what_the_command_says(tmp_path, name, content):
     with pytest.raises(InputError) as e:
         posedrop.Part.from_file(path)
     assert isinstance(e.value, ValueError) and isinstance(e.value, posedrop.PosedropError)
-    assert e.value.status != Status.OK and e.value.message in proc.stderr
+    # The same words, but for the option's name in each language.
+    message = e.value.message.replace("com=(x, y, z)", "--com X,Y,Z")
+    assert e.value.status != Status.OK and message in proc.stderr
 
 
 def test_missing_file():
@@ -50,6 +52,8 @@ def test_open_mesh_needs_a_centre_of_mass():
     with pytest.raises(InputError) as e:
         posedrop.Part(CUBE_V, faces)
     assert e.value.status == Status.ERR_NOT_CLOSED
+    # The command's advice, in Python's words (--com is com= here).
+    assert str(e.value).endswith("give its centre of mass with com=(x, y, z) to use it anyway")
     with pytest.warns(posedrop.PosedropWarning, match="boundary edge"):
         part = posedrop.Part(CUBE_V, faces, com=[0.005, 0.005, 0.005])
     assert not part.closed and part.volume is None and len(part.stable_poses()) == 6
@@ -190,6 +194,6 @@ def test_mutated_files_fail_where_the_command_fails(tmp_path, name, units):
         else:
             with pytest.raises(InputError) as e:
                 posedrop.Part.from_file(path, units=units).stable_poses()
-            assert e.value.message in proc.stderr
+            assert e.value.message.replace("com=(x, y, z)", "--com X,Y,Z") in proc.stderr
         outcomes.add(proc.returncode)
     assert 2 in outcomes

@@ -148,8 +148,10 @@ def unsettled_line(drops, path):
                      % (drops.time_limited, drops.time_limit))
     if drops.collision_limited:
         parts.append(" %d at the collision limit" % drops.collision_limited)
-    return "posedrop: %s: %d of %d drops did not settle and are in no count:%s" % (
-        path, drops.unsettled, drops.n, ",".join(parts))
+    total = ("" if drops.transitions is not None
+             else " (p sums to %.4g, not 1)" % ((drops.n - drops.unsettled) / drops.n))
+    return "posedrop: %s: %d of %d drops did not settle and are in no count%s:%s" % (
+        path, drops.unsettled, drops.n, total, ",".join(parts))
 
 
 def test_ends_and_time_limit_equal_command(tmp_path):

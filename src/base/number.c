@@ -132,3 +132,18 @@ const char *pd_num_message(char *buf, size_t size, const pd_num_rule *rule, cons
              strlen(text) > 40 ? "..." : "", why);
     return buf;
 }
+
+const char *pd_num_format(char *buf, size_t size, double v, double scale)
+{
+    if (!buf || size == 0)
+        return buf;
+    /* Fewest significant digits first: "9.81" rather than the
+     * 9.8100000000000005 of %.17g, which reads back the same. */
+    for (int digits = 1; digits <= 17; digits++) {
+        snprintf(buf, size, "%.*g", digits, v / scale);
+        if (strtod(buf, NULL) * scale == v)
+            return buf;
+    }
+    snprintf(buf, size, "%.17g", v / scale);
+    return buf;
+}

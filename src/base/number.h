@@ -44,4 +44,9 @@ int pd_num_read(const pd_num_rule *rule, const char *text, double *real, long lo
 const char *pd_num_message(char *buf, size_t size, const pd_num_rule *rule, const char *text,
                            int outcome);
 
+/* v as the shortest text (%.Ng, N from 1 to 17) that reads back to it
+ * when its number is multiplied by scale, the way a scene stores a value
+ * typed in degrees: "9.81", not "9.8100000000000005". Returns buf. */
+const char *pd_num_format(char *buf, size_t size, double v, double scale);
+
 #endif

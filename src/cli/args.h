@@ -30,6 +30,7 @@ typedef struct {
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
     int crosscheck;                /* --crosscheck: every engine on the same releases */
+    char scene_option[32];         /* the first scene option given ("--mu"), "" if none */
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;
     const char *sensitivity;       /* --sensitivity FILE */

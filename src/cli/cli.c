@@ -153,8 +153,8 @@ static const cli_option options[] = {
     {OPT_CONTACT_TIME, "contact-time", ARG_SCENE, "S", NO_RULE, NULL, "contact_time",
      "how long one contact takes to compress and restore, s,\n"
      "0..1, or auto (default): a plastic part on a rubber belt,\n"
-     "5e-4 s for a 1 cm cube, as (volume^2 / size)^(1/5);\n"
-     "0: rigid, the paper's model"},
+     "5e-4 s for a 1 cm cube, as (volume^2 / size)^(1/5), or a\n"
+     "multiple of it (3x); 0: rigid, the paper's model"},
     {OPT_TUMBLE, "tumble", ARG_SCENE, "W", NO_RULE, NULL, "tumble",
      "angular speed at release, rad/s, about an axis drawn\n"
      "uniformly for each drop, 0..10000 (0)"},
@@ -382,6 +382,8 @@ static int scene_option(cli_args *a, const cli_option *o, const char *value)
                 d.message, prog, prog);
         return EXIT_USAGE;
     }
+    if (!a->scene_option[0])
+        option_name(o, a->scene_option, sizeof a->scene_option);
     return -1;
 }
 
@@ -461,6 +463,8 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
             fprintf(stderr, "%s: %s\n", prog, d.message);
             return pd_status_is_input_error(st) ? EXIT_USAGE : EXIT_INTERNAL;
         }
+        if (!a->scene_option[0])
+            snprintf(a->scene_option, sizeof a->scene_option, "--scene");
         break;
     }
     case OPT_TRIALS:
@@ -643,6 +647,11 @@ static int parse_args(int argc, char **argv, cli_args *a)
         a->sim.keep_trials = 1;
     if (a->facets && a->dynamic)
         return fail_usage("%s", "--facets lists hull facets; it does not go with -n or --ci");
+    /* QS and PQS depend on the part alone: a scene given without drops
+     * would change nothing, silently. */
+    if (a->scene_option[0] && !a->dynamic)
+        fprintf(stderr, "%s: warning: %s (like every scene option) applies to drops, and none "
+                        "are run: give -n N to drop the part\n", prog, a->scene_option);
     if (a->facets && a->group)
         return fail_usage("%s", "--facets lists hull facets; it does not go with --group");
     const char *const *pic = a->pictures;

@@ -88,8 +88,10 @@ void progress_clear(void);
 
 /* plausible.c: warns on stderr when the part's size, or the drop height
  * against it, suggests a unit mistaken (a file in millimetres read as
- * metres). */
+ * metres). plausible_warn_size: the size's warning alone
+ * (pd_units_plausible), for posedrop fit's parts too; 1 when it warned. */
 void plausible_warn(const cli_args *a, const pd_part *part);
+int plausible_warn_size(const char *path, double size, pd_units units);
 
 /* same_file.c: 1 when no output is the same file as an input or as another
  * output (standard output included when it is a regular file); otherwise 0,

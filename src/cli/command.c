@@ -456,14 +456,20 @@ static void print_stationary_summary(const cli_args *a, const pd_sim_result *sim
  * them. A merged result from shard files has no breakdown, only the count. */
 static void print_unsettled(const cli_args *a, const pd_sim_result *sim)
 {
+    /* p is count / n, so the rows' p no longer sum to 1: said with the
+     * count (a stationary run's p is the chain's, which does). */
+    char sum[64] = "";
+    if (!sim->transitions && sim->n > 0)
+        snprintf(sum, sizeof sum, " (p sums to %.4g, not 1)",
+                 (double)(sim->n - sim->unsettled) / (double)sim->n);
     if (sim->time_limited + sim->collision_limited + sim->failed != sim->unsettled) {
         fprintf(stderr, "%s: %s: %ld of %ld drops did not settle (time or collision limit, or "
-                        "a solver failed) and are in no count\n", prog, a->path, sim->unsettled,
-                sim->n);
+                        "a solver failed) and are in no count%s\n", prog, a->path,
+                sim->unsettled, sim->n, sum);
         return;
     }
-    fprintf(stderr, "%s: %s: %ld of %ld drops did not settle and are in no count:", prog,
-            a->path, sim->unsettled, sim->n);
+    fprintf(stderr, "%s: %s: %ld of %ld drops did not settle and are in no count%s:", prog,
+            a->path, sim->unsettled, sim->n, sum);
     const char *sep = "";
     if (sim->time_limited) {
         fprintf(stderr, " %ld at the time limit (%.6g s simulated; --time-limit)",

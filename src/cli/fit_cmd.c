@@ -238,8 +238,11 @@ static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
     pd_status st = pd_mesh_read(in->path, read, &in->mesh, &diag);
     if (st == PD_OK)
         st = pd_part_build(in->mesh, &po, &in->part, &diag);
-    if (st == PD_OK)
+    if (st == PD_OK) {
+        /* The same warning as the command's, before minutes of fitting. */
+        plausible_warn_size(in->path, in->part->size, read->units);
         st = pd_static_estimate(in->part, NULL, &in->res, &diag);
+    }
     if (st == PD_OK && group) {
         in->class_of = malloc(sizeof *in->class_of * (size_t)in->res->nposes);
         st = in->class_of ? pd_pose_classes(in->part, in->res, in->class_of, &in->nclasses, &diag)
@@ -287,9 +290,9 @@ static void write_scene(FILE *f, const pd_fit_result *r, const pd_fit_param *par
     for (int k = 0; k < PD_NPARAMS; k++)
         fprintf(f, "%s = %s\n", pd_scene_param_name((pd_scene_param)k),
                 pd_scene_format(s, (pd_scene_param)k, buf, sizeof buf));
-    fprintf(f, "restitution_law = %s\ninitial = %s\ngravity = %.17g\n",
+    fprintf(f, "restitution_law = %s\ninitial = %s\ngravity = %s\n",
             s->law == PD_RESTITUTION_ENERGETIC ? "energetic" : "poisson", initial_name(s->initial),
-            s->gravity);
+            pd_num_format(buf, sizeof buf, s->gravity, 1.0));
 }
 
 /* The unit of a parameter's values as --fit gave them ("auto": multiples of

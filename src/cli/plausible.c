@@ -9,14 +9,6 @@
 #include <stdio.h>
 #include "cli/cli.h"
 
-/* A part dropped onto a feeder, a belt or a bin: from a grain of 0.5 mm (a
- * small SMD part, a watch screw) to 2 m across (a panel). A file in
- * millimetres read as metres is a thousand times too large, one in metres
- * read as millimetres a thousand times too small, so either lands well
- * outside this range for any part inside it. */
-#define PLAUSIBLE_SIZE_MIN 0.5e-3 /* m, bounding-box diagonal */
-#define PLAUSIBLE_SIZE_MAX 2.0    /* m */
-
 /* The drop height against the part's size. Drops in practice fall one to a
  * few tens of part sizes (the paper's belt: 0.12 m for parts of 1.5 to 3
  * cm, 4 to 8 sizes). Over 100 sizes the part lands at more than
@@ -28,10 +20,6 @@
 #define PLAUSIBLE_HEIGHT_MAX_SIZES 100.0
 #define PLAUSIBLE_HEIGHT_MIN_SIZES 0.1
 
-/* From the smallest unit to the largest. A part too large is suggested the
- * first smaller unit that makes it plausible (millimetres, the usual CAD
- * unit, first); one too small the first larger one from the other end
- * (metres first). */
 static const struct {
     pd_units units;
     const char *option, *name;
@@ -43,11 +31,6 @@ static const struct {
 };
 enum { NUNITS = sizeof unit_names / sizeof unit_names[0] };
 
-static int plausible_size(double size)
-{
-    return size >= PLAUSIBLE_SIZE_MIN && size <= PLAUSIBLE_SIZE_MAX;
-}
-
 /* "54 m", "0.04 mm": a length in metres, or in millimetres under 1 m. */
 static void length_text(double m, char *buf, size_t size)
 {
@@ -57,38 +40,31 @@ static void length_text(double m, char *buf, size_t size)
         snprintf(buf, size, "%.3g mm", m * 1e3);
 }
 
-static const char *option_of(pd_units units)
+static int unit_index(pd_units units)
 {
     for (int k = 0; k < NUNITS; k++)
         if (unit_names[k].units == units)
-            return unit_names[k].option;
-    return "?";
+            return k;
+    return NUNITS - 1;
 }
 
-/* Returns 1 when it warned. */
-static int warn_size(const cli_args *a, double size)
+int plausible_warn_size(const char *path, double size, pd_units units)
 {
-    if (plausible_size(size))
+    pd_units suggest;
+    if (pd_units_plausible(size, units, &suggest))
         return 0;
     char len[32];
     length_text(size, len, sizeof len);
-    fprintf(stderr, "%s: warning: %s: the part is %s across", prog, a->path, len);
-    double file_size = size / pd_units_scale(a->read.units); /* in the file's numbers */
-    int large = size > PLAUSIBLE_SIZE_MAX;
-    for (int i = 0; i < NUNITS; i++) {
-        int k = large ? i : NUNITS - 1 - i;
-        if (unit_names[k].units == a->read.units ||
-            !plausible_size(file_size * pd_units_scale(unit_names[k].units)))
-            continue;
-        if (a->read.units == PD_UNITS_M)
-            fprintf(stderr, "; if the file is in %s, add --units %s\n", unit_names[k].name,
-                    unit_names[k].option);
-        else
-            fprintf(stderr, "; if the file is in %s, give --units %s, not --units %s\n",
-                    unit_names[k].name, unit_names[k].option, option_of(a->read.units));
-        return 1;
-    }
-    fprintf(stderr, "; is that what you meant? (--units says what the file's numbers mean)\n");
+    fprintf(stderr, "%s: warning: %s: the part is %s across", prog, path, len);
+    int k = unit_index(suggest);
+    if (suggest == units)
+        fprintf(stderr, "; is that what you meant? (--units says what the file's numbers mean)\n");
+    else if (units == PD_UNITS_M)
+        fprintf(stderr, "; if the file is in %s, add --units %s\n", unit_names[k].name,
+                unit_names[k].option);
+    else
+        fprintf(stderr, "; if the file is in %s, give --units %s, not --units %s\n",
+                unit_names[k].name, unit_names[k].option, unit_names[unit_index(units)].option);
     return 1;
 }
 
@@ -130,7 +106,7 @@ void plausible_warn(const cli_args *a, const pd_part *part)
 {
     /* A part of the wrong size makes any height look wrong: one warning, on
      * the likelier cause. */
-    if (!warn_size(a, part->size) && a->dynamic)
+    if (!plausible_warn_size(a->path, part->size, a->read.units) && a->dynamic)
         warn_height(a, part->size);
     if (a->dynamic)
         warn_tumble(a, part->size);

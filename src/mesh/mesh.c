@@ -46,6 +46,45 @@ pd_status pd_units_parse(const char *text, pd_units *units)
     return PD_ERR_USAGE;
 }
 
+/* A part dropped onto a feeder, a belt or a bin: from a grain of 0.5 mm (a
+ * small SMD part, a watch screw) to 2 m across (a panel). A file in
+ * millimetres read as metres is a thousand times too large, one in metres
+ * read as millimetres a thousand times too small, so either lands well
+ * outside this range for any part inside it. */
+#define PLAUSIBLE_SIZE_MIN 0.5e-3 /* m, bounding-box diagonal */
+#define PLAUSIBLE_SIZE_MAX 2.0    /* m */
+
+static int plausible_size(double size)
+{
+    return size >= PLAUSIBLE_SIZE_MIN && size <= PLAUSIBLE_SIZE_MAX;
+}
+
+int pd_units_plausible(double size, pd_units units, pd_units *suggest)
+{
+    /* From the smallest unit to the largest: a part too large is suggested
+     * the first smaller unit that makes it plausible (millimetres, the usual
+     * CAD unit, first), one too small the first larger from the other end
+     * (metres first). */
+    static const pd_units order[] = {PD_UNITS_MM, PD_UNITS_CM, PD_UNITS_IN, PD_UNITS_M};
+    enum { N = sizeof order / sizeof order[0] };
+    if (suggest)
+        *suggest = units;
+    double scale = pd_units_scale(units);
+    if (!(size == size) || scale == 0.0 || plausible_size(size))
+        return 1;
+    double file_size = size / scale; /* in the file's numbers */
+    int large = size > PLAUSIBLE_SIZE_MAX;
+    for (int i = 0; i < N; i++) {
+        pd_units u = order[large ? i : N - 1 - i];
+        if (u != units && plausible_size(file_size * pd_units_scale(u))) {
+            if (suggest)
+                *suggest = u;
+            break;
+        }
+    }
+    return 0;
+}
+
 void pd_mesh_read_options_default(pd_mesh_read_options *options)
 {
     if (!options)

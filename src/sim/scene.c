@@ -247,14 +247,23 @@ const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *b
     double v = *field((pd_scene *)scene, k);
     if (d->kind == PD_DIST_FIXED && param == PD_PARAM_CONTACT_TIME && v == PD_CONTACT_TIME_AUTO)
         snprintf(buf, size, "auto");
-    else if (d->kind == PD_DIST_FIXED)
-        snprintf(buf, size, "%.6g", v / k->scale);
-    else if (d->auto_multiple)
-        snprintf(buf, size, "%.6gx:%.6gx%s", d->lo, d->hi,
-                 d->kind == PD_DIST_LOG_UNIFORM ? " log" : " uniform");
-    else
-        snprintf(buf, size, "%.6g:%.6g%s", d->lo / k->scale, d->hi / k->scale,
-                 d->kind == PD_DIST_LOG_UNIFORM ? " log" : "");
+    else {
+        /* Each number the shortest that reads back to the same scene. */
+        char a[32], b[32];
+        double scale = d->auto_multiple ? 1.0 : k->scale;
+        if (d->kind == PD_DIST_FIXED)
+            snprintf(buf, size, "%s", pd_num_format(a, sizeof a, v, k->scale));
+        else if (d->auto_multiple && d->lo == d->hi)
+            snprintf(buf, size, "%sx", pd_num_format(a, sizeof a, d->lo, scale));
+        else if (d->auto_multiple)
+            snprintf(buf, size, "%sx:%sx%s", pd_num_format(a, sizeof a, d->lo, scale),
+                     pd_num_format(b, sizeof b, d->hi, scale),
+                     d->kind == PD_DIST_LOG_UNIFORM ? " log" : " uniform");
+        else
+            snprintf(buf, size, "%s:%s%s", pd_num_format(a, sizeof a, d->lo, scale),
+                     pd_num_format(b, sizeof b, d->hi, scale),
+                     d->kind == PD_DIST_LOG_UNIFORM ? " log" : "");
+    }
     return buf;
 }
 
@@ -428,6 +437,15 @@ static pd_status parse_range(const numeric_key *k, const char *value, pd_dist *d
     return PD_OK;
 }
 
+/* Whether value is one multiple of auto, "3x" (blanks around allowed). */
+static int multiple_alone(const char *value)
+{
+    size_t n = strlen(value);
+    while (n > 0 && (value[n - 1] == ' ' || value[n - 1] == '\t'))
+        n--;
+    return n > 1 && value[n - 1] == 'x' && n < 70;
+}
+
 pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag *diag)
 {
     if (!s || !key || !value)
@@ -446,6 +464,12 @@ pd_status pd_scene_set(pd_scene *s, const char *key, const char *value, pd_diag 
                          key, value);
         } else if (strchr(value, ':')) {
             st = parse_range(k, value, &next.range[k->param], diag);
+        } else if (k->param == PD_PARAM_CONTACT_TIME && multiple_alone(value)) {
+            /* "3x": the zero-width range 3x:3x, which every drop draws as 3
+             * times its part's automatic duration (as posedrop fit sets it). */
+            char range[160];
+            snprintf(range, sizeof range, "%.70s:%.70s", value, value);
+            st = parse_range(k, range, &next.range[k->param], diag);
         } else if (k->field == offsetof(pd_scene, contact_time) && strcmp(value, "auto") == 0) {
             next.contact_time = PD_CONTACT_TIME_AUTO;
             memset(&next.range[k->param], 0, sizeof next.range[k->param]);

@@ -183,6 +183,40 @@ static pd_status join_poses(class_ctx *k, const pd_part *part, pd_symmetry_metho
     return st;
 }
 
+/* Renumbers classes 0..nc-1 (numbered by first appearance) by decreasing
+ * summed QS probability. The members of a class are symmetric, so the
+ * sums order the classes as the paper's tables do; sums within
+ * PD_TOL_PROB_TIE_REL of each other (round-off) keep the first-appearance
+ * order, so the numbering does not hang on the last digits. */
+static pd_status number_by_qs(const pd_static_result *res, int *class_of, int nc, pd_diag *diag)
+{
+    double *qs = calloc((size_t)nc, sizeof *qs);
+    int *order = malloc(sizeof *order * (size_t)nc), *rank = malloc(sizeof *rank * (size_t)nc);
+    pd_status st = qs && order && rank ? PD_OK
+                                       : pd_fail(diag, PD_ERR_NOMEM, "out of memory grouping poses");
+    if (st == PD_OK) {
+        for (int i = 0; i < res->nposes; i++)
+            qs[class_of[i]] += res->poses[i].p_qs;
+        /* Insertion sort: stable, and classes are few. */
+        for (int c = 0; c < nc; c++) {
+            int j = c;
+            while (j > 0 && qs[c] - qs[order[j - 1]] > PD_TOL_PROB_TIE_REL * qs[c]) {
+                order[j] = order[j - 1];
+                j--;
+            }
+            order[j] = c;
+        }
+        for (int j = 0; j < nc; j++)
+            rank[order[j]] = j;
+        for (int i = 0; i < res->nposes; i++)
+            class_of[i] = rank[class_of[i]];
+    }
+    free(qs);
+    free(order);
+    free(rank);
+    return st;
+}
+
 pd_status pd_pose_classes_by(const pd_part *part, const pd_static_result *res,
                              pd_symmetry_method method, int *class_of, int *nclasses,
                              pd_diag *diag)
@@ -232,12 +266,14 @@ pd_status pd_pose_classes_by(const pd_part *part, const pd_static_result *res,
     }
     if (st == PD_OK) {
         /* Roots are each class's lowest pose, so numbering roots in pose order
-         * numbers classes by first appearance. */
+         * numbers classes by first appearance; then by QS, most probable
+         * first, as the poses are. */
         int nc = 0;
         for (int i = 0; i < res->nposes; i++) {
             int r = root(k.parent, i);
             class_of[i] = r == i ? nc++ : class_of[r];
         }
+        st = number_by_qs(res, class_of, nc, diag);
         *nclasses = nc;
     }
     free(fill);

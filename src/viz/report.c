@@ -160,6 +160,11 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
         vbuf_put(b, "</tr>\n");
     }
     vbuf_put(b, "</table>\n");
+    if (e[0].has_dyn && in->sim->unsettled > 0 && !in->sim->transitions)
+        vbuf_printf(b, "<p class=\"note\">%ld of %ld drops did not settle (time or collision "
+                       "limit, or a solver failed) and are in no pose's count: the dynamic "
+                       "column sums to %.1f%%, not 100%%.</p>\n", in->sim->unsettled, in->sim->n,
+                    100.0 * (double)(in->sim->n - in->sim->unsettled) / (double)in->sim->n);
     if (in->class_of)
         vbuf_put(b, "<p class=\"note\">* a class of poses that rotations of the part map onto "
                     "each other; its probabilities are summed, its geometry is its first "
@@ -229,7 +234,7 @@ static void crosscheck_section(vbuf *b, const viz_input *in, const viz_entry *e,
 static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
                         const pd_sim_result *sim, const pd_scene *scene, int crosscheck)
 {
-    char v[640], contact[128];
+    char v[1024], contact[192];
     vbuf_put(b, "<section id=\"run\"><h2>Scene, engine and timings</h2>\n<table>\n");
     const pd_static_options *o = run->estimate;
     snprintf(v, sizeof v, "topple %s; PQS epsilon %.4g deg, compare %s, band %s",
@@ -238,7 +243,7 @@ static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
     row(b, "static estimators", v);
     if (scene && sim) {
         const pd_scene *s = scene;
-        char p[PD_NPARAMS][48];
+        char p[PD_NPARAMS][64];
         for (int k = 0; k < PD_NPARAMS; k++)
             pd_scene_format(s, (pd_scene_param)k, p[k], sizeof p[k]);
         /* The automatic contact time by name and with the value it stands

@@ -75,7 +75,7 @@ pd_status viz_sensitivity(const viz_input *in, int standalone, vbuf *b, pd_diag 
     for (int pose = 0; pose < s->nposes; pose++) {
         double y = TOP + pose * ROW_H;
         char lab[96];
-        snprintf(lab, sizeof lab, "%s %d", in->class_of ? "class" : "pose", pose + 1);
+        snprintf(lab, sizeof lab, "pose %d", pose + 1); /* the gallery's word, classes too */
         viz_text(b, LEFT - 8, y + 16, 12, "end", 1, "#111111", lab);
         for (int col = 0; col < s->nparams; col++) {
             const pd_sensitivity_row *r = row_of(s, pose, col);
@@ -108,7 +108,7 @@ void viz_sensitivity_words(vbuf *b, const viz_input *in)
     const pd_sensitivity *s = in->sensitivity;
     if (!s || s->nparams == 0)
         return;
-    const char *what = in->class_of ? "Class" : "Pose";
+    const char *what = "Pose"; /* the gallery's word, classes too */
     vbuf_put(b, "<ul class=\"words\">\n");
     for (int pose = 0; pose < s->nposes; pose++) {
         /* The parameters that move it, by the size of their effect. */

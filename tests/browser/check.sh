@@ -18,11 +18,7 @@ bin=${POSEDROP:-build/opt/posedrop}
 [ -x "$bin" ] || { echo "check-browser: $bin not built" >&2; exit 1; }
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
-passed=0
-failed=0
-ok() { passed=$((passed + 1)); }
-bad() { failed=$((failed + 1)); echo "FAIL: $*"; }
-check() { if eval "$1"; then ok; else bad "$2"; fi; }
+. tests/support/check.sh
 
 # Chromium as root needs --no-sandbox; its own profile in tmp; a bound on
 # time so a hung browser fails the test instead of hanging it.

@@ -144,6 +144,15 @@ static void c_units_parse(const fixture *f, int k, outcome *o)
     o->touched = o->st != PD_OK && u != (pd_units)77;
 }
 
+static void c_units_plausible(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_units u = (pd_units)77;
+    /* 40 m read as metres: not plausible, millimetres suggested. */
+    int r = pd_units_plausible(40.0, PD_UNITS_M, P(0, &u));
+    o->st = r == 0 && (k == 0 || u == PD_UNITS_MM) ? PD_OK : PD_ERR_INTERNAL;
+}
+
 DEFAULTS(mesh_read_options_default, pd_mesh_read_options)
 
 static void c_mesh_read(const fixture *f, int k, outcome *o)
@@ -717,6 +726,7 @@ static const entry table[] = {
     {"pd_mass_compute", "mesh mass ?diag", c_mass_compute},
     {"pd_units_scale", "", c_units_scale},
     {"pd_units_parse", "text units", c_units_parse},
+    {"pd_units_plausible", "?suggest", c_units_plausible},
     {"pd_mesh_read_options_default", "?options", c_mesh_read_options_default},
     {"pd_mesh_read", "path ?options mesh ?diag", c_mesh_read},
     {"pd_mesh_parse", "data ?name ?options mesh ?diag", c_mesh_parse},

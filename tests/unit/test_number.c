@@ -3,11 +3,33 @@
  * and the same refusal of an underflowing number in a mesh coordinate. */
 #include <float.h>
 #include <limits.h>
+#include <stdlib.h>
 #include <string.h>
 #include "base/number.h"
 #include "check.h"
 #include "posedrop/mesh.h"
 #include "suites.h"
+
+/* The shortest round-trip text: the fewest digits that read back, checked
+ * by reading back (an invariance) on values whose short form is known and
+ * on values that need all 17 digits. */
+static void test_format(void)
+{
+    char buf[32];
+    CHECK(strcmp(pd_num_format(buf, sizeof buf, 9.81, 1.0), "9.81") == 0);
+    CHECK(strcmp(pd_num_format(buf, sizeof buf, 0.3, 1.0), "0.3") == 0);
+    CHECK(strcmp(pd_num_format(buf, sizeof buf, 5e-4, 1.0), "0.0005") == 0);
+    /* Degrees stored as radians: the text typed, not (v / scale)'s digits. */
+    const double deg = 3.14159265358979323846 / 180.0;
+    CHECK(strcmp(pd_num_format(buf, sizeof buf, 1.5 * deg, deg), "1.5") == 0);
+    const double hard[] = {0.1 + 0.2, 1.0 / 3.0, 2.0 / 3.0 * deg, DBL_MIN, DBL_MAX, -7.25e-300};
+    for (int i = 0; i < 6; i++) {
+        double scale = i == 2 ? deg : 1.0;
+        pd_num_format(buf, sizeof buf, hard[i], scale);
+        CHECK(strtod(buf, NULL) * scale == hard[i]);
+    }
+    CHECK(strcmp(pd_num_format(buf, sizeof buf, 0.1 + 0.2, 1.0), "0.30000000000000004") == 0);
+}
 
 static int real(const pd_num_rule *r, const char *text, double *v)
 {
@@ -16,6 +38,7 @@ static int real(const pd_num_rule *r, const char *text, double *v)
 
 void suite_number(void)
 {
+    test_format();
     const pd_num_rule angle = {"an angle", 0, 0.0, 90.0, 0, 0, 0, 0};
     const pd_num_rule open = {"a half-width", 0, 0.0, 0.5, 1, 1, 0, 0};
     const pd_num_rule seed = {"a seed", 1, 0, 0, 0, 0, 0, LLONG_MAX};

@@ -93,6 +93,20 @@ static void test_ranges(void)
     CHECK(s.range[PD_PARAM_CONTACT_TIME].kind == PD_DIST_LOG_UNIFORM &&
           s.range[PD_PARAM_CONTACT_TIME].auto_multiple == 1 &&
           s.range[PD_PARAM_CONTACT_TIME].lo == 0.3 && s.range[PD_PARAM_CONTACT_TIME].hi == 3.0);
+    /* One multiple alone: the zero-width range, each drop 3 times its part's
+     * auto (exact: a log-uniform draw over [3, 3] is 3), formatted back as
+     * given. */
+    pd_scene m = s;
+    CHECK_STATUS(pd_scene_set(&m, "contact_time", "3x", &d), PD_OK);
+    CHECK(m.range[PD_PARAM_CONTACT_TIME].auto_multiple == 1 &&
+          m.range[PD_PARAM_CONTACT_TIME].lo == 3.0 && m.range[PD_PARAM_CONTACT_TIME].hi == 3.0);
+    double mv[PD_NPARAMS];
+    pd_scene_draw(&m, 0.01, 1, 7, mv, NULL);
+    CHECK_REL(mv[PD_PARAM_CONTACT_TIME], 3.0 * pd_contact_time_auto(0.01), 1e-15, "round-off");
+    char mt[64];
+    CHECK(strcmp(pd_scene_format(&m, PD_PARAM_CONTACT_TIME, mt, sizeof mt), "3x") == 0);
+    CHECK_STATUS(pd_scene_set(&m, "contact_time", "3000x", &d), PD_ERR_RANGE);
+    CHECK_STATUS(pd_scene_set(&m, "mu", "3x", &d), PD_ERR_PARSE);
     CHECK_STATUS(pd_scene_set(&s, "restitution", "0.1:0.5:log", &d), PD_OK);
     CHECK(s.range[PD_PARAM_RESTITUTION].kind == PD_DIST_LOG_UNIFORM);
     CHECK_STATUS(pd_scene_set(&s, "vibration", "0:3", &d), PD_OK);

@@ -318,7 +318,7 @@ static void test_command(void)
     if (!ok)
         printf("     report: %s\n", msg);
     CHECK(ok);
-    CHECK(r && strstr(r, "What each ranged parameter moves") && strstr(r, "Class 1: ") &&
+    CHECK(r && strstr(r, "What each ranged parameter moves") && strstr(r, "Pose 1: ") &&
           strstr(r, "friction") && strstr(r, "initial uniform"));
     free(c);
     free(r);

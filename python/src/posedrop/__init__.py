@@ -22,7 +22,7 @@ import threading as _threading
 from . import _posedrop
 from ._api import (END_NAMES, PARAM_NAMES, Design, DesignSensitivity, Drops, Facets, Part,
                    PoseClasses, Sensitivity, StablePoses, Trials)
-from ._errors import InputError, InternalError, PosedropError, PosedropWarning
+from ._errors import InputError, InternalError, PosedropError, PosedropWarning, UnitsWarning
 from ._trimesh import compute_stable_poses
 
 #: The library's statuses (``pd_status``), e.g. ``Status.ERR_PARSE``.
@@ -56,4 +56,4 @@ __all__ = ["Part", "StablePoses", "Facets", "PoseClasses", "Drops", "Trials", "S
            "Design", "DesignSensitivity",
            "END_NAMES", "PARAM_NAMES",
            "compute_stable_poses", "PosedropError", "InputError", "InternalError",
-           "PosedropWarning", "Status", "engine_available", "__version__"]
+           "PosedropWarning", "UnitsWarning", "Status", "engine_available", "__version__"]

@@ -5,12 +5,14 @@ this module only converts arguments and wraps results as numpy arrays.
 """
 import numbers
 import os
+import sys
+import warnings
 from collections.abc import Mapping
 
 import numpy as np
 
 from . import _posedrop
-from ._errors import InputError
+from ._errors import InputError, PosedropWarning, UnitsWarning
 
 _STATUS = _posedrop.statuses()
 
@@ -25,6 +27,16 @@ _FAILED = END_NAMES.index("failed")
 # its fixed name with blanks, hyphens and slashes as underscores.
 _STATUS_WORDS = tuple(t.replace(" ", "_").replace("-", "_").replace("/", "_")
                       for t in _STATUS_TEXTS)
+
+
+def _user_stacklevel():
+    """The stacklevel, for warnings.warn called by this function's caller,
+    of the first frame outside the package: the user's line that called it."""
+    here = os.path.dirname(os.path.abspath(__file__))
+    frame, level = sys._getframe(1), 1
+    while frame is not None and os.path.dirname(os.path.abspath(frame.f_code.co_filename)) == here:
+        frame, level = frame.f_back, level + 1
+    return level
 
 
 def _failure_words(stage, status):
@@ -103,8 +115,10 @@ class Part:
                              "faces[%d, %d] is %d: expected a vertex index from 0 to %d"
                              % (bad[0], bad[1], f[bad[0], bad[1]], len(v) - 1))
         f = np.ascontiguousarray(f, dtype=np.intc)
-        self._h = _posedrop.part_from_arrays(v, f, _com(com), units)
+        with _com_hint(com):
+            self._h = _posedrop.part_from_arrays(v, f, _com(com), units)
         self._init()
+        self._warn_units(units, "the mesh")
 
     @classmethod
     def from_file(cls, path, units="m", format=None, com=None):
@@ -121,8 +135,10 @@ class Part:
             Centre of mass in the file's units and frame (``--com``).
         """
         part = cls.__new__(cls)
-        part._h = _posedrop.part_from_file(os.fspath(path), units, format, _com(com))
+        with _com_hint(com):
+            part._h = _posedrop.part_from_file(os.fspath(path), units, format, _com(com))
         part._init()
+        part._warn_units(units, os.fspath(path))
         return part
 
     @classmethod
@@ -133,6 +149,12 @@ class Part:
         mesh at uniform density, as ``mesh.center_mass`` gives it for a
         watertight mesh.
         """
+        if not (hasattr(mesh, "vertices") and hasattr(mesh, "faces")):
+            hint = (": a trimesh.Scene holds several meshes; pass one of scene.geometry.values(), "
+                    "or scene.to_geometry() (scene.dump(concatenate=True) in older trimesh) for "
+                    "all of them as one" if type(mesh).__name__ == "Scene" else "")
+            raise _usage("from_trimesh: expected a trimesh.Trimesh (with vertices and faces), "
+                         "got %s%s" % (type(mesh).__name__, hint))
         return cls(mesh.vertices, mesh.faces, com=com, units=units)
 
     @classmethod
@@ -146,6 +168,22 @@ class Part:
         info = self._h.info()
         self._info = info
         self._poses = None
+
+    def _warn_units(self, units, what):
+        """The command's warning for a part of a size no dropped part has
+        (pd_units_plausible): a UnitsWarning naming the units to try."""
+        suggest = _posedrop.units_plausible(self.size, units)
+        if suggest is None:
+            return
+        size = self.size
+        length = "%.3g m" % size if size >= 1.0 else "%.3g mm" % (size * 1e3)
+        if suggest:
+            names = {"m": "metres", "cm": "centimetres", "mm": "millimetres", "in": "inches"}
+            hint = "if the coordinates are in %s, pass units=%r" % (names[suggest], suggest)
+        else:
+            hint = "is that what you meant? (units= says what the coordinates mean)"
+        warnings.warn("%s: the part is %s across; %s" % (what, length, hint), UnitsWarning,
+                      stacklevel=_user_stacklevel())
 
     # -- properties ---------------------------------------------------------
 
@@ -389,6 +427,24 @@ class DesignSensitivity:
         return len(self.pose)
 
 
+class _com_hint:
+    """Adds the command's advice to a mesh refused as not closed: in Python
+    the centre of mass is given with com= (the command's --com)."""
+
+    def __init__(self, com):
+        self.com = com
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, kind, e, tb):
+        if (isinstance(e, InputError) and self.com is None
+                and e.status in (_STATUS["ERR_NOT_CLOSED"], _STATUS["ERR_ORIENTATION"])):
+            raise type(e)(e.status, e.status_name, e.message + "; give its centre of mass "
+                          "with com=(x, y, z) to use it anyway") from None
+        return False
+
+
 def _com(com):
     if com is None:
         return None
@@ -567,6 +623,8 @@ class StablePoses:
         for name, value in (("n", n), ("max_drops", max_drops)):
             if value is not None and not -2 ** 63 <= value < 2 ** 63:
                 raise _usage("%s: %d is out of range" % (name, value))
+        if n is not None and n < 1:
+            raise _usage("n: expected a number of drops of at least 1, got %d" % n)
         for name, value in (("threads", threads), ("max_collisions", max_collisions)):
             if value is not None and not -2 ** 31 <= value < 2 ** 31:
                 raise _usage("%s: %d is out of range" % (name, value))
@@ -575,7 +633,29 @@ class StablePoses:
                          max_drops=_opt_int(max_drops), time_limit=time_limit,
                          max_collisions=_opt_int(max_collisions), trials=bool(trials),
                          cancel=cancel, progress=progress)
-        return Drops(self, h)
+        drops = Drops(self, h)
+        _warn_unsettled(drops)
+        return drops
+
+
+def _warn_unsettled(drops):
+    """The command's line for drops that did not settle: how many, why, and
+    that p (count / n) then sums to less than 1."""
+    if drops.unsettled == 0:
+        return
+    why = []
+    if drops.time_limited:
+        why.append("%d at the time limit (%.6g s simulated; time_limit=)"
+                   % (drops.time_limited, drops.time_limit))
+    if drops.collision_limited:
+        why.append("%d at the collision limit (max_collisions=)" % drops.collision_limited)
+    if drops.failed:
+        why.append("%d failed" % drops.failed)
+    total = ("" if drops.transitions is not None
+             else " (p sums to %.4g, not 1)" % ((drops.n - drops.unsettled) / drops.n))
+    warnings.warn("%d of %d drops did not settle and are in no count%s: %s"
+                  % (drops.unsettled, drops.n, total, ", ".join(why)), PosedropWarning,
+                  stacklevel=_user_stacklevel())
 
 
 def _opt_int(x):
@@ -620,7 +700,7 @@ class Facets:
 class PoseClasses:
     """Stable poses grouped into classes that a rotation of the part about
     its centre of mass maps onto each other (a prism's sides, a nut's six
-    flats; mirror images stay apart), numbered in order of first member.
+    flats; mirror images stay apart), numbered most probable (summed QS) first.
 
     Attributes
     ----------
@@ -886,6 +966,9 @@ class Drops:
         -------
         Sensitivity
         """
+        if (self._parent if self._parent is not None else self).trials is None:
+            raise _usage("sensitivity: these drops kept no per-drop records: run them with "
+                         "drop(..., trials=True)")
         if self._parent is not None:
             c = self.classes
             return Sensitivity(self._parent._h.sensitivity(_class_array(c), len(c)))

@@ -45,6 +45,12 @@ class PosedropWarning(UserWarning):
     """A warning from the library: faces re-oriented, knife-edge facets, ..."""
 
 
+class UnitsWarning(PosedropWarning):
+    """A part of a size no dropped part has (outside 0.5 mm to 2 m across): most
+    likely a file in millimetres read as metres (trimesh reads STL without
+    units); the warning names the ``units=`` to try. The command's warning."""
+
+
 # Shown and pickled as posedrop.InputError etc., where users import them.
-for _cls in (PosedropError, InputError, InternalError, PosedropWarning):
+for _cls in (PosedropError, InputError, InternalError, PosedropWarning, UnitsWarning):
     _cls.__module__ = "posedrop"

@@ -53,15 +53,28 @@ def compute_stable_poses(mesh, center_mass=None, sigma=0.0, n_samples=1, thresho
     else:
         if n_samples < 1:
             raise ValueError("n_samples: expected at least 1, got %r" % (n_samples,))
-        centre = (Part(vertices, faces).com if center_mass is None
+        base = Part(vertices, faces, com=center_mass)
+        centre = (base.com if center_mass is None
                   else np.asarray(center_mass, dtype=np.float64))
+        # Only the centre of mass moves between samples: each is a part made
+        # of the convex hull alone (all the static estimates read), built in
+        # a fraction of the mesh's time, and a centre outside the hull is
+        # rejected before any build.
+        hull_v = base.hull_vertices
+        hull_t = np.array([(f[0], f[i], f[i + 1]) for f in base.hull_facets
+                           for i in range(1, len(f) - 1)], dtype=np.intc)
+        normals = base.hull_normals
+        offsets = np.einsum("ij,ij->i", normals,
+                            hull_v[[f[0] for f in base.hull_facets]])
         rng = seed if isinstance(seed, np.random.Generator) else np.random.default_rng(seed)
         samples = []
         while len(samples) < n_samples:
             for com in rng.multivariate_normal(centre, sigma * np.eye(3),
                                                n_samples - len(samples)):
+                if np.any(normals @ com - offsets >= 0.0):
+                    continue
                 try:
-                    samples.append(Part(vertices, faces, com=com).stable_poses())
+                    samples.append(Part(hull_v, hull_t, com=com).stable_poses())
                 except InputError as e:
                     if e.status != _STATUS["ERR_COM_OUTSIDE"]:
                         raise
