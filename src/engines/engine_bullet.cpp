@@ -38,6 +38,7 @@ extern "C" {
 #include "engines/engine_contact.h"
 #include "posedrop/bullet.h"
 #include "engines/engines_tol.h"
+#include "base/base_tol.h"
 #include "posedrop/version.h"
 }
 
@@ -309,6 +310,23 @@ static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
     law.slide = fmax(PD_ENGINE_SLIDE_STEPS * scene->mu * g * w->step_s,
                      2.0 * sqrt(double(FLT_EPSILON)));
     w->body.setRestitution(law.on ? btScalar(0) : btScalar(scene->restitution));
+    /* Drilling friction, as ODE's adapter has it (drilling_arm in
+     * engine_ode.c): a contact is a patch of radius a = sqrt(R d), a corner
+     * of radius R = PD_CORNER_RADIUS_REL L pressed as deep as the scene's
+     * contact sinks under the weight, d = g / omega^2, resisting a spin
+     * about the floor's normal with a couple of at most (2/3) mu a N.
+     * Bullet's spinning friction is that couple's arm: Bullet combines the
+     * part's with the floor's friction (1) plus the floor's (0) with the
+     * part's, which leaves the part's exactly. It applies it only where
+     * rolling friction is on, at the first contact of a manifold: rolling
+     * friction is set to 1e-30 of an arm (no rolling resistance), and a
+     * face's drilling acts at one of its corners only. A rigid scene
+     * (contact time 0) has no patch, as in the impulse engine. */
+    double arm = 0.0;
+    if (scene->contact_time > 0.0)
+        arm = 2.0 / 3.0 * scene->mu * sqrt(PD_CORNER_RADIUS_REL * w->size_m * g) / law.omega;
+    w->body.setSpinningFriction(btScalar(arm));
+    w->body.setRollingFriction(btScalar(arm > 0.0 ? 1e-30 * arm : 0.0));
     return PD_OK;
 }
 

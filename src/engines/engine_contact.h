@@ -86,11 +86,11 @@ static inline int pd_engine_contact_resolved(double dt, double contact_time, dou
  * time the scene can draw, T, is cut into this many steps, so that every
  * contact is the scene's spring-dashpot (at least PD_ENGINE_CONTACT_STEPS
  * steps) and the engines' first-order loss of rebound, about
- * e g^2 / 2 h / T (above), stays a few hundredths of e. Why 20: it is the
- * coarsest step at which halving the step moves no pose class of the
- * cross-check corpus beyond sampling noise, on either engine
- * (docs/engines-crosscheck.md, "Converged by default", measured by
- * scripts/engine-convergence.py); 10 did not hold. */
+ * e g^2 / 2 h / T (above), stays a few hundredths of e. Why 20: the
+ * coarsest of 10, 20 and 40 at which halving the step moved no pose class
+ * of the cross-check corpus's parts measured beyond sampling noise, on
+ * either engine; at 10 Bullet was far off (docs/engines-crosscheck.md,
+ * "Converged by default", scripts/engine-convergence.py). */
 #define PD_ENGINE_AUTO_STEPS 20.0
 
 /* The most a corner may travel in one automatic step at the fall speed,
