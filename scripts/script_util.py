@@ -30,9 +30,11 @@ def git(*args):
 
 
 def commit_here():
-    """The commit checked out, and ', with changes' when tracked files differ."""
-    return (git("rev-parse", "--short", "HEAD"),
-            ", with changes" if git("status", "--porcelain", "--untracked-files=no") else "")
+    """The commit checked out, and ', with changes' when tracked files other
+    than the documents the scripts write into (docs/, README.md) differ."""
+    changed = git("status", "--porcelain", "--untracked-files=no", "--", ".", ":!docs",
+                  ":!README.md")
+    return git("rev-parse", "--short", "HEAD"), ", with changes" if changed else ""
 
 
 def put_between(path, tag, text, who):
