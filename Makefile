@@ -104,8 +104,8 @@ BENCH_OBJS := $(BENCH_SRCS:%.c=$(BUILD)/bench-%.o)
 BENCH_BIN  := $(BUILD)/bench_posedrop
 DEMO_PART  := parts/cap.off
 
-.PHONY: all check check-full check-install test bench bench-mujoco demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
-        check-browser check-readme figures mpi
+.PHONY: all check check-full check-install test bench bench-mujoco referee demo paper install uninstall clean help deps golden lint fuzz fuzz-build \
+        check-browser check-readme figures check-figures mpi
 .DEFAULT_GOAL := all
 
 all: $(LIB) $(LIB_BULLET) $(SO) $(SO_BULLET) $(CLI) $(if $(WITH_MPI),$(CLI_MPI))
@@ -173,7 +173,8 @@ $(BUILD)/mpi/%.o: src/cli/%.c Makefile
 $(CLI_MPI): $(CLI_MPI_OBJS) $(BUILD)/src/base/number.o $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
 	OMPI_CC=$(CXX) $(MPICC) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_LIB) $(LDLIBS_BULLET) -lstdc++
 
-$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(LIB_BULLET) $(LIB)
+# The tests (the fuzz targets' replay) read shards as posedrop merge does.
+$(TEST_BIN): $(TEST_OBJS) $(VIZ_OBJS) $(BUILD)/src/cli/shard_read.o $(LIB_BULLET) $(LIB)
 	$(CXX) $(LDFLAGS_SAN) $(LDFLAGS) -o $@ $^ $(LDLIBS_TEST) $(LDLIBS_LIB) $(LDLIBS_BULLET)
 
 $(BENCH_BIN): $(BENCH_OBJS) $(LIB_BULLET) $(LIB)
@@ -211,6 +212,7 @@ check check-full: deps lint
 	@$(MAKE) --no-print-directory $(if $(filter -j%,$(MAKEFLAGS)),,-j2) all $(TEST_BIN)
 	@$(MAKE) --no-print-directory check-install
 	@$(MAKE) --no-print-directory test $(if $(filter check-full,$@),TEST_FULL=1)
+	$(if $(filter check-full,$@),@$(MAKE) --no-print-directory check-figures)
 
 # make demo builds as make check does (two jobs unless make was given its
 # own -j) and prints the pose classes in words (scripts/demo.sh).
@@ -232,11 +234,23 @@ check-readme: deps
 
 # The insulator cap's gallery, chart against the paper's physical tests and
 # gauss-sphere map, and the cost-accuracy chart, into docs/figures/
-# (docs/figures.md). CHART_ONLY=1 redraws the cost-accuracy chart from its
-# kept CSV instead of rerunning its several minutes of drops.
+# (docs/figures.md); the table of docs/uncertainty.md, ranged runs beside
+# sweeps (docs/figures/uncertainty/); make paper's tables, whose eq. (16)
+# errors README quotes (docs/figures/paper.txt). CHART_ONLY=1 redraws the
+# cost-accuracy chart from its kept CSV instead of rerunning its several
+# minutes of drops.
 figures: deps
 	@$(MAKE) --no-print-directory all
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
+	POSEDROP=$(CLI) scripts/uncertainty.sh
+	{ echo "# scripts/paper.sh (POSEDROP=$(CLI); make figures), commit $$(git rev-parse --short HEAD), $$(date -u +%F)"; \
+	  POSEDROP=$(CLI) scripts/paper.sh; } > docs/figures/paper.txt
+
+# The cheap measured files behind docs/ rerun: fails when a number moved
+# beyond its drops' noise (make check-full runs it).
+check-figures:
+	@$(MAKE) --no-print-directory $(CLI)
+	python3 scripts/check_figures.py -b $(CLI) docs/figures/uncertainty/*-ranged.csv
 
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
@@ -260,21 +274,30 @@ bench-mujoco: deps
 	@$(MAKE) --no-print-directory $(CLI)
 	$(MUJOCO_PY) scripts/bench-mujoco.py --posedrop $(CLI) $(BENCH_MUJOCO)
 
+# The cross-check corpus on the three engines and MuJoCo, its table put in
+# docs/engines-crosscheck.md (scripts/referee-mujoco.py; about an hour of CPU).
+referee: deps
+	@$(MAKE) --no-print-directory $(CLI)
+	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) --law --doc docs/engines-crosscheck.md
+	$(MUJOCO_PY) scripts/referee-mujoco.py --posedrop $(CLI) -o results/referee \
+	    --doc docs/engines-crosscheck.md $(REFEREE)
+
 # make fuzz: libFuzzer targets built with clang (installed on first use) for
 # the OFF, STL and OBJ readers, scene files, the part build (mesh in, part
-# model and static estimate out) and programs of library calls (api), each
+# model and static estimate out), programs of library calls (api), and the
+# command's readers of measured counts (measured) and of shards (shard), each
 # run for FUZZ_SECONDS from the seeds in parts/ and tests/fuzz/
 # (scripts/fuzz.sh). The C library is built with address and
 # undefined-behaviour sanitizers (Bullet, C++, is left out: not registered).
 FUZZ_SECONDS ?= 60
-FUZZ_TARGETS := off stl obj scene part api
+FUZZ_TARGETS := off stl obj scene part api measured shard
 FUZZ_BUILD   := build/fuzz
 FUZZ_CC      ?= clang
 FUZZ_CFLAGS  := -std=c11 -g -O1 -pthread -fsanitize=fuzzer-no-link,address,undefined \
                 -fno-sanitize-recover=undefined -fno-omit-frame-pointer -ffp-contract=off \
                 -D_DEFAULT_SOURCE -Iinclude -Isrc -Itests/support \
                 $(shell $(PKG_CONFIG) --cflags $(LIB_PKGS) 2>/dev/null)
-FUZZ_SRCS    := $(LIB_SRCS) tests/support/fuzz_targets.c
+FUZZ_SRCS    := $(LIB_SRCS) src/viz/measured.c src/cli/shard_read.c tests/support/fuzz_targets.c
 FUZZ_OBJS    := $(FUZZ_SRCS:%.c=$(FUZZ_BUILD)/%.o)
 # Kept between runs: make would otherwise delete them as intermediate files
 # of the pattern rule below and compile them all again next time.
@@ -338,10 +361,11 @@ help:
 	@echo "make paper      the paper's Tables 1-4 with posedrop's columns beside them"
 	@echo "make bench      speed figures, as ratios against reference runs"
 	@echo "make bench-mujoco  cost per drop against MuJoCo (pip install mujoco; see the script)"
+	@echo "make referee    the cross-check corpus on the three engines and MuJoCo, into docs"
 	@echo "make lint       check that no layer of src/ includes one above it"
 	@echo "make check-browser  the report and pictures in headless Chromium and rsvg-convert"
 	@echo "make check-readme   every command README.md gives, run as written"
-	@echo "make figures    the cap's pictures and the cost-accuracy chart in docs/figures/"
+	@echo "make figures    the cap's pictures, the cost-accuracy chart and the uncertainty table in docs/"
 	@echo "make check-install  install to a temporary prefix, build the library example"
 	@echo "                with plain pkg-config, compare it with the command"
 	@echo "make MPI=1      also build posedrop-mpi with OpenMPI (scripts/install-deps.sh mpi)"

@@ -49,6 +49,15 @@ awk -F, -v part=insulator_cap -v tag=figures.sh -f "$here/scripts/measured.awk" 
 "$bin" --group -n 2000 --initial stationary --seed 1 \
     --svg "$out/cap-gallery.svg" --chart "$out/cap-chart.svg" --sphere "$out/cap-sphere.svg" \
     --measured "$out/insulator_cap.measured.csv" "$part" > "$out/cap.csv"
+# What made them and when: the command and the commit it ran on.
+{
+    echo "cap-gallery.svg, cap-chart.svg, cap-sphere.svg, cap.csv (scripts/figures.sh):"
+    echo "posedrop --group -n 2000 --initial stationary --seed 1 --svg cap-gallery.svg" \
+        "--chart cap-chart.svg --sphere cap-sphere.svg --measured insulator_cap.measured.csv" \
+        "parts/insulator_cap.off > cap.csv"
+    echo "commit $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)," \
+        "$(date -u +%Y-%m-%d)"
+} > "$out/cap.provenance.txt"
 echo "figures.sh: wrote $out/cap-gallery.svg, cap-chart.svg, cap-sphere.svg (rows: cap.csv)" >&2
 
 # shellcheck disable=SC2086

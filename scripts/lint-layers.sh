@@ -22,6 +22,7 @@ lower() {
     engines)   echo "base hull part dynamics" ;;
     sim)       echo "base mesh hull part static symmetry dynamics impact settle contact engines" ;;
     fit)       echo "base" ;; # the calibration: the public API (drops, pose classes), base's GSL door
+    design)    echo "base static" ;; # changes to the part: the public API, the static estimators' derivatives
     viz)       echo "base" ;; # the pictures: the public API, base's helpers
     cli)       echo "base viz" ;; # the public API, base/number.h (linked in directly), the pictures
     *)         echo "?" ;;

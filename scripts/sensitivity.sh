@@ -12,14 +12,15 @@
 # from uniform orientations. POSEDROP-OPTIONS come after the ranges, so they
 # can change them (e.g. -- --mu 0.2:0.6). Writes DIR (default results/):
 #   <part>-sensitivity.csv  posedrop --sensitivity: per class and parameter,
-#                           p in the range's lower and upper thirds and the
-#                           first-order index with its 95% interval;
+#                           the effect (p in the range's upper third less
+#                           its lower) with its 95% interval, the thirds,
+#                           the first-order index and interactions;
 #   <part>-curves.csv       parameter,value,pose,n,p,ci_lo,ci_hi: the drops
 #                           binned by the value they drew (8 bins of equal
 #                           count), each class's share with its 95% interval,
 #                           and PQS against epsilon (its own parameter);
 #   <part>-sensitivity.png and .svg: one panel per parameter, a line per
-#                           class with its band, each class's index in the
+#                           class with its band, each class's effect in the
 #                           key. Unlike a sweep, each curve is averaged over
 #                           the other parameters' ranges.
 set -u
@@ -71,7 +72,7 @@ awk -F, -v OFS=, -v initial="$initial" -v k="$k" -v n="$n" '
     NR == 1 {
         for (i = 1; i <= NF; i++) c[$i] = i
         np = 0
-        for (i = c["end"] + 1; i <= NF; i++) if ($i != "member") param[++np] = $i
+        for (i = c["end"] + 1; i <= NF; i++) if ($i != "member" && $i != "partial") param[++np] = $i
         next
     }
     {
@@ -122,8 +123,10 @@ params=$(awk -F, 'NR > 1 && !seen[$1]++ { printf "%s ", $1 }' "$curves")
 npanel=$(echo $params | wc -w)
 poses=$(awk -F, 'NR > 1 { print $3 }' "$curves" | sort -n -u | tr '\n' ' ')
 drops=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "n") col = i } NR == 2 { print $col }' "$out")
-# Each class's index per parameter, for the keys: "pose 2 (S 0.45)".
-keys=$(awk -F, 'NR > 1 { printf "%s:%s:%.2f ", $2, $1, $11 }' "$sens")
+# Each class's effect per parameter in points, for the keys: "pose 2 (+12
+# pts)"; columns by name.
+keys=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) c[$i] = i; next }
+                { printf "%s:%s:%+.0f ", $c["parameter"], $c["pose"], 100 * $c["effect"] }' "$sens")
 cols=$(( npanel > 2 ? 3 : npanel ))
 rowsn=$(( (npanel + cols - 1) / cols ))
 for term in png svg; do
@@ -131,7 +134,7 @@ for term in png svg; do
 set datafile separator ","
 set terminal ${term} size $((cols * 420)),$((rowsn * 330 + 40)) noenhanced $( [ "$term" = png ] && echo "font ',9'" )
 set output "$outdir/$name-sensitivity.${term}"
-set multiplot layout $rowsn,$cols title "$name: pose classes over the scene's ranges, one run of $drops drops, initial $initial (95% bands; S: first-order index)"
+set multiplot layout $rowsn,$cols title "$name: pose classes over the scene's ranges, one run of $drops drops, initial $initial (95% bands; in the key: the effect, upper third less lower, in points)"
 set ylabel "probability"
 set yrange [0:1]
 set grid
@@ -139,7 +142,7 @@ set key top right
 keys = "$keys"
 array label[7] = ["mu", "restitution", "height", "contact_time", "belt_speed", "vibration", "tumble"]
 array unit[7] = ["friction mu", "restitution e", "drop height, m", "contact time, s", "belt speed, m/s", "vibration, deg", "tumble, rad/s"]
-index_of(p, par) = (pos = strstrt(keys, par.":".p.":"), pos ? real(substr(keys, pos + strlen(par.":".p.":"), pos + strlen(par.":".p.":") + 3)) : -1)
+effect_of(p, par) = (pos = strstrt(keys, par.":".p.":"), pos ? int(real(substr(keys, pos + strlen(par.":".p.":"), pos + strlen(par.":".p.":") + 3))) : 0)
 do for [par in "$params"] {
     xl = par
     do for [i = 1:7] { if (label[i] eq par) { xl = unit[i] } }
@@ -151,7 +154,7 @@ do for [par in "$params"] {
          using 2:6:7 with filledcurves fs transparent solid 0.15 lc (p+0) notitle, \
          for [p in "$poses"] "< grep '^".par.",' $curves | awk -F, '\$3 == ".p."'" \
          using 2:5 with linespoints lc (p+0) \
-         title (par eq "epsilon" ? "pose ".p : sprintf("pose %s (S %.2f)", p, index_of(p, par)))
+         title (par eq "epsilon" ? "pose ".p : sprintf("pose %s (%+d pts)", p, effect_of(p, par)))
 }
 unset multiplot
 GP

@@ -46,16 +46,48 @@ typedef struct pd_fit_param {
     int multiple;
 } pd_fit_param;
 
+/* The most measured drops a part's counts may add up to: far more than any
+ * feeder is observed for, far below where a sum of counts overflows. */
+#define PD_FIT_MAX_COUNT 1000000000000000L
+
 /* One part. count NULL: the part is not fitted, only predicted at the
- * fitted values (and averaged over the values the data allow). */
+ * fitted values (and averaged over the values the data allow). Its counts
+ * add up to at most PD_FIT_MAX_COUNT (PD_ERR_RANGE otherwise). */
 typedef struct pd_fit_part {
     const pd_part *part;
     const pd_static_result *poses; /* its stable poses (pd_static_estimate) */
     const int *class_of;  /* poses->nposes classes in [0, nclasses) (pd_pose_classes),
                              or NULL: every pose its own class */
     int nclasses;         /* with class_of NULL: poses->nposes */
-    const long *count;    /* nclasses measured counts (>= 0, not all 0), or NULL */
+    const long *count;    /* nclasses measured counts (>= 0, not all 0), or NULL; with
+                             cell_of, ncells counts */
+    /* Counts of sets of classes, for a label that stands for several poses
+     * (a die's face read as either of two facets, counts folded by mirror
+     * pairs): class c was counted in cell cell_of[c] (0 .. ncells - 1, each
+     * cell holding at least one class), and its likelihood is that of the
+     * cell, the sum of its classes' probabilities. NULL: every class its own
+     * cell (ncells is then ignored). */
+    const int *cell_of;
+    int ncells;
 } pd_fit_part;
+
+/* Where a fit stands, after each evaluation (and once before the first, with
+ * evaluation 0): for a progress line, never needed for the result. */
+typedef struct pd_fit_progress {
+    const char *stage;     /* "design", "search", "weighting", "prediction", "fresh",
+                              and "start" before the first evaluation */
+    const char *initial;   /* the initial mode being searched */
+    int held_out;          /* choosing the initial mode: the part left out (1..), else 0 */
+    int round;             /* the weighting's round (1..6), else 0 */
+    int evaluation;        /* evaluations spent */
+    int max_evaluations;   /* the most the fit can spend (planned at the start) */
+    long drops;            /* drops simulated */
+    long max_drops;        /* the most the fit can simulate */
+    double best_loglik;    /* the best log-likelihood of the current search or
+                              weighting so far (-HUGE_VAL before one) */
+} pd_fit_progress;
+
+typedef void (*pd_fit_progress_fn)(const pd_fit_progress *progress, void *user);
 
 typedef struct pd_fit_options {
     long ndrops;        /* simulated drops per part and evaluation, >= 10; 1000
@@ -66,14 +98,40 @@ typedef struct pd_fit_options {
     int fit_initial;    /* 1: the initial mode is fitted too, as a discrete choice:
                            uniform, bootstrap and stationary are each fitted and the
                            one of highest maximised likelihood kept; 0 */
-    int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150 */
+    int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150. The simplex
+                           stops once it has spent them, finishing its step (up to
+                           max_evals + d + 1); each search's design (4 d + 1), the
+                           weighting, the predicted parts and the fresh drops come
+                           on top (pd_fit_progress's max_evaluations adds them up) */
     int npoints;        /* likelihood-weighted points per round (3 to 6 rounds),
                            >= 1; 0: 8 (d + 1) for d parameters */
     double alpha;       /* pseudo-count added to every class's simulated count
                            (Dirichlet smoothing), > 0; 0.5 (Jeffreys) */
+    pd_cancel_flag *cancel; /* may be NULL. Set non-zero (atomic_store, from any
+                           thread or a signal handler, as pd_sim_options' cancel)
+                           to stop the fit: the drops under way stop, and
+                           pd_fit_run returns PD_ERR_CANCELLED with no result.
+                           Only read, never reset; NULL by default */
+    pd_fit_progress_fn progress; /* NULL: none */
+    void *progress_user;
 } pd_fit_options;
 
 PD_API void pd_fit_options_default(pd_fit_options *options);
+
+/* The counts against drops simulated afresh (a seed no evaluation used), so
+ * that the fit's own drops, which the search tuned the values to, do not
+ * flatter it: Pearson's X^2 of the 2 x K table of measured and simulated
+ * counts (the test that both come from one distribution, which counts the
+ * simulation's error), its degrees of freedom, p, and the total variation
+ * distance between the measured and the simulated frequencies. */
+typedef struct pd_fit_quality {
+    double chi2;
+    int df;             /* classes seen in either row, minus 1; for all parts,
+                           their sum minus the fitted parameters (<= 0: the data
+                           cannot test the fit) */
+    double pvalue;      /* 1 when df <= 0 */
+    double tv;          /* half the sum of |measured - simulated| frequencies */
+} pd_fit_quality;
 
 /* What the fit says about one part; arrays of nclasses. */
 typedef struct pd_fit_part_result {
@@ -86,8 +144,11 @@ typedef struct pd_fit_part_result {
                            parameters' spread and the simulation's own error */
     double loglik;      /* sum_k count_k log p_best_k (0 for a predicted part) */
     double chi2;        /* Pearson's X^2 of the counts against n p_best */
-    int df;             /* nclasses - 1 */
+    int df;             /* cells of counts (nclasses without cell_of) - 1 */
     double pvalue;      /* P(chi2_df > chi2) */
+    double tv;          /* total variation between the counts and p_best: in-sample */
+    pd_fit_quality fresh_best, fresh_mean; /* against fresh drops at the best
+                           values and at the weighted means (fitted parts only) */
 } pd_fit_part_result;
 
 typedef struct pd_fit_result {
@@ -97,14 +158,21 @@ typedef struct pd_fit_result {
     double *mean;       /* the weighted mean */
     pd_scene scene;     /* the base scene with the fitted values (and initial mode) */
     pd_initial initial; /* the initial mode used (the one chosen with fit_initial) */
-    double loglik_initial[3]; /* maximised log-likelihood per initial mode tried
-                                 (indexed by pd_initial; -HUGE_VAL if not tried) */
+    double loglik_initial[3]; /* per initial mode tried (indexed by pd_initial;
+                                 -HUGE_VAL if not tried): with two or more fitted
+                                 parts, the log-likelihood of each part's counts
+                                 predicted by a fit to the others, summed over the
+                                 parts (the mode kept is the best predictor); with
+                                 one, the maximised log-likelihood */
+    int initial_untested; /* 1: the initial mode was chosen on one part's own
+                             counts, which cannot test it */
     double loglik;      /* at the maximum, all fitted parts: sum_k count_k log p_k */
-    double chi2;        /* the parts' X^2 summed */
-    int df;             /* sum of (nclasses - 1) over the fitted parts, minus nparams */
-    double pvalue;
-    double temper;      /* the weights' exponent: 1 / (1 + n / nsim) for equal shares
-                           (docs/calibration.md: the simulation's own error) */
+    double chi2;        /* the parts' X^2 summed: in-sample, a diagnostic (the
+                           search tuned the values to these drops) */
+    int df;             /* sum of (nclasses - 1) over the fitted parts, minus nparams;
+                           <= 0: the data cannot test the fit */
+    double pvalue;      /* 1 when df <= 0 */
+    pd_fit_quality fresh_best, fresh_mean; /* all fitted parts, against fresh drops */
     double dispersion;  /* >= 1: the parts' X^2 at the best fit over what the data's
                            and the simulation's noise explain; the weights' log-
                            likelihood is divided by it, widening the intervals by
@@ -115,6 +183,8 @@ typedef struct pd_fit_result {
     long drops;         /* drops simulated in all */
     int nparts;
     pd_fit_part_result *parts; /* in the order given */
+    long failed;        /* of the drops simulated, those that failed (a solver
+                           could not go on): in no count, as in pd_sim_run */
 } pd_fit_result;
 
 /* Fits params (nparams in 1..PD_FIT_MAX_PARAMS, distinct keys) to the parts
@@ -126,7 +196,8 @@ typedef struct pd_fit_result {
  * probability alpha / (nsim + K alpha) instead of 0, so that no value makes
  * the likelihood minus infinity. PD_ERR_USAGE (a bad argument: the message
  * names it), PD_ERR_RANGE (a range outside its key's limits), PD_ERR_NOMEM,
- * and what pd_sim_run returns. On success *result is the caller's
+ * PD_ERR_CANCELLED (options->cancel set), PD_ERR_NO_CONVERGENCE when every
+ * drop of a part at one evaluation failed, and what pd_sim_run returns. On success *result is the caller's
  * (pd_fit_result_free). */
 PD_API pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
                             int nparams, const pd_scene *base, const pd_fit_options *options,
@@ -146,6 +217,18 @@ PD_API void pd_fit_smooth(int k, const double *p_sim, double nsim, double alpha,
  * (no counts) when count or p_sim is NULL. */
 PD_API double pd_fit_loglik(int k, const long *count, const double *p_sim, double nsim,
                             double alpha);
+
+/* The Dirichlet-multinomial log-likelihood of counts (k) given nsim simulated
+ * drops whose class frequencies are p_sim: the probability of the counts
+ * averaged over what the simulated drops leave open about the classes'
+ * probabilities (their posterior Dirichlet(nsim p_sim + alpha)),
+ * sum_k [lnGamma(s_k + alpha + c_k) - lnGamma(s_k + alpha)] - [lnGamma(nsim +
+ * k alpha + n) - lnGamma(nsim + k alpha)] with s_k = nsim p_sim_k, without the
+ * multinomial coefficient. It tends to pd_fit_loglik as nsim grows; this is
+ * what the fit maximises and weighs (docs/calibration.md). 0 when count or
+ * p_sim is NULL. */
+PD_API double pd_fit_loglik_dm(int k, const long *count, const double *p_sim, double nsim,
+                               double alpha);
 
 #ifdef __cplusplus
 }

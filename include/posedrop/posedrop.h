@@ -15,6 +15,7 @@
 #define POSEDROP_POSEDROP_H
 
 #include "posedrop/bullet.h"
+#include "posedrop/design.h"
 #include "posedrop/diag.h"
 #include "posedrop/fit.h"
 #include "posedrop/hull.h"

@@ -6,9 +6,12 @@
  * first-order variance-based (Sobol') index
  *     S_i = Var(E[Y | X_i]) / Var(Y),
  * Y the drop's pose indicator (1 if the drop ended in the pose), X_i the
- * parameter's drawn value; and the pose's probability in the lower and
- * upper thirds of the range. docs/uncertainty.md gives the estimator, its
- * sources and how to read it. */
+ * parameter's drawn value; the pose's probability in the lower and
+ * upper thirds of the range and their difference, the effect in
+ * probability points, with a bootstrap interval; and where one parameter's
+ * effect changes across another's thirds (an interaction).
+ * docs/uncertainty.md gives the estimators, their sources and how to read
+ * them. */
 #ifndef POSEDROP_SENSITIVITY_H
 #define POSEDROP_SENSITIVITY_H
 
@@ -44,6 +47,22 @@ PD_API pd_status pd_first_order_index(const double *x, const double *y, long n, 
 typedef struct pd_sensitivity_row {
     int pose;               /* 0-based: a pose of the result, or a class with class_of */
     pd_scene_param param;
+    double effect, effect_lo, effect_hi; /* p_high - p_low: how far the pose moves
+                                            across the range, in probability (0.05:
+                                            5 points), and its 95% percentile
+                                            interval over PD_SENSITIVITY_RESAMPLES
+                                            resamples of the drops */
+    int interacts;          /* -1, or the parameter (pd_scene_param) across
+                               whose thirds this effect changes: its effect in
+                               two of that parameter's thirds differ by more
+                               than their joint interval (z 2.39, the 95%
+                               two-sided point shared by the three pairs of
+                               thirds, Bonferroni) */
+    double effect_in[3];    /* with interacts: the effect among the drops in
+                               that parameter's lower, middle, upper third */
+    double interaction, interaction_lo, interaction_hi; /* with interacts: the
+                               largest difference of effect_in, the later third's
+                               less the earlier's, and its interval */
     long n_low, n_high;     /* settled drops whose value fell in the lower,
                                upper third of the range (by its distribution:
                                thirds of log for log uniform) */
@@ -59,6 +78,12 @@ typedef struct pd_sensitivity {
     int nparams;            /* ranged parameters, in pd_scene_param order */
     pd_scene_param param[PD_NPARAMS];
     pd_sensitivity_row *rows; /* nposes * nparams, pose-major */
+    double resolution;      /* the largest half-width of an effect's interval:
+                               an effect smaller than this the run could not
+                               tell from none (0 without rows) */
+    int interaction_tests;  /* pose and ordered parameter pairs tested for an
+                               interaction: about 5% of them are flagged by
+                               chance alone */
 } pd_sensitivity;
 
 /* The sensitivity of a run made with keep_trials from scene (the scene given

@@ -170,7 +170,12 @@ PD_API const char *pd_scene_param_name(pd_scene_param param);
 PD_API const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *buf,
                                    size_t size);
 
-/* Whether any parameter of scene is a range. */
+/* Whether parameter param of scene is a range of nonzero width, so that
+ * drops draw different values of it. A range of zero width is its one
+ * value: the drops run as with that value fixed, byte for byte. */
+PD_API int pd_scene_varies(const pd_scene *scene, pd_scene_param param);
+
+/* Whether any parameter of scene varies (pd_scene_varies). */
 PD_API int pd_scene_ranged(const pd_scene *scene);
 
 /* The values drop `drop` of a run seeded `seed` uses, one per parameter
@@ -244,12 +249,38 @@ typedef enum pd_engine_kind {
     PD_ENGINE_BULLET       /* Bullet Physics, fixed step */
 } pd_engine_kind;
 
+/* One state of a traced drop (pd_sim_options.trace), the same fields for
+ * every engine, so that two engines' runs of the same drop can be laid side
+ * by side. The orientation is that of the part's principal frame (the
+ * engines' body frame), whose origin is the centre of mass. */
+typedef struct pd_trace_row {
+    double t;          /* s since the release */
+    double x[3];       /* centre of mass, world, m (z up, the floor at 0) */
+    double q[4];       /* principal frame -> world, w x y z */
+    double v[3];       /* centre of mass velocity, m/s */
+    double w[3];       /* angular velocity, world frame, rad/s */
+    double energy;     /* kinetic plus potential energy over the weight: the
+                          height the centre of mass could reach, m */
+    double depth;      /* the lowest hull vertex's depth below the floor, m
+                          (negative: its height above it) */
+    int contacts;      /* hull vertices below the floor or within
+                          PD_TOL_REST_FALL_REL of the size above it (the
+                          depth a soft contact lets a resting part sink) */
+    const char *event; /* what the state follows: "release", "step" (a
+                          stepping engine's), "flight" (the impulse engine's
+                          closed-form flight or rest step), "impact",
+                          "compliant" (a compliant impact's end), "phase" (a
+                          contact phase's end), "end" */
+} pd_trace_row;
+
 /* Defaults after the field's meaning; pd_sim_run refuses values outside the
  * stated ranges. */
 typedef struct pd_sim_options {
     pd_engine_kind engine;  /* PD_ENGINE_IMPULSE */
-    double dt;              /* s, fixed step of ODE and Bullet, at most 0.01; 0 picks
-                               each engine's default (ODE 1 ms, Bullet 1/960 s) */
+    double dt;              /* s, fixed step of ODE and Bullet, at most 0.01; 0
+                               (automatic): 20 steps per contact time, at most
+                               a tenth of the thickness travelled per step
+                               (docs/engines.md) */
     long ndrops;            /* drops to run (with ci_halfwidth: at least these), >= 0; 2000 */
     uint64_t seed;          /* 1 */
     int threads;            /* 0: all cores; at most 256 are used */
@@ -280,6 +311,23 @@ typedef struct pd_sim_options {
                                with the drops done so far (of the shard) and
                                those planned; must return quickly */
     void *progress_user;
+    double effect_halfwidth; /* in (0, 0.5): with a scene parameter that
+                               varies and keep_trials, keep dropping (after
+                               ndrops, in rounds sized from the widest
+                               interval so far, up to max_drops) until every
+                               effect's 95% interval (pd_sim_sensitivity, per
+                               pose) is at most this wide on each side; 0 */
+    const int *effect_class_of; /* NULL, or with effect_halfwidth the effects
+                               are those of effect_nclasses classes of poses
+                               (pd_pose_classes' class_of, one per pose) */
+    int effect_nclasses;
+    /* May be NULL. Else drop trace_drop (numbered as in the run, >= 0) calls
+     * it with every state it passes through, in order, from the thread
+     * running that drop: a stepping engine's after every step, the impulse
+     * engine's at every event (docs/engines.md, "Tracing a drop"). */
+    void (*trace)(void *user, const pd_trace_row *row);
+    void *trace_user;
+    long trace_drop;        /* 0 */
 } pd_sim_options;
 
 /* Cancelling a run: point options->cancel at an atomic_int holding 0 and
@@ -402,6 +450,13 @@ typedef struct pd_sim_result {
                                the options that change outcomes (not threads,
                                keep_trials or the shard); pd_sim_result_add
                                refuses a shard whose own differs */
+    /* A sum (pd_sim_result_new): the split of the shards added (their
+     * nshards, 1 for whole runs; 0 before the first) and which of them were
+     * added, so that pd_sim_result_add refuses a shard added twice or one of
+     * another split, either of which would count drops twice. The library's
+     * bookkeeping: read it, never write it. NULL in any other result. */
+    int added_nshards;
+    unsigned char *added;
 } pd_sim_result;
 
 /* Drop i (from 0) of a sharded run belongs to shard i mod nshards: every
@@ -462,8 +517,9 @@ PD_API void pd_sim_result_free(pd_sim_result *result);
  * give the unsharded run's result, byte for byte (trials aside: none are
  * kept). scene and options may be NULL (defaults). PD_ERR_USAGE for a NULL
  * static_result, result, sum or shard, or a shard of another run (its
- * run_fingerprint: another part, pose table, scene, seed or drop count),
- * PD_ERR_NOMEM. */
+ * run_fingerprint: another part, pose table, scene, seed or drop count), a
+ * shard added before, one of another split (another nshards) or sum itself
+ * (each would count drops twice), PD_ERR_NOMEM. */
 PD_API pd_status pd_sim_result_new(const pd_static_result *static_result,
                                    const pd_scene *scene, const pd_sim_options *options,
                                    pd_sim_result **result, pd_diag *diag);

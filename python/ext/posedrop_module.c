@@ -789,6 +789,20 @@ static int wait_slice(run_ctx *c)
     return finished;
 }
 
+/* Ctrl-C reaches only the main thread's Python code: the module's SIGINT
+ * handler (posedrop/__init__.py) counts it here, and a run waiting on any
+ * other thread that sees the count move stops as the main thread's would,
+ * raising KeyboardInterrupt there too. */
+static atomic_long interrupts;
+
+static PyObject *mod_interrupt(PyObject *mod, PyObject *unused)
+{
+    (void)mod;
+    (void)unused;
+    atomic_fetch_add(&interrupts, 1);
+    Py_RETURN_NONE;
+}
+
 /* The caller's cancel event: 1 if set, 0 if not, -1 on an error. */
 static int cancel_requested(PyObject *event)
 {
@@ -824,8 +838,8 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
         pthread_mutex_destroy(&c->lock);
         return -1;
     }
-    int failed = 0, finished = 0;
-    long reported = -1;
+    int failed = 0, finished = 0, interrupted = 0;
+    long reported = -1, seen = atomic_load(&interrupts);
     while (!finished) {
         Py_BEGIN_ALLOW_THREADS
         finished = wait_slice(c);
@@ -833,6 +847,10 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
         if (finished)
             break;
         int set = PyErr_CheckSignals() < 0 ? -1 : cancel_requested(event);
+        if (set == 0 && atomic_load(&interrupts) != seen) {
+            interrupted = 1;
+            set = -1;
+        }
         if (set == 0 && progress != Py_None && atomic_load(&c->done) != reported) {
             reported = atomic_load(&c->done);
             PyObject *r = PyObject_CallFunction(progress, "ll", reported, atomic_load(&c->total));
@@ -852,6 +870,8 @@ static int run_and_wait(run_ctx *c, PyObject *event, PyObject *progress)
     Py_END_ALLOW_THREADS
     pthread_cond_destroy(&c->finished_cv);
     pthread_mutex_destroy(&c->lock);
+    if (interrupted)
+        PyErr_SetNone(PyExc_KeyboardInterrupt);
     return failed ? -1 : 0;
 }
 
@@ -981,6 +1001,17 @@ static PyObject *Poses_drop(PosesObject *self, PyObject *args, PyObject *kw)
         return NULL;
     if (progress != Py_None && !PyCallable_Check(progress)) {
         PyErr_SetString(PyExc_TypeError, "progress must be callable");
+        return NULL;
+    }
+    /* Checked now, not when the first slice asks it (cancel=5 ran until
+     * then). */
+    PyObject *is_set = event == Py_None ? NULL : PyObject_GetAttrString(event, "is_set");
+    int callable = is_set && PyCallable_Check(is_set);
+    Py_XDECREF(is_set);
+    if (event != Py_None && !callable) {
+        PyErr_Clear();
+        PyErr_SetString(PyExc_TypeError, "cancel must have an is_set() method, as "
+                                         "threading.Event has");
         return NULL;
     }
     run_ctx *c = calloc(1, sizeof *c);
@@ -1189,27 +1220,265 @@ static PyObject *Drops_sensitivity(DropsObject *self, PyObject *args)
     size_t m = (size_t)s->nposes * (size_t)s->nparams;
     PyObject *d = PyDict_New(), *params = d ? PyList_New(0) : NULL;
     int bad = !d || put(d, "params", params) || put(d, "n", PyLong_FromLong(s->n)) ||
-              put(d, "nposes", PyLong_FromLong(s->nposes));
+              put(d, "nposes", PyLong_FromLong(s->nposes)) ||
+              put(d, "resolution", PyFloat_FromDouble(s->resolution)) ||
+              put(d, "interaction_tests", PyLong_FromLong(s->interaction_tests));
     for (int k = 0; !bad && k < s->nparams; k++) {
         PyObject *name = PyUnicode_FromString(pd_scene_param_name(s->param[k]));
         bad = !name || PyList_Append(params, name) < 0;
         Py_XDECREF(name);
     }
     void *pose = NULL, *nlow = NULL, *nhigh = NULL, *v = NULL;
+    PyObject *with = bad ? NULL : PyList_New(0);
     bad = bad || put(d, "pose", new_buffer(m, sizeof(int32_t), &pose)) ||
           put(d, "n_low", new_buffer(m, sizeof(int64_t), &nlow)) ||
           put(d, "n_high", new_buffer(m, sizeof(int64_t), &nhigh)) ||
-          put(d, "values", new_buffer(9 * m, sizeof(double), &v));
+          put(d, "interacts", with) ||
+          put(d, "values", new_buffer(18 * m, sizeof(double), &v));
     for (size_t i = 0; !bad && i < m; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        const double row[9] = {r->p_low,  r->p_low_lo,  r->p_low_hi, r->p_high,  r->p_high_lo,
-                               r->p_high_hi, r->index, r->index_lo, r->index_hi};
+        const double row[18] = {r->effect, r->effect_lo, r->effect_hi, r->p_low, r->p_low_lo,
+                                r->p_low_hi, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
+                                r->index_lo, r->index_hi, r->effect_in[0], r->effect_in[1],
+                                r->effect_in[2], r->interaction, r->interaction_lo,
+                                r->interaction_hi};
         ((int32_t *)pose)[i] = r->pose;
         ((int64_t *)nlow)[i] = r->n_low;
         ((int64_t *)nhigh)[i] = r->n_high;
-        memcpy((double *)v + 9 * i, row, sizeof row);
+        PyObject *name = PyUnicode_FromString(
+            r->interacts >= 0 ? pd_scene_param_name((pd_scene_param)r->interacts) : "");
+        bad = !name || PyList_Append(with, name) < 0;
+        Py_XDECREF(name);
+        memcpy((double *)v + 18 * i, row, sizeof row);
     }
     pd_sensitivity_free(s);
+    if (bad) {
+        Py_XDECREF(d);
+        return NULL;
+    }
+    return d;
+}
+
+/* --- design ------------------------------------------------------------ */
+
+/* changes: a sequence of (kind, axis, lo, hi) tuples, kind "scale" or
+ * "com", or ("stretch", axis, lo, hi, from, to) for a slab; metres. */
+static int read_changes(PyObject *seq, pd_change *ch, int *n)
+{
+    PyObject *fast = PySequence_Fast(seq, "changes: expected a sequence of tuples");
+    if (!fast)
+        return -1;
+    Py_ssize_t m = PySequence_Fast_GET_SIZE(fast);
+    int rc = 0;
+    if (m < 1 || m > PD_DESIGN_MAX_CHANGES) {
+        PyErr_Format(PyExc_ValueError, "changes: expected 1 to %d, got %zd",
+                     PD_DESIGN_MAX_CHANGES, m);
+        rc = -1;
+    }
+    for (Py_ssize_t i = 0; rc == 0 && i < m; i++) {
+        const char *kind;
+        int axis;
+        double lo, hi, from = 0.0, to = 0.0;
+        PyObject *item = PySequence_Fast_GET_ITEM(fast, i);
+        if (!PyTuple_Check(item) ||
+            !PyArg_ParseTuple(item, "sidd|dd", &kind, &axis, &lo, &hi, &from, &to)) {
+            PyErr_Clear();
+            PyErr_Format(PyExc_ValueError, "changes[%zd]: expected (kind, axis, lo, hi) or "
+                         "('stretch', axis, lo, hi, from, to)", i);
+            rc = -1;
+            break;
+        }
+        memset(&ch[i], 0, sizeof ch[i]);
+        ch[i].axis = axis;
+        ch[i].lo = lo;
+        ch[i].hi = hi;
+        if (strcmp(kind, "scale") == 0 && PyTuple_GET_SIZE(item) == 4)
+            ch[i].kind = PD_CHANGE_SCALE;
+        else if (strcmp(kind, "com") == 0 && PyTuple_GET_SIZE(item) == 4)
+            ch[i].kind = PD_CHANGE_COM;
+        else if (strcmp(kind, "stretch") == 0 && PyTuple_GET_SIZE(item) == 6) {
+            ch[i].kind = PD_CHANGE_SCALE;
+            ch[i].slab = 1;
+            ch[i].from = from;
+            ch[i].to = to;
+        } else {
+            PyErr_Format(PyExc_ValueError, "changes[%zd]: kind '%s': expected 'scale' or 'com' "
+                         "(4 items) or 'stretch' (6 items)", i, kind);
+            rc = -1;
+        }
+    }
+    *n = (int)m;
+    Py_DECREF(fast);
+    return rc;
+}
+
+static PyObject *Poses_design_sensitivity(PosesObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"changes", "classes", "nclasses", "drops", "seed", "threads", NULL};
+    PyObject *changes, *classes = Py_None;
+    int nclasses = 0, threads = 0;
+    long drops = 0;
+    unsigned long long seed = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "O|OilKi", kwlist, &changes, &classes, &nclasses,
+                                     &drops, &seed, &threads))
+        return NULL;
+    pd_change ch[PD_DESIGN_MAX_CHANGES];
+    int n = 0;
+    if (read_changes(changes, ch, &n) < 0)
+        return NULL;
+    Py_buffer view = {0};
+    if (classes != Py_None) {
+        if (PyObject_GetBuffer(classes, &view, PyBUF_C_CONTIGUOUS | PyBUF_FORMAT) < 0)
+            return NULL;
+        if (view.itemsize != sizeof(int) ||
+            view.len != (Py_ssize_t)(sizeof(int) * (size_t)self->res->nposes)) {
+            PyBuffer_Release(&view);
+            PyErr_SetString(PyExc_ValueError, "classes: expected one C int per pose");
+            return NULL;
+        }
+    }
+    pd_sim_options so;
+    pd_sim_options_default(&so);
+    so.ndrops = drops;
+    so.seed = (uint64_t)seed;
+    so.threads = threads;
+    warn_box w;
+    pd_diag diag;
+    diag_start(&diag, &w);
+    pd_design_sens *s = NULL;
+    pd_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = pd_design_sensitivity(self->part->part, self->res, NULL, ch, n,
+                               classes != Py_None ? view.buf : NULL, nclasses, NULL,
+                               drops > 0 ? &so : NULL, &s, &diag);
+    Py_END_ALLOW_THREADS
+    if (classes != Py_None)
+        PyBuffer_Release(&view);
+    if (st != PD_OK)
+        return fail(st, &diag, &w);
+    if (diag_finish(&w) < 0) {
+        pd_design_sens_free(s);
+        return NULL;
+    }
+    size_t m = (size_t)s->nposes * (size_t)s->nchanges;
+    PyObject *d = PyDict_New();
+    void *pose = NULL, *v = NULL;
+    int bad = !d || put(d, "nposes", PyLong_FromLong(s->nposes)) ||
+              put(d, "ndrops", PyLong_FromLong(s->ndrops)) ||
+              put_doubles(d, "step", s->step, (size_t)s->nchanges) ||
+              put(d, "pose", new_buffer(m, sizeof(int32_t), &pose)) ||
+              put(d, "values", new_buffer(7 * m, sizeof(double), &v));
+    for (size_t i = 0; !bad && i < m; i++) {
+        const pd_design_sens_row *r = &s->rows[i];
+        const double row[7] = {r->d_qs, r->d_pqs, r->d_p, r->lo, r->hi, r->qs_kink, r->pqs_kink};
+        ((int32_t *)pose)[i] = r->pose;
+        memcpy((double *)v + 7 * i, row, sizeof row);
+    }
+    pd_design_sens_free(s);
+    if (bad) {
+        Py_XDECREF(d);
+        return NULL;
+    }
+    return d;
+}
+
+static const char *const goal_names[] = {"target", "maximise", "equalise", NULL};
+static const char *const model_names[] = {"qs", "pqs", NULL};
+
+static PyObject *Part_design(PartObject *self, PyObject *args, PyObject *kw)
+{
+    static char *kwlist[] = {"changes", "goal", "normals", "p", "model", "group", "n",
+                             "max_evals", "check", "seed", "threads", NULL};
+    PyObject *changes, *goal = Py_None, *normals, *probs = Py_None, *model = Py_None;
+    int group = 0, max_evals = 12, threads = 0;
+    long ndrops = 20000, check = 20000;
+    unsigned long long seed = 1;
+    if (!PyArg_ParseTupleAndKeywords(args, kw, "OOO|OOplilKi", kwlist, &changes, &goal, &normals,
+                                     &probs, &model, &group, &ndrops, &max_evals, &check, &seed,
+                                     &threads))
+        return NULL;
+    pd_change ch[PD_DESIGN_MAX_CHANGES];
+    int n = 0, g = 0, mdl = PD_DESIGN_PQS;
+    if (read_changes(changes, ch, &n) < 0 || choose("goal", goal_names, goal, &g) < 0 ||
+        choose("model", model_names, model, &mdl) < 0)
+        return NULL;
+    enum { MAXT = 64 };
+    pd_design_target t[MAXT];
+    PyObject *fn = PySequence_Fast(normals, "normals: expected a sequence of (nx, ny, nz)");
+    if (!fn)
+        return NULL;
+    Py_ssize_t nt = PySequence_Fast_GET_SIZE(fn);
+    PyObject *fp = probs != Py_None ? PySequence_Fast(probs, "p: expected a sequence") : NULL;
+    int rc = probs != Py_None && !fp ? -1 : 0;
+    if (rc == 0 && (nt < 1 || nt > MAXT || (fp && PySequence_Fast_GET_SIZE(fp) != nt))) {
+        PyErr_Format(PyExc_ValueError, "normals: expected 1 to %d, and as many p", MAXT);
+        rc = -1;
+    }
+    for (Py_ssize_t i = 0; rc == 0 && i < nt; i++) {
+        double x, y, z;
+        if (!PyArg_ParseTuple(PySequence_Fast_GET_ITEM(fn, i), "ddd", &x, &y, &z)) {
+            rc = -1;
+            break;
+        }
+        t[i].normal = (pd_vec3){x, y, z};
+        t[i].p = fp ? PyFloat_AsDouble(PySequence_Fast_GET_ITEM(fp, i)) : 0.0;
+        if (PyErr_Occurred())
+            rc = -1;
+    }
+    Py_DECREF(fn);
+    Py_XDECREF(fp);
+    if (rc < 0)
+        return NULL;
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.model = (pd_design_model)mdl;
+    o.group = group;
+    o.sim.ndrops = ndrops;
+    o.sim.seed = (uint64_t)seed;
+    o.sim.threads = threads;
+    o.max_evals = max_evals;
+    o.check_drops = check;
+    o.check_seed = (uint64_t)seed + 1;
+    warn_box w;
+    pd_diag diag;
+    diag_start(&diag, &w);
+    pd_design_result *r = NULL;
+    pd_status st;
+    Py_BEGIN_ALLOW_THREADS
+    st = pd_design_run(self->part, ch, n, (pd_design_goal)g, t, (int)nt, &o, &r, &diag);
+    Py_END_ALLOW_THREADS
+    if (st != PD_OK)
+        return fail(st, &diag, &w);
+    if (diag_finish(&w) < 0) {
+        pd_design_result_free(r);
+        return NULL;
+    }
+    PyObject *d = PyDict_New();
+    void *v = NULL;
+    int bad = !d || put_doubles(d, "value_before", r->value_before, (size_t)n) ||
+              put_doubles(d, "value_static", r->value_static, (size_t)n) ||
+              put_doubles(d, "value", r->value, (size_t)n) ||
+              put(d, "objective_static", PyFloat_FromDouble(r->objective_static)) ||
+              put(d, "objective_refine", PyFloat_FromDouble(r->objective_refine)) ||
+              put(d, "objective_after", PyFloat_FromDouble(r->objective_after)) ||
+              put(d, "static_evals", PyLong_FromLong(r->static_evals)) ||
+              put(d, "drop_evals", PyLong_FromLong(r->drop_evals)) ||
+              put(d, "drops", PyLong_FromLong(r->drops)) ||
+              put(d, "poses_before", PyLong_FromLong(r->poses_before)) ||
+              put(d, "poses_after", PyLong_FromLong(r->poses_after)) ||
+              put(d, "targets", new_buffer(14 * (size_t)nt, sizeof(double), &v));
+    for (Py_ssize_t i = 0; !bad && i < nt; i++) {
+        const pd_design_target_result *q = &r->targets[i];
+        const double row[14] = {q->p_target, q->qs_before, q->pqs_before, q->qs_static,
+                                q->pqs_static, q->qs_after, q->pqs_after, q->p_refine,
+                                q->p_after, q->lo, q->hi, q->vanished, q->appeared, 0.0};
+        memcpy((double *)v + 14 * i, row, sizeof row);
+    }
+    if (!bad) {
+        bad = put(d, "part", part_new(r->part));
+        r->part = NULL; /* the new Part owns it (part_new frees it on failure) */
+    }
+    pd_design_result_free(r);
     if (bad) {
         Py_XDECREF(d);
         return NULL;
@@ -1240,7 +1509,7 @@ static PyObject *mod_statuses(PyObject *mod, PyObject *unused)
         STATUS(PD_ERR_TOO_FEW_POINTS), STATUS(PD_ERR_COLOCATED), STATUS(PD_ERR_COLLINEAR),
         STATUS(PD_ERR_COPLANAR), STATUS(PD_ERR_NOT_CLOSED), STATUS(PD_ERR_ORIENTATION),
         STATUS(PD_ERR_COM_OUTSIDE), STATUS(PD_ERR_NO_CONVERGENCE), STATUS(PD_ERR_NOMEM),
-        STATUS(PD_ERR_INTERNAL), STATUS(PD_ERR_UNAVAILABLE),
+        STATUS(PD_ERR_INTERNAL), STATUS(PD_ERR_UNAVAILABLE), STATUS(PD_ERR_CANCELLED),
     };
 #undef STATUS
     _Static_assert(sizeof table / sizeof table[0] == PD_STATUS_COUNT, "every status is listed");
@@ -1310,6 +1579,8 @@ static PyMethodDef Part_methods[] = {
     {"info", (PyCFunction)Part_info, METH_NOARGS, "the part's properties as a dict"},
     {"mesh", (PyCFunction)Part_mesh, METH_NOARGS, "(vertices, faces) buffers of the welded mesh"},
     {"hull", (PyCFunction)Part_hull, METH_NOARGS, "the convex hull as a dict of buffers"},
+    {"design", (PyCFunction)(void (*)(void))Part_design, METH_VARARGS | METH_KEYWORDS,
+     "pd_design_run"},
     {"estimate", (PyCFunction)(void (*)(void))Part_estimate, METH_VARARGS | METH_KEYWORDS,
      "pd_static_estimate"},
     {NULL, NULL, 0, NULL}};
@@ -1319,6 +1590,8 @@ static PyMethodDef Poses_methods[] = {
     {"facets", (PyCFunction)Poses_facets, METH_NOARGS, "the hull facets as a dict of buffers"},
     {"classes", (PyCFunction)Poses_classes, METH_NOARGS, "pd_pose_classes: (buffer, nclasses)"},
     {"drop", (PyCFunction)(void (*)(void))Poses_drop, METH_VARARGS | METH_KEYWORDS, "pd_sim_run"},
+    {"design_sensitivity", (PyCFunction)(void (*)(void))Poses_design_sensitivity,
+     METH_VARARGS | METH_KEYWORDS, "pd_design_sensitivity"},
     {NULL, NULL, 0, NULL}};
 
 static PyMethodDef Drops_methods[] = {
@@ -1369,6 +1642,7 @@ static PyMethodDef module_methods[] = {
      METH_VARARGS | METH_KEYWORDS, "pd_part_build from (n, 3) float64 and (m, 3) int32 buffers"},
     {"version", mod_version, METH_NOARGS, "pd_version()"},
     {"statuses", mod_statuses, METH_NOARGS, "the pd_status names and values"},
+    {"interrupt", mod_interrupt, METH_NOARGS, "stop the runs waiting on other threads (Ctrl-C)"},
     {"engine_available", mod_engine_available, METH_O, "pd_engine_available"},
     {"units_plausible", mod_units_plausible, METH_VARARGS, "pd_units_plausible"},
     {"names", mod_names, METH_NOARGS, "(stage names, status strings, parameter names)"},

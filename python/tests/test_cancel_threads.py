@@ -30,6 +30,32 @@ def test_sigint_raises_keyboard_interrupt(cap):
     assert d.n == 20 and not d.partial
 
 
+def test_sigint_stops_drops_on_another_thread(cap):
+    """Ctrl-C in the main thread stops drops a worker thread waits for: they
+    ran on for a minute, the worker's Python code out of the signal's reach."""
+    started, outcome = threading.Event(), []
+
+    def work():
+        try:
+            cap.drop(LONG, threads=1, progress=lambda done, total: started.set())
+            outcome.append("finished")
+        except KeyboardInterrupt:
+            outcome.append("interrupted")
+    worker = threading.Thread(target=work)
+    worker.start()
+    started.wait()
+    with pytest.raises(KeyboardInterrupt):
+        os.kill(os.getpid(), signal.SIGINT)
+        threading.Event().wait(60)  # the handler's KeyboardInterrupt ends it
+    worker.join(60)
+    assert not worker.is_alive() and outcome == ["interrupted"]
+
+
+def test_cancel_without_is_set_refused_at_once(cap):
+    with pytest.raises(TypeError, match="is_set"):
+        cap.drop(LONG, cancel=5)
+
+
 def test_cancel_event_returns_the_first_drops(cap):
     cancel = threading.Event()
     drops = cap.drop(LONG, threads=2, cancel=cancel,

@@ -29,19 +29,28 @@ def range_kwargs():
 
 
 def trial_rows(t):
-    """The rows of --trials (write_trials in src/cli/command.c) from Python's arrays."""
+    """The rows of --trials (write_trials in src/cli/command.c) from Python's arrays, of a
+    whole run (partial 0)."""
     return [[str(i + 1), *map(g17, t.q0[i]), str(t.pose[i] + 1), str(t.collisions[i]),
-             g10(t.time[i]), t.end_text[i], *(g17(v[i]) for v in t.params.values())]
+             g10(t.time[i]), t.end_text[i], *(g17(v[i]) for v in t.params.values()),
+             "0"]
             for i in range(len(t))]
 
 
 def sensitivity_rows(s):
     """The rows of --sensitivity FILE (write_sensitivity in src/cli/command.c)."""
     g6 = "%.6g".__mod__
-    return [[str(s.pose[i] + 1), s.parameter[i], str(s.n_low[i]), g10(s.p_low[i]),
+    def interaction(i):
+        if not s.interacts[i]:
+            return [""] * 7
+        return [s.interacts[i], *(g6(getattr(s, c)[i]) for c in (
+            "effect_in_low", "effect_in_middle", "effect_in_high", "interaction",
+            "interaction_lo", "interaction_hi"))]
+    return [[str(s.pose[i] + 1), s.parameter[i], g6(s.effect[i]), g6(s.effect_lo[i]),
+             g6(s.effect_hi[i]), str(s.n_low[i]), g10(s.p_low[i]),
              g10(s.p_low_lo[i]), g10(s.p_low_hi[i]), str(s.n_high[i]), g10(s.p_high[i]),
              g10(s.p_high_lo[i]), g10(s.p_high_hi[i]), g6(s.index[i]), g6(s.index_lo[i]),
-             g6(s.index_hi[i])] for i in range(len(s))]
+             g6(s.index_hi[i]), *interaction(i), "0"] for i in range(len(s))]
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +69,7 @@ def test_ranged_counts_and_drawn_values_equal_command(ranged_run):
     poses, drops, rows, (trows, theader), _ = ranged_run
     assert pose_rows(poses, drops) == rows
     names = [key for _, key, _ in RANGES]
-    assert theader[9:] == names and list(drops.trials.params) == names
+    assert theader[9:-1] == names and list(drops.trials.params) == names
     assert trial_rows(drops.trials) == trows
     # Each drop drew its own values, inside its range.
     for _, key, text in RANGES:
@@ -74,8 +83,11 @@ def test_ranged_counts_and_drawn_values_equal_command(ranged_run):
 def test_sensitivity_equals_command(ranged_run):
     _, drops, _, _, (srows, sheader) = ranged_run
     s = drops.sensitivity()
-    assert sheader == ["pose", "parameter", "n_low", "p_low", "p_low_lo", "p_low_hi", "n_high",
-                       "p_high", "p_high_lo", "p_high_hi", "index", "index_lo", "index_hi"]
+    assert sheader == ["pose", "parameter", "effect", "effect_lo", "effect_hi", "n_low", "p_low",
+                       "p_low_lo", "p_low_hi", "n_high", "p_high", "p_high_lo", "p_high_hi",
+                       "index", "index_lo", "index_hi", "interacts", "effect_in_low",
+                       "effect_in_middle", "effect_in_high", "interaction", "interaction_lo",
+                       "interaction_hi", "partial"]
     assert s.params == [key for _, key, _ in RANGES] and s.nposes == len(drops)
     assert s.n == drops.n - drops.unsettled
     assert sensitivity_rows(s) == srows

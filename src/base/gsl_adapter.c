@@ -9,6 +9,7 @@
 #include <gsl/gsl_rng.h>
 #include <gsl/gsl_sf_ellint.h>
 #include <gsl/gsl_sf_elljac.h>
+#include <gsl/gsl_sf_gamma.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -52,6 +53,13 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 /* --- distributions ---------------------------------------------------------- */
 
 double pd_gsl_chisq_q(double x, double dof) { return gsl_cdf_chisq_Q(x, dof); }
+
+double pd_gsl_lnpoch(double a, double x)
+{
+    gsl_sf_result r;
+    gsl_set_error_handler_off();
+    return gsl_sf_lnpoch_e(a, x, &r) == GSL_SUCCESS ? r.val : lgamma(a + x) - lgamma(a);
+}
 
 double pd_gsl_normal_quantile(double p) { return gsl_cdf_ugaussian_Pinv(p); }
 

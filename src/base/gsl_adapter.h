@@ -22,6 +22,9 @@ pd_status pd_quad_integrate(pd_quad_fn fn, void *user, double a, double b, doubl
 double pd_gsl_chisq_q(double x, double dof);        /* P(chi2_dof > x) */
 double pd_gsl_normal_quantile(double p);            /* Phi^-1(p), p in (0, 1) */
 double pd_gsl_beta_p(double x, double a, double b); /* P(X <= x), X ~ Beta(a, b) */
+/* log Gamma(a + x) - log Gamma(a) for a > 0, x >= 0, without the cancellation
+ * of the difference of two large lgamma values (GSL's lnpoch). */
+double pd_gsl_lnpoch(double a, double x);
 
 /* The real roots of x^3 + a x^2 + b x + c, ascending, into x[0..n); returns n
  * (1 or 3; a double root is reported twice). GSL's closed form, no iteration. */

@@ -191,8 +191,8 @@ pd_status pd_text_coord(pd_text *t, pd_diag *diag, const char *what, double scal
                             pd_text_show(shown, sizeof shown, s, n));
     v *= scale;
     if (rc == PD_NUM_NONFINITE || !isfinite(v))
-        return pd_text_fail(t, diag, PD_ERR_NONFINITE, "non-finite %s %s", what,
-                            pd_text_show(shown, sizeof shown, s, n));
+        return pd_text_fail(t, diag, PD_ERR_NONFINITE, "expected %s (a finite number), found %s",
+                            what, pd_text_show(shown, sizeof shown, s, n));
     if (rc == PD_NUM_TINY)
         return pd_text_fail(t, diag, PD_ERR_RANGE, "%s %s is non-zero but below the smallest "
                             "normal double, 2.2e-308", what, pd_text_show(shown, sizeof shown, s, n));

@@ -22,13 +22,14 @@ typedef struct {
 } cli_file;
 
 typedef struct {
-    const char *path, *trials, *transitions, *com_text;
+    const char *path, *trials, *transitions, *trace, *com_text;
     pd_mesh_read_options read;
     pd_part_options part;
     pd_static_options estimate;
     pd_scene scene;
     pd_sim_options sim;
     int dynamic, facets, group, verbose;
+    int crosscheck;                /* --crosscheck: every engine on the same releases */
     char scene_option[32];         /* the first scene option given ("--mu"), "" if none */
     const char *pictures[VIZ_KINDS]; /* --svg, --chart, --sphere, --report */
     const char *measured;

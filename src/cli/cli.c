@@ -30,7 +30,7 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY, OPT_TIME_LIMIT };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT, OPT_TRACE, OPT_TRACE_DROP };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -100,9 +100,19 @@ static const cli_option options[] = {
     {OPT_ENGINE, "engine", ARG_CHOICE, "E", NO_RULE, engine_names, NULL,
      "impulse (default): posedrop's own simulator; ode or\n"
      "bullet: the same drops on a stepping engine, to cross-check"},
-    {OPT_DT, "dt", ARG_REAL, "S", REAL("a time step in s", 0, 0.01, 1, 0), NULL, NULL,
-     "time step of ode (default 0.001) or bullet (1/960),\n"
-     "above 0 and at most 0.01"},
+    {OPT_DT, "dt", ARG_TEXT, "S", REAL("auto or a time step in s", 0, 0.01, 1, 0), NULL, NULL,
+     "time step of ode and bullet, above 0 and at most 0.01,\n"
+     "or auto (default): 20 steps per contact time (the\n"
+     "shortest the scene draws), each corner travelling at\n"
+     "most a tenth of the part's thickness per step"},
+    {OPT_CROSSCHECK, "crosscheck", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "the same drops (the same releases) on all three engines;\n"
+     "p and its interval stay --engine's, and each row adds\n"
+     "p_impulse, p_ode, p_bullet, their lowest and highest,\n"
+     "p_engine_min and p_engine_max, and engines_disagree: 1\n"
+     "when two engines' 95% intervals are apart (the model, not\n"
+     "the sampling, limits that estimate); said on stderr too.\n"
+     "Costs the three runs together (docs/engines.md)"},
     {OPT_TIME_LIMIT, "time-limit", ARG_TEXT, "S", REAL("auto or a time in s", 0, 1e9, 1, 0), NULL, NULL,
      "simulated seconds a drop may take before it ends\n"
      "unsettled (time_limit), above 0 and at most 1e9, or auto\n"
@@ -114,6 +124,10 @@ static const cli_option options[] = {
     {OPT_CI, "ci", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
      "drop until every pose's 95% interval is within DELTA\n"
      "(above 0 and below 0.5)"},
+    {OPT_EFFECT, "effect", ARG_REAL, "DELTA", REAL("a half-width", 0, 0.5, 1, 1), NULL, NULL,
+     "with a range, drop (from -n, in rounds) until every\n"
+     "effect's 95% interval is within DELTA (0.03: 3 points\n"
+     "each side; --sensitivity, docs/uncertainty.md)"},
     {OPT_SEED, "seed", ARG_WHOLE, "S", WHOLE("a seed", 0, LLONG_MAX), NULL, NULL,
      "random seed, 0..2^63-1 (default 1); same seed, same bytes"},
     {'j', NULL, ARG_WHOLE, "THREADS", WHOLE("a number of threads", 1, 256), NULL, NULL,
@@ -177,15 +191,27 @@ static const cli_option options[] = {
      "number of the output and a last column member the pose\n"
      "within it, numbered as without --group; then one column\n"
      "per ranged scene parameter, named by its key, the value\n"
-     "the drop drew (vibration in degrees)"},
+     "the drop drew (vibration in degrees); last partial, 1 in\n"
+     "every row of an interrupted run"},
+    {OPT_TRACE, "trace", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
+     "one drop's motion as CSV, the same columns on every\n"
+     "engine: t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,energy,\n"
+     "depth,contacts,event (docs/engines.md, \"Tracing a drop\");\n"
+     "a stepping engine's every step, the impulse engine's\n"
+     "every event"},
+    {OPT_TRACE_DROP, "trace-drop", ARG_WHOLE, "I", WHOLE("a drop number", 0, LONG_MAX), NULL, NULL,
+     "the drop --trace records, numbered from 0 (default 0):\n"
+     "the same I starts from the same state on every engine"},
     {OPT_SENSITIVITY, "sensitivity", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with ranges, what each ranged parameter moves, as CSV:\n"
-     "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,\n"
-     "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi: the\n"
-     "pose's probability in the lower and upper third of the\n"
-     "range (95% Wilson) and the first-order index, the share\n"
-     "of the pose's variance the parameter explains (95%\n"
-     "bootstrap interval; docs/uncertainty.md)"},
+     "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,...,\n"
+     "index,index_lo,index_hi,interacts,...: the effect, how far\n"
+     "the pose's probability moves from the range's lower third\n"
+     "to its upper (95% bootstrap interval), the thirds' p (95%\n"
+     "Wilson), the first-order index, and the parameter across\n"
+     "whose thirds the effect changes, if any; stderr says what\n"
+     "effect the drops resolve; last partial, 1 in every row\n"
+     "of an interrupted run (docs/uncertainty.md)"},
     {OPT_TRANSITIONS, "transitions", ARG_OUTPUT, "FILE", NO_RULE, NULL, NULL,
      "with --initial stationary, the estimated chain as CSV:\n"
      "from_pose,to_pose,count,p, one row per pair of poses\n"
@@ -249,6 +275,8 @@ static void usage(FILE *out)
         "       %s merge [options] SHARD...   (sums shards: see 'posedrop merge --help')\n"
         "       %s fit [options] --fit SPEC --part PART --measured CSV ...\n"
         "                             (calibrates the scene: see 'posedrop fit --help')\n"
+        "       %s design [options] --vary SPEC --target CSV --out OFF PART\n"
+        "                             (changes the part to a target: see 'posedrop design --help')\n"
         "\n"
         "Predicts the probability of each stable pose of a rigid part dropped on a\n"
         "flat surface and prints one CSV row per stable pose:\n"
@@ -264,7 +292,7 @@ static void usage(FILE *out)
         "ci_lo, ci_hi its 95%% resampled interval; n and count still count drops.\n"
         "\n"
         "PART is an OFF, STL (ASCII or binary) or OBJ file.\n"
-        "\n", prog, prog, prog);
+        "\n", prog, prog, prog, prog);
     for (int i = 0; i < NOPTIONS; i++) {
         const cli_option *o = &options[i];
         if (o->kind == ARG_HEADING) {
@@ -405,10 +433,21 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.ci_halfwidth = x;
         a->dynamic = 1;
         break;
+    case OPT_EFFECT:
+        a->sim.effect_halfwidth = x;
+        a->sim.keep_trials = 1;
+        a->dynamic = 1;
+        break;
     case OPT_SEED: a->sim.seed = (uint64_t)n; break;
     case 'j': a->sim.threads = (int)n; break;
     case OPT_ENGINE: a->sim.engine = (pd_engine_kind)k; break;
-    case OPT_DT: a->sim.dt = x; break;
+    case OPT_DT: {
+        int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
+        if (rc != PD_NUM_OK)
+            return fail_number(o, "", arg, rc);
+        a->sim.dt = strcmp(arg, "auto") == 0 ? 0.0 : x;
+        break;
+    }
     case OPT_TIME_LIMIT: {
         int rc = strcmp(arg, "auto") == 0 ? PD_NUM_OK : pd_num_read(&o->rule, arg, &x, NULL);
         if (rc != PD_NUM_OK)
@@ -433,12 +472,15 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
         a->sim.keep_trials = 1;
         break;
     case OPT_TRANSITIONS: a->transitions = arg; break;
+    case OPT_TRACE: a->trace = arg; break;
+    case OPT_TRACE_DROP: a->sim.trace_drop = (long)n; break;
     case OPT_SENSITIVITY:
         a->sensitivity = arg;
         a->sim.keep_trials = 1;
         break;
     case OPT_FACETS: a->facets = 1; break;
     case OPT_GROUP: a->group = 1; break;
+    case OPT_CROSSCHECK: a->crosscheck = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
     case OPT_SVG: a->pictures[VIZ_GALLERY] = arg; break;
     case OPT_CHART: a->pictures[VIZ_CHART] = arg; break;
@@ -576,17 +618,27 @@ static int parse_args(int argc, char **argv, cli_args *a)
     if (optind != argc - 1)
         return fail_usage("%s", optind >= argc ? "expected one PART file" : "expected exactly one PART file");
     note_file(a, NULL, argv[optind], 0);
-    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE)
+    if (a->sim.dt > 0 && a->sim.engine == PD_ENGINE_IMPULSE && !a->crosscheck)
         return fail_usage("%s", "--dt sets the time step of the ode and bullet engines only; the "
                           "impulse engine (the default) has no step and would ignore it");
+    if (a->crosscheck && (!a->dynamic || a->sim.nshards))
+        return fail_usage("%s", "--crosscheck runs the drops on every engine: it needs -n or --ci, "
+                          "and does not go with --shard");
     if (a->trials && !a->dynamic)
         return fail_usage("%s", "--trials needs drops to record (-n or --ci)");
+    if (a->trace && !a->dynamic)
+        return fail_usage("%s", "--trace needs drops to record (-n or --ci)");
     int stationary = a->scene.initial == PD_INITIAL_STATIONARY;
     if (a->transitions && (!stationary || !a->dynamic))
         return fail_usage("%s", "--transitions needs the drops of --initial stationary and -n");
     if (stationary && a->sim.ci_halfwidth > 0)
         return fail_usage("%s", "--ci does not go with --initial stationary, which splits a fixed "
                           "number of drops over the poses in advance: give -n");
+    if (a->sim.effect_halfwidth > 0 && (!pd_scene_ranged(&a->scene) || a->sim.nshards ||
+                                        a->scene.initial != PD_INITIAL_UNIFORM))
+        return fail_usage("%s", "--effect needs a scene with a range (such as --mu 0.2:0.5) and "
+                          "the uniform start, and does not go with --shard (the drops' number "
+                          "comes from their effects)");
     if (a->sensitivity && (!a->dynamic || !pd_scene_ranged(&a->scene) || a->sim.nshards))
         return fail_usage("%s", "--sensitivity needs drops (-n or --ci) of a scene with a range "
                           "(such as --mu 0.2:0.5), and does not go with --shard");
@@ -642,6 +694,8 @@ int main(int argc, char **argv)
         return cli_end(cli_merge(argc - 1, argv + 1));
     if (argc > 1 && strcmp(argv[1], "fit") == 0)
         return cli_end(cli_fit(argc - 1, argv + 1));
+    if (argc > 1 && strcmp(argv[1], "design") == 0)
+        return cli_end(cli_design(argc - 1, argv + 1));
     cli_args a;
     int code = parse_args(argc, argv, &a);
     if (code < 0)

@@ -31,9 +31,11 @@ double cli_cpu_seconds(void); /* the CPU time of the run (MPI: all ranks) */
 double cli_wall_seconds(void); /* a monotonic clock, s, for timings (command.c) */
 
 /* A side file written to a temporary beside its path and renamed onto it
- * once complete (command.c): out_open makes it ready before any work (0 and a
- * message when it cannot be written), out_commit puts it in place (0 and a
- * message on a write error), out_abort drops it. */
+ * once the run's every output is complete (command.c): out_open makes it
+ * ready before any work (0 and a message when it cannot be written),
+ * out_close closes it (0 and a message on a write error, the file then
+ * dropped), out_place puts a closed file in place, out_place_all each of n
+ * that was opened (after stdout is written in full), out_abort drops it. */
 typedef struct {
     const char *path;
     char *target; /* where the temporary is renamed to (a symbolic link resolved) */
@@ -41,11 +43,16 @@ typedef struct {
     FILE *f;
 } out_file;
 int out_open(out_file *o, const char *path);
-int out_commit(out_file *o);
+int out_close(out_file *o);
+int out_place(out_file *o);
+int out_place_all(out_file *const *files, int n);
 void out_abort(out_file *o);
 
 /* fit_cmd.c: the fit subcommand (parses its own options). */
 int cli_fit(int argc, char **argv);
+
+/* design_cmd.c: the design subcommand (parses its own options). */
+int cli_design(int argc, char **argv);
 
 /* shard.c: --shard K/N parses into a->sim; the shard's leading comment lines;
  * the shards of a merge read and checked into a->scene, a->sim and the
@@ -60,8 +67,10 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
                        pd_diag *diag);
 
 /* json_out.c: one JSON document for the poses (or classes) and the run. */
+/* xe: --crosscheck's engines (NULL: none), their columns added to the rows. */
 void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_static_result *res,
-                const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s);
+                const pd_sim_result *sim, const int *class_of, int nclasses,
+                const viz_engines *xe, double wall_s);
 
 /* signals.c: signals_install, the first thing main does, catches SIGINT and
  * SIGTERM (and unblocks them). signals_catch makes them set options->cancel:
@@ -70,6 +79,7 @@ void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_stat
  * signals_caught: whether one arrived in this process. */
 void signals_install(void);
 void signals_catch(pd_sim_options *options);
+void signals_catch_fit(pd_fit_options *options);
 int signals_caught(void);
 
 /* progress.c: when stderr is a terminal, options->progress draws a line. */

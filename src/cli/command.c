@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include "cli/cli.h"
@@ -19,14 +20,40 @@ static void print_warning(void *user, const char *message)
     fprintf(stderr, "%s: warning: %s\n", prog, message);
 }
 
+/* --crosscheck's columns (xe NULL: none): each engine's p (empty for an
+ * engine an interruption kept from running), their lowest and highest, and
+ * whether two engines' intervals are apart. */
+static void print_spread_header(const viz_engines *xe)
+{
+    if (xe)
+        printf(",p_impulse,p_ode,p_bullet,p_engine_min,p_engine_max,engines_disagree");
+}
+
+static void print_spread(const viz_engines *xe, int row)
+{
+    if (!xe)
+        return;
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        const pd_sim_result *r = xe->sim[k];
+        if (r && r->n > 0)
+            printf(",%.10g", r->p[row]);
+        else
+            printf(",");
+    }
+    viz_spread x = viz_engine_spread(xe, row);
+    printf(",%.10g,%.10g,%d", x.lo, x.hi, x.apart);
+}
+
 /* A stationary shard adds the counts its merge needs to estimate the chain:
  * first (uniform drops settled in the row's pose) and to_J (drops started
  * resting on the row's pose that settled in pose J). */
-static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
+static void print_poses(const pd_static_result *res, const pd_sim_result *sim,
+                        const viz_engines *xe)
 {
     int chain = sim && sim->nshards > 0 && sim->transitions;
     printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s%s",
            sim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "", chain ? ",first" : "");
+    print_spread_header(xe);
     for (int j = 0; chain && j < res->nposes; j++)
         printf(",to_%d", j + 1);
     printf("\n");
@@ -41,6 +68,7 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
         for (int j = -1; chain && j < res->nposes; j++)
             printf(",%ld", j < 0 ? sim->first_count[i]
                                  : sim->transitions[(size_t)i * (size_t)res->nposes + (size_t)j]);
+        print_spread(xe, i);
         printf("\n");
     }
 }
@@ -49,10 +77,11 @@ static void print_poses(const pd_static_result *res, const pd_sim_result *sim)
  * probabilities summed (gsim holds the library's grouped counts and
  * intervals), and the members' pose numbers. */
 static void print_classes(const pd_static_result *res, const pd_sim_result *gsim,
-                          const int *class_of, int nclasses)
+                          const int *class_of, int nclasses, const viz_engines *xe)
 {
-    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s,members\n",
-           gsim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    printf("pose,nx,ny,nz,area,height,p_qs,p_pqs%s", gsim ? ",n,count,p,ci_lo,ci_hi,unsettled,partial" : "");
+    print_spread_header(xe);
+    printf(",members\n");
     for (int c = 0; c < nclasses; c++) {
         int first = -1;
         double qs = 0.0, pqs = 0.0;
@@ -70,6 +99,7 @@ static void print_classes(const pd_static_result *res, const pd_sim_result *gsim
         if (gsim)
             printf(",%ld,%ld,%.10g,%.10g,%.10g,%ld,%d", gsim->n, gsim->count[c], gsim->p[c],
                    gsim->ci_lo[c], gsim->ci_hi[c], gsim->unsettled, gsim->partial);
+        print_spread(xe, c);
         printf(",");
         for (int i = first, sep = 0; i < res->nposes; i++)
             if (class_of[i] == c) {
@@ -151,6 +181,23 @@ int out_open(out_file *o, const char *path)
     int exists = stat(path, &sb) == 0;
     if (exists && S_ISDIR(sb.st_mode))
         return out_fail(path, "is a directory");
+    if (exists && S_ISFIFO(sb.st_mode)) {
+        /* open(2) of a named pipe waits for a reader, for ever if none
+         * comes, and no signal then stops the run as it should: one with
+         * no reader yet is refused at once. */
+        int fd = open(path, O_WRONLY | O_NONBLOCK | O_CLOEXEC);
+        if (fd < 0)
+            return out_fail(path, errno == ENXIO ? "a named pipe that no program is reading"
+                                                 : strerror(errno));
+        int flags = fcntl(fd, F_GETFL);
+        if (flags < 0 || fcntl(fd, F_SETFL, flags & ~O_NONBLOCK) != 0 ||
+            !(o->f = fdopen(fd, "w"))) {
+            int err = errno;
+            close(fd);
+            return out_fail(path, strerror(err));
+        }
+        return 1;
+    }
     if (exists && !S_ISREG(sb.st_mode)) {
         if (!(o->f = fopen(path, "w")))
             return out_fail(path, strerror(errno));
@@ -214,20 +261,35 @@ void out_abort(out_file *o)
     memset(o, 0, sizeof *o);
 }
 
-/* Closes with every write error caught, then puts the file in place. */
-int out_commit(out_file *o)
+/* Closes with every write error caught; the temporary stays until
+ * out_place (or out_abort). Does nothing when the file is closed already. */
+int out_close(out_file *o)
 {
+    if (!o->f)
+        return 1;
+    errno = 0;
     int ok = fflush(o->f) == 0 && !ferror(o->f);
     int err = errno;
-    ok &= fclose(o->f) == 0;
-    o->f = NULL;
-    if (ok && o->tmp && rename(o->tmp, o->target) != 0) {
-        err = errno;
+    if (fclose(o->f) != 0 && ok) {
         ok = 0;
+        err = errno;
     }
-    if (!ok)
+    o->f = NULL;
+    if (!ok) {
         fprintf(stderr, "%s: %s: write error: %s\n", prog, o->path, strerror(err ? err : EIO));
-    if (ok) {
+        out_abort(o);
+    }
+    return ok;
+}
+
+/* Puts a closed file in place. */
+int out_place(out_file *o)
+{
+    int ok = 1;
+    if (o->tmp && rename(o->tmp, o->target) != 0) {
+        fprintf(stderr, "%s: %s: cannot put it in place: %s\n", prog, o->path, strerror(errno));
+        ok = 0;
+    } else {
         free(o->tmp);
         o->tmp = NULL;
     }
@@ -235,18 +297,41 @@ int out_commit(out_file *o)
     return ok;
 }
 
+int out_place_all(out_file *const *files, int n)
+{
+    int ok = 1;
+    for (int i = 0; i < n; i++)
+        if (files[i]->path)
+            ok &= out_place(files[i]);
+    return ok;
+}
+
+/* --trace: one row per state of the traced drop, in full precision; called
+ * from the thread that runs that drop, the only writer of the file while
+ * the drops run. */
+static void write_trace_row(void *user, const pd_trace_row *r)
+{
+    fprintf((FILE *)user,
+            "%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,%.17g,"
+            "%.17g,%.17g,%d,%s\n",
+            r->t, r->x[0], r->x[1], r->x[2], r->q[0], r->q[1], r->q[2], r->q[3], r->v[0], r->v[1],
+            r->v[2], r->w[0], r->w[1], r->w[2], r->energy, r->depth, r->contacts, r->event);
+}
+
 /* One row per drop. With --group (class_of not NULL) the pose column holds
  * the class number, as in the main output, so the two files join on it; the
- * pose within the class follows in a last column, member. An unsettled drop
- * has pose (and member) 0. */
+ * pose within the class follows in a column member. An unsettled drop has
+ * pose (and member) 0. The last column, partial, is 1 in every row of an
+ * interrupted run (its file holds only the drops done), as in the main
+ * output. */
 static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
-                         const pd_scene *scene)
+                         const pd_scene *scene, int partial)
 {
     fprintf(f, "drop,qw,qx,qy,qz,pose,collisions,time,end%s", class_of ? ",member" : "");
     for (int k = 0; k < PD_NPARAMS; k++)
-        if (scene->range[k].kind != PD_DIST_FIXED)
+        if (pd_scene_varies(scene, (pd_scene_param)k))
             fprintf(f, ",%s", pd_scene_param_name((pd_scene_param)k));
-    fputc('\n', f);
+    fprintf(f, ",partial\n");
     for (long i = 0; i < sim->n; i++) {
         const pd_trial *t = &sim->trials[i];
         int pose = t->pose < 0 ? 0 : class_of ? class_of[t->pose] + 1 : t->pose + 1;
@@ -257,9 +342,9 @@ static void write_trials(FILE *f, const pd_sim_result *sim, const int *class_of,
         if (class_of)
             fprintf(f, ",%d", t->pose + 1);
         for (int k = 0; k < PD_NPARAMS; k++)
-            if (scene->range[k].kind != PD_DIST_FIXED)
+            if (pd_scene_varies(scene, (pd_scene_param)k))
                 fprintf(f, ",%.17g", t->param[k] / (k == PD_PARAM_VIBRATION ? M_PI / 180.0 : 1.0));
-        fputc('\n', f);
+        fprintf(f, ",%d\n", partial);
     }
 }
 
@@ -282,17 +367,27 @@ static void write_transitions(FILE *f, const pd_sim_result *sim)
 }
 
 /* --sensitivity: one row per pose (class with --group) and ranged
- * parameter, numbered as in the output. */
-static void write_sensitivity(FILE *f, const pd_sensitivity *s)
+ * parameter, numbered as in the output: the effect first, then the thirds
+ * it comes from, the index, and an interaction where one is flagged (its
+ * columns empty where none is); partial as in --trials. */
+static void write_sensitivity(FILE *f, const pd_sensitivity *s, int partial)
 {
-    fprintf(f, "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,p_high_hi,"
-               "index,index_lo,index_hi\n");
+    fprintf(f, "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,p_low_lo,p_low_hi,n_high,"
+               "p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,interacts,effect_in_low,"
+               "effect_in_middle,effect_in_high,interaction,interaction_lo,interaction_hi,partial\n");
     for (int i = 0; i < s->nposes * s->nparams; i++) {
         const pd_sensitivity_row *r = &s->rows[i];
-        fprintf(f, "%d,%s,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,%.6g\n",
-                r->pose + 1, pd_scene_param_name(r->param), r->n_low, r->p_low, r->p_low_lo,
-                r->p_low_hi, r->n_high, r->p_high, r->p_high_lo, r->p_high_hi, r->index,
-                r->index_lo, r->index_hi);
+        fprintf(f, "%d,%s,%.6g,%.6g,%.6g,%ld,%.10g,%.10g,%.10g,%ld,%.10g,%.10g,%.10g,%.6g,%.6g,"
+                   "%.6g,", r->pose + 1, pd_scene_param_name(r->param), r->effect, r->effect_lo,
+                r->effect_hi, r->n_low, r->p_low, r->p_low_lo, r->p_low_hi, r->n_high, r->p_high,
+                r->p_high_lo, r->p_high_hi, r->index, r->index_lo, r->index_hi);
+        if (r->interacts >= 0)
+            fprintf(f, "%s,%.6g,%.6g,%.6g,%.6g,%.6g,%.6g,%d\n",
+                    pd_scene_param_name((pd_scene_param)r->interacts), r->effect_in[0],
+                    r->effect_in[1], r->effect_in[2], r->interaction, r->interaction_lo,
+                    r->interaction_hi, partial);
+        else
+            fprintf(f, ",,,,,,,%d\n", partial);
     }
 }
 
@@ -445,6 +540,79 @@ static void print_sim_summary(const cli_args *a, const pd_sim_result *sim)
         fprintf(stderr, "%s: interrupted after %ld drops: results are partial\n", prog, sim->n);
 }
 
+/* --crosscheck: the drops on the other engines, from the same seed, so that
+ * drop i starts from the same state on each; xsim[k] for engine k, the
+ * main run's own slot left NULL. A signal stops it: the engines not yet run
+ * stay NULL. ODE and Bullet take --dt when given; the impulse engine has no
+ * step. Only the main run keeps its drops' records (--trials,
+ * --sensitivity). */
+static pd_status crosscheck_run(const pd_part *part, const pd_static_result *res, cli_args *a,
+                                pd_sim_result *xsim[VIZ_ENGINES], pd_diag *diag)
+{
+    pd_sim_options main_run = a->sim;
+    pd_status st = PD_OK;
+    for (int k = 0; k < VIZ_ENGINES && st == PD_OK; k++) {
+        if (k == (int)main_run.engine)
+            continue;
+        if (cli_any(signals_caught()))
+            break;
+        a->sim.engine = (pd_engine_kind)k;
+        a->sim.dt = k == PD_ENGINE_IMPULSE ? 0.0 : main_run.dt;
+        a->sim.keep_trials = 0;
+        /* --trace records --engine's drop only. */
+        a->sim.trace = NULL;
+        st = cli_simulate(part, res, a, &xsim[k], diag);
+    }
+    a->sim = main_run;
+    return st;
+}
+
+/* --crosscheck in words on stderr, always: whether the engines' 95%
+ * intervals are apart on any pose (class), and where. */
+static void print_crosscheck(const cli_args *a, const viz_engines *xe, int n, int grouped)
+{
+    const char *what = grouped ? "class" : "pose";
+    int apart = 0, ran = 0, widest = 0;
+    double wide = -1.0;
+    for (int k = 0; k < VIZ_ENGINES; k++)
+        ran += xe->sim[k] && xe->sim[k]->n > 0;
+    for (int i = 0; i < n; i++) {
+        viz_spread x = viz_engine_spread(xe, i);
+        apart += x.apart;
+        if (x.hi - x.lo > wide) {
+            wide = x.hi - x.lo;
+            widest = i;
+        }
+    }
+    if (ran < VIZ_ENGINES)
+        fprintf(stderr, "%s: %s: crosscheck: %d of %d engines ran before the interruption\n",
+                prog, a->path, ran, VIZ_ENGINES);
+    if (ran < 2)
+        return;
+    if (!apart) {
+        fprintf(stderr, "%s: %s: crosscheck: the engines agree within their 95%% intervals on "
+                        "every %s (widest range %.1f points, %s %d)\n", prog, a->path, what,
+                100.0 * wide, what, widest + 1);
+        return;
+    }
+    fprintf(stderr, "%s: %s: crosscheck: the engines disagree beyond their 95%% intervals on "
+                    "%d of %d %s%s:", prog, a->path, apart, n, what,
+            n == 1 ? "" : grouped ? "es" : "s");
+    for (int i = 0, sep = 0; i < n; i++) {
+        viz_spread x = viz_engine_spread(xe, i);
+        if (!x.apart)
+            continue;
+        fprintf(stderr, "%s %s %d (", sep++ ? ";" : "", what, i + 1);
+        for (int k = 0, c = 0; k < VIZ_ENGINES; k++)
+            if (xe->sim[k] && xe->sim[k]->n > 0)
+                fprintf(stderr, "%s%s %.1f%%", c++ ? ", " : "", viz_engine_label(k),
+                        100.0 * xe->sim[k]->p[i]);
+        fprintf(stderr, ")");
+    }
+    fprintf(stderr, "; there the contact model limits the estimate, not the number of drops "
+                    "(p_engine_min, p_engine_max)\n");
+}
+
 double cli_wall_seconds(void)
 {
     struct timespec ts;
@@ -471,8 +639,10 @@ int cli_run(cli_args *a)
     /* Output paths first: a run never does its work only to fail writing.
      * Every MPI rank checks them, so that all stop together; only rank 0
      * puts its files in place (the others' are dropped at the end). */
-    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, pic_out[VIZ_KINDS] = {{0}};
+    out_file trials_out = {0}, transitions_out = {0}, sens_out = {0}, trace_out = {0},
+             pic_out[VIZ_KINDS] = {{0}};
     int opened = (!a->trials || out_open(&trials_out, a->trials)) &&
+                 (!a->trace || out_open(&trace_out, a->trace)) &&
                  (!a->transitions || out_open(&transitions_out, a->transitions)) &&
                  (!a->sensitivity || out_open(&sens_out, a->sensitivity));
     for (int k = 0; k < VIZ_KINDS && opened; k++)
@@ -486,6 +656,7 @@ int cli_run(cli_args *a)
     }
     if (!opened) {
         out_abort(&trials_out);
+        out_abort(&trace_out);
         out_abort(&transitions_out);
         out_abort(&sens_out);
         for (int k = 0; k < VIZ_KINDS; k++)
@@ -497,6 +668,8 @@ int cli_run(cli_args *a)
     pd_part *part = NULL;
     pd_static_result *res = NULL;
     pd_sim_result *sim = NULL, *gsim = NULL;
+    pd_sim_result *xsim[VIZ_ENGINES] = {NULL}, *xgsim[VIZ_ENGINES] = {NULL};
+    viz_engines xe_store, *xe = NULL;
     pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
@@ -516,20 +689,47 @@ int cli_run(cli_args *a)
         code = cli_interrupt_code();
         goto done;
     }
+    /* A shard prints its poses' own counts; its merge groups them. */
+    if (st == PD_OK && a->group && !a->sim.nshards) {
+        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
+        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
+        /* --effect resolves the effects the output shows, the classes'. */
+        a->sim.effect_class_of = class_of;
+        a->sim.effect_nclasses = nclasses;
+    }
+    if (st == PD_OK && a->dynamic && trace_out.f) {
+        fprintf(trace_out.f, "t,x,y,z,qw,qx,qy,qz,vx,vy,vz,wx,wy,wz,energy,depth,contacts,event\n");
+        a->sim.trace = write_trace_row;
+        a->sim.trace_user = trace_out.f;
+    }
     if (st == PD_OK && a->dynamic) {
         st = cli_simulate(part, res, a, &sim, &diag);
+        if (st == PD_OK && a->crosscheck && !sim->partial)
+            st = crosscheck_run(part, res, a, xsim, &diag);
         t_sim = cli_wall_seconds() - t0 - t_static;
     }
     if (st == PD_OK && !cli_writer()) {
         code = 0;
         goto done;
     }
-    /* A shard prints its poses' own counts; its merge groups them. */
-    if (st == PD_OK && a->group && !a->sim.nshards) {
-        class_of = malloc(sizeof *class_of * (size_t)(res->nposes + 1));
-        st = class_of ? pd_pose_classes(part, res, class_of, &nclasses, &diag) : PD_ERR_NOMEM;
-        if (st == PD_OK && sim)
-            st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+    if (st == PD_OK && class_of && sim)
+        st = pd_sim_result_grouped(sim, class_of, nclasses, &gsim, &diag);
+    for (int k = 0; k < VIZ_ENGINES && st == PD_OK && class_of; k++)
+        if (xsim[k])
+            st = pd_sim_result_grouped(xsim[k], class_of, nclasses, &xgsim[k], &diag);
+    if (st == PD_OK && sim && a->crosscheck) {
+        /* An engine an interruption kept from running leaves the run partial. */
+        int partial = 0;
+        for (int k = 0; k < VIZ_ENGINES; k++) {
+            int mine = k == (int)a->sim.engine;
+            const pd_sim_result *r = mine ? (gsim ? gsim : sim) : xgsim[k] ? xgsim[k] : xsim[k];
+            xe_store.sim[k] = r;
+            partial |= !r || r->partial;
+        }
+        xe = &xe_store;
+        sim->partial |= partial;
+        if (gsim)
+            gsim->partial |= partial;
     }
     /* The report shows it when the drops' records were kept (not across
      * MPI ranks); --sensitivity needs them. */
@@ -539,7 +739,7 @@ int cli_run(cli_args *a)
                                 nclasses, &sens, &diag);
     static const char *const engine_labels[] = {"impulse", "ODE", "Bullet"};
     viz_input in = {a->path, part, res, gsim ? gsim : sim, class_of, nclasses,
-                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens};
+                    engine_labels[a->sim.engine], sim ? &a->scene : NULL, measured, sens, xe};
     if (st == PD_OK && measured && (st = viz_check(&in, &diag)) != PD_OK) {
         code = fail_status(st, &diag, NULL);
         goto done;
@@ -549,16 +749,25 @@ int cli_run(cli_args *a)
         goto done;
     }
     /* The side files before stdout: if one cannot be written in full (a
-     * full disk, /dev/full), the run fails with nothing on stdout. */
+     * full disk, /dev/full), the run fails with nothing on stdout. None is
+     * put in place before stdout is written in full too: a failed run
+     * leaves every earlier file as it was. */
+    int partial = sim && sim->partial;
     if (trials_out.f)
-        write_trials(trials_out.f, sim, class_of, &a->scene);
+        write_trials(trials_out.f, sim, class_of, &a->scene, partial);
     if (transitions_out.f)
         write_transitions(transitions_out.f, gsim ? gsim : sim);
-    if (sens_out.f)
-        write_sensitivity(sens_out.f, sens);
-    if ((trials_out.f && !out_commit(&trials_out)) ||
-        (transitions_out.f && !out_commit(&transitions_out)) ||
-        (sens_out.f && !out_commit(&sens_out))) {
+    if (sens_out.f) {
+        write_sensitivity(sens_out.f, sens, partial);
+        /* What the effects can tell apart, said whether or not it was
+         * asked for: an effect inside it is no evidence of none. */
+        if (sens->nparams > 0)
+            fprintf(stderr, "%s: %s: these %ld drops resolve an effect to %.1f points (the "
+                    "widest half of an effect's 95%% interval); four times the drops halve "
+                    "it\n", prog, a->path, sens->n, 100 * sens->resolution);
+    }
+    if (!out_close(&trials_out) || !out_close(&trace_out) || !out_close(&transitions_out) ||
+        !out_close(&sens_out)) {
         code = EXIT_INTERNAL;
         goto done;
     }
@@ -571,7 +780,7 @@ int cli_run(cli_args *a)
             code = fail_status(st, &diag, NULL);
             goto done;
         }
-        if (!out_commit(&pic_out[k])) {
+        if (!out_close(&pic_out[k])) {
             code = EXIT_INTERNAL;
             goto done;
         }
@@ -580,22 +789,31 @@ int cli_run(cli_args *a)
         print_summary(a, part, res);
     if (sim)
         print_sim_summary(a, sim);
+    if (xe)
+        print_crosscheck(a, xe, class_of ? nclasses : res->nposes, class_of != NULL);
     if (a->sim.nshards && !shard_write_identity(stdout, a, sim)) {
         code = EXIT_INTERNAL;
         goto done;
     }
     if (a->json)
-        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses,
+        json_print(stdout, a, part, res, gsim ? gsim : sim, class_of, nclasses, xe,
                    cli_wall_seconds() - t0);
     else if (a->facets)
         print_facets(part, res);
     else if (class_of)
-        print_classes(res, gsim, class_of, nclasses);
+        print_classes(res, gsim, class_of, nclasses, xe);
     else
-        print_poses(res, sim);
+        print_poses(res, sim, xe);
     code = fflush(stdout) == 0 && !ferror(stdout) ? 0 : EXIT_INTERNAL;
-    if (code)
+    if (code) {
         fprintf(stderr, "%s: error writing the output: %s\n", prog, strerror(errno));
+        goto done;
+    }
+    out_file *const outs[] = {&trials_out,  &trace_out,  &transitions_out, &sens_out,
+                              &pic_out[0], &pic_out[1], &pic_out[2],      &pic_out[3]};
+    _Static_assert(VIZ_KINDS == 4, "every picture is put in place");
+    if (!out_place_all(outs, (int)(sizeof outs / sizeof outs[0])))
+        code = EXIT_INTERNAL;
     if (code == 0 && sim && sim->partial)
         code = cli_interrupt_code();
     else if (code == 0 && sim && sim->n > 0 && sim->failed == sim->n) {
@@ -606,6 +824,7 @@ int cli_run(cli_args *a)
     }
 done:
     out_abort(&trials_out);
+    out_abort(&trace_out);
     out_abort(&transitions_out);
     out_abort(&sens_out);
     pd_sensitivity_free(sens);
@@ -615,6 +834,10 @@ done:
     free(class_of);
     pd_sim_result_free(gsim);
     pd_sim_result_free(sim);
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        pd_sim_result_free(xgsim[k]);
+        pd_sim_result_free(xsim[k]);
+    }
     pd_static_result_free(res);
     pd_part_free(part);
     pd_mesh_free(mesh);

@@ -1,5 +1,6 @@
 /* fit_cmd.c: posedrop fit, the scene calibrated to measured drops
  * (pd_fit_run; docs/calibration.md). */
+#include <errno.h>
 #include <getopt.h>
 #include <limits.h>
 #include <math.h>
@@ -13,6 +14,12 @@ enum { MAX_PARTS = 64 };
 /* Fewer effective weighted values than this leave the 2.5% and 97.5%
  * quantiles to one or two points each. */
 static const double FEW_EFFECTIVE = 10.0;
+/* An interval spanning more than this share of its range (on the scale
+ * searched): the data do not pin the parameter down. */
+static const double UNIDENTIFIED_SHARE = 0.8;
+/* A progress line at most this often, s of wall time: a fit's evaluation
+ * takes from milliseconds to seconds. */
+static const double PROGRESS_EVERY_S = 10.0;
 
 static void fit_usage(FILE *out)
 {
@@ -34,10 +41,18 @@ static void fit_usage(FILE *out)
         "more drops, so that a pose seen but never simulated is not impossible); p:\n"
         "averaged over the likelihood-weighted values, ci_lo, ci_hi: its 95%% interval,\n"
         "which carries both the parameters' spread and the simulation's own error.\n"
-        "stderr: the fitted values with their intervals, the initial modes' likelihoods,\n"
-        "goodness of fit per part (Pearson's X^2 and p) and the cost (evaluations,\n"
-        "drops, wall and CPU seconds).\n"
-        "\n"
+        "stderr: before the first evaluation, the most the fit can cost (evaluations,\n"
+        "drops); after it, an estimate in seconds; then a progress line every 10 s\n"
+        "(evaluation, stage and round, best log-likelihood so far, time left at most);\n"
+        "at the end the fitted values with their intervals (and whether the data\n"
+        "identify them), the initial modes' scores, the goodness of fit per part from\n"
+        "fresh drops (the fitted scene, at its best and at its weighted-mean values,\n"
+        "simulated with a seed no evaluation used: Pearson's X^2 of the measured and\n"
+        "simulated counts, p, and the total variation distance TV; the in-sample\n"
+        "figures, which the search tuned, only as a diagnostic) and the cost\n"
+        "(evaluations, drops, wall and CPU seconds).\n"
+        "\n", prog);
+    fprintf(out,
         "  --fit SPEC       the parameters to fit and their ranges, comma-separated:\n"
         "                   KEY=LO:HI with KEY one of height (m), belt_speed (m/s),\n"
         "                   mu, restitution, vibration (degrees), gravity (m/s^2),\n"
@@ -45,7 +60,10 @@ static void fit_usage(FILE *out)
         "                   part's automatic duration as 0.3x:3x, one multiple\n"
         "                   shared by the parts; searched on a log scale); and 'initial'\n"
         "                   alone to fit the initial mode as a discrete choice\n"
-        "                   (uniform, bootstrap, stationary: each fitted, the best kept).\n"
+        "                   (uniform, bootstrap, stationary): with two or more parts\n"
+        "                   the mode whose fits to all parts but one best predict the\n"
+        "                   one left out is kept (a search per mode and part, and one\n"
+        "                   more); with one part, the best fit's, with a warning.\n"
         "                   e.g. --fit mu=0.1:0.8,restitution=0.05:0.7,initial\n"
         "  --part PART      a part file (OFF, STL, OBJ), followed by its --measured\n"
         "  --measured CSV   its measured counts: pose,count (or pose,p,n), the poses\n"
@@ -63,16 +81,23 @@ static void fit_usage(FILE *out)
         "  --seed S         the drops' seed, the same at every evaluation (default 1)\n"
         "  -j THREADS       threads (default: all cores); never changes results\n"
         "  --engine E       impulse (default), ode or bullet\n"
-        "  --max-evals N    Nelder-Mead evaluations per search (default 150)\n"
+        "  --max-evals N    Nelder-Mead evaluations per search (default 150): the\n"
+        "                   simplex stops once it has spent N, finishing its step (up\n"
+        "                   to N + d + 1); each search's design of 4d+1 points, the\n"
+        "                   weighting (1 + 3 to 6 rounds of --points), the predicted\n"
+        "                   parts' --points and the 2 fresh-drop checks come on top,\n"
+        "                   and 'initial' runs 3 searches (3 (parts + 1) with two or\n"
+        "                   more parts)\n"
         "  --points M       likelihood-weighted values per round, 3 to 6 rounds\n"
         "                   (default 8 (d+1) for d parameters)\n"
         "  --out FILE       the fitted scene, a file --scene reads\n"
         "  --params FILE    CSV parameter,value,lo,hi,mean,range_lo,range_hi,unit: the\n"
         "                   best value, the 95%% interval and the weighted mean (unit\n"
         "                   auto: multiples of each part's automatic contact time)\n"
-        "  --gof FILE       CSV part,n,classes,loglik,chi2,df,p: goodness of fit\n"
-        "  --help           this help\n",
-        prog);
+        "  --gof FILE       CSV part,n,classes,loglik,chi2,df,p,tv (in-sample), then\n"
+        "                   fresh_chi2,fresh_df,fresh_p,fresh_tv (fresh drops at the best\n"
+        "                   values) and fresh_mean_* (at the weighted means)\n"
+        "  --help           this help\n");
 }
 
 static int fit_fail(const char *fmt, const char *a, const char *b)
@@ -130,32 +155,65 @@ static int parse_spec(char *spec, pd_fit_param *params, int *nparams, int *fit_i
     return -1;
 }
 
-/* The measured file of a part, as counts per class (k of them). */
-static int read_counts(const char *path, const char *part, int k, long **count)
+/* The measured file of a part, as counts per class (k of them; poses with
+ * --no-group), or with sets of poses ("3|4") as counts per cell: every class
+ * not in a set its own cell, in class order, then the sets (*cell_of: k
+ * cells, *ncells). */
+static int read_counts(const char *path, const char *part, int k, int group, long **count,
+                       int **cell_of, int *ncells)
 {
     viz_measured *m = NULL;
     pd_diag diag;
     pd_diag_init(&diag);
-    pd_status st = viz_measured_read(path, &m, &diag);
+    pd_status st = viz_measured_read_sets(path, &m, &diag);
     if (st != PD_OK) {
         fprintf(stderr, "%s: %s\n", prog, diag.message);
         return 0;
     }
-    int ok = 1;
+    int ok = 1, maxpose = m->npose;
     if (m->n <= 0) {
         fprintf(stderr, "%s: %s: the fit needs counts: columns pose,count, or pose,p,n\n", prog,
                 path);
         ok = 0;
-    } else if (m->npose > k) {
-        fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, m->npose, part, k,
-                k == 1 ? "" : "s");
+    } else if (maxpose > k) {
+        if (group)
+            fprintf(stderr, "%s: %s: pose class %d, but %s has %d pose class%s (numbered as "
+                    "'posedrop --group' numbers them; --no-group for its poses)\n", prog, path,
+                    maxpose, part, k, k == 1 ? "" : "es");
+        else
+            fprintf(stderr, "%s: %s: pose %d, but %s has %d pose%s\n", prog, path, maxpose,
+                    part, k, k == 1 ? "" : "s");
         ok = 0;
     }
     if (ok && !(*count = calloc((size_t)k, sizeof **count))) {
         fprintf(stderr, "%s: out of memory\n", prog);
         ok = 0;
     }
-    for (int i = 0; ok && i < m->npose; i++)
+    if (ok && m->nsets && !(*cell_of = malloc(sizeof **cell_of * (size_t)k))) {
+        fprintf(stderr, "%s: out of memory\n", prog);
+        ok = 0;
+    }
+    if (ok && m->nsets) {
+        /* The sets' cells after the classes counted alone. */
+        for (int c = 0; c < k; c++)
+            (*cell_of)[c] = -1;
+        for (int s = 0, at = 0; s < m->nsets; at += m->set_size[s], s++)
+            for (int a = 0; a < m->set_size[s]; a++)
+                (*cell_of)[m->set_pose[at + a] - 1] = -2 - s;
+        int n = 0;
+        for (int c = 0; c < k; c++)
+            if ((*cell_of)[c] == -1) {
+                (*count)[n] = c < m->npose ? lround(m->p[c] * (double)m->n) : 0;
+                (*cell_of)[c] = n++;
+            }
+        for (int s = 0; s < m->nsets; s++)
+            (*count)[n + s] = lround(m->set_p[s] * (double)m->n);
+        for (int c = 0; c < k; c++)
+            if ((*cell_of)[c] <= -2)
+                (*cell_of)[c] = n - 2 - (*cell_of)[c];
+        *ncells = n + m->nsets;
+    }
+    for (int i = 0; ok && !m->nsets && i < m->npose; i++)
         (*count)[i] = lround(m->p[i] * (double)m->n);
     viz_measured_free(m);
     return ok;
@@ -168,6 +226,7 @@ typedef struct {
     pd_static_result *res;
     int *class_of, nclasses;
     long *count;
+    int *cell_of, ncells; /* with sets of poses measured; else NULL */
 } fit_input;
 
 static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
@@ -199,7 +258,8 @@ static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
             fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
         return 0;
     }
-    return !in->measured || read_counts(in->measured, in->path, in->nclasses, &in->count);
+    return !in->measured || read_counts(in->measured, in->path, in->nclasses, group,
+                                        &in->count, &in->cell_of, &in->ncells);
 }
 
 static const char *initial_name(pd_initial i)
@@ -258,66 +318,158 @@ static void write_params(FILE *f, const pd_fit_result *r, const pd_fit_param *pa
 
 static void write_gof(FILE *f, const pd_fit_result *r, const fit_input *in, int nin)
 {
-    fprintf(f, "part,n,classes,loglik,chi2,df,p\n");
+    fprintf(f, "part,n,classes,loglik,chi2,df,p,tv,fresh_chi2,fresh_df,fresh_p,fresh_tv,"
+               "fresh_mean_chi2,fresh_mean_df,fresh_mean_p,fresh_mean_tv\n");
     for (int i = 0; i < nin; i++) {
         const pd_fit_part_result *q = &r->parts[i];
+        const pd_fit_quality *b = &q->fresh_best, *m = &q->fresh_mean;
         if (in[i].count)
-            fprintf(f, "%s,%ld,%d,%.10g,%.10g,%d,%.10g\n", in[i].path, q->n, q->nclasses,
-                    q->loglik, q->chi2, q->df, q->pvalue);
+            fprintf(f, "%s,%ld,%d,%.10g,%.10g,%d,%.10g,%.10g,%.10g,%d,%.10g,%.10g,%.10g,%d,%.10g,"
+                    "%.10g\n", in[i].path, q->n, q->nclasses, q->loglik, q->chi2, q->df,
+                    q->pvalue, q->tv, b->chi2, b->df, b->pvalue, b->tv, m->chi2, m->df, m->pvalue,
+                    m->tv);
     }
 }
 
 static void print_table(const pd_fit_result *r, const fit_input *in, int nin)
 {
-    printf("part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi\n");
+    printf("part,role,pose,count,p_measured,p_best,p,ci_lo,ci_hi,set\n");
     for (int i = 0; i < nin; i++) {
         const pd_fit_part_result *q = &r->parts[i];
+        const int *of = in[i].cell_of;
         for (int c = 0; c < q->nclasses; c++) {
             printf("%s,%s,%d,", in[i].path, in[i].count ? "fitted" : "predicted", c + 1);
-            if (in[i].count)
-                printf("%ld,%.10g,", in[i].count[c], (double)in[i].count[c] / (double)q->n);
+            /* A set holds two poses or more. */
+            int cell = of ? of[c] : c, members = 0;
+            for (int e = 0; of && e < q->nclasses; e++)
+                members += of[e] == cell;
+            int in_set = members >= 2;
+            if (in[i].count && !in_set)
+                printf("%ld,%.10g,", in[i].count[cell], (double)in[i].count[cell] / (double)q->n);
             else
                 printf(",,");
-            printf("%.10g,%.10g,%.10g,%.10g\n", q->p_best[c], q->p[c], q->lo[c], q->hi[c]);
+            printf("%.10g,%.10g,%.10g,%.10g,", q->p_best[c], q->p[c], q->lo[c], q->hi[c]);
+            /* A set's count is its own row's in the measured file: the
+             * members name the set. */
+            for (int e = 0, first = 1; in_set && e < q->nclasses; e++)
+                if (of[e] == cell) {
+                    printf("%s%d", first ? "" : "|", e + 1);
+                    first = 0;
+                }
+            printf("\n");
         }
     }
+}
+
+/* How the fit did against fresh drops, as words. */
+static void print_quality(const char *what, const pd_fit_quality *q)
+{
+    if (q->df <= 0)
+        fprintf(stderr, "%s: fit: %s: X^2 = %.2f, TV %.3f: the data cannot test this fit (as many "
+                "fitted parameters as free classes, or more)\n", prog, what, q->chi2, q->tv);
+    else
+        fprintf(stderr, "%s: fit: %s: X^2 = %.2f, df %d, p = %.3g, TV %.3f%s\n", prog, what,
+                q->chi2, q->df, q->pvalue, q->tv,
+                q->pvalue < 0.05 ? " (the model does not fit)" : "");
 }
 
 static void print_summary(const pd_fit_result *r, const pd_fit_param *params, const fit_input *in,
                           int nin, int fit_initial, double wall, double cpu)
 {
     for (int i = 0; i < r->nparams; i++) {
-        const char *x = params[i].multiple ? "x" : "";
+        const pd_fit_param *q = &params[i];
+        const char *x = q->multiple ? "x" : "";
+        double span = q->log ? log(r->hi[i] / r->lo[i]) / log(q->hi / q->lo)
+                             : (r->hi[i] - r->lo[i]) / (q->hi - q->lo);
         fprintf(stderr, "%s: fit: %s = %.4g%s, 95%% interval [%.4g%s, %.4g%s] (weighted mean "
-                "%.4g%s; range %g%s:%g%s)%s\n", prog, params[i].key, r->value[i], x, r->lo[i], x,
-                r->hi[i], x, r->mean[i], x, params[i].lo, x, params[i].hi, x,
-                params[i].multiple ? " in multiples of each part's automatic duration" : "");
+                "%.4g%s; range %g%s:%g%s)%s\n", prog, q->key, r->value[i], x, r->lo[i], x,
+                r->hi[i], x, r->mean[i], x, q->lo, x, q->hi, x,
+                q->multiple ? " in multiples of each part's automatic duration" : "");
+        if (span > UNIDENTIFIED_SHARE)
+            fprintf(stderr, "%s: fit: %s is not identified by the data: its interval spans %.0f%% "
+                    "of its range\n", prog, q->key, 100.0 * span);
     }
-    if (fit_initial)
+    if (fit_initial && r->initial_untested)
         fprintf(stderr, "%s: fit: initial %s: maximised log-likelihood uniform %.2f, bootstrap "
-                "%.2f, stationary %.2f\n", prog, initial_name(r->initial),
-                r->loglik_initial[PD_INITIAL_UNIFORM], r->loglik_initial[PD_INITIAL_BOOTSTRAP],
-                r->loglik_initial[PD_INITIAL_STATIONARY]);
+                "%.2f, stationary %.2f\n%s: fit: warning: with one part the initial mode is "
+                "chosen on the counts it is fitted to, which cannot test it\n", prog,
+                initial_name(r->initial), r->loglik_initial[PD_INITIAL_UNIFORM],
+                r->loglik_initial[PD_INITIAL_BOOTSTRAP], r->loglik_initial[PD_INITIAL_STATIONARY],
+                prog);
+    else if (fit_initial)
+        fprintf(stderr, "%s: fit: initial %s: log-likelihood of each part predicted by a fit to "
+                "the others, summed: uniform %.2f, bootstrap %.2f, stationary %.2f\n", prog,
+                initial_name(r->initial), r->loglik_initial[PD_INITIAL_UNIFORM],
+                r->loglik_initial[PD_INITIAL_BOOTSTRAP], r->loglik_initial[PD_INITIAL_STATIONARY]);
+    char what[4200];
     for (int i = 0; i < nin; i++) {
         const pd_fit_part_result *q = &r->parts[i];
-        if (in[i].count)
-            fprintf(stderr, "%s: fit: %s: %ld measured drops, %d classes: X^2 = %.2f, df %d, "
-                    "p = %.3g%s\n", prog, in[i].path, q->n, q->nclasses, q->chi2, q->df,
-                    q->pvalue, q->pvalue < 0.05 ? " (the model does not fit this part)" : "");
+        if (!in[i].count)
+            continue;
+        fprintf(stderr, "%s: fit: %s: %ld measured drops, %d classes\n", prog, in[i].path, q->n,
+                q->nclasses);
+        snprintf(what, sizeof what, "%s: fresh drops at the best values", in[i].path);
+        print_quality(what, &q->fresh_best);
+        snprintf(what, sizeof what, "%s: fresh drops at the weighted means", in[i].path);
+        print_quality(what, &q->fresh_mean);
+        fprintf(stderr, "%s: fit: %s: in-sample (the drops the search was tuned to, a "
+                "diagnostic): X^2 = %.2f, TV %.3f\n", prog, in[i].path, q->chi2, q->tv);
     }
-    fprintf(stderr, "%s: fit: all parts: X^2 = %.2f, df %d, p = %.3g; log-likelihood %.2f\n",
-            prog, r->chi2, r->df, r->pvalue, r->loglik);
+    print_quality("all parts: fresh drops at the best values", &r->fresh_best);
+    print_quality("all parts: fresh drops at the weighted means", &r->fresh_mean);
+    fprintf(stderr, "%s: fit: all parts in-sample (a diagnostic): X^2 = %.2f, log-likelihood "
+            "%.2f\n", prog, r->chi2, r->loglik);
+    if (r->failed)
+        fprintf(stderr, "%s: fit: warning: %ld of the %ld simulated drops failed (a solver could "
+                "not go on) and are in no count\n", prog, r->failed, r->drops);
     if (r->dispersion > 1.0)
         fprintf(stderr, "%s: fit: X^2 is %.3g times what the noise explains: the intervals are "
                 "widened by its square root for the model's misfit\n", prog, r->dispersion);
     fprintf(stderr, "%s: fit: %d evaluations, %ld drops simulated, %d weighted values (effective "
-            "%.1f, likelihood tempered by %.3f for the simulation's error); %.1f s wall, "
-            "%.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints, r->ess, r->temper, wall,
-            cpu);
+            "%.1f); %.1f s wall, %.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints,
+            r->ess, wall, cpu);
     if (r->ess < FEW_EFFECTIVE)
         fprintf(stderr, "%s: fit: warning: the weighting rests on %.1f effective values: the "
                 "intervals and the averaged predictions are coarse (raise --points)\n", prog,
                 r->ess);
+}
+
+/* Progress on stderr: the plan before the first evaluation, an estimate of
+ * the time after it, then a line every PROGRESS_EVERY_S. */
+typedef struct {
+    double t0, c0, last;
+} fit_clock;
+
+static void fit_progress(const pd_fit_progress *g, void *user)
+{
+    fit_clock *k = user;
+    double t = cli_wall_seconds() - k->t0;
+    if (g->evaluation == 0) {
+        fprintf(stderr, "%s: fit: at most %d evaluations and %ld drops\n", prog,
+                g->max_evaluations, g->max_drops);
+        return;
+    }
+    double cpu = cli_cpu_seconds() - k->c0;
+    double left = (double)(g->max_evaluations - g->evaluation) * cpu / g->evaluation;
+    if (g->evaluation == 1) {
+        fprintf(stderr, "%s: fit: the first evaluation took %.2f s of CPU: at most about %.0f s "
+                "of CPU in all\n", prog, cpu, cpu * g->max_evaluations);
+        k->last = t;
+        return;
+    }
+    if (t - k->last < PROGRESS_EVERY_S)
+        return;
+    k->last = t;
+    char held[48] = "", round[32] = "", best[64] = "";
+    if (g->held_out)
+        snprintf(held, sizeof held, ", part %d left out", g->held_out);
+    if (g->round)
+        snprintf(round, sizeof round, " round %d", g->round);
+    if (isfinite(g->best_loglik))
+        snprintf(best, sizeof best, ", best log-likelihood %.2f", g->best_loglik);
+    fprintf(stderr, "%s: fit: evaluation %d of at most %d (initial %s%s, %s%s%s); %.0f s of CPU "
+            "so far, at most about %.0f s left\n", prog, g->evaluation, g->max_evaluations,
+            g->initial, held, g->stage, round, best, cpu, left);
 }
 
 int cli_fit(int argc, char **argv)
@@ -418,7 +570,8 @@ int cli_fit(int argc, char **argv)
             int outcome = pd_num_read(&rule, optarg, NULL, &v);
             if (outcome != PD_NUM_OK) {
                 char msg[256];
-                code = fit_fail("%s: %s", argv[optind - 1],
+                code = fit_fail("%s: %s", c == 'n' ? "-n" : c == 'j' ? "-j" : c == F_SEED
+                                ? "--seed" : c == F_MAXEVALS ? "--max-evals" : "--points",
                                 pd_num_message(msg, sizeof msg, &rule, optarg, outcome));
                 break;
             }
@@ -493,16 +646,27 @@ int cli_fit(int argc, char **argv)
     for (int i = 0; code < 0 && i < nin; i++)
         if (!load_part(&in[i], &read, group))
             code = EXIT_USAGE;
+    /* A signal before the fit ends the run here, nothing written. */
+    if (code < 0 && signals_caught())
+        code = cli_interrupt_code();
     pd_fit_result *r = NULL;
     if (code < 0) {
         pd_fit_part parts[MAX_PARTS];
         for (int i = 0; i < nin; i++)
-            parts[i] = (pd_fit_part){in[i].part, in[i].res, in[i].class_of, in[i].nclasses,
-                                     in[i].count};
+            parts[i] = (pd_fit_part){in[i].part,  in[i].res,     in[i].class_of, in[i].nclasses,
+                                     in[i].count, in[i].cell_of, in[i].ncells};
         fo.fit_initial = fit_initial;
+        signals_catch_fit(&fo);
         double t0 = cli_wall_seconds(), c0 = cli_cpu_seconds();
+        fit_clock clock = {t0, c0, 0.0};
+        fo.progress = fit_progress;
+        fo.progress_user = &clock;
         pd_status st = pd_fit_run(parts, nin, params, nparams, &scene, &fo, &r, &diag);
-        if (st != PD_OK) {
+        if (st == PD_ERR_CANCELLED) {
+            fprintf(stderr, "%s: fit: interrupted: nothing written (a fit stopped part way has no "
+                    "result; earlier files are as they were)\n", prog);
+            code = cli_interrupt_code();
+        } else if (st != PD_OK) {
             fprintf(stderr, "%s: fit: %s\n", prog, diag.message[0] ? diag.message
                                                                     : pd_status_str(st));
             code = pd_status_is_input_error(st) || st == PD_ERR_USAGE ? EXIT_USAGE
@@ -515,16 +679,24 @@ int cli_fit(int argc, char **argv)
                 write_params(outs[1].f, r, params);
             if (outs[2].f)
                 write_gof(outs[2].f, r, in, nin);
+            /* The files are put in place together, once stdout is written
+             * too: a failed run leaves every earlier file as it was. */
             code = 0;
             for (int k = 0; k < 3; k++)
-                if (outs[k].f && !out_commit(&outs[k]))
+                if (!out_close(&outs[k]))
                     code = EXIT_INTERNAL;
             if (code == 0) {
                 print_summary(r, params, in, nin, fit_initial, wall, cpu);
                 print_table(r, in, nin);
-                if (fflush(stdout) != 0 || ferror(stdout))
+                if (fflush(stdout) != 0 || ferror(stdout)) {
+                    fprintf(stderr, "%s: fit: error writing the output: %s\n", prog,
+                            strerror(errno));
                     code = EXIT_INTERNAL;
+                }
             }
+            out_file *const placed[3] = {&outs[0], &outs[1], &outs[2]};
+            if (code == 0 && !out_place_all(placed, 3))
+                code = EXIT_INTERNAL;
         }
     }
     for (int k = 0; k < 3; k++)
@@ -532,6 +704,7 @@ int cli_fit(int argc, char **argv)
     pd_fit_result_free(r);
     for (int i = 0; i < nin; i++) {
         free(in[i].count);
+        free(in[i].cell_of);
         free(in[i].class_of);
         pd_static_result_free(in[i].res);
         pd_part_free(in[i].part);

@@ -68,7 +68,7 @@ static void part_json(FILE *out, const cli_args *a, const pd_part *part)
 }
 
 static void run_json(FILE *out, const cli_args *a, const pd_part *part, const pd_sim_result *sim,
-                     double wall_s)
+                     const viz_engines *xe, double wall_s)
 {
     static const char *const engines[] = {"impulse", "ode", "bullet"};
     static const char *const laws[] = {"poisson", "energetic"};
@@ -120,11 +120,25 @@ static void run_json(FILE *out, const cli_args *a, const pd_part *part, const pd
             "\"energy_gain\": %ld, \"fallbacks\": %ld},\n",
             name_of(a->sim.engine, engines), a->sim.seed, a->sim.ndrops, sim->n, sim->unsettled,
             sim->partial ? "true" : "false", sim->collisions, sim->energy_gain, sim->fallbacks);
+    if (!xe)
+        return;
+    /* --crosscheck: what each engine ran (null: stopped before it ran). */
+    fprintf(out, "  \"crosscheck\": {");
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        const pd_sim_result *x = xe->sim[k];
+        fprintf(out, "%s\"%s\": ", k ? ", " : "", engines[k]);
+        if (x)
+            fprintf(out, "{\"run\": %ld, \"unsettled\": %ld, \"partial\": %s}", x->n,
+                    x->unsettled, x->partial ? "true" : "false");
+        else
+            fprintf(out, "null");
+    }
+    fprintf(out, "},\n");
 }
 
 /* The rows: one object per CSV row, keys the CSV's column names. */
 static void rows_json(FILE *out, const pd_static_result *res, const pd_sim_result *sim,
-                      const int *class_of, int nclasses)
+                      const int *class_of, int nclasses, const viz_engines *xe)
 {
     int nrows = class_of ? nclasses : res->nposes;
     fprintf(out, "  \"%s\": [\n", class_of ? "classes" : "poses");
@@ -146,6 +160,20 @@ static void rows_json(FILE *out, const pd_static_result *res, const pd_sim_resul
             fprintf(out, ", \"n\": %ld, \"count\": %ld, \"p\": %.10g, \"ci_lo\": %.10g, "
                     "\"ci_hi\": %.10g, \"unsettled\": %ld, \"partial\": %d", sim->n, sim->count[r],
                     sim->p[r], sim->ci_lo[r], sim->ci_hi[r], sim->unsettled, sim->partial);
+        if (xe) {
+            /* As the CSV's columns; an engine that did not run is null. */
+            static const char *const keys[] = {"p_impulse", "p_ode", "p_bullet"};
+            for (int k = 0; k < VIZ_ENGINES; k++) {
+                const pd_sim_result *x = xe->sim[k];
+                if (x && x->n > 0)
+                    fprintf(out, ", \"%s\": %.10g", keys[k], x->p[r]);
+                else
+                    fprintf(out, ", \"%s\": null", keys[k]);
+            }
+            viz_spread x = viz_engine_spread(xe, r);
+            fprintf(out, ", \"p_engine_min\": %.10g, \"p_engine_max\": %.10g, "
+                    "\"engines_disagree\": %d", x.lo, x.hi, x.apart);
+        }
         if (class_of) {
             fprintf(out, ", \"members\": [");
             for (int i = 0, sep = 0; i < res->nposes; i++)
@@ -161,11 +189,12 @@ static void rows_json(FILE *out, const pd_static_result *res, const pd_sim_resul
 }
 
 void json_print(FILE *out, const cli_args *a, const pd_part *part, const pd_static_result *res,
-                const pd_sim_result *sim, const int *class_of, int nclasses, double wall_s)
+                const pd_sim_result *sim, const int *class_of, int nclasses,
+                const viz_engines *xe, double wall_s)
 {
     fprintf(out, "{\n");
-    run_json(out, a, part, sim, wall_s);
+    run_json(out, a, part, sim, xe, wall_s);
     part_json(out, a, part);
-    rows_json(out, res, sim, class_of, nclasses);
+    rows_json(out, res, sim, class_of, nclasses, xe);
     fprintf(out, "}\n");
 }

@@ -110,11 +110,12 @@ pd_status cli_simulate(const pd_part *part, const pd_static_result *res, cli_arg
 {
     if (a->merge)
         return merge_shards(res, a, sim, diag);
-    if (nranks > 1 && (a->sim.nshards || a->trials || a->sensitivity))
-        return refuse(diag, "--shard, --trials and --sensitivity need a single process (mpirun "
-                      "-n 1)");
-    if (nranks > 1 && (a->sim.ci_halfwidth > 0 || a->scene.initial == PD_INITIAL_BOOTSTRAP))
-        return refuse(diag, "--ci and --initial bootstrap choose each batch of drops from the "
+    if (nranks > 1 && (a->sim.nshards || a->trials || a->sensitivity || a->trace))
+        return refuse(diag, "--shard, --trials, --trace and --sensitivity need a single process "
+                      "(mpirun -n 1)");
+    if (nranks > 1 && (a->sim.ci_halfwidth > 0 || a->sim.effect_halfwidth > 0 ||
+                       a->scene.initial == PD_INITIAL_BOOTSTRAP))
+        return refuse(diag, "--ci, --effect and --initial bootstrap choose each batch of drops from the "
                       "outcomes before it, so they run in one process (mpirun -n 1, or posedrop "
                       "with -j threads)");
     signals_catch(&a->sim);

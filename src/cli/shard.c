@@ -16,6 +16,7 @@
 #include <string.h>
 #include "base/file_read.h"
 #include "cli/cli.h"
+#include "cli/shard_read.h"
 
 /* The largest shard count: far beyond a cluster's job array limits (Slurm's
  * MaxArraySize defaults to 1001), so a larger N is a typo. */
@@ -156,235 +157,13 @@ int shard_write_identity(FILE *out, const cli_args *a, const pd_sim_result *sim)
 
 /* ---- merge ---- */
 
-typedef struct {
-    const char *file;
-    char *identity;  /* line 1 after "shard=K/N" */
-    char *version;
-    int k, n;        /* shard k (1-based) of n */
-    long collisions, energy_gain, fallbacks;
-    int nposes;
-    long drops, unsettled;
-    int partial;
-    long *count, *first, *to; /* to: nposes * nposes, NULL unless stationary */
-} shard_file;
-
 static shard_file *shards;
 static int nshard_files;
 
-static int merge_fail(const char *file, int line, const char *what)
-{
-    if (line > 0)
-        fprintf(stderr, "%s: %s:%d: %s\n", prog, file, line, what);
-    else
-        fprintf(stderr, "%s: %s: %s\n", prog, file, what);
-    return 0;
-}
-
-static char *read_line(FILE *f)
-{
-    size_t cap = 256, n = 0;
-    char *buf = malloc(cap);
-    int c;
-    while (buf && (c = fgetc(f)) != EOF && c != '\n') {
-        if (n + 1 >= cap) {
-            char *b = realloc(buf, cap *= 2);
-            if (!b) {
-                free(buf);
-                return NULL;
-            }
-            buf = b;
-        }
-        buf[n++] = (char)c;
-    }
-    if (buf && n == 0 && feof(f)) {
-        free(buf);
-        return NULL;
-    }
-    /* A shard copied through a Windows machine ends its lines in CR LF. */
-    if (buf && n > 0 && buf[n - 1] == '\r')
-        n--;
-    if (buf)
-        buf[n] = '\0';
-    return buf;
-}
-
-static int parse_count(const char *s, long *out)
-{
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (end == s || (*end != '\0' && *end != ',') || errno || v < 0)
-        return 0;
-    *out = v;
-    return 1;
-}
-
-/* The value of key=... in a line of words, copied into buf; NULL if absent. */
-static const char *find_word(const char *line, const char *key, char *buf, size_t size)
-{
-    size_t kl = strlen(key);
-    for (const char *p = line; (p = strstr(p, key)) != NULL; p += kl) {
-        if ((p != line && p[-1] != ' ') || p[kl] != '=')
-            continue;
-        const char *v = p + kl + 1;
-        size_t len = strcspn(v, " ");
-        if (len >= size)
-            return NULL;
-        memcpy(buf, v, len);
-        buf[len] = '\0';
-        return buf;
-    }
-    return NULL;
-}
-
-/* Column index of name in a CSV header, -1 if absent. */
-static int column(const char *header, const char *name)
-{
-    size_t nl = strlen(name);
-    int col = 0;
-    for (const char *p = header;; col++) {
-        size_t len = strcspn(p, ",");
-        if (len == nl && strncmp(p, name, nl) == 0)
-            return col;
-        if (!p[len])
-            return -1;
-        p += len + 1;
-    }
-}
-
-/* The field of a CSV row at column col. */
-static const char *field(const char *row, int col)
-{
-    for (int c = 0; c < col; c++) {
-        row = strchr(row, ',');
-        if (!row)
-            return "";
-        row++;
-    }
-    return row;
-}
-
-static int read_rows(FILE *f, shard_file *s, const char *header, int *lineno)
-{
-    int cpose = column(header, "pose"), cn = column(header, "n"), ccount = column(header, "count"),
-        cuns = column(header, "unsettled"), cpart = column(header, "partial"),
-        cfirst = column(header, "first");
-    if (cpose < 0 || cn < 0 || ccount < 0 || cuns < 0 || cpart < 0)
-        return merge_fail(s->file, *lineno, "expected a header with the columns pose, n, count, "
-                          "unsettled and partial (a shard of a run with -n)");
-    char **rows = NULL, *line;
-    int nrows = 0, cap = 0, ok = 1;
-    while (ok && (line = read_line(f)) != NULL) {
-        if (nrows == cap) {
-            char **r = realloc(rows, sizeof *r * (size_t)(cap = 2 * cap + 64));
-            if (!r) {
-                free(line);
-                ok = merge_fail(s->file, 0, "out of memory");
-                break;
-            }
-            rows = r;
-        }
-        rows[nrows++] = line;
-    }
-    ok = ok && (nrows > 0 || merge_fail(s->file, *lineno, "no pose rows after the header"));
-    s->nposes = nrows;
-    size_t k = (size_t)(nrows > 0 ? nrows : 1);
-    s->count = calloc(k, sizeof *s->count);
-    if (cfirst >= 0) {
-        s->first = calloc(k, sizeof *s->first);
-        s->to = calloc(k * k, sizeof *s->to);
-    }
-    if (!s->count || (cfirst >= 0 && (!s->first || !s->to)))
-        ok = merge_fail(s->file, 0, "out of memory");
-    char msg[160];
-    for (int i = 0; ok && i < nrows; i++) {
-        int ln = *lineno + 1 + i;
-        long pose = 0, n = 0, uns = 0, part = 0;
-        ok = parse_count(field(rows[i], cpose), &pose) && pose == i + 1 &&
-             parse_count(field(rows[i], cn), &n) && parse_count(field(rows[i], ccount), &s->count[i]) &&
-             parse_count(field(rows[i], cuns), &uns) && parse_count(field(rows[i], cpart), &part) &&
-             part <= 1 && (i == 0 || (n == s->drops && uns == s->unsettled && part == s->partial));
-        for (int j = -1; ok && cfirst >= 0 && j < nrows; j++)
-            ok = parse_count(field(rows[i], cfirst + 1 + j),
-                             j < 0 ? &s->first[i] : &s->to[(size_t)i * k + (size_t)j]);
-        if (!ok) {
-            snprintf(msg, sizeof msg, "expected pose %d's row: non-negative counts%s, n, "
-                     "unsettled and partial as in the first row", i + 1,
-                     cfirst >= 0 ? " (count, first, to_1 ..)" : "");
-            merge_fail(s->file, ln, msg);
-        }
-        s->drops = n;
-        s->unsettled = uns;
-        s->partial = (int)part;
-    }
-    for (int i = 0; i < nrows; i++)
-        free(rows[i]);
-    free(rows);
-    *lineno += nrows;
-    return ok;
-}
-
-/* Reads one shard file into s; 0 (with a message) if it is not one. */
-static int read_shard(const char *file, shard_file *s)
-{
-    memset(s, 0, sizeof *s);
-    s->file = file;
-    FILE *f = pd_file_fopen_read(file);
-    if (!f) {
-        fprintf(stderr, "%s: %s: cannot read: %s\n", prog, file, strerror(errno));
-        return 0;
-    }
-    char *l1 = read_line(f), *l2 = l1 ? read_line(f) : NULL, *hdr = l2 ? read_line(f) : NULL;
-    pd_diag pipe;
-    pd_diag_init(&pipe);
-    if (!l1 && pd_file_check_fifo(fileno(f), 0, file, &pipe) != PD_OK) {
-        fprintf(stderr, "%s: %s\n", prog, pipe.message);
-        fclose(f);
-        return 0;
-    }
-    char version[64], buf[64];
-    int ok = 1, lineno = 3;
-    if (!l1 || strncmp(l1, "# posedrop ", 11) != 0 || sscanf(l1 + 11, "%63s", version) != 1 ||
-        !find_word(l1, "shard", buf, sizeof buf) || sscanf(buf, "%d/%d", &s->k, &s->n) != 2 ||
-        s->n < 1 || s->k < 1 || s->k > s->n)
-        ok = merge_fail(file, 1, "not a shard: expected a first line '# posedrop VERSION "
-                        "shard=K/N ...', as 'posedrop --shard K/N' prints");
-    if (ok && (!l2 || strncmp(l2, "# totals ", 9) != 0 ||
-               !find_word(l2, "collisions", buf, sizeof buf) || !parse_count(buf, &s->collisions) ||
-               !find_word(l2, "energy_gain", buf, sizeof buf) || !parse_count(buf, &s->energy_gain) ||
-               !find_word(l2, "fallbacks", buf, sizeof buf) || !parse_count(buf, &s->fallbacks)))
-        ok = merge_fail(file, 2, "expected '# totals collisions=C energy_gain=G fallbacks=F'");
-    if (ok && !hdr)
-        ok = merge_fail(file, 3, "expected the CSV header");
-    if (ok)
-        ok = read_rows(f, s, hdr, &lineno);
-    if (ok && s->partial) {
-        snprintf(buf, sizeof buf, "shard %d/%d was interrupted (partial)", s->k, s->n);
-        ok = merge_fail(file, 0, buf);
-        fprintf(stderr, "%s: run it again to the end before merging\n", prog);
-    }
-    if (ok) {
-        /* The identity after shard=K/N, to compare with the other shards'. */
-        s->identity = strdup(strstr(l1, " shard=") + 7 + strcspn(strstr(l1, " shard=") + 7, " "));
-        s->version = strdup(version);
-        ok = s->identity && s->version;
-    }
-    free(l1);
-    free(l2);
-    free(hdr);
-    fclose(f);
-    return ok;
-}
-
 static void free_shards(void)
 {
-    for (int i = 0; i < nshard_files; i++) {
-        free(shards[i].identity);
-        free(shards[i].version);
-        free(shards[i].count);
-        free(shards[i].first);
-        free(shards[i].to);
-    }
+    for (int i = 0; i < nshard_files; i++)
+        shard_file_clear(&shards[i]);
     free(shards);
     shards = NULL;
     nshard_files = 0;
@@ -426,12 +205,12 @@ static int check_shards(void)
         } else
             msg[0] = '\0';
         if (msg[0])
-            return merge_fail(s->file, 0, msg);
+            return shard_fail(s->file, 0, msg);
         for (int j = 0; j < i; j++)
             if (shards[j].k == s->k) {
                 snprintf(msg, sizeof msg, "shard %d/%d again (already in %s)", s->k, s->n,
                          shards[j].file);
-                return merge_fail(s->file, 0, msg);
+                return shard_fail(s->file, 0, msg);
             }
     }
     if (nshard_files != s0->n) {
@@ -490,12 +269,12 @@ static int read_double(const char *text, double *out)
 static int ranges_from_identity(const char *id, pd_scene *s)
 {
     char v[1100];
-    if (find_word(id, "tumble", v, sizeof v) && !read_double(v, &s->tumble))
+    if (shard_find_word(id, "tumble", v, sizeof v) && !read_double(v, &s->tumble))
         return 0;
     for (int k = 0; k < PD_NPARAMS; k++) {
         char key[48];
         snprintf(key, sizeof key, "%s_range", pd_scene_param_name((pd_scene_param)k));
-        if (!find_word(id, key, v, sizeof v))
+        if (!shard_find_word(id, key, v, sizeof v))
             continue;
         pd_dist *d = &s->range[k];
         char kind[16], *end;
@@ -533,28 +312,28 @@ static int options_from_identity(const shard_file *s, cli_args *a, char *path, s
     static const char *const dkeys[] = {"epsilon_rad", "dt", "height", "belt_speed", "mu",
                                         "restitution", "vibration_rad", "gravity", "contact_time"};
     for (int i = 0; ok && i < 9; i++)
-        ok = find_word(id, dkeys[i], v, sizeof v) && read_double(v, doubles[i]);
-    ok = ok && find_word(id, "part", v, sizeof v) && unescape(v, path, path_size) &&
-         find_word(id, "sha256", v, sizeof v) && strlen(v) == 64 && strcpy(sha, v) &&
-         find_word(id, "units", v, sizeof v) && pick(v, units_names, &e[0]) &&
-         find_word(id, "format", v, sizeof v) && pick(v, format_names, &e[1]) &&
-         find_word(id, "topple", v, sizeof v) && pick(v, topple_names, &e[2]) &&
-         find_word(id, "pqs_compare", v, sizeof v) && pick(v, compare_names, &e[3]) &&
-         find_word(id, "pqs_band", v, sizeof v) && pick(v, band_names, &e[4]) &&
-         find_word(id, "engine", v, sizeof v) && pick(v, engine_names, &e[5]) &&
-         find_word(id, "restitution_law", v, sizeof v) && pick(v, law_names, &e[6]) &&
-         find_word(id, "initial", v, sizeof v) && pick(v, initial_names, &e[7]) &&
-         find_word(id, "group", v, sizeof v) && sscanf(v, "%d", &e[8]) == 1 &&
-         find_word(id, "n", v, sizeof v) && sscanf(v, "%ld", &a->sim.ndrops) == 1 &&
-         find_word(id, "seed", v, sizeof v) && sscanf(v, "%" SCNu64, &seed) == 1 &&
-         find_word(id, "com", v, sizeof v);
+        ok = shard_find_word(id, dkeys[i], v, sizeof v) && read_double(v, doubles[i]);
+    ok = ok && shard_find_word(id, "part", v, sizeof v) && unescape(v, path, path_size) &&
+         shard_find_word(id, "sha256", v, sizeof v) && strlen(v) == 64 && strcpy(sha, v) &&
+         shard_find_word(id, "units", v, sizeof v) && pick(v, units_names, &e[0]) &&
+         shard_find_word(id, "format", v, sizeof v) && pick(v, format_names, &e[1]) &&
+         shard_find_word(id, "topple", v, sizeof v) && pick(v, topple_names, &e[2]) &&
+         shard_find_word(id, "pqs_compare", v, sizeof v) && pick(v, compare_names, &e[3]) &&
+         shard_find_word(id, "pqs_band", v, sizeof v) && pick(v, band_names, &e[4]) &&
+         shard_find_word(id, "engine", v, sizeof v) && pick(v, engine_names, &e[5]) &&
+         shard_find_word(id, "restitution_law", v, sizeof v) && pick(v, law_names, &e[6]) &&
+         shard_find_word(id, "initial", v, sizeof v) && pick(v, initial_names, &e[7]) &&
+         shard_find_word(id, "group", v, sizeof v) && sscanf(v, "%d", &e[8]) == 1 &&
+         shard_find_word(id, "n", v, sizeof v) && sscanf(v, "%ld", &a->sim.ndrops) == 1 &&
+         shard_find_word(id, "seed", v, sizeof v) && sscanf(v, "%" SCNu64, &seed) == 1 &&
+         shard_find_word(id, "com", v, sizeof v);
     if (ok && strcmp(v, "mesh") != 0) {
         a->part.com_given = 1;
         ok = sscanf(v, "%lf,%lf,%lf", &a->part.com.x, &a->part.com.y, &a->part.com.z) == 3;
     }
     ok = ok && ranges_from_identity(id, &a->scene);
     if (!ok)
-        return merge_fail(s->file, 1, "the run's settings are incomplete or unreadable");
+        return shard_fail(s->file, 1, "the run's settings are incomplete or unreadable");
     a->read.units = (pd_units)e[0];
     a->read.format = (pd_mesh_format)e[1];
     a->estimate.topple = (pd_topple_rule)e[2];
@@ -570,7 +349,7 @@ static int options_from_identity(const shard_file *s, cli_args *a, char *path, s
     words w;
     identity_words(a, sha, &w);
     if (strcmp(w.text, id) != 0)
-        return merge_fail(s->file, 1, "the run's settings do not read back as written (a shard "
+        return shard_fail(s->file, 1, "the run's settings do not read back as written (a shard "
                           "of another posedrop version, or edited)");
     return 1;
 }
@@ -607,6 +386,10 @@ pd_status merge_shards(const pd_static_result *res, cli_args *a, pd_sim_result *
         s.count = f->count;
         s.first_count = f->first;
         s.transitions = f->to;
+        s.nshards = f->n;
+        s.shard = f->k - 1;
+        s.added = NULL;
+        s.added_nshards = 0;
         st = pd_sim_result_add(*sum, &s, diag);
     }
     if (st == PD_OK)
@@ -628,7 +411,7 @@ int shard_load(char **files, int nfiles, cli_args *a, char *path, size_t path_si
     }
     int ok = 1;
     for (int i = 0; ok && i < nshard_files; i++)
-        ok = read_shard(files[i], &shards[i]);
+        ok = shard_read(files[i], &shards[i]);
     return ok && check_shards() && options_from_identity(&shards[0], a, path, path_size, sha);
 }
 

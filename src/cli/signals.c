@@ -36,6 +36,11 @@ void signals_catch(pd_sim_options *options)
     options->cancel = &caught;
 }
 
+void signals_catch_fit(pd_fit_options *options)
+{
+    options->cancel = &caught;
+}
+
 int signals_caught(void)
 {
     return atomic_load(&caught) != 0;

@@ -82,6 +82,40 @@ static inline int pd_engine_contact_resolved(double dt, double contact_time, dou
            v <= PD_ENGINE_CONTACT_DEPTH_REL * width * omega;
 }
 
+/* Steps per contact of the automatic step (dt auto): the lowest contact
+ * time the scene can draw, T, is cut into this many steps, so that every
+ * contact is the scene's spring-dashpot (at least PD_ENGINE_CONTACT_STEPS
+ * steps) and the engines' first-order loss of rebound, about
+ * e g^2 / 2 h / T (above), stays a few hundredths of e. Why 20: it is the
+ * coarsest step at which halving the step moves no pose class of the
+ * cross-check corpus beyond sampling noise, on either engine
+ * (docs/engines-crosscheck.md, "Converged by default", measured by
+ * scripts/engine-convergence.py); 10 did not hold. */
+#define PD_ENGINE_AUTO_STEPS 20.0
+
+/* The most a corner may travel in one automatic step at the fall speed,
+ * times the part's thickness: a rigid scene (contact time 0) has no
+ * contact to resolve, and this bounds its step by the motion instead, so
+ * that no step lets a corner pass a tenth of the part's thickness before
+ * its contact is found (0.6 ms for a 1 cm cube dropped 12 cm). Parts of
+ * centimetres with a soft contact never meet it: their contact is shorter. */
+#define PD_ENGINE_AUTO_TRAVEL_REL 0.1
+
+/* The automatic step (s) of a stepping engine for a scene whose contacts
+ * last at least contact_time (0: rigid), whose corners meet the floor at
+ * up to speed v, for a part of thickness width: PD_ENGINE_AUTO_STEPS steps
+ * per contact, and no more than PD_ENGINE_AUTO_TRAVEL_REL of the thickness
+ * travelled per step; at most dt_max. */
+static inline double pd_engine_dt_auto(double contact_time, double v, double width, double dt_max)
+{
+    double dt = dt_max;
+    if (contact_time > 0.0)
+        dt = fmin(dt, contact_time / PD_ENGINE_AUTO_STEPS);
+    if (v > 0.0 && width > 0.0)
+        dt = fmin(dt, PD_ENGINE_AUTO_TRAVEL_REL * width / v);
+    return dt;
+}
+
 /* Bisection halvings of zeta's bracket: 200 reach round-off of any bracket. */
 enum { PD_ENGINE_CONTACT_HALVINGS = 200 };
 

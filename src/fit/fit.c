@@ -32,6 +32,7 @@ static const char *const fit_keys[] = {"height", "belt_speed", "mu", "restitutio
 
 typedef struct {
     const pd_fit_part *parts;
+    const long **count; /* per part: the counts the current search uses (NULL: not fitted) */
     int nparts;
     const pd_fit_param *params;
     int d;
@@ -39,8 +40,51 @@ typedef struct {
     pd_sim_options sim;
     long *ndrops;  /* per part */
     long drops;    /* simulated so far */
+    long failed;   /* of them, drops that failed */
     double *pose_p; /* scratch, the largest part's poses */
+    pd_fit_progress_fn progress;
+    void *progress_user;
+    pd_fit_progress prog;
 } model;
+
+/* The fresh drops' seed: any seed but the evaluations' own. */
+static const uint64_t FRESH_SEED = 0x9e3779b97f4a7c15u;
+
+static const char *mode_name(pd_initial i)
+{
+    return i == PD_INITIAL_BOOTSTRAP ? "bootstrap" : i == PD_INITIAL_STATIONARY ? "stationary"
+                                                                              : "uniform";
+}
+
+/* The engine's note after each evaluation, passed on as pd_fit_progress. */
+static void note(void *user, const char *stage, int round, double loglik)
+{
+    model *m = user;
+    pd_fit_progress *g = &m->prog;
+    if (strcmp(stage, g->stage) != 0 || round != g->round)
+        g->best_loglik = -HUGE_VAL;
+    g->stage = stage;
+    g->round = round;
+    g->evaluation++;
+    g->drops = m->drops;
+    if (strcmp(stage, "prediction") != 0 && loglik > g->best_loglik)
+        g->best_loglik = loglik;
+    if (m->progress)
+        m->progress(g, m->progress_user);
+}
+
+/* Drops per part for an initial mode: the stationary start needs
+ * PD_STATIONARY_MIN_POSE_DROPS per pose and as many uniform ones. */
+static void set_ndrops(model *m, long ndrops, pd_initial mode)
+{
+    m->base.initial = mode;
+    for (int i = 0; i < m->nparts; i++) {
+        long need = mode == PD_INITIAL_STATIONARY
+                        ? (long)(m->parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
+                        : 0;
+        m->ndrops[i] = ndrops > need ? ndrops : need;
+    }
+}
 
 /* A value of q as pd_scene_set reads it: a multiple of auto as the
  * zero-width range "Mx:Mx", which every drop of every part draws as M times
@@ -68,22 +112,47 @@ static pd_status scene_at(const model *m, const double *theta, pd_scene *sc, pd_
     return PD_OK;
 }
 
+static int cancelled(const pd_sim_options *o)
+{
+    return o->cancel && atomic_load(o->cancel) != 0;
+}
+
 static pd_status run_model(void *user, const double *theta, int all, double *const *p,
                            double *nsim, pd_diag *diag)
 {
     model *m = user;
     pd_scene sc;
+    if (cancelled(&m->sim))
+        return pd_fail(diag, PD_ERR_CANCELLED, "pd_fit_run: cancelled");
     pd_status st = scene_at(m, theta, &sc, diag);
     for (int i = 0; st == PD_OK && i < m->nparts; i++) {
         const pd_fit_part *fp = &m->parts[i];
-        if (!all && !fp->count)
+        if ((all == 0 && !m->count[i]) || (all == 2 && m->count[i]))
             continue;
         pd_sim_options o = m->sim;
         o.ndrops = m->ndrops[i];
         pd_sim_result *r = NULL;
         if ((st = pd_sim_run(fp->part, fp->poses, &sc, &o, &r, diag)) != PD_OK)
             break;
+        /* Stopped part way: its counts are not those of the fixed drops. */
+        if (r->partial) {
+            pd_sim_result_free(r);
+            st = pd_fail(diag, PD_ERR_CANCELLED, "pd_fit_run: cancelled");
+            break;
+        }
         m->drops += r->n;
+        m->failed += r->failed;
+        /* No drop ran to an end the model defines: the likelihood would be
+         * the smoothing's alone, flat, and its optimum meaningless. */
+        if (r->n > 0 && r->failed == r->n) {
+            char st_name[64];
+            snprintf(st_name, sizeof st_name, "%s", pd_status_str(r->failed_status));
+            st = pd_fail(diag, PD_ERR_NO_CONVERGENCE, "every one of the %ld simulated drops of "
+                         "part %d failed (the first at stage %s: %s): no likelihood to fit", r->n,
+                         i + 1, pd_drop_stage_name(r->failed_stage), st_name);
+            pd_sim_result_free(r);
+            break;
+        }
         long settled = r->n - r->unsettled;
         int chain = r->transitions && r->closed_classes > 0;
         for (int j = 0; j < r->nposes; j++)
@@ -133,11 +202,34 @@ static pd_status check_parts(const pd_fit_part *parts, int nparts, pd_diag *diag
         }
         if (!fp->count)
             continue;
+        int ncells = fp->cell_of ? fp->ncells : k;
+        if (fp->cell_of) {
+            if (ncells < 1 || ncells > k)
+                return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: %d cells of counts for "
+                               "%d classes: expected 1 to %d", i + 1, ncells, k, k);
+            for (int c = 0; c < k; c++)
+                if (fp->cell_of[c] < 0 || fp->cell_of[c] >= ncells)
+                    return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d counted in "
+                                   "cell %d, outside 1..%d", i + 1, c + 1, fp->cell_of[c] + 1,
+                                   ncells);
+            for (int j = 0; j < ncells; j++) {
+                int members = 0;
+                for (int c = 0; c < k; c++)
+                    members += fp->cell_of[c] == j;
+                if (!members)
+                    return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: cell %d of counts "
+                                   "has no class", i + 1, j + 1);
+            }
+        }
         long n = 0;
-        for (int c = 0; c < k; c++) {
+        for (int c = 0; c < ncells; c++) {
             if (fp->count[c] < 0)
                 return pd_fail(diag, PD_ERR_USAGE, "pd_fit_run: part %d: class %d has a negative "
                                "count (%ld)", i + 1, c + 1, fp->count[c]);
+            if (fp->count[c] > PD_FIT_MAX_COUNT - n)
+                return pd_fail(diag, PD_ERR_RANGE, "pd_fit_run: part %d: the counts add up to "
+                               "more than %.0e drops, more than were ever measured", i + 1,
+                               (double)PD_FIT_MAX_COUNT);
             n += fp->count[c];
         }
         if (n == 0)
@@ -264,6 +356,90 @@ static pd_fit_result *result_alloc(int d, const pd_fit_part *parts, int nparts)
     return r;
 }
 
+/* Pearson's X^2 of the 2 x K table of counts (n of them, per cell) and
+ * simulated frequencies p (per class) of nsim drops, the cells neither
+ * reached left out; the TV distance of their frequencies. */
+static pd_fit_quality quality(int k, const int *cell_of, int ncells, const long *count,
+                              const double *p, double nsim)
+{
+    pd_fit_quality q = {0.0, -1, 1.0, 0.0};
+    long n = 0;
+    for (int c = 0; c < ncells; c++)
+        n += count[c];
+    if (!(nsim > 0) || n <= 0) {
+        q.df = 0;
+        return q;
+    }
+    double tot = (double)n + nsim;
+    for (int c = 0; c < ncells; c++) {
+        double pc = fit_cell_p(k, cell_of, c, p), s = nsim * pc, both = (double)count[c] + s;
+        q.tv += 0.5 * fabs((double)count[c] / (double)n - pc);
+        if (!(both > 0))
+            continue;
+        q.df++;
+        double em = (double)n * both / tot, es = nsim * both / tot;
+        q.chi2 += ((double)count[c] - em) * ((double)count[c] - em) / em + (s - es) * (s - es) / es;
+    }
+    q.pvalue = q.df > 0 ? pd_gsl_chisq_q(q.chi2, q.df) : 1.0;
+    return q;
+}
+
+/* Part i's cells of counts (its classes when it has no cell_of). */
+static int part_cells(const pd_fit_part *fp)
+{
+    return fp->cell_of ? fp->ncells : fp->nclasses;
+}
+
+/* Each fitted part's fresh-drop quality at theta (the problem's scale), and
+ * all parts' together (df less the d fitted parameters). */
+static pd_status fresh(model *m, const fit_problem *pb, const double *theta, uint64_t seed,
+                       double *const *p, double *nsim, pd_fit_result *r, int at_mean,
+                       pd_diag *diag)
+{
+    uint64_t seed0 = m->sim.seed;
+    m->sim.seed = seed;
+    m->prog.stage = "fresh";
+    pd_status st = run_model(m, theta, 0, p, nsim, diag);
+    m->sim.seed = seed0;
+    if (st != PD_OK)
+        return st;
+    note(m, "fresh", 0, 0.0);
+    r->evaluations++;
+    pd_fit_quality all = {0.0, -m->d, 1.0, 0.0};
+    long ntot = 0;
+    for (int i = 0; i < m->nparts; i++) {
+        if (!pb->count[i])
+            continue;
+        const pd_fit_part *fp = &m->parts[i];
+        pd_fit_quality q = quality(pb->k[i], fp->cell_of, part_cells(fp), pb->count[i], p[i],
+                                   nsim[i]);
+        long n = 0;
+        for (int c = 0; c < part_cells(fp); c++)
+            n += pb->count[i][c];
+        all.chi2 += q.chi2;
+        all.df += q.df;
+        all.tv += (double)n * q.tv; /* count-weighted mean */
+        ntot += n;
+        if (at_mean)
+            r->parts[i].fresh_mean = q;
+        else
+            r->parts[i].fresh_best = q;
+    }
+    all.tv /= (double)ntot;
+    all.pvalue = all.df > 0 ? pd_gsl_chisq_q(all.chi2, all.df) : 1.0;
+    if (at_mean)
+        r->fresh_mean = all;
+    else
+        r->fresh_best = all;
+    return PD_OK;
+}
+
+/* Every search's most evaluations: the design, the simplex and its last step. */
+static int search_max_evals(int d, int max_evals)
+{
+    return 4 * d + 1 + max_evals + d + 1;
+}
+
 pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
                      int nparams, const pd_scene *base, const pd_fit_options *options,
                      pd_fit_result **result, pd_diag *diag)
@@ -286,24 +462,43 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         st = check_params(params, nparams, &sc0, diag);
     if (st != PD_OK)
         return st;
-    int d = nparams, maxposes = 1;
-    for (int i = 0; i < nparts; i++)
+    int d = nparams, maxposes = 1, nfit = 0;
+    for (int i = 0; i < nparts; i++) {
         maxposes = parts[i].poses->nposes > maxposes ? parts[i].poses->nposes : maxposes;
-    model m = {.parts = parts, .nparts = nparts, .params = params, .d = d, .base = sc0};
+        nfit += parts[i].count != NULL;
+    }
+    model m = {.parts = parts, .nparts = nparts, .params = params, .d = d, .base = sc0,
+               .progress = o.progress, .progress_user = o.progress_user};
     pd_sim_options_default(&m.sim);
     m.sim.seed = o.seed;
     m.sim.threads = o.threads;
     m.sim.engine = o.engine;
+    m.sim.cancel = o.cancel;
     m.ndrops = malloc(sizeof *m.ndrops * (size_t)nparts);
     m.pose_p = malloc(sizeof *m.pose_p * (size_t)maxposes);
     double lo[PD_FIT_MAX_PARAMS], hi[PD_FIT_MAX_PARAMS];
     int *kk = malloc(sizeof *kk * (size_t)nparts);
     const long **count = malloc(sizeof *count * (size_t)nparts);
+    const long **one = malloc(sizeof *one * (size_t)nparts);
+    const int **cell_of = malloc(sizeof *cell_of * (size_t)nparts);
+    int *ncells = malloc(sizeof *ncells * (size_t)nparts);
     pd_fit_result *r = result_alloc(d, parts, nparts);
-    if (!m.ndrops || !m.pose_p || !kk || !count || !r) {
+    double **pb_best = malloc(sizeof *pb_best * (size_t)nparts);
+    double **pp = malloc(sizeof *pp * (size_t)nparts), **plo = malloc(sizeof *plo * (size_t)nparts);
+    double **phi = malloc(sizeof *phi * (size_t)nparts), *nsim = malloc(sizeof *nsim * (size_t)nparts);
+    /* The model's output outside the result: the held-out predictions and
+     * the fresh drops. */
+    double **ps = malloc(sizeof *ps * (size_t)nparts), *ns = malloc(sizeof *ns * (size_t)nparts);
+    size_t ksum = 0;
+    for (int i = 0; i < nparts; i++)
+        ksum += (size_t)parts[i].nclasses;
+    double *pbuf = malloc(sizeof *pbuf * ksum);
+    if (!m.ndrops || !m.pose_p || !kk || !count || !one || !cell_of || !ncells || !r || !pb_best || !pp || !plo || !phi ||
+        !nsim || !ps || !ns || !pbuf) {
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
         goto done;
     }
+    m.count = count;
     for (int i = 0; i < d; i++) {
         lo[i] = params[i].log ? log(params[i].lo) : params[i].lo;
         hi[i] = params[i].log ? log(params[i].hi) : params[i].hi;
@@ -311,26 +506,81 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     for (int i = 0; i < nparts; i++) {
         kk[i] = parts[i].nclasses;
         count[i] = parts[i].count;
+        cell_of[i] = parts[i].cell_of;
+        ncells[i] = part_cells(&parts[i]);
+        pb_best[i] = r->parts[i].p_best;
+        pp[i] = r->parts[i].p;
+        plo[i] = r->parts[i].lo;
+        phi[i] = r->parts[i].hi;
+        ps[i] = i ? ps[i - 1] + kk[i - 1] : pbuf;
     }
-    fit_problem pb = {d, lo, hi, nparts, kk, count, o.alpha, run_model, &m};
+    fit_problem pb = {d,      lo,      hi,        nparts,    kk,   count, cell_of,
+                      ncells, o.alpha, run_model, &m, note, &m};
     fit_settings set = {o.max_evals, o.npoints ? o.npoints : 8 * (d + 1)};
     double theta[PD_FIT_MAX_PARAMS], best_theta[PD_FIT_MAX_PARAMS], best = -HUGE_VAL;
     pd_initial modes[3] = {PD_INITIAL_UNIFORM, PD_INITIAL_BOOTSTRAP, PD_INITIAL_STATIONARY};
     int nmodes = o.fit_initial ? 3 : 1;
     if (!o.fit_initial)
         modes[0] = sc0.initial;
+    /* With two or more fitted parts the mode is chosen by how well a fit to
+     * all parts but one predicts the one left out: the in-sample likelihood
+     * ranks the modes by how they absorb the fitted parts' misfit. */
+    int holdout = o.fit_initial && nfit >= 2;
+    r->initial_untested = o.fit_initial && nfit < 2;
     for (int i = 0; i < 3; i++)
         r->loglik_initial[i] = -HUGE_VAL;
+    /* The plan, before the first evaluation. */
+    int searches = nmodes * (holdout ? nfit + 1 : 1) - (holdout ? nmodes - 1 : 0);
+    long per_eval = 0;
+    for (int i = 0; i < nparts; i++) {
+        long need = (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS;
+        int stat = o.fit_initial || sc0.initial == PD_INITIAL_STATIONARY;
+        per_eval += stat && need > o.ndrops ? need : o.ndrops;
+    }
+    m.prog = (pd_fit_progress){"start", mode_name(modes[0]), 0, 0, 0, 0, 0, 0, -HUGE_VAL};
+    m.prog.max_evaluations = searches * search_max_evals(d, o.max_evals) +
+                             (holdout ? nmodes * nfit : 0) + fit_weigh_max_evals(&set) + 2;
+    m.prog.max_drops = (long)m.prog.max_evaluations * per_eval;
+    if (m.progress)
+        m.progress(&m.prog, m.progress_user);
     pd_initial chosen = modes[0];
     for (int mi = 0; st == PD_OK && mi < nmodes; mi++) {
-        m.base.initial = modes[mi];
-        for (int i = 0; i < nparts; i++) {
-            long need = modes[mi] == PD_INITIAL_STATIONARY
-                            ? (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
-                            : 0;
-            m.ndrops[i] = o.ndrops > need ? o.ndrops : need;
+        set_ndrops(&m, o.ndrops, modes[mi]);
+        m.prog.initial = mode_name(modes[mi]);
+        double l, score = 0.0;
+        for (int j = 0; holdout && st == PD_OK && j < nparts; j++) {
+            if (!parts[j].count)
+                continue;
+            /* The search without part j, then part j's counts at its maximum
+             * (the Dirichlet-multinomial, as the search weighs them). */
+            count[j] = NULL;
+            m.prog.held_out = j + 1;
+            st = fit_search(&pb, &set, theta, &l, &r->evaluations, diag);
+            count[j] = parts[j].count;
+            for (int i = 0; i < nparts; i++)
+                one[i] = i == j ? parts[j].count : NULL;
+            m.count = one;
+            if (st == PD_OK)
+                st = run_model(&m, theta, 0, ps, ns, diag);
+            m.count = count;
+            if (st == PD_OK) {
+                r->evaluations++;
+                note(&m, "prediction", 0, 0.0);
+                score += fit_loglik_cells(kk[j], cell_of[j], ncells[j], parts[j].count, ps[j],
+                                          ns[j], o.alpha);
+            }
         }
-        double l;
+        m.prog.held_out = 0;
+        if (st != PD_OK)
+            break;
+        if (holdout) {
+            r->loglik_initial[modes[mi]] = score;
+            if (score > best) {
+                best = score;
+                chosen = modes[mi];
+            }
+            continue;
+        }
         st = fit_search(&pb, &set, theta, &l, &r->evaluations, diag);
         if (st != PD_OK)
             break;
@@ -341,29 +591,51 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
             memcpy(best_theta, theta, sizeof theta[0] * (size_t)d);
         }
     }
+    set_ndrops(&m, o.ndrops, chosen);
+    m.prog.initial = mode_name(chosen);
+    if (st == PD_OK && holdout) {
+        double l;
+        st = fit_search(&pb, &set, best_theta, &l, &r->evaluations, diag);
+    }
     if (st != PD_OK)
         goto done;
-    m.base.initial = chosen;
-    for (int i = 0; i < nparts; i++) {
-        long need = chosen == PD_INITIAL_STATIONARY
-                        ? (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
-                        : 0;
-        m.ndrops[i] = o.ndrops > need ? o.ndrops : need;
+    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 1.0, 0.0, 0};
+    st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
+    if (st == PD_OK) {
+        r->loglik = 0.0;
+        r->chi2 = 0.0;
+        r->df = -d;
+        for (int i = 0; i < nparts; i++) {
+            pd_fit_part_result *q = &r->parts[i];
+            q->nsim = (long)nsim[i];
+            q->df = ncells[i] - 1;
+            if (!parts[i].count)
+                continue;
+            for (int c = 0; c < ncells[i]; c++)
+                q->n += parts[i].count[c];
+            for (int c = 0; c < ncells[i]; c++) {
+                double pc = fit_cell_p(kk[i], cell_of[i], c, q->p_best);
+                if (parts[i].count[c] > 0)
+                    q->loglik += (double)parts[i].count[c] * log(pc);
+                q->tv += 0.5 * fabs((double)parts[i].count[c] / (double)q->n - pc);
+            }
+            q->chi2 = fit_chi2_cells(kk[i], cell_of[i], ncells[i], parts[i].count, q->p_best);
+            q->pvalue = q->df > 0 ? pd_gsl_chisq_q(q->chi2, q->df) : 1.0;
+            r->loglik += q->loglik;
+            r->chi2 += q->chi2;
+            r->df += q->df;
+        }
+        r->pvalue = r->df > 0 ? pd_gsl_chisq_q(r->chi2, r->df) : 1.0;
+        r->initial = chosen;
+        r->dispersion = w.dispersion;
+        r->ess = w.ess;
+        r->npoints = w.npoints;
+        /* The fit's quality from drops it was not tuned to, at the best
+         * values and at the weighted means. */
+        st = fresh(&m, &pb, best_theta, o.seed ^ FRESH_SEED, ps, ns, r, 0, diag);
+        if (st == PD_OK)
+            st = fresh(&m, &pb, r->mean, o.seed ^ FRESH_SEED, ps, ns, r, 1, diag);
     }
-    double **pb_best = malloc(sizeof *pb_best * (size_t)nparts);
-    double **pp = malloc(sizeof *pp * (size_t)nparts), **plo = malloc(sizeof *plo * (size_t)nparts);
-    double **phi = malloc(sizeof *phi * (size_t)nparts), *nsim = malloc(sizeof *nsim * (size_t)nparts);
-    if (!pb_best || !pp || !plo || !phi || !nsim)
-        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
-    for (int i = 0; st == PD_OK && i < nparts; i++) {
-        pb_best[i] = r->parts[i].p_best;
-        pp[i] = r->parts[i].p;
-        plo[i] = r->parts[i].lo;
-        phi[i] = r->parts[i].hi;
-    }
-    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 0.0, 1.0, 0.0, 0};
-    if (st == PD_OK)
-        st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
     if (st == PD_OK) {
         for (int i = 0; i < d; i++) {
             r->value[i] = best_theta[i];
@@ -375,44 +647,25 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
             }
         }
         st = scene_at(&m, best_theta, &r->scene, diag);
-        r->initial = chosen;
-        r->temper = w.temper;
-        r->dispersion = w.dispersion;
-        r->ess = w.ess;
-        r->npoints = w.npoints;
-        r->loglik = 0.0;
-        r->chi2 = 0.0;
-        r->df = -d;
-        for (int i = 0; i < nparts; i++) {
-            pd_fit_part_result *q = &r->parts[i];
-            q->nsim = (long)nsim[i];
-            q->df = q->nclasses - 1;
-            if (!parts[i].count)
-                continue;
-            for (int c = 0; c < q->nclasses; c++) {
-                q->n += parts[i].count[c];
-                if (parts[i].count[c] > 0)
-                    q->loglik += (double)parts[i].count[c] * log(q->p_best[c]);
-            }
-            q->chi2 = fit_chi2(q->nclasses, parts[i].count, q->p_best);
-            q->pvalue = q->df > 0 ? pd_gsl_chisq_q(q->chi2, q->df) : 1.0;
-            r->loglik += q->loglik;
-            r->chi2 += q->chi2;
-            r->df += q->df;
-        }
-        r->pvalue = r->df > 0 ? pd_gsl_chisq_q(r->chi2, r->df) : 1.0;
         r->drops = m.drops;
+        r->failed = m.failed;
     }
+done:
     free(pb_best);
     free(pp);
     free(plo);
     free(phi);
     free(nsim);
-done:
+    free(ps);
+    free(ns);
+    free(pbuf);
     free(m.ndrops);
     free(m.pose_p);
     free(kk);
     free(count);
+    free(one);
+    free(cell_of);
+    free(ncells);
     if (st == PD_OK)
         *result = r;
     else

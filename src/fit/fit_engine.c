@@ -41,7 +41,17 @@ typedef struct {
     pd_status st;
     pd_diag *diag;
     int evals;
+    const char *stage; /* for fit_problem's note */
+    int round;
 } ctx;
+
+/* Part i's cells of counts. */
+static const int *cells(const fit_problem *pb, int i, int *ncells)
+{
+    const int *of = pb->cell_of ? pb->cell_of[i] : NULL;
+    *ncells = of && pb->ncells ? pb->ncells[i] : pb->k[i];
+    return of;
+}
 
 static void to_theta(const fit_problem *pb, const double *z, double *theta)
 {
@@ -49,9 +59,10 @@ static void to_theta(const fit_problem *pb, const double *z, double *theta)
         theta[i] = pb->lo[i] + (pb->hi[i] - pb->lo[i]) * z[i];
 }
 
-/* The log-likelihood at z of the parts with counts: plain (*plain) and each
- * part's tempered by 1 / (1 + n_i / nsim_i) (the return value). */
-static pd_status evaluate(ctx *c, const double *z, int all, double *plain, double *tempered)
+/* The Dirichlet-multinomial log-likelihood at z of the parts with counts
+ * (docs/calibration.md: it carries the simulation's own error, so that a
+ * class reached by one lucky drop gains little). all as the model's. */
+static pd_status evaluate(ctx *c, const double *z, int all, double *loglik)
 {
     const fit_problem *pb = c->pb;
     to_theta(pb, z, c->theta);
@@ -59,20 +70,16 @@ static pd_status evaluate(ctx *c, const double *z, int all, double *plain, doubl
     pd_status st = pb->model(pb->user, c->theta, all, c->p, c->nsim, c->diag);
     if (st != PD_OK)
         return st;
-    double l = 0.0, lt = 0.0;
-    for (int i = 0; i < pb->nparts; i++) {
-        if (!pb->count[i])
-            continue;
-        long n = 0;
-        for (int j = 0; j < pb->k[i]; j++)
-            n += pb->count[i][j];
-        double li = pd_fit_loglik(pb->k[i], pb->count[i], c->p[i], c->nsim[i], pb->alpha);
-        l += li;
-        lt += li / (1.0 + (double)n / c->nsim[i]);
-    }
-    *plain = l;
-    if (tempered)
-        *tempered = lt;
+    double l = 0.0;
+    for (int i = 0; all != 2 && i < pb->nparts; i++)
+        if (pb->count[i]) {
+            int nc;
+            const int *of = cells(pb, i, &nc);
+            l += fit_loglik_cells(pb->k[i], of, nc, pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+        }
+    *loglik = l;
+    if (pb->note)
+        pb->note(pb->note_user, c->stage, c->round, l);
     return PD_OK;
 }
 
@@ -84,7 +91,7 @@ static double objective(const double *u, void *user)
         double v = u[i] > U_MAX ? U_MAX : u[i] < -U_MAX ? -U_MAX : u[i];
         z[i] = 1.0 / (1.0 + exp(-v));
     }
-    c->st = evaluate(c, z, 0, &l, NULL);
+    c->st = evaluate(c, z, 0, &l);
     return c->st == PD_OK ? -l : HUGE_VAL;
 }
 
@@ -93,7 +100,7 @@ static double **part_arrays(const fit_problem *pb)
 {
     double **p = calloc((size_t)pb->nparts, sizeof *p);
     for (int i = 0; p && i < pb->nparts; i++)
-        if (!(p[i] = malloc(sizeof **p * (size_t)pb->k[i]))) {
+        if (!(p[i] = malloc(sizeof **p * (size_t)(pb->k[i] > 0 ? pb->k[i] : 1)))) {
             for (int j = 0; j < i; j++)
                 free(p[j]);
             free(p);
@@ -118,7 +125,7 @@ pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta
         free(nsim);
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
     }
-    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag};
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "design"};
     int d = pb->d;
     /* The design: the middle of the box and 4 d Halton points; the search
      * starts from the best, so a maximum away from the middle is not left
@@ -129,7 +136,7 @@ pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta
         double l;
         for (int j = 0; j < d; j++)
             z[j] = i == 0 ? 0.5 : fit_halton(i, j);
-        st = evaluate(&c, z, 0, &l, NULL);
+        st = evaluate(&c, z, 0, &l);
         if (st == PD_OK && l > best) {
             best = l;
             memcpy(zbest, z, sizeof z[0] * (size_t)d);
@@ -141,6 +148,7 @@ pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta
         u[j] = log(zbest[j] / (1.0 - zbest[j]));
         step[j] = SIMPLEX_STEP;
     }
+    c.stage = "search";
     if (st == PD_OK) {
         st = pd_gsl_nelder_mead(objective, &c, d, u, step, SIMPLEX_TOL, s->max_evals, &nm_evals,
                                 &fmin);
@@ -190,8 +198,9 @@ typedef struct {
     int npoints;
 } box;
 
-/* The balance heuristic's weights: each point's tempered likelihood over
- * the mixture density of the rounds' uniform boxes at that point. */
+/* The balance heuristic's weights: each point's likelihood (its log over
+ * the dispersion) over the mixture density of the rounds' uniform boxes at
+ * that point. */
 static void weights(int d, int n, const double *z, const double *lt, const box *b, int nboxes,
                     double *w)
 {
@@ -219,45 +228,59 @@ static void weights(int d, int n, const double *z, const double *lt, const box *
         w[j] /= sum;
 }
 
+int fit_weigh_max_evals(const fit_settings *s)
+{
+    return 1 + (MAX_ROUNDS + 1) * s->npoints;
+}
+
+/* Systematic resampling: m indices of n points drawn in proportion to w
+ * (summing to 1), ascending, with the fixed offset 1/2 (a deterministic
+ * draw, whose counts are within one of m w_j for every point). */
+static void resample(int n, const double *w, int m, int *pick)
+{
+    double acc = 0.0;
+    int j = 0;
+    for (int i = 0; i < m; i++) {
+        double u = ((double)i + 0.5) / (double)m;
+        while (j < n - 1 && acc + w[j] < u)
+            acc += w[j++];
+        pick[i] = j;
+    }
+}
+
 pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
                     fit_weighed *out, int *evals, pd_diag *diag)
 {
-    int d = pb->d, np = pb->nparts, total = MAX_ROUNDS * s->npoints;
+    int d = pb->d, np = pb->nparts, total = MAX_ROUNDS * s->npoints, npred = 0;
     size_t ksum = 0;
-    for (int i = 0; i < np; i++)
+    for (int i = 0; i < np; i++) {
         ksum += (size_t)pb->k[i];
+        npred += !pb->count[i];
+    }
     double **p = part_arrays(pb), *nsim = malloc(sizeof *nsim * (size_t)np);
     double *z = malloc(sizeof *z * (size_t)total * (size_t)d);
     double *lt = malloc(sizeof *lt * (size_t)total), *w = malloc(sizeof *w * (size_t)total);
     double *store = malloc(sizeof *store * (size_t)total * ksum);
     double *sims = malloc(sizeof *sims * (size_t)total * (size_t)np);
     double *x = malloc(sizeof *x * (size_t)total), *a = malloc(sizeof *a * (size_t)total);
-    double *bb = malloc(sizeof *bb * (size_t)total);
+    double *bb = malloc(sizeof *bb * (size_t)total), *wp = malloc(sizeof *wp * (size_t)total);
     int *order = malloc(sizeof *order * (size_t)total);
-    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag};
+    int *pick = malloc(sizeof *pick * (size_t)(s->npoints > 0 ? s->npoints : 1));
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "weighting"};
     pd_status st = PD_OK;
-    if (!p || !nsim || !z || !lt || !w || !store || !sims || !x || !a || !bb || !order)
+    if (!p || !nsim || !z || !lt || !w || !store || !sims || !x || !a || !bb || !wp || !order ||
+        !pick)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit's weighting");
-    double zhat[PD_FIT_MAX_PARAMS], l, ltb;
+    double zhat[PD_FIT_MAX_PARAMS], l;
     for (int i = 0; i < d; i++)
         zhat[i] = (theta[i] - pb->lo[i]) / (pb->hi[i] - pb->lo[i]);
     if (st == PD_OK)
-        st = evaluate(&c, zhat, 1, &l, &ltb);
+        st = evaluate(&c, zhat, 1, &l);
     if (st == PD_OK) {
-        long ntot = 0;
-        double tsum = 0.0;
         for (int i = 0; i < np; i++) {
             pd_fit_smooth(pb->k[i], p[i], nsim[i], pb->alpha, out->p_best[i]);
             out->nsim_best[i] = nsim[i];
-            if (!pb->count[i])
-                continue;
-            long n = 0;
-            for (int j = 0; j < pb->k[i]; j++)
-                n += pb->count[i][j];
-            ntot += n;
-            tsum += (double)n / (1.0 + (double)n / nsim[i]);
         }
-        out->temper = ntot ? tsum / (double)ntot : 1.0;
         /* Overdispersion: X^2 beyond what the data's and the simulation's
          * noise explain is the model's own misfit, and widens the
          * weights' spread by its square root (quasi-likelihood). */
@@ -267,11 +290,13 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             if (!pb->count[i])
                 continue;
             long n = 0;
-            for (int j = 0; j < pb->k[i]; j++)
+            int nc;
+            const int *of = cells(pb, i, &nc);
+            for (int j = 0; j < nc; j++)
                 n += pb->count[i][j];
-            x2 += fit_chi2(pb->k[i], pb->count[i], out->p_best[i]);
-            expect += (double)(pb->k[i] - 1) * (1.0 + (double)n / nsim[i]);
-            df += pb->k[i] - 1;
+            x2 += fit_chi2_cells(pb->k[i], of, nc, pb->count[i], out->p_best[i]);
+            expect += (double)(nc - 1) * (1.0 + (double)n / nsim[i]);
+            df += nc - 1;
         }
         /* Without a degree of freedom left, X^2 says nothing of the fit. */
         expect *= df > 0 ? (double)df / (double)(df + d) : 0.0;
@@ -285,6 +310,7 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
     for (int r = 0; st == PD_OK && r < MAX_ROUNDS; r++) {
         if (r >= MIN_ROUNDS && ess >= s->npoints)
             break;
+        c.round = r + 1;
         for (int i = 0; i < d; i++) {
             if (r == 0) {
                 half[i] = 0.5;
@@ -311,7 +337,7 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             double *zj = z + (size_t)n * (size_t)d;
             for (int i = 0; i < d; i++)
                 zj[i] = b[r].lo[i] + (b[r].hi[i] - b[r].lo[i]) * fit_halton(index, i);
-            st = evaluate(&c, zj, 1, &l, &lt[n]);
+            st = evaluate(&c, zj, 0, &lt[n]);
             lt[n] /= out->dispersion;
             double *sj = store + (size_t)n * ksum;
             for (int i = 0; st == PD_OK && i < np; i++) {
@@ -328,6 +354,30 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             ess = 1.0 / sw2;
         }
     }
+    /* The parts without counts do not move the weights: they are simulated
+     * only at s->npoints of the points, drawn by weight, each standing for
+     * its share (an unbiased estimate of their weighted mixture). */
+    for (int j = 0; j < n; j++)
+        wp[j] = 0.0;
+    if (st == PD_OK && npred > 0) {
+        resample(n, w, s->npoints, pick);
+        c.stage = "prediction";
+        c.round = 0;
+        for (int t = 0; st == PD_OK && t < s->npoints; t++) {
+            int j = pick[t];
+            wp[j] += 1.0 / (double)s->npoints;
+            if (t > 0 && pick[t - 1] == j)
+                continue;
+            st = evaluate(&c, z + (size_t)j * (size_t)d, 2, &l);
+            size_t off = 0;
+            for (int i = 0; st == PD_OK && i < np; off += (size_t)pb->k[i], i++) {
+                if (pb->count[i])
+                    continue;
+                memcpy(store + (size_t)j * ksum + off, p[i], sizeof *store * (size_t)pb->k[i]);
+                sims[(size_t)j * (size_t)np + (size_t)i] = nsim[i];
+            }
+        }
+    }
     if (st == PD_OK) {
         out->ess = ess;
         out->npoints = n;
@@ -338,9 +388,16 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
                 m += w[j] * x[j];
             }
             double span = pb->hi[i] - pb->lo[i];
+            double qlo = weighted_quantile(n, x, w, 0.025, order);
+            double qhi = weighted_quantile(n, x, w, 0.975, order);
+            /* The best value is one the data allow: with a skewed
+             * likelihood, or the weight on few points, the central 95%
+             * can miss it, and the interval is then stretched to it. */
+            qlo = zhat[i] < qlo ? zhat[i] : qlo;
+            qhi = zhat[i] > qhi ? zhat[i] : qhi;
             out->mean[i] = pb->lo[i] + span * m;
-            out->lo[i] = pb->lo[i] + span * weighted_quantile(n, x, w, 0.025, order);
-            out->hi[i] = pb->lo[i] + span * weighted_quantile(n, x, w, 0.975, order);
+            out->lo[i] = pb->lo[i] + span * qlo;
+            out->hi[i] = pb->lo[i] + span * qhi;
         }
         /* Each point's probability of a class is known to within its own
          * drops' error: the posterior Beta of that class under the
@@ -349,20 +406,25 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
         size_t off = 0;
         for (int i = 0; i < np; i++) {
             int k = pb->k[i];
+            const double *wi = pb->count[i] ? w : wp;
             for (int cl = 0; cl < k; cl++) {
                 double mean = 0.0;
                 for (int j = 0; j < n; j++) {
+                    if (!(wi[j] > 0)) {
+                        a[j] = bb[j] = 1.0; /* weightless: never read */
+                        continue;
+                    }
                     double ns = sims[(size_t)j * (size_t)np + (size_t)i];
                     double pj = store[(size_t)j * ksum + off + (size_t)cl];
                     a[j] = ns * pj + pb->alpha;
                     bb[j] = ns * (1.0 - pj) + (double)(k - 1) * pb->alpha;
                     if (bb[j] < pb->alpha) /* round-off of 1 - pj */
                         bb[j] = pb->alpha;
-                    mean += w[j] * a[j] / (a[j] + bb[j]);
+                    mean += wi[j] * a[j] / (a[j] + bb[j]);
                 }
                 out->p[i][cl] = mean;
-                out->plo[i][cl] = fit_beta_mixture_quantile(n, w, a, bb, 0.025);
-                out->phi[i][cl] = fit_beta_mixture_quantile(n, w, a, bb, 0.975);
+                out->plo[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.025);
+                out->phi[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.975);
             }
             off += (size_t)k;
         }
@@ -378,6 +440,8 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
     free(x);
     free(a);
     free(bb);
+    free(wp);
     free(order);
+    free(pick);
     return st;
 }

@@ -9,8 +9,9 @@
 #include "posedrop/status.h"
 
 /* Fills p[i][0..k[i]) (summing to 1) and nsim[i] (the simulated drops behind
- * them) for every part i with counts, and for the others too when all is 1.
- * theta is in the problem's scale (lo..hi). */
+ * them) for every part i with counts when all is 0, for every part when all
+ * is 1, and for the parts without counts alone when all is 2 (a model may
+ * fill more). theta is in the problem's scale (lo..hi). */
 typedef pd_status (*fit_model_fn)(void *user, const double *theta, int all, double *const *p,
                                   double *nsim, pd_diag *diag);
 
@@ -19,10 +20,19 @@ typedef struct fit_problem {
     const double *lo, *hi;    /* the box, lo < hi */
     int nparts;
     const int *k;             /* classes per part */
-    const long *const *count; /* per part; NULL: predicted only */
+    const long *const *count; /* per part, one per cell; NULL: predicted only */
+    const int *const *cell_of; /* per part: each class's cell of counts, or NULL (or
+                                  cell_of NULL): every class its own cell */
+    const int *ncells;        /* per part, with cell_of; NULL: k */
     double alpha;             /* the smoothing pseudo-count */
     fit_model_fn model;
     void *user;
+    /* Called after every evaluation, when not NULL: the stage ("design",
+     * "search", "weighting", "prediction"), the weighting's round (1..) or 0,
+     * and the evaluation's log-likelihood (the parts with counts; 0 for a
+     * prediction). */
+    void (*note)(void *note_user, const char *stage, int round, double loglik);
+    void *note_user;
 } fit_problem;
 
 typedef struct fit_settings {
@@ -43,29 +53,44 @@ typedef struct fit_weighed {
     double *nsim_best;        /* per part */
     double *const *p;         /* per part, k[i]: averaged */
     double *const *plo, *const *phi; /* per part, k[i]: 95% interval */
-    double temper;            /* the count-weighted mean of the parts' exponents */
     double dispersion;        /* X^2 at theta over what the noise explains
                                  (sum (k_i - 1)(1 + n_i / nsim_i) - d), at least 1:
-                                 the tempered log-likelihood is divided by it */
+                                 the log-likelihood the weights use is divided by it */
     double ess;
     int npoints;
 } fit_weighed;
 
 /* Evaluates theta (the search's maximum) with every part (and its
- * dispersion from there), then rounds of
- * s->npoints quasi-random points: the whole box, then boxes around theta
- * shrunk to the weighted spread (at least 3 rounds, at most 6, stopping once
- * the effective sample size reaches s->npoints), all weighed by their
- * tempered likelihood over the density they were drawn from (the balance
- * heuristic). */
+ * dispersion from there), then rounds of s->npoints quasi-random points
+ * with the fitted parts: the whole box, then boxes around theta shrunk to
+ * the weighted spread (at least 3 rounds, at most 6, stopping once the
+ * effective sample size reaches s->npoints), all weighed by their
+ * Dirichlet-multinomial likelihood over the density they were drawn from
+ * (the balance heuristic). The parts without counts are then simulated at
+ * s->npoints of those points drawn by their weights (systematic
+ * resampling), and averaged over them. The interval of every parameter
+ * holds theta. */
 pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *theta,
                     fit_weighed *out, int *evals, pd_diag *diag);
+
+/* The most evaluations fit_weigh spends: the maximum, MAX_ROUNDS rounds and
+ * the predicted parts' points. */
+int fit_weigh_max_evals(const fit_settings *s);
 
 /* The Halton sequence's coordinate j (0..6) of point i >= 1, in (0, 1). */
 double fit_halton(long i, int j);
 
 /* Pearson's X^2 of counts (k) against n p. */
 double fit_chi2(int k, const long *count, const double *p);
+
+/* With counts of cells of classes: class i of k in cell cell_of[i] (cell_of
+ * NULL: every class its own cell, ncells = k); count has ncells entries.
+ * The Dirichlet-multinomial log-likelihood, Pearson's X^2, and the
+ * probability of cell j. */
+double fit_loglik_cells(int k, const int *cell_of, int ncells, const long *count,
+                        const double *p_sim, double nsim, double alpha);
+double fit_chi2_cells(int k, const int *cell_of, int ncells, const long *count, const double *p);
+double fit_cell_p(int k, const int *cell_of, int j, const double *p);
 
 /* The q-quantile of a mixture of Beta(a_j, b_j) with weights w_j (n terms,
  * summing to 1), by bisection to 1e-9. */

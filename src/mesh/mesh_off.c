@@ -135,8 +135,9 @@ static pd_status read_header(pd_text *t, pd_diag *diag, long long *nv, long long
         return pd_text_fail(t, diag, PD_ERR_RANGE,
                             "header declares %lld vertices and %lld faces; the limit is %d each",
                             *nv, *nf, PD_MAX_ELEMENTS);
-    /* Smallest records: "0 0 0\n" and "3 0 1 2\n"; the last may lack its '\n'. */
-    long long need = 6 * *nv + 8 * *nf - 1;
+    /* Smallest records: "0 0 0\n" and a face "0\n" (refused by the face's
+     * reader, which says why); the last may lack its '\n'. */
+    long long need = 6 * *nv + 2 * *nf - 1;
     if (need > 0 && (unsigned long long)need > pd_text_left(t))
         return pd_text_fail(t, diag, PD_ERR_PARSE,
                             "header declares %lld vertices and %lld faces, but only %zu bytes "

@@ -125,7 +125,7 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
             return PD_OK;
         c = v3_scale(c, 1.0 / wsum);
         pd_vec3 u0 = v3_add(s->v, v3_cross(ww, c));
-        double e = -u0.z <= m->settle.v_rest ? 0.0 : sc->restitution;
+        double e = -u0.z <= w->settle.v_rest ? 0.0 : sc->restitution;
         double K[3][3];
         pd_impact_K(1.0 / b->mass, CONST_M3(J), c, K);
         pd_impact_result res;
@@ -142,14 +142,14 @@ pd_status pd_drop_collide(const pd_sim_model *m, pd_drop_work *w, const pd_scene
         }
         s->v = v3_add(s->v, v3_scale(res.p, 1.0 / b->mass));
         ww = v3_add(ww, m3_vec(CONST_M3(J), v3_cross(c, res.p)));
-        if (e == 0.0 && m->settle.patch > 0.0 && J[2][2] > 0.0) {
+        if (e == 0.0 && w->settle.patch > 0.0 && J[2][2] > 0.0) {
             /* Resting contact: drilling friction over its patch
              * (docs/contact.md), an angular impulse about the normal of at
              * most (2/3) mu a times the normal impulse, against the spin
              * and never reversing it, so that it only takes energy. An
              * impact keeps the rigid law (Poisson's; the compliant law's
              * limit but where friction turns or stops the slip). */
-            double cap = 2.0 / 3.0 * sc->mu * m->settle.patch * res.p.z;
+            double cap = 2.0 / 3.0 * sc->mu * w->settle.patch * res.p.z;
             double dl = fmax(-cap, fmin(cap, -ww.z / J[2][2]));
             ww = v3_add(ww, v3_scale(v3(J[0][2], J[1][2], J[2][2]), dl));
         }
@@ -276,7 +276,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
      * vertex under drilling friction (a top) is left out of it, up to the
      * longest such spin its energy allows: that time is the drilling's,
      * not the part's natural time, which the limit is made of. */
-    double top_left = run.time_limit > 0 ? 0.0 : m->top_time;
+    double top_left = run.time_limit > 0 ? 0.0 : w->top_time;
     if (!(run.time_limit > 0))
         run.time_limit = m->time_limit;
     o = &run;
@@ -286,6 +286,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     }
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
+    pd_drop_trace_state(m, o, sc->gravity, index, 0.0, &s, "release");
     if (w->compliant_work)
         pd_compliant_work_watch(w->compliant_work, o->cancel);
     w->rest_depth = 0.0;
@@ -293,7 +294,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
     /* Resting contact advances by the time to fall rest_fall, so that a
      * vertex pressed on the floor by gravity meets it again with the speed
      * that fall gives (a microcollision) rather than at speed 0. */
-    double dt_rest = sqrt(2.0 * m->settle.rest_fall / g);
+    double dt_rest = sqrt(2.0 * w->settle.rest_fall / g);
     int hint = 0, phase_ok = 1, nc = 0;
     pd_flight f;
     double f_at = -1.0; /* time on f at which s lies; < 0: plan from s */
@@ -316,7 +317,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         double e_now = energy_height(m->body, &s, g);
         e_low = fmin(e_low, e_now);
         w->energy_rise = fmax(w->energy_rise, (e_now - e_low) / m->body->size);
-        int pose, d = pd_settle_outcome(&m->settle, &s, g, sc->mu, &hint, &pose);
+        int pose, d = pd_settle_outcome(&w->settle, &s, g, sc->mu, &hint, &pose);
         if (d < 0) {
             pd_drop_failed(out, PD_STAGE_SETTLE, PD_ERR_INTERNAL);
             break;
@@ -365,6 +366,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 }
                 t += imp.t - f_at;
                 f_at = imp.t;
+                pd_drop_trace_state(m, o, g, index, t, &s, "flight");
             }
             rest_from = -HUGE_VAL;
             nc = imp.ncontacts < PD_MAX_CONTACTS ? imp.ncontacts : PD_MAX_CONTACTS;
@@ -378,9 +380,9 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                  * rigid limit). */
                 double approach;
                 int ntouch = keep_touching(m->body, &s, w->contacts, nc, &approach);
-                if (nc >= 2 && approach > m->settle.v_rest) {
+                if (nc >= 2 && approach > w->settle.v_rest) {
                     pd_compliant_result cr;
-                    st = pd_compliant_run(&w->compliant, w->compliant_work, &m->settle, sc, &s,
+                    st = pd_compliant_run(&w->compliant, w->compliant_work, &w->settle, sc, &s,
                                           o->time_limit - t, &cr);
                     if (st != PD_OK) {
                         pd_drop_failed(out, PD_STAGE_COMPLIANT, st);
@@ -390,6 +392,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                     *energy_gain += cr.energy_gain;
                     w->rest_depth = fmax(w->rest_depth, cr.rest_depth);
                     t += cr.time;
+                    pd_drop_trace_state(m, o, g, index, t, &s, "compliant");
                     f_at = -1.0;
                     phase_ok = 1;
                     if (cr.end == PD_COMPLIANT_CANCELLED) {
@@ -418,6 +421,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 break;
             }
             if (out->collisions != before) {
+                pd_drop_trace_state(m, o, g, index, t, &s, "impact");
                 /* Each round applies one impulse, so fewer than
                  * PD_MAX_ROUNDS means a round found nothing approaching. */
                 resolved = out->collisions - before < PD_MAX_ROUNDS && w->contact_time == 0.0;
@@ -427,7 +431,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         }
         resolved = 0;
         pd_phase phase;
-        if (phase_ok && pd_contact_phase_start(&m->settle, sc, &s, w->contacts, nc, &phase)) {
+        if (phase_ok && pd_contact_phase_start(&w->settle, sc, &s, w->contacts, nc, &phase)) {
             /* One vertex or one edge in lasting contact, sliding or
              * sticking: the exact continuous motion. It ends at an event the
              * microcollisions must resolve, so the next rest step is theirs
@@ -436,7 +440,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             f_at = -1.0;
             int top = phase.nc == 1 && phase.drill[0] != 0.0;
             pd_ode *ode = pd_contact_phase_spins_fast(m->body, g, &s) ? w->phase_spin : w->phase;
-            if ((st = pd_contact_phase(&m->settle, ode, w->pivot, sc, &phase, &s,
+            if ((st = pd_contact_phase(&w->settle, ode, w->pivot, sc, &phase, &s,
                                        o->time_limit - t + (top ? top_left : 0.0), &dt)) !=
                 PD_OK) {
                 pd_drop_failed(out, PD_STAGE_CONTACT_PHASE, st);
@@ -448,6 +452,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
                 run.time_limit += spun;
             }
             t += dt;
+            pd_drop_trace_state(m, o, g, index, t, &s, "phase");
             phase_ok = 0;
             if (t >= o->time_limit) {
                 out->end = PD_END_TIME_LIMIT;
@@ -466,7 +471,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
         if (!plan_if_stale(m->body, &s, g, &f, &f_at, 1, out))
             break;
         double dt = dt_rest, rise = touching_rise(m->body, &s, w->contacts, nc);
-        if (rise > m->settle.v_rest)
+        if (rise > w->settle.v_rest)
             dt = fmin(dt, 2.0 * PD_TOL_CONTACT_REL * m->body->size / rise);
         /* Nor long enough for any vertex to sink further than
          * PD_REST_SINK_REL below the floor: the step is blind to vertices
@@ -477,7 +482,7 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
          * back (lift_onto_floor), or than the outcome test allows for
          * (PD_REST_TURN_REL): lifted partly for free, a slowly rocking part
          * gained height every step and never settled below a low barrier. */
-        double payable = fmax(energy_height(m->body, &s, g) - s.x.z, m->settle.margin);
+        double payable = fmax(energy_height(m->body, &s, g) - s.x.z, w->settle.margin);
         dt = turn_step(m->body, &s, f.wmax, 0.0, payable, dt);
         f_at += dt;
         rest_from = s.x.z;
@@ -486,10 +491,13 @@ void pd_drop_run(const pd_sim_model *m, pd_drop_work *w, const pd_scene *sc,
             break;
         }
         t += dt;
+        pd_drop_trace_state(m, o, g, index, t, &s, "flight");
         if (t >= o->time_limit) {
             out->end = PD_END_TIME_LIMIT;
             break;
         }
     }
     out->time = t;
+    if (out->end == PD_END_SETTLED)
+        pd_drop_trace_state(m, o, g, index, t, &s, "end");
 }

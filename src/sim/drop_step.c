@@ -62,6 +62,7 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
     pd_state s;
     pd_drop_release(m, sc, o, index, init_cdf, &s, out);
     pd_status st = m->engine->reset(w->world, &s);
+    pd_drop_trace_state(m, o, sc->gravity, index, 0.0, &s, "release");
     if (st != PD_OK) {
         pd_drop_failed(out, PD_STAGE_ENGINE_RESET, st);
         return;
@@ -82,6 +83,7 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
         if (d > 0) {
             out->pose = pose;
             out->end = PD_END_SETTLED;
+            pd_drop_trace_state(m, o, sc->gravity, index, out->time, &s, "end");
             return;
         }
         if ((st = m->engine->step(w->world, &s)) != PD_OK) {
@@ -89,6 +91,7 @@ void pd_drop_run_stepping(const pd_sim_model *m, pd_drop_work *w, const pd_scene
             return;
         }
         out->time = (double)(k + 1) * m->dt;
+        pd_drop_trace_state(m, o, sc->gravity, index, out->time, &s, "step");
     }
     out->end = PD_END_TIME_LIMIT;
 }

@@ -21,6 +21,8 @@
 #include "sim/drop.h"
 #include "sim/markov.h"
 #include "sim/scene.h"
+#include "posedrop/sensitivity.h"
+#include "sim/sim_tol.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
 #include "static/static_check.h"
@@ -32,10 +34,6 @@ enum { BOOTSTRAP_FIRST = 20, BOOTSTRAP_ROUND = 100 };
 /* --ci: drops between checks of the stopping rule. Plain runs go in batches
  * of at most BATCH_MAX, so the outcome buffer stays small for any -n. */
 enum { CI_BATCH = 1000, BATCH_MAX = 65536 };
-/* The coarsest fixed step a stepping engine is given, the CLI's --dt limit:
- * a part of 1 cm dropped 0.12 m meets the floor at 1.5 m/s and crosses its
- * own size in under 7 ms, so a longer step would pass through contacts. */
-static const double PD_SIM_DT_MAX = 0.01;
 /* Two-sided 95% normal quantile for the Wilson intervals. */
 static const double Z95 = PD_Z95;
 
@@ -59,6 +57,9 @@ void pd_sim_options_default(pd_sim_options *o)
     o->shard = 0;
     o->progress = NULL;
     o->progress_user = NULL;
+    o->trace = NULL;
+    o->trace_user = NULL;
+    o->trace_drop = 0;
 }
 
 double pd_time_limit_auto(double size, const pd_scene *scene)
@@ -127,6 +128,7 @@ void pd_sim_result_free(pd_sim_result *r)
     free(r->trials);
     free(r->first_count);
     free(r->transitions);
+    free(r->added);
     free(r);
 }
 
@@ -365,6 +367,29 @@ static int thread_count(const pd_sim_options *o)
     return o->threads > 0 ? (o->threads > 256 ? 256 : o->threads) : default_threads();
 }
 
+/* With effect_halfwidth: the drops the effects ask for, given the widest
+ * half-width res now at r->n drops; a half-width goes as 1 / sqrt(n), so
+ * n (res / delta)^2, a tenth more for the estimate's own noise, and at
+ * least a batch more. 0 once res is within delta. */
+static pd_status effect_want(const pd_sim_model *model, const pd_scene *scene,
+                             const pd_sim_options *o, const pd_sim_result *r, long *want,
+                             pd_diag *diag)
+{
+    pd_sensitivity *s = NULL;
+    pd_status st = pd_sim_sensitivity(r, scene, model->part_size, o->effect_class_of,
+                                      o->effect_nclasses, &s, diag);
+    if (st != PD_OK)
+        return st;
+    double res = s->resolution, delta = o->effect_halfwidth;
+    pd_sensitivity_free(s);
+    *want = 0;
+    if (res > delta) {
+        double more = 1.1 * (double)r->n * (res * res / (delta * delta) - 1.0);
+        *want = r->n + (more > CI_BATCH ? (more < 1e15 ? (long)more : (long)1e15) : CI_BATCH);
+    }
+    return PD_OK;
+}
+
 static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const pd_sim_options *o,
                        pd_sim_result *r, pd_diag *diag)
 {
@@ -373,10 +398,11 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
      * at once in the worst case (p = 1/2, Bonferroni over the poses: the
      * corrected eq. 17), then adds batches while an interval is still wider. */
     long want = pd_shard_drops(o->ndrops, r->shard, r->nshards), cap = want;
+    if (o->ci_halfwidth > 0 || o->effect_halfwidth > 0)
+        cap = o->max_drops > want ? o->max_drops : want;
     if (o->ci_halfwidth > 0) {
         /* max_drops bounds the run whatever the half-width asks (1e-7 asks
          * for ~1e14 drops); the ndrops asked for run in any case. */
-        cap = o->max_drops > want ? o->max_drops : want;
         long bound = pd_sample_size(o->ci_halfwidth, 0.05, r->nposes);
         want = bound > want ? bound : want;
         want = want < cap ? want : cap;
@@ -388,6 +414,12 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
     if (!buf || !cdf || !before)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
     while (st == PD_OK && r->n < cap && !r->partial) {
+        if (r->n >= want && o->effect_halfwidth > 0) {
+            long more = 0;
+            if ((st = effect_want(model, scene, o, r, &more, diag)) != PD_OK)
+                break;
+            want = more < cap ? more : cap;
+        }
         if (r->n >= want && (o->ci_halfwidth <= 0 || ci_reached(r, o->ci_halfwidth)))
             break;
         long size = next_batch(r, scene, o, want, cap);
@@ -535,6 +567,8 @@ static uint64_t run_fingerprint(const pd_static_result *poses, const pd_scene *s
         pd_hash_ints(&s, kind, 2);
     }
     pd_hash_u64(&s, (uint64_t)o->ndrops);
+    if (o->effect_halfwidth > 0) /* runs before it existed keep their identity */
+        pd_hash_doubles(&s, &o->effect_halfwidth, 1);
     pd_hash_u64(&s, (uint64_t)o->max_drops);
     pd_hash_u64(&s, o->seed);
     return s.h;
@@ -603,6 +637,23 @@ pd_status pd_sim_result_add(pd_sim_result *sum, const pd_sim_result *s, pd_diag 
                        "(%d poses, seed %llu; the run: %d poses, seed %llu; or another part, "
                        "scene or drop count)", s->nposes, (unsigned long long)s->seed,
                        sum->nposes, (unsigned long long)sum->seed);
+    /* Every drop of the run in one shard only: the shards of one split,
+     * each once. */
+    int split = s->nshards > 0 ? s->nshards : 1, which = s->nshards > 0 ? s->shard : 0;
+    if (s == sum || (sum->added_nshards && split != sum->added_nshards) || which < 0 ||
+        which >= split || (sum->added && sum->added[which]))
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_add: %s", s == sum
+                       ? "the sum added to itself"
+                       : sum->added_nshards && split != sum->added_nshards
+                           ? "a shard of another split than the shards added (its drops would "
+                             "count twice)"
+                           : "this shard was added already (its drops would count twice)");
+    if (!sum->added) {
+        if (!(sum->added = calloc((size_t)split, 1)))
+            return pd_fail(diag, PD_ERR_NOMEM, "out of memory");
+        sum->added_nshards = split;
+    }
+    sum->added[which] = 1;
     size_t k = (size_t)sum->nposes;
     sum->n += s->n;
     sum->unsettled += s->unsettled;
@@ -648,10 +699,13 @@ pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
         return pd_fail(diag, PD_ERR_USAGE, "option engine is %d: expected PD_ENGINE_IMPULSE, "
                        "PD_ENGINE_ODE or PD_ENGINE_BULLET", (int)o->engine);
     if (o->dt < 0 || o->dt > PD_SIM_DT_MAX)
-        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (the engine's "
-                       "default) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
+        return pd_fail(diag, PD_ERR_USAGE, "option dt is %g s: expected 0 (automatic, "
+                       "from the scene) or a step above 0 and at most %g s", o->dt, PD_SIM_DT_MAX);
     if (o->ndrops < 0)
         return pd_fail(diag, PD_ERR_USAGE, "option ndrops is %ld: expected 0 or more", o->ndrops);
+    if (o->trace_drop < 0)
+        return pd_fail(diag, PD_ERR_USAGE, "option trace_drop is %ld: expected 0 or more",
+                       o->trace_drop);
     if (o->threads < 0)
         return pd_fail(diag, PD_ERR_USAGE, "option threads is %d: expected 0 (all cores) or "
                        "more", o->threads);
@@ -676,6 +730,17 @@ pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
     if (o->nshards > 0 && o->ci_halfwidth > 0)
         return pd_fail(diag, PD_ERR_USAGE, "option nshards with ci_halfwidth: a run split into "
                        "shards needs a fixed number of drops");
+    if (!isfinite(o->effect_halfwidth))
+        return pd_fail(diag, PD_ERR_NONFINITE, "option effect_halfwidth is %g",
+                       o->effect_halfwidth);
+    if (o->effect_halfwidth < 0 || o->effect_halfwidth >= 0.5)
+        return pd_fail(diag, PD_ERR_USAGE, "option effect_halfwidth is %g: expected 0 (a fixed "
+                       "number of drops) or a half-width above 0 and below 0.5",
+                       o->effect_halfwidth);
+    if (o->effect_halfwidth > 0 && (o->nshards > 0 || !o->keep_trials))
+        return pd_fail(diag, PD_ERR_USAGE, "option effect_halfwidth needs keep_trials and no "
+                       "shards: the effects come from the drops' records, and their number "
+                       "from the effects");
     return PD_OK;
 }
 
@@ -712,6 +777,12 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "a run split into shards needs a fixed number of "
                        "drops, each independent of the others' outcomes: not a confidence "
                        "half-width, nor the bootstrap start, which draws from the outcomes so far");
+    if (o.effect_halfwidth > 0 && !pd_scene_ranged(&sc))
+        return pd_fail(diag, PD_ERR_USAGE, "option effect_halfwidth: no scene parameter varies, "
+                       "so there is no effect to resolve (give a range)");
+    if (o.effect_halfwidth > 0 && sc.initial != PD_INITIAL_UNIFORM)
+        return pd_fail(diag, PD_ERR_USAGE, "option effect_halfwidth goes with the uniform start "
+                       "only");
     int stationary = sc.initial == PD_INITIAL_STATIONARY;
     if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
         return PD_ERR_USAGE;

@@ -138,8 +138,12 @@ static double *field(pd_scene *s, const numeric_key *k)
     return (double *)(void *)((char *)s + k->field);
 }
 
+/* The key of a pd_scene_param; NULL for any other number (gravity's -1,
+ * which marks a key that takes no range, included). */
 static const numeric_key *param_key(int param)
 {
+    if (param < 0 || param >= PD_NPARAMS)
+        return NULL;
     for (int i = 0; i < NNUMERIC; i++)
         if (keys[i].param == param)
             return &keys[i];
@@ -263,10 +267,18 @@ const char *pd_scene_format(const pd_scene *scene, pd_scene_param param, char *b
     return buf;
 }
 
+int pd_scene_varies(const pd_scene *scene, pd_scene_param param)
+{
+    if (!scene || (unsigned)param >= PD_NPARAMS)
+        return 0;
+    const pd_dist *d = &scene->range[param];
+    return d->kind != PD_DIST_FIXED && d->lo < d->hi;
+}
+
 int pd_scene_ranged(const pd_scene *scene)
 {
-    for (int i = 0; scene && i < PD_NPARAMS; i++)
-        if (scene->range[i].kind != PD_DIST_FIXED)
+    for (int i = 0; i < PD_NPARAMS; i++)
+        if (pd_scene_varies(scene, (pd_scene_param)i))
             return 1;
     return 0;
 }

@@ -105,8 +105,8 @@ static int by_value(const void *a, const void *b)
     return (x > y) - (x < y);
 }
 
-/* The 95% percentile interval of v[0..nv) (sorted in place), clipped. */
-static void percentile_interval(double *v, int nv, double *lo, double *hi)
+/* The 95% percentile interval of v[0..nv) (sorted in place), unclipped. */
+static void percentile_raw(double *v, int nv, double *lo, double *hi)
 {
     qsort(v, (size_t)nv, sizeof *v, by_value);
     double at[2] = {0.025 * (nv - 1), 0.975 * (nv - 1)}, out[2];
@@ -115,8 +115,16 @@ static void percentile_interval(double *v, int nv, double *lo, double *hi)
         double f = at[s] - i;
         out[s] = i + 1 < nv ? v[i] + f * (v[i + 1] - v[i]) : v[i];
     }
-    *lo = fmin(fmax(out[0], 0.0), 1.0);
-    *hi = fmin(fmax(out[1], 0.0), 1.0);
+    *lo = out[0];
+    *hi = out[1];
+}
+
+/* The same, clipped to [0, 1]. */
+static void percentile_interval(double *v, int nv, double *lo, double *hi)
+{
+    percentile_raw(v, nv, lo, hi);
+    *lo = fmin(fmax(*lo, 0.0), 1.0);
+    *hi = fmin(fmax(*hi, 0.0), 1.0);
 }
 
 static double clip01(double s)
@@ -238,6 +246,14 @@ static long used_drops(const pd_sim_result *r, const pd_scene *sc, double size,
     return n;
 }
 
+/* Which third of parameter i's distribution drop j's value fell in: 0
+ * lower, 1 middle, 2 upper. */
+static int third_of(const double *q, long j, int i)
+{
+    double u = q[(size_t)j * PD_NPARAMS + (size_t)i];
+    return u < 1.0 / 3.0 ? 0 : u > 2.0 / 3.0 ? 2 : 1;
+}
+
 /* Thirds: the pose's share of the drops in the lower and upper third of
  * the parameter's distribution. */
 static void thirds(const int *cat, const double *q, long n, int i, int k, pd_sensitivity_row *row)
@@ -276,8 +292,12 @@ static pd_status indices(const int *cat, const double *q, long n, int i, int k, 
     double *tot = malloc(sizeof *tot * (size_t)k);
     double *rep = malloc(sizeof *rep * PD_SENSITIVITY_RESAMPLES * (size_t)k);
     double *point = malloc(sizeof *point * (size_t)k);
+    /* The effect's resamples: the pose's weighted counts in the lower and
+     * upper thirds. */
+    double *eff = malloc(sizeof *eff * PD_SENSITIVITY_RESAMPLES * (size_t)k);
+    double *cnt = malloc(sizeof *cnt * 2 * (size_t)k);
     pd_status st = PD_OK;
-    if (!key || !order || !w || !nb || !n2 || !sb || !tot || !rep || !point)
+    if (!key || !order || !w || !nb || !n2 || !sb || !tot || !rep || !point || !eff || !cnt)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the sensitivity");
     for (long j = 0; st == PD_OK && j < n; j++)
         key[j] = q[(size_t)j * PD_NPARAMS + (size_t)i];
@@ -286,6 +306,23 @@ static pd_status indices(const int *cat, const double *q, long n, int i, int k, 
     for (int b = -1; st == PD_OK && b < PD_SENSITIVITY_RESAMPLES; b++) {
         if (b >= 0)
             resample(seed ^ (uint64_t)(i + 1) * 0x9e3779b97f4a7c15ULL, b, n, w);
+        if (b >= 0) {
+            double nl = 0.0, nh = 0.0;
+            memset(cnt, 0, sizeof *cnt * 2 * (size_t)k);
+            for (long j = 0; j < n; j++) {
+                int t = third_of(q, j, i);
+                if (t == 0) {
+                    nl += w[j];
+                    cnt[cat[j]] += w[j];
+                } else if (t == 2) {
+                    nh += w[j];
+                    cnt[k + cat[j]] += w[j];
+                }
+            }
+            for (int c = 0; c < k; c++)
+                eff[(size_t)c * PD_SENSITIVITY_RESAMPLES + (size_t)b] =
+                    (nh > 0.0 ? cnt[k + c] / nh : 0.0) - (nl > 0.0 ? cnt[c] / nl : 0.0);
+        }
         double w2 = bin_sums(order, n, b >= 0 ? w : NULL, m, cat, NULL, k, nb, n2, sb);
         memset(tot, 0, sizeof *tot * (size_t)k);
         for (int bin = 0; bin < m; bin++)
@@ -307,6 +344,8 @@ static pd_status indices(const int *cat, const double *q, long n, int i, int k, 
         if (!isnan(point[c]))
             percentile_interval(rep + (size_t)c * PD_SENSITIVITY_RESAMPLES,
                                 PD_SENSITIVITY_RESAMPLES, &row->index_lo, &row->index_hi);
+        percentile_raw(eff + (size_t)c * PD_SENSITIVITY_RESAMPLES, PD_SENSITIVITY_RESAMPLES,
+                       &row->effect_lo, &row->effect_hi);
     }
     free(key);
     free(order);
@@ -317,7 +356,75 @@ static pd_status indices(const int *cat, const double *q, long n, int i, int k, 
     free(tot);
     free(rep);
     free(point);
+    free(eff);
+    free(cnt);
     return st;
+}
+
+/* The two-sided normal point shared by the three pairs of a parameter's
+ * thirds (Bonferroni: 0.05 / 3 each), Phi^-1(1 - 0.05 / 6). */
+#define PD_Z95_THIRDS 2.3940
+
+/* Parameter col's effect on pose c among the drops in third t of
+ * parameter other, and its variance by Agresti and Caffo's adjustment (a
+ * success and a failure added to each third: a variance that is never 0,
+ * for a pose that no drop of a small cell reaches). */
+static double cell_effect(const int *cat, const double *q, long n, int i, int other, int t, int c,
+                          double *var)
+{
+    double nn[2] = {0.0, 0.0}, hit[2] = {0.0, 0.0};
+    for (long j = 0; j < n; j++) {
+        if (third_of(q, j, other) != t)
+            continue;
+        int u = third_of(q, j, i);
+        if (u == 1)
+            continue;
+        nn[u / 2] += 1.0;
+        hit[u / 2] += cat[j] == c;
+    }
+    *var = 0.0;
+    for (int s = 0; s < 2; s++) {
+        double p = (hit[s] + 1.0) / (nn[s] + 2.0);
+        *var += p * (1.0 - p) / (nn[s] + 2.0);
+    }
+    return (nn[1] > 0.0 ? hit[1] / nn[1] : 0.0) - (nn[0] > 0.0 ? hit[0] / nn[0] : 0.0);
+}
+
+/* For every pose and ordered pair of parameters: whether the first one's
+ * effect changes across the second one's thirds, the pair of thirds whose
+ * effects differ by the most joint standard errors (beyond PD_Z95_THIRDS
+ * to be flagged); of several flagged partners, the one furthest out. */
+static int interactions(const int *cat, const double *q, long n, int k, pd_sensitivity *s)
+{
+    int tests = 0;
+    for (int c = 0; c < k; c++)
+        for (int col = 0; col < s->nparams; col++) {
+            pd_sensitivity_row *row = &s->rows[(size_t)c * (size_t)s->nparams + (size_t)col];
+            row->interacts = -1;
+            double best = PD_Z95_THIRDS;
+            for (int oc = 0; oc < s->nparams; oc++) {
+                if (oc == col)
+                    continue;
+                tests++;
+                double e[3], v[3];
+                for (int t = 0; t < 3; t++)
+                    e[t] = cell_effect(cat, q, n, (int)s->param[col], (int)s->param[oc], t, c,
+                                       &v[t]);
+                for (int a = 0; a < 3; a++)
+                    for (int b = a + 1; b < 3; b++) {
+                        double sd = sqrt(v[a] + v[b]), z = fabs(e[b] - e[a]) / sd;
+                        if (!(z > best))
+                            continue;
+                        best = z;
+                        row->interacts = (int)s->param[oc];
+                        memcpy(row->effect_in, e, sizeof e);
+                        row->interaction = e[b] - e[a];
+                        row->interaction_lo = e[b] - e[a] - PD_Z95_THIRDS * sd;
+                        row->interaction_hi = e[b] - e[a] + PD_Z95_THIRDS * sd;
+                    }
+            }
+        }
+    return tests;
 }
 
 pd_status pd_sim_sensitivity(const pd_sim_result *r, const pd_scene *sc, double size,
@@ -341,7 +448,7 @@ pd_status pd_sim_sensitivity(const pd_sim_result *r, const pd_scene *sc, double 
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the sensitivity");
     s->nposes = k;
     for (int i = 0; i < PD_NPARAMS; i++)
-        if (sc->range[i].kind != PD_DIST_FIXED && sc->range[i].lo < sc->range[i].hi)
+        if (pd_scene_varies(sc, (pd_scene_param)i))
             s->param[s->nparams++] = (pd_scene_param)i;
     size_t nt = (size_t)(r->n > 0 ? r->n : 1);
     int *cat = malloc(sizeof *cat * nt);
@@ -363,6 +470,13 @@ pd_status pd_sim_sensitivity(const pd_sim_result *r, const pd_scene *sc, double 
         if (s->n >= 4)
             st = indices(cat, q, s->n, i, k, col, s->nparams, r->seed, s->rows, diag);
     }
+    for (int j = 0; st == PD_OK && j < k * s->nparams; j++) {
+        pd_sensitivity_row *row = &s->rows[j];
+        row->effect = row->p_high - row->p_low;
+        s->resolution = fmax(s->resolution, 0.5 * (row->effect_hi - row->effect_lo));
+    }
+    if (st == PD_OK)
+        s->interaction_tests = interactions(cat, q, s->n, k, s);
     free(cat);
     free(q);
     if (st != PD_OK) {

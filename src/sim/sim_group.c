@@ -38,6 +38,8 @@ pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, i
     pd_hash_ints(&h, class_of, sim->nposes);
     g->run_fingerprint = h.h;
     g->trials = NULL;
+    g->added = NULL;
+    g->added_nshards = 0;
     g->first_count = NULL;
     g->transitions = NULL;
     size_t k = nclasses > 0 ? (size_t)nclasses : 1;

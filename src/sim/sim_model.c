@@ -8,6 +8,7 @@
 #include "base/rng.h"
 #include "base/vec3.h"
 #include "contact/contact_phase.h"
+#include "engines/engine_contact.h"
 #include "base/base_tol.h"
 #include "posedrop/tolerances.h"
 #include "sim/sim_tol.h"
@@ -57,6 +58,23 @@ static double top_spin_down(const pd_body *b, const pd_scene *sc, double patch)
     return Lz / (2.0 / 3.0 * mu * patch * m * g);
 }
 
+/* A stepping engine's automatic step (dt 0): pd_engine_dt_auto for the
+ * shortest contact the scene can draw and its fastest fall, but never so
+ * short that a drop run to its time limit takes more than PD_STEPS_MAX
+ * steps (a part of a fraction of a millimetre, whose contact is
+ * microseconds); the engines then keep their own contact, the scene law's
+ * rigid limit, as they do for any contact their step does not resolve. */
+static double step_auto(const pd_sim_model *m, const pd_part *part, const pd_scene *scene,
+                        const pd_dist *ct)
+{
+    double t_lo = ct->kind == PD_DIST_FIXED ? m->contact_time
+                  : ct->auto_multiple       ? ct->lo * pd_contact_time_auto(m->part_size)
+                                            : ct->lo;
+    double dt = pd_engine_dt_auto(t_lo, pd_engine_fall_speed(scene, part->size),
+                                  pd_engine_hull_width(part->hull), PD_SIM_DT_MAX);
+    return fmax(dt, m->time_limit / PD_STEPS_MAX);
+}
+
 pd_status pd_sim_model_build(const pd_part *part, const pd_static_result *poses,
                              const pd_scene *scene, const pd_sim_options *options,
                              pd_sim_model **model, pd_diag *diag)
@@ -74,21 +92,24 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
     if (!m)
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop model");
     m->tol_scale = tol_scale;
-    /* The issue's default steps: ODE 1 ms; Bullet 1/960 s, its usual 1/60 s
-     * frame cut into 16 substeps. */
     m->engine = pd_engine_get(options->engine);
     if (options->engine != PD_ENGINE_IMPULSE && !m->engine) {
         free(m);
         return pd_fail(diag, PD_ERR_UNAVAILABLE, "the %s engine is not in this program",
                        options->engine == PD_ENGINE_BULLET ? "Bullet" : "requested");
     }
-    if (options->engine == PD_ENGINE_ODE)
-        m->dt = options->dt > 0 ? options->dt : 1e-3;
-    else if (options->engine == PD_ENGINE_BULLET)
-        m->dt = options->dt > 0 ? options->dt : 1.0 / 960.0;
     m->time_limit = options->time_limit > 0 ? options->time_limit
                                             : pd_time_limit_auto(part->size, scene);
-    if (m->engine && m->time_limit / m->dt > PD_STEPS_MAX) {
+    /* Auto, fixed or as a range's multiple, from one length, so that a
+     * zero-width range gives the fixed run's bytes. */
+    m->part_size = pd_contact_time_auto_size(part);
+    m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
+                          ? pd_contact_time_auto(m->part_size)
+                          : scene->contact_time;
+    const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
+    if (m->engine)
+        m->dt = options->dt > 0 ? options->dt : step_auto(m, part, scene, ct);
+    if (m->engine && options->dt > 0 && m->time_limit / m->dt > PD_STEPS_MAX) {
         double dt = m->dt, limit = m->time_limit;
         free(m);
         return pd_fail(diag, PD_ERR_RANGE, "the %s engine would take %.3g steps of %g s per drop "
@@ -96,6 +117,15 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
                        "give a longer step (dt) or a shorter time limit",
                        options->engine == PD_ENGINE_BULLET ? "Bullet" : "ODE", limit / dt, dt,
                        limit, part->size, PD_STEPS_MAX);
+    }
+    const pd_dist *hr = &scene->range[PD_PARAM_HEIGHT];
+    double h_hi = hr->kind == PD_DIST_FIXED ? scene->height : hr->hi;
+    if (h_hi > PD_HEIGHT_SIZES_MAX * part->size) {
+        free(m);
+        return pd_fail(diag, PD_ERR_RANGE, "a drop height of %g m is %.3g times the part's size "
+                       "(%.3g m), more than the %g at which a drop can be simulated (it would "
+                       "bounce for hours of CPU, or fail): a part or height in the wrong unit?",
+                       h_hi, h_hi / part->size, part->size, PD_HEIGHT_SIZES_MAX);
     }
     m->hull = part->hull;
     m->com = part->com;
@@ -117,13 +147,6 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         m->settle.margin = PD_REST_TURN_REL * m->body->size;
         m->settle.still = PD_TOL_CONTACT_REL * m->body->size;
     }
-    /* Auto, fixed or as a range's multiple, from one length, so that a
-     * zero-width range gives the fixed run's bytes. */
-    m->part_size = pd_contact_time_auto_size(part);
-    m->contact_time = scene->contact_time == PD_CONTACT_TIME_AUTO
-                          ? pd_contact_time_auto(m->part_size)
-                          : scene->contact_time;
-    const pd_dist *ct = &scene->range[PD_PARAM_CONTACT_TIME], *e = &scene->range[PD_PARAM_RESTITUTION];
     m->material_ranged = scene->range[PD_PARAM_MU].kind != PD_DIST_FIXED ||
                          e->kind != PD_DIST_FIXED || ct->kind != PD_DIST_FIXED;
     double ct_hi = ct->kind == PD_DIST_FIXED ? m->contact_time
@@ -135,6 +158,11 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         st = pd_fail(diag, PD_ERR_RANGE, "scene contact_time: the range reaches %g s for this "
                      "part: expected at most 1 s", ct_hi);
     m->compliant_any = !m->engine && ct_hi > 0.0;
+    /* A contact carrying the part's weight at the part's mass sinks
+     * g / omega^2 by the compliant law; a corner of radius R pressed that
+     * deep touches over a patch of radius sqrt(R g) / omega (Hertz's
+     * geometry, a^2 = R d). */
+    m->patch_omega = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity);
     if (st == PD_OK && m->compliant_any && m->material_ranged) {
         double e_lo = e->kind == PD_DIST_FIXED ? scene->restitution : e->lo;
         double e_hi = e->kind == PD_DIST_FIXED ? scene->restitution : e->hi;
@@ -150,13 +178,8 @@ pd_status pd_sim_model_build_tol(const pd_part *part, const pd_static_result *po
         if (st != PD_OK)
             st = pd_fail(diag, st, "the compliant contact law for restitution %g and contact "
                          "time %g s could not be set up", scene->restitution, m->contact_time);
-        /* A contact carrying the part's weight at the part's mass sinks
-         * g / omega^2 by the compliant law; a corner of radius R pressed
-         * that deep touches over a patch of radius sqrt(R g) / omega
-         * (Hertz's geometry, a^2 = R d). */
         else
-            m->settle.patch = sqrt(PD_CORNER_RADIUS_REL * part->size * scene->gravity) /
-                              m->compliant.law.omega;
+            m->settle.patch = m->patch_omega / m->compliant.law.omega;
     }
     if (st == PD_OK)
         m->top_time = top_spin_down(m->body, scene, m->settle.patch);
@@ -206,6 +229,8 @@ pd_drop_work *pd_drop_work_alloc(const pd_sim_model *model, const pd_scene *scen
     w->contact_time = model->contact_time;
     w->compliant_on = model->compliant_on;
     w->compliant = model->compliant;
+    w->settle = model->settle;
+    w->top_time = model->top_time;
     return w;
 }
 
@@ -221,12 +246,18 @@ pd_status pd_drop_material(const pd_sim_model *m, pd_drop_work *w, const pd_scen
         resolved.contact_time = w->contact_time;
         return m->engine->material(w->world, &resolved);
     }
+    /* The patch and the top's spin-down follow the drop's own law and
+     * values, as a fixed run's follow its scene's: a zero-width range then
+     * gives the fixed run's bytes. */
     w->compliant_on = w->contact_time > 0.0;
+    w->settle.patch = 0.0;
     if (w->compliant_on) {
         pd_compliant_law law;
         pd_compliant_table_law(&m->table, drawn->restitution, w->contact_time, &law);
         pd_compliant_from_law(&law, m->body, m->tol_scale, &w->compliant);
+        w->settle.patch = m->patch_omega / w->compliant.law.omega;
     }
+    w->top_time = top_spin_down(m->body, drawn, w->settle.patch);
     return PD_OK;
 }
 
@@ -320,4 +351,34 @@ void pd_drop_release(const pd_sim_model *m, const pd_scene *sc, const pd_sim_opt
     out->stage = PD_STAGE_NONE;
     out->status = PD_OK;
     out->time = 0.0;
+}
+
+void pd_drop_trace_state(const pd_sim_model *m, const pd_sim_options *o, double gravity, long index,
+                         double t, const pd_state *s, const char *event)
+{
+    if (!o->trace || index != o->trace_drop)
+        return;
+    const pd_body *b = m->body;
+    double g = fabs(gravity);
+    pd_trace_row r;
+    r.t = t;
+    r.x[0] = s->x.x, r.x[1] = s->x.y, r.x[2] = s->x.z;
+    pd_quat q = quat_normalize(s->q);
+    r.q[0] = q.w, r.q[1] = q.x, r.q[2] = q.y, r.q[3] = q.z;
+    r.v[0] = s->v.x, r.v[1] = s->v.y, r.v[2] = s->v.z;
+    pd_vec3 w = quat_rotate(q, s->w);
+    r.w[0] = w.x, r.w[1] = w.y, r.w[2] = w.z;
+    double rot = b->moment[0] * s->w.x * s->w.x + b->moment[1] * s->w.y * s->w.y +
+                 b->moment[2] * s->w.z * s->w.z;
+    r.energy = s->x.z + (v3_dot(s->v, s->v) + rot / b->mass) / (2.0 * g);
+    double low = HUGE_VAL, near = PD_TOL_REST_FALL_REL * b->size;
+    r.contacts = 0;
+    for (int i = 0; i < b->nverts; i++) {
+        double z = s->x.z + quat_rotate(q, b->verts[i]).z;
+        low = fmin(low, z);
+        r.contacts += z <= near;
+    }
+    r.depth = -low;
+    r.event = event;
+    o->trace(o->trace_user, &r);
 }

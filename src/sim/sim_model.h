@@ -46,6 +46,8 @@ typedef struct pd_sim_model {
     int compliant_any;          /* some drop may be compliant: work areas need it */
     pd_compliant_table table;   /* the impulse engine's laws across the
                                    restitution's range, when it has one */
+    double patch_omega;         /* m rad/s: the contact patch's radius under
+                                   the part's weight times the law's omega */
 } pd_sim_model;
 
 typedef struct pd_drop_work {
@@ -64,6 +66,9 @@ typedef struct pd_drop_work {
     double contact_time;        /* this drop's: s, resolved (the model's unless ranged) */
     int compliant_on;           /* this drop's impacts of several contacts are compliant */
     pd_compliant compliant;     /* and their law */
+    pd_settle settle;           /* the model's, but for this drop's contact
+                                   patch, which its law's stiffness sets */
+    double top_time;            /* this drop's pd_sim_model.top_time */
     double energy_rise;         /* the last drop's largest rise of its energy
                                    (kinetic per weight plus the centre's
                                    height) above its lowest so far, per L:
@@ -114,6 +119,12 @@ void pd_drop_work_free(pd_drop_work *work);
 void pd_drop_release(const pd_sim_model *model, const pd_scene *scene,
                      const pd_sim_options *options, long index, const double *init_cdf,
                      pd_state *s, pd_trial *out);
+
+/* Hands drop `index`'s state s at time t, after `event`, to options->trace
+ * if that drop is traced (pd_trace_row, its energy under gravity);
+ * nothing otherwise. */
+void pd_drop_trace_state(const pd_sim_model *model, const pd_sim_options *options, double gravity,
+                         long index, double t, const pd_state *s, const char *event);
 
 /* Marks the drop's record failed at that stage with that status. */
 static inline void pd_drop_failed(pd_trial *out, pd_drop_stage stage, pd_status status)

@@ -82,4 +82,21 @@
  * would take hours; smaller: the 1000 m cube would need a coarser step. */
 #define PD_STEPS_MAX 1e7
 
+/* The highest drop height, in sizes of the part, that a run accepts
+ * (pd_sim_run refuses more with PD_ERR_RANGE, naming the ratio). Why 1e6:
+ * the part lands at sqrt(2 h / L) times its own natural speed and bounces
+ * for longer, in its own natural time, the higher that is, and a drop's
+ * cost grows faster than in proportion to h / L (docs/limits.md gives the
+ * measured cost per drop): at 1e6 one drop would take hours, and from about
+ * 1e11 (a 1e-12 m part from 0.12 m) the collisions' searches fail outright.
+ * The command warns from 100 sizes (a height or a part in the wrong unit).
+ * Larger: runs that never end and internal failures instead of a clear
+ * refusal; smaller: would refuse grains dropped from a metre. */
+#define PD_HEIGHT_SIZES_MAX 1e6
+
+/* The coarsest fixed step a stepping engine is given, the CLI's --dt limit:
+ * a part of 1 cm dropped 0.12 m meets the floor at 1.5 m/s and crosses its
+ * own size in under 7 ms, so a longer step would pass through contacts. */
+#define PD_SIM_DT_MAX 0.01
+
 #endif

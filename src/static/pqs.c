@@ -83,6 +83,15 @@ static int strictly_greater(double q, double p)
     return q - p > PD_TOL_PROB_TIE_REL * fmax(fabs(p), fabs(q));
 }
 
+int pd_pqs_moves(const pd_static_options *opt, const pd_static_result *res, int i, int j)
+{
+    const pd_facet_result *fr = res->facets;
+    if (!fr[j].stable)
+        return 1;
+    int qs = opt->compare == PD_PQS_COMPARE_QS;
+    return strictly_greater(qs ? fr[j].p_qs : fr[j].p_raw, qs ? fr[i].p_qs : fr[i].p_raw);
+}
+
 pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geom,
                          const pd_static_options *opt, const pd_static_result *res,
                          double *pert, pd_diag *diag)
@@ -95,13 +104,11 @@ pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geo
     for (int i = 0; i < hull->nfacets; i++) {
         if (!fr[i].stable)
             continue;
-        double pi_cmp = opt->compare == PD_PQS_COMPARE_QS ? fr[i].p_qs : fr[i].p_raw;
         int base = hull->facet_start[i], k = hull->facet_start[i + 1] - base;
         pd_vec3 foot = v3_sub(geom[i].foot, com);
         for (int e = 0; e < k; e++) {
             int j = hull->facet_adj[base + e];
-            double pj_cmp = opt->compare == PD_PQS_COMPARE_QS ? fr[j].p_qs : fr[j].p_raw;
-            if (fr[j].stable && !strictly_greater(pj_cmp, pi_cmp))
+            if (!pd_pqs_moves(opt, res, i, j))
                 continue;
             pd_vec3 a = v3_sub(hull->verts[hull->facet_vert[base + e]], com);
             pd_vec3 b = v3_sub(hull->verts[hull->facet_vert[base + (e + 1) % k]], com);

@@ -85,6 +85,11 @@ pd_status pd_pqs_perturb(const pd_hull *hull, pd_vec3 com, const facet_geom *geo
                          const pd_static_options *opt, const pd_static_result *res,
                          double *pert, pd_diag *diag);
 
+/* 1 when the band of stable facet i along its edge shared with facet j moves
+ * to j: j is unstable, or starts strictly more probable (beyond a relative
+ * tie), by opt->compare's measure. */
+int pd_pqs_moves(const pd_static_options *opt, const pd_static_result *res, int i, int j);
+
 /* Exact spherical area of the part of triangle (A, B, N) (unit vectors, N on
  * the positive side of the great circle AB) within angle eps of that circle. */
 pd_status pd_band_area_exact(pd_vec3 A, pd_vec3 B, pd_vec3 N, double eps, double *area);

@@ -30,6 +30,8 @@ static double axis_top(const viz_entry *e, int n, double *step)
         top = fmax(top, fmax(e[i].p_qs, e[i].p_pqs));
         if (e[i].has_dyn)
             top = fmax(top, fmax(e[i].p, e[i].hi));
+        if (e[i].has_xc)
+            top = fmax(top, e[i].x.hi);
         if (e[i].has_meas)
             top = fmax(top, e[i].meas_ci ? fmax(e[i].mp, e[i].mhi) : e[i].mp);
     }
@@ -53,6 +55,19 @@ static void bar(vbuf *b, double x, double y0, double hpx, const char *colour)
     char attrs[80];
     fill_attrs(colour, attrs, sizeof attrs);
     viz_rect(b, x, y0 - hpx, BAR_W, hpx, attrs);
+}
+
+/* The engines' range (--crosscheck) over the drops' bar: a box from the
+ * lowest engine's p to the highest's, a little wider than the bar, so that
+ * the bar's own top and whisker show through it. */
+static const char *const band_attrs =
+    "fill=\"#111111\" fill-opacity=\"0.14\" stroke=\"#111111\" stroke-width=\"1.2\" "
+    "stroke-dasharray=\"3 2\"";
+
+static void band(vbuf *b, double xc, double ylo, double yhi)
+{
+    /* A range of zero height still shows, as a line. */
+    viz_rect(b, xc - BAR_W / 2.0 - 3, yhi, BAR_W + 6, fmax(ylo - yhi, 0.0), band_attrs);
 }
 
 static void whisker(vbuf *b, double xc, double ylo, double yhi)
@@ -108,17 +123,28 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     int which[4] = {0, 1, 2, 3};
     if (!has_dyn)
         which[2] = 3;
-    int legend_rows = nser;
+    int has_xc = has_dyn && e[0].has_xc;
+    int legend_rows = nser + has_xc;
     double legend_h = legend_rows * LEGEND_LINE + 8;
-    char title[512], legend[4][256];
-    snprintf(title, sizeof title, "Pose probabilities of %s%s", viz_base_name(in->name),
-             in->class_of ? ", by class" : "");
+    char title[512], legend[5][256];
+    /* An interrupted run's chart says so where it is seen, as its CSV does. */
+    snprintf(title, sizeof title, "Pose probabilities of %s%s%s", viz_base_name(in->name),
+             in->class_of ? ", by class" : "",
+             in->sim && in->sim->partial ? " (interrupted: partial)" : "");
     const char *whiskers = has_dyn || (has_meas && e[0].meas_ci) ? "whiskers: 95% intervals" : "";
     const char *caption = in->class_of
                               ? "pose class (as numbered by --group), drawn as in the gallery"
                               : "pose (as numbered in the output), drawn as in the gallery";
     for (int k = 0; k < nser; k++)
         legend_line(in, e, n, &s[which[k]], which[k], legend[k], sizeof legend[k]);
+    if (has_xc) {
+        int apart = 0;
+        for (int i = 0; i < n; i++)
+            apart += e[i].x.apart;
+        snprintf(legend[nser], sizeof legend[nser], "dashed box: the range across the engines "
+                 "(impulse, ODE, Bullet; same releases)%s", apart ? "; apart beyond their "
+                 "95% intervals where marked !" : "");
+    }
     /* As wide as the bars need, or as the title and the whiskers' note, the
      * legend or the caption (centred under the plot), whichever is widest;
      * the groups then share the plot's width. */
@@ -129,7 +155,7 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     int nrows = (n + per_row - 1) / per_row;
     double w = fmax(LEFT + per_row * group_min + RIGHT, 640);
     w = fmax(w, 10 + viz_text_width(title, 16, 1) + 20 + viz_text_width(whiskers, 11, 0) + RIGHT);
-    for (int k = 0; k < nser; k++)
+    for (int k = 0; k < nser + has_xc; k++)
         w = fmax(w, LEFT + 18 + viz_text_width(legend[k], 12, 0) + RIGHT);
     w = ceil(fmax(w, LEFT + viz_text_width(caption, 11, 0) + LEFT));
     double plot_w = w - LEFT - RIGHT, group_w = plot_w / per_row;
@@ -143,6 +169,11 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
         fill_attrs(s[which[k]].colour, attrs, sizeof attrs);
         viz_rect(b, LEFT, y, 12, 12, attrs);
         viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", legend[k]);
+    }
+    if (has_xc) {
+        double y = TOP + nser * LEGEND_LINE;
+        viz_rect(b, LEFT, y, 12, 12, band_attrs);
+        viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", legend[nser]);
     }
     if (whiskers[0])
         viz_text(b, w - RIGHT, 22, 11, "end", 0, "#555555", whiskers);
@@ -186,11 +217,13 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
             bar(b, x, y0, v * ppu, s[wk].colour);
             if (wk == 2)
                 whisker(b, xc, y0 - e[i].lo * ppu, y0 - e[i].hi * ppu);
+            if (wk == 2 && e[i].has_xc)
+                band(b, xc, y0 - e[i].x.lo * ppu, y0 - e[i].x.hi * ppu);
             if (wk == 3 && e[i].meas_ci)
                 whisker(b, xc, y0 - e[i].mlo * ppu, y0 - e[i].mhi * ppu);
         }
         char lab[16];
-        snprintf(lab, sizeof lab, "%d", e[i].number);
+        snprintf(lab, sizeof lab, "%d%s", e[i].number, has_xc && e[i].x.apart ? " !" : "");
         double cx = gx + (group_w - GROUP_GAP) / 2.0;
         viz_text(b, cx, y0 + 16, 12, "middle", 1, "#111111", lab);
         if (pics)

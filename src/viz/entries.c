@@ -36,6 +36,10 @@ pd_status viz_entries(const viz_input *in, viz_entry **out, int *n, pd_diag *dia
             e[c].lo = in->sim->ci_lo[c];
             e[c].hi = in->sim->ci_hi[c];
         }
+        if (in->engines) {
+            e[c].x = viz_engine_spread(in->engines, c);
+            e[c].has_xc = e[c].x.ran > 0;
+        }
         if (m) {
             e[c].has_meas = 1;
             e[c].mp = c < m->npose ? m->p[c] : 0.0;
@@ -49,6 +53,35 @@ pd_status viz_entries(const viz_input *in, viz_entry **out, int *n, pd_diag *dia
     *out = e;
     *n = k;
     return PD_OK;
+}
+
+viz_spread viz_engine_spread(const viz_engines *x, int entry)
+{
+    viz_spread s = {0.0, 0.0, 0, 0};
+    double min_hi = 0.0, max_lo = 0.0;
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        const pd_sim_result *r = x->sim[k];
+        if (!r || r->n == 0)
+            continue;
+        double p = r->p[entry], lo = r->ci_lo[entry], hi = r->ci_hi[entry];
+        if (s.ran++ == 0) {
+            s.lo = s.hi = p;
+            min_hi = hi;
+            max_lo = lo;
+        }
+        s.lo = fmin(s.lo, p);
+        s.hi = fmax(s.hi, p);
+        min_hi = fmin(min_hi, hi);
+        max_lo = fmax(max_lo, lo);
+    }
+    s.apart = s.ran > 1 && min_hi < max_lo;
+    return s;
+}
+
+const char *viz_engine_label(int k)
+{
+    static const char *const names[VIZ_ENGINES] = {"impulse", "ODE", "Bullet"};
+    return k >= 0 && k < VIZ_ENGINES ? names[k] : "?";
 }
 
 void viz_eq16(const viz_entry *e, int n, int which, double *e16, double *tv)

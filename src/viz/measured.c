@@ -22,6 +22,9 @@ void viz_measured_free(viz_measured *m)
     free(m->lo);
     free(m->hi);
     free(m->path);
+    free(m->set_size);
+    free(m->set_pose);
+    free(m->set_p);
     free(m);
 }
 
@@ -54,12 +57,97 @@ static int number(const char *s, double *out)
     return pd_parse_double(s, strlen(s), out) == PD_NUM_OK;
 }
 
+/* Half a unit in the last digit the text of a number gives (0.333: 5e-4,
+ * 1.5e-2: 5e-4), the most by which it may differ from what it was rounded
+ * from. */
+static double half_last_digit(const char *s)
+{
+    const char *dot = strchr(s, '.'), *e = strpbrk(s, "eE");
+    int decimals = 0;
+    for (const char *c = dot ? dot + 1 : s + strlen(s); *c >= '0' && *c <= '9'; c++)
+        decimals++;
+    long exponent = e ? strtol(e + 1, NULL, 10) : 0;
+    return 0.5 * pow(10.0, (double)(exponent - decimals));
+}
+
+/* One line into line (size bytes): 1, 0 at the end of the file, -1 for a
+ * line too long, -2 for a NUL byte (no text file holds one). */
+static int read_line(FILE *f, char *line, int size)
+{
+    int n = 0, c;
+    while ((c = getc(f)) != EOF) {
+        if (c == '\0')
+            return -2;
+        if (n == size - 1)
+            return -1;
+        line[n++] = (char)c;
+        if (c == '\n')
+            break;
+    }
+    line[n] = '\0';
+    return n > 0 ? 1 : 0;
+}
+
 typedef struct {
-    int pose;
+    int pose;      /* 0 for a set */
+    int first, nm; /* a set: its poses are members[first .. first + nm) */
     double value;
 } row;
 
+/* The pose field: one pose, or with sets a set "3|4" whose poses are
+ * appended to *members. Returns 0 (the caller reports) on a bad field. */
+static int parse_pose(char *text, int sets, int *pose, int **members, int *nmembers, int *mcap,
+                      int *nm)
+{
+    double v;
+    *nm = 0;
+    if (!sets || !strchr(text, '|')) {
+        if (!number(text, &v) || v != floor(v) || v < 1 || v > MAX_POSES)
+            return 0;
+        *pose = (int)v;
+        return 1;
+    }
+    *pose = 0;
+    for (char *s = text;;) {
+        char *bar = strchr(s, '|');
+        if (bar)
+            *bar = '\0';
+        if (!number(s, &v) || v != floor(v) || v < 1 || v > MAX_POSES)
+            return 0;
+        for (int i = 0; i < *nm; i++)
+            if ((*members)[*nmembers - *nm + i] == (int)v)
+                return 0;
+        if (*nmembers == *mcap) {
+            *mcap = *mcap ? 2 * *mcap : 16;
+            int *grown = realloc(*members, sizeof *grown * (size_t)*mcap);
+            if (!grown)
+                return 0;
+            *members = grown;
+        }
+        (*members)[(*nmembers)++] = (int)v;
+        (*nm)++;
+        if (bar)
+            *bar = '|';
+        if (!bar)
+            break;
+        s = bar + 1;
+    }
+    return *nm >= 2;
+}
+
+static pd_status measured_read(const char *path, int sets, viz_measured **out, pd_diag *diag);
+
 pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
+{
+    return measured_read(path, 0, out, diag);
+}
+
+pd_status viz_measured_read_sets(const char *path, viz_measured **out, pd_diag *diag)
+{
+    return measured_read(path, 1, out, diag);
+}
+
+static pd_status measured_read(const char *path, int sets, viz_measured **out, pd_diag *diag)
 {
     FILE *f = pd_file_fopen_read(path);
     if (!f)
@@ -70,16 +158,22 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
     long lineno = 0;
     double n_given = -1.0;
     row *rows = NULL;
-    int nrows = 0, cap = 0, maxpose = 0;
+    int nrows = 0, cap = 0, maxpose = 0, *members = NULL, nmembers = 0, mcap = 0, nsets = 0;
     pd_status st = PD_OK;
-    while (st == PD_OK && fgets(line, sizeof line, f)) {
+    int got;
+    while (st == PD_OK && (got = read_line(f, line, sizeof line)) != 0) {
         lineno++;
-        if (!strchr(line, '\n') && !feof(f)) {
-            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: line longer than %d characters", path,
-                         lineno, LINE_MAX_LEN - 2);
+        if (got < 0) {
+            st = got == -2 ? pd_fail(diag, PD_ERR_PARSE, "%s:%ld: a NUL byte: binary data, not a "
+                                     "CSV table", path, lineno)
+                           : pd_fail(diag, PD_ERR_PARSE, "%s:%ld: line longer than %d "
+                                     "characters", path, lineno, LINE_MAX_LEN - 2);
             break;
         }
         char *p = line;
+        /* A UTF-8 byte order mark, as spreadsheets write one, is no text. */
+        if (lineno == 1 && strncmp(p, "\xEF\xBB\xBF", 3) == 0)
+            memmove(p, p + 3, strlen(p + 3) + 1);
         while (*p == ' ' || *p == '\t')
             p++;
         if (*p == '\0' || *p == '\n' || *p == '\r' || *p == '#')
@@ -103,11 +197,16 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
                          path, lineno, ncols, nf);
             break;
         }
-        double pose, v = 0.0, nv = 0.0;
+        double v = 0.0, nv = 0.0;
+        int pose, nm;
         const char *vtext = field[col_count >= 0 ? col_count : col_p];
-        if (!number(field[col_pose], &pose) || pose != floor(pose) || pose < 1 || pose > MAX_POSES) {
-            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a pose number from 1 to %d, got '%s'",
-                         path, lineno, MAX_POSES, field[col_pose]);
+        if (!parse_pose(field[col_pose], sets, &pose, &members, &nmembers, &mcap, &nm)) {
+            st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: expected a pose number from 1 to %d%s, got "
+                         "'%s'", path, lineno, MAX_POSES,
+                         sets ? ", or a set of two or more distinct ones as 3|4"
+                              : strchr(field[col_pose], '|') ? " (sets of poses as 3|4 are for "
+                                                               "posedrop fit)" : "",
+                         field[col_pose]);
             break;
         }
         if (col_count >= 0 && (!number(vtext, &v) || v != floor(v) || v < 0 || v > 1e15)) {
@@ -128,12 +227,27 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
                 break;
             }
             n_given = nv;
-        }
-        for (int i = 0; i < nrows; i++)
-            if (rows[i].pose == (int)pose) {
-                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: pose %d given twice", path, lineno,
-                             (int)pose);
+            /* p of n drops is a whole number of drops, to p's last digit:
+             * 0.333 of 10 is no count, and would be rounded silently. */
+            double drops = v * nv;
+            if (fabs(drops - nearbyint(drops)) > nv * half_last_digit(vtext) + 1e-9 * nv) {
+                st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: p %s of n %s drops is %.6g drops, not a "
+                             "whole number: give p to enough digits, or the counts (pose,count)",
+                             path, lineno, vtext, field[col_n], drops);
                 break;
+            }
+        }
+        /* Every pose in one row at most, alone or in a set. */
+        const int *mine = nm ? members + nmembers - nm : &pose;
+        for (int a = 0; a < (nm ? nm : 1); a++)
+            for (int i = 0; st == PD_OK && i < nrows; i++) {
+                const int *theirs = rows[i].nm ? members + rows[i].first : &rows[i].pose;
+                for (int b = 0; b < (rows[i].nm ? rows[i].nm : 1); b++)
+                    if (theirs[b] == mine[a]) {
+                        st = pd_fail(diag, PD_ERR_PARSE, "%s:%ld: pose %d given twice", path,
+                                     lineno, mine[a]);
+                        break;
+                    }
             }
         if (st != PD_OK)
             break;
@@ -146,11 +260,15 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
             }
             rows = r;
         }
-        rows[nrows].pose = (int)pose;
+        rows[nrows].pose = pose;
+        rows[nrows].first = nmembers - nm;
+        rows[nrows].nm = nm;
         rows[nrows].value = v;
         nrows++;
-        if ((int)pose > maxpose)
-            maxpose = (int)pose;
+        nsets += nm > 0;
+        for (int a = 0; a < (nm ? nm : 1); a++)
+            if (mine[a] > maxpose)
+                maxpose = mine[a];
     }
     if (st == PD_OK && ferror(f))
         st = pd_fail(diag, PD_ERR_IO, "%s: read error", path);
@@ -165,6 +283,9 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
                      ncols ? "rows after the header" : "header (pose,count or pose,p)");
     else if (st == PD_OK && col_count >= 0 && !(total > 0))
         st = pd_fail(diag, PD_ERR_RANGE, "%s: the counts add up to 0", path);
+    else if (st == PD_OK && col_count >= 0 && total > 1e15)
+        st = pd_fail(diag, PD_ERR_RANGE, "%s: the counts add up to %.6g, more than the 1e15 "
+                     "drops a count may be", path, total);
     else if (st == PD_OK && col_p >= 0 && fabs(total - 1.0) > VIZ_MEASURED_SUM_TOL)
         st = pd_fail(diag, PD_ERR_RANGE, "%s: the p column adds up to %.6g, expected 1 (within %g)",
                      path, total, VIZ_MEASURED_SUM_TOL);
@@ -177,8 +298,14 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
             m->lo = ci ? calloc((size_t)maxpose, sizeof *m->lo) : NULL;
             m->hi = ci ? calloc((size_t)maxpose, sizeof *m->hi) : NULL;
             m->path = malloc(strlen(path) + 1);
+            if (nsets) {
+                m->set_size = calloc((size_t)nsets, sizeof *m->set_size);
+                m->set_pose = calloc((size_t)nmembers, sizeof *m->set_pose);
+                m->set_p = calloc((size_t)nsets, sizeof *m->set_p);
+            }
         }
-        if (!m || !m->p || !m->path || (ci && (!m->lo || !m->hi))) {
+        if (!m || !m->p || !m->path || (ci && (!m->lo || !m->hi)) ||
+            (nsets && (!m->set_size || !m->set_pose || !m->set_p))) {
             viz_measured_free(m);
             m = NULL;
             st = pd_fail(diag, PD_ERR_NOMEM, "out of memory");
@@ -188,10 +315,19 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
         strcpy(m->path, path);
         m->npose = maxpose;
         m->n = col_count >= 0 ? (long)total : col_n >= 0 ? (long)n_given : 0;
+        int ns = 0, np = 0;
         for (int i = 0; i < nrows; i++) {
-            int k = rows[i].pose - 1;
-            m->p[k] = col_count >= 0 ? rows[i].value / total : rows[i].value;
+            double pv = col_count >= 0 ? rows[i].value / total : rows[i].value;
+            if (!rows[i].nm) {
+                m->p[rows[i].pose - 1] = pv;
+                continue;
+            }
+            m->set_size[ns] = rows[i].nm;
+            m->set_p[ns++] = pv;
+            for (int a = 0; a < rows[i].nm; a++)
+                m->set_pose[np++] = members[rows[i].first + a];
         }
+        m->nsets = ns;
         if (m->lo)
             for (int k = 0; k < maxpose; k++)
                 pd_wilson(lround(m->p[k] * (double)m->n), m->n, PD_Z95, &m->lo[k],
@@ -199,5 +335,6 @@ pd_status viz_measured_read(const char *path, viz_measured **out, pd_diag *diag)
         *out = m;
     }
     free(rows);
+    free(members);
     return st;
 }

@@ -125,6 +125,11 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
                 "<th>QS</th><th>PQS</th>");
     if (e[0].has_dyn)
         vbuf_put(b, "<th>dynamic</th><th>95% interval</th>");
+    if (e[0].has_xc) {
+        for (int k = 0; k < VIZ_ENGINES; k++)
+            vbuf_printf(b, "<th>%s</th>", viz_engine_label(k));
+        vbuf_put(b, "<th>range across engines</th>");
+    }
     if (e[0].has_meas)
         vbuf_put(b, "<th>measured</th>");
     vbuf_put(b, "</tr>\n");
@@ -138,6 +143,17 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
         if (e[i].has_dyn) {
             pct(b, e[i].p);
             vbuf_printf(b, "<td>%.2f%% to %.2f%%</td>", 100.0 * e[i].lo, 100.0 * e[i].hi);
+        }
+        if (e[i].has_xc) {
+            for (int k = 0; k < VIZ_ENGINES; k++) {
+                const pd_sim_result *r = in->engines->sim[k];
+                if (r && r->n > 0)
+                    pct(b, r->p[i]);
+                else
+                    vbuf_put(b, "<td>not run</td>");
+            }
+            vbuf_printf(b, "<td>%.2f%% to %.2f%%%s</td>", 100.0 * e[i].x.lo, 100.0 * e[i].x.hi,
+                        e[i].x.apart ? " !" : "");
         }
         if (e[i].has_meas)
             pct(b, e[i].mp);
@@ -167,8 +183,56 @@ static void table_section(vbuf *b, const viz_input *in, const viz_entry *e, int 
     vbuf_put(b, "</section>\n");
 }
 
+/* --crosscheck in words: whether the engines' 95% intervals are apart on
+ * any pose, which, and what that means for the estimate. */
+static void crosscheck_section(vbuf *b, const viz_input *in, const viz_entry *e, int n)
+{
+    const char *what = in->class_of ? "class" : "pose";
+    int apart = 0, widest = 0, ran = 0;
+    for (int i = 0; i < n; i++) {
+        apart += e[i].x.apart;
+        if (e[i].x.hi - e[i].x.lo > e[widest].x.hi - e[widest].x.lo)
+            widest = i;
+    }
+    vbuf_put(b, "<section id=\"crosscheck\"><h2>The three engines</h2>\n<p>The same releases "
+                "(drop i of the seed starts from the same state) were run on ");
+    for (int k = 0; k < VIZ_ENGINES; k++) {
+        const pd_sim_result *r = in->engines->sim[k];
+        if (!r || r->n == 0)
+            continue;
+        vbuf_printf(b, "%s%s (%ld drops, %ld unsettled)", ran ? ", " : "", viz_engine_label(k),
+                    r->n, r->unsettled);
+        ran++;
+    }
+    vbuf_put(b, ". They model the same physics with different contacts, so their spread is the "
+                "model's uncertainty, beside the sampling interval of each.</p>\n<p>");
+    if (ran < 2) {
+        vbuf_put(b, "Only one engine ran (the run was interrupted): nothing to compare.");
+    } else if (!apart) {
+        vbuf_printf(b, "<strong>The engines agree within their sampling intervals</strong>: "
+                    "their 95%% intervals overlap on every %s. The widest range across them is "
+                    "%.1f points, on %s %d.", what, 100.0 * (e[widest].x.hi - e[widest].x.lo),
+                    what, e[widest].number);
+    } else {
+        vbuf_printf(b, "<strong>The engines disagree beyond their sampling intervals</strong> "
+                    "on %d of %d %s%s (marked ! in the table and the chart): ", apart, n, what,
+                    n == 1 ? "" : in->class_of ? "es" : "s");
+        int shown = 0;
+        for (int i = 0; i < n; i++) {
+            if (!e[i].x.apart)
+                continue;
+            vbuf_printf(b, "%s%s %d from %.1f%% to %.1f%%", shown++ ? "; " : "", what,
+                        e[i].number, 100.0 * e[i].x.lo, 100.0 * e[i].x.hi);
+        }
+        vbuf_put(b, ". There the contact model, not the number of drops, limits the estimate: "
+                    "more drops will not narrow it; take the range across the engines as "
+                    "what is known (docs/engines.md).");
+    }
+    vbuf_put(b, "</p></section>\n");
+}
+
 static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
-                        const pd_sim_result *sim, const pd_scene *scene)
+                        const pd_sim_result *sim, const pd_scene *scene, int crosscheck)
 {
     char v[1024], contact[192];
     vbuf_put(b, "<section id=\"run\"><h2>Scene, engine and timings</h2>\n<table>\n");
@@ -208,7 +272,12 @@ static void run_section(vbuf *b, const viz_run *run, const pd_part *part,
             snprintf(v, sizeof v, "%s; seed %llu", engines[so->engine], (unsigned long long)so->seed);
         else
             snprintf(v, sizeof v, "%s, time step %s; seed %llu", engines[so->engine],
-                     so->dt > 0 ? "as given" : "the engine's default", (unsigned long long)so->seed);
+                     so->dt > 0 ? "as given" : "automatic, from the scene",
+                     (unsigned long long)so->seed);
+        if (crosscheck)
+            snprintf(v + strlen(v), sizeof v - strlen(v), "; the same releases on every engine "
+                     "(--crosscheck), ODE and Bullet at %s", so->dt > 0 ? "the step given"
+                                                                   : "their automatic steps");
         row(b, "engine", v);
         snprintf(v, sizeof v, "%ld drops, %ld unsettled (in no count)%s", sim->n, sim->unsettled,
                  sim->partial ? "; interrupted: partial" : "");
@@ -295,9 +364,11 @@ pd_status viz_report(const viz_input *in, const viz_run *run, vbuf *b, pd_diag *
         st = viz_sensitivity(in, 0, b, diag);
         vbuf_put(b, "</figure></section>\n");
     }
+    if (st == PD_OK && in->sim && e[0].has_xc)
+        crosscheck_section(b, in, e, n);
     if (st == PD_OK) {
         table_section(b, in, e, n);
-        run_section(b, run, in->part, in->sim, in->scene);
+        run_section(b, run, in->part, in->sim, in->scene, in->engines != NULL);
         vbuf_put(b, "</body></html>\n");
     }
     free(e);

@@ -16,6 +16,8 @@ typedef struct viz_entry {
     double p, lo, hi;  /* dynamic estimate and its 95% interval */
     int has_meas, meas_ci;
     double mp, mlo, mhi;
+    int has_xc;        /* --crosscheck: the engines' spread below */
+    viz_spread x;
 } viz_entry;
 
 /* The entries of in (caller frees *out). PD_ERR_USAGE when the measured

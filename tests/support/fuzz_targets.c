@@ -1,10 +1,14 @@
 /* fuzz_targets.c: the fuzz targets' bodies (see fuzz_targets.h). */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 #include "fuzz_targets.h"
+#include "cli/shard_read.h"
 #include "posedrop/posedrop.h"
 #include "sim/scene.h"
+#include "viz/viz.h"
 
 /* A reader's answer: on success a mesh whose indices are in range and whose
  * coordinates are finite; on failure no mesh and a message. */
@@ -690,4 +694,75 @@ int pd_fuzz_api(const uint8_t *data, size_t size)
         pd_sim_result_free(s.sim[k]);
     }
     return s.ok;
+}
+
+/* The readers of files take a path: each input is written to one file of
+ * the process's own, made on first use. NULL if it cannot be written. */
+static char fuzz_path[64];
+
+static void remove_fuzz_file(void)
+{
+    unlink(fuzz_path);
+}
+
+static const char *as_file(const uint8_t *data, size_t size)
+{
+    const char *path = fuzz_path;
+    if (!fuzz_path[0]) {
+        snprintf(fuzz_path, sizeof fuzz_path, "/tmp/posedrop-fuzz-%ld", (long)getpid());
+        atexit(remove_fuzz_file);
+    }
+    FILE *f = fopen(path, "wb");
+    if (!f)
+        return NULL;
+    int ok = fwrite(data, 1, size, f) == size;
+    ok &= fclose(f) == 0;
+    return ok ? path : NULL;
+}
+
+/* A measured table: probabilities in [0, 1] summing to 1, a count of
+ * drops that is no overflow; or a refusal with a message. */
+int pd_fuzz_measured(const uint8_t *data, size_t size)
+{
+    const char *path = as_file(data, size);
+    if (!path)
+        return 1; /* nothing to read: no answer to judge */
+    viz_measured *m = NULL;
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_status st = viz_measured_read(path, &m, &d);
+    if (st != PD_OK)
+        return m == NULL && st < PD_STATUS_COUNT && d.message[0] != '\0';
+    int ok = m && m->npose >= 1 && m->n >= 0;
+    double sum = 0.0;
+    for (int i = 0; ok && i < m->npose; i++) {
+        ok = m->p[i] >= 0.0 && m->p[i] <= 1.0;
+        sum += m->p[i];
+        if (ok && m->lo)
+            ok = m->lo[i] >= 0.0 && m->lo[i] <= m->hi[i] && m->hi[i] <= 1.0;
+    }
+    /* The file's p column may be off 1 by its stated tolerance. */
+    ok = ok && fabs(sum - 1.0) < 0.01;
+    viz_measured_free(m);
+    return ok;
+}
+
+/* posedrop merge's reader of one shard: pose rows with counts that are no
+ * overflow, as many as the header's run has poses; or a refusal. */
+const char *prog = "fuzz";
+int pd_fuzz_shard(const uint8_t *data, size_t size)
+{
+    const char *path = as_file(data, size);
+    if (!path)
+        return 1;
+    shard_file s;
+    int ok = 1;
+    if (shard_read(path, &s)) {
+        ok = s.nposes >= 1 && s.k >= 1 && s.k <= s.n && s.identity && s.version && !s.partial &&
+             s.drops >= 0 && s.unsettled >= 0;
+        for (int i = 0; ok && i < s.nposes; i++)
+            ok = s.count[i] >= 0;
+    }
+    shard_file_clear(&s);
+    return ok;
 }

@@ -17,5 +17,10 @@ int pd_fuzz_scene(const uint8_t *data, size_t size);
 int pd_fuzz_part(const uint8_t *data, size_t size);
 /* A program of library calls (see fuzz_targets.c). */
 int pd_fuzz_api(const uint8_t *data, size_t size);
+/* The readers of two files the command takes, fed through a file: posedrop
+ * fit's measured counts (viz_measured_read, also --measured) and posedrop
+ * merge's shards (shard_read). */
+int pd_fuzz_measured(const uint8_t *data, size_t size);
+int pd_fuzz_shard(const uint8_t *data, size_t size);
 
 #endif

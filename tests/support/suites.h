@@ -32,6 +32,7 @@
     PD_SUITE(sensitivity) \
     PD_SUITE(markov) \
     PD_SUITE(fit)    \
+    PD_SUITE(design) \
     PD_SUITE(drop_step) \
     PD_SUITE(engine_ode) \
     PD_SUITE(engine_bullet) \

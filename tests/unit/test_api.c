@@ -327,6 +327,14 @@ static void test_shard_of_another_run(void)
         CHECK_STATUS(pd_sim_result_add(sum, mine, NULL), PD_OK);
         CHECK_STATUS(pd_sim_result_add(sum, threads, NULL), PD_OK);
         CHECK_INT(sum->n, o.ndrops);
+        /* Each shard once, all of one split, never the sum into itself:
+         * each would count drops twice, silently. */
+        REFUSED(pd_sim_result_add(sum, mine, &d), d, "added already");
+        REFUSED(pd_sim_result_add(sum, sum, &d), d, "itself");
+        pd_sim_result thirds = *mine;
+        thirds.nshards = 3;
+        REFUSED(pd_sim_result_add(sum, &thirds, &d), d, "another split");
+        CHECK_INT(sum->n, o.ndrops);
         /* A hand-made shard without its counts. */
         pd_sim_result bare = *mine;
         bare.count = NULL;
@@ -351,6 +359,27 @@ done:
     pd_static_result_free(rb);
     pd_part_free(a);
     pd_part_free(b);
+}
+
+/* Enum values outside their enum: pd_scene_format read range[-1] for -1
+ * (gravity's marker of a key without a range matched it) and
+ * pd_scene_param_name(-1) said "gravity". An unknown unit's scale is the
+ * documented 0, no length. */
+static void test_enums_outside(void)
+{
+    pd_scene sc;
+    pd_scene_default(&sc);
+    char buf[64] = "untouched";
+    static const int bad[] = {-1, PD_NPARAMS, 1000};
+    for (int i = 0; i < 3; i++) {
+        CHECK(pd_scene_format(&sc, (pd_scene_param)bad[i], buf, sizeof buf) == buf);
+        CHECK(buf[0] == '\0');
+        CHECK(pd_scene_param_name((pd_scene_param)bad[i]) == NULL);
+    }
+    CHECK(strcmp(pd_scene_param_name(PD_PARAM_MU), "mu") == 0);
+    CHECK(pd_units_scale((pd_units)99) == 0.0);
+    CHECK(pd_units_scale((pd_units)-1) == 0.0);
+    CHECK(pd_contact_time_auto_part(NULL) == 0.0);
 }
 
 /* Values a program can put in a struct that no reader or command would:
@@ -506,6 +535,7 @@ void suite_api(void)
 {
     test_result_of_another_part();
     test_shard_of_another_run();
+    test_enums_outside();
     test_version();
     fixture f;
     if (!setup(&f))

@@ -52,7 +52,7 @@ static void test_merge_equals_run(void)
     }
     /* Grouping happens at the merge, from the shards' per-pose counts. */
     check_shards_merge("grp", "-n 140 --initial stationary --group " BOX, 3);
-    check_shards_merge("eng", "-n 40 --engine ode --mu 0.5 --units mm parts/block.stl", 3);
+    check_shards_merge("eng", "-n 40 --engine ode --dt 0.001 --mu 0.5 --units mm parts/block.stl", 3);
 }
 
 /* The side files: merge --transitions writes the unsharded run's chain; the
@@ -384,7 +384,7 @@ static void test_mpi(void)
     static const char *const runs[] = {
         "-n 200 --seed 4 parts/cap.off",
         "-n 140 --initial stationary --group " BOX,
-        "-n 30 --engine ode --units mm parts/block.stl",
+        "-n 30 --engine ode --dt 0.001 --units mm parts/block.stl",
     };
     for (int i = 0; i < 3; i++) {
         char cmd[512], *one, *two, *err;
@@ -406,6 +406,30 @@ static void test_mpi(void)
     CHECK(out[0] == '\0' && strstr(err, "--ci") != NULL);
     free(out);
     free(err);
+    /* The command's rules over ranks: an output on a named pipe that no
+     * program reads is refused at once (each rank waited in open(2)). A
+     * stdout that fails is mpirun's to see, not the ranks' (it forwards
+     * their output), so that rule is checked on posedrop alone. */
+    static const struct {
+        const char *script;
+        int code;
+        const char *mention;
+    } rules[] = {
+        {"mkfifo f; timeout -s KILL 60 $M $B -n 5 --chart f $P", 2,
+         "f: cannot write: a named pipe that no program is reading"},
+    };
+    for (size_t k = 0; k < sizeof rules / sizeof *rules; k++) {
+        char cmd[1024];
+        snprintf(cmd, sizeof cmd, "(R=$PWD; M='" MPIRUN_2 "'; B=$R/" PD_CLI_MPI_PATH "; "
+                 "P=$R/parts/cap.off; D=%s/mpirule%zu; mkdir -p $D && cd $D && %s)", tmpdir, k,
+                 rules[k].script);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), rules[k].code);
+        if (!strstr(err, rules[k].mention))
+            printf("     posedrop-mpi case %zu should say '%s':\n%s", k, rules[k].mention, err);
+        CHECK(strstr(err, rules[k].mention) != NULL);
+        free(out);
+        free(err);
+    }
 }
 
 /* The part's SHA-256 (shards, JSON) against coreutils' sha256sum, for files
@@ -480,6 +504,50 @@ static void test_batch_short_forms(void)
     free(berr);
 }
 
+/* A batch that fails or is stopped keeps every earlier result: a part's
+ * DIR/<name>.csv until its new one is complete, all.csv until every part has
+ * one, with the parts that failed or did not run named on stderr; nothing
+ * temporary stays. SIGINT and SIGTERM reach the runs under way (10^6 drops
+ * of the cap take minutes, so the signal always comes first). */
+static void test_batch_keeps_results(void)
+{
+    char cmd[1024], *out, *err;
+    snprintf(cmd, sizeof cmd, "(set -e; D=%s/keep; scripts/posedrop-batch -o $D/out -n 20 -- "
+             "parts/cap.off parts/canonical/cube.off 2>/dev/null; cp -r $D/out $D/first)", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    free(out);
+    free(err);
+    static const struct {
+        const char *run;
+        int code;
+        const char *mention;
+    } cases[] = {
+        {"scripts/posedrop-batch -o $D/out -n 20 --com 5,5,5 -- parts/cap.off "
+         "parts/canonical/cube.off", 1, "parts/cap.off (failed), parts/canonical/cube.off (failed)"},
+        {"timeout --preserve-status -s INT 2 scripts/posedrop-batch -j1 -o $D/out -n 1000000 -- "
+         "parts/cap.off parts/canonical/cube.off", 130, "parts/canonical/cube.off (not run)"},
+        {"timeout --preserve-status -s TERM 2 scripts/posedrop-batch -j2 -o $D/out -n 1000000 -- "
+         "parts/cap.off parts/canonical/cube.off", 143, "(interrupted)"},
+    };
+    for (size_t k = 0; k < sizeof cases / sizeof *cases; k++) {
+        snprintf(cmd, sizeof cmd, "(D=%s/keep; %s)", tmpdir, cases[k].run);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), cases[k].code);
+        if (!strstr(err, cases[k].mention))
+            printf("     '%s' should say '%s':\n%s", cases[k].run, cases[k].mention, err);
+        CHECK(strstr(err, cases[k].mention) != NULL);
+        CHECK(strstr(err, "all.csv is left as it was") != NULL);
+        free(out);
+        free(err);
+        /* The first run's files, byte for byte; besides them only .err files. */
+        snprintf(cmd, sizeof cmd, "(set -e; D=%s/keep; for f in all cap cube; do cmp $D/first/$f.csv "
+                 "$D/out/$f.csv; done; test -z \"$(ls $D/out | grep -v -e '\\.csv$' -e '\\.err$')\")",
+                 tmpdir);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        free(out);
+        free(err);
+    }
+}
+
 /* Every script under scripts/ refuses a bad argument with one line on stderr
  * that names the script and what was wrong, exit status 2, nothing on
  * stdout, and nothing left in the directory it ran in (the issue's case:
@@ -494,6 +562,7 @@ static void test_script_refusals(void)
          "posedrop-batch: '-n' after --: options for posedrop go before --"},
         {"posedrop-batch -j x -- $R/parts/cap.off", "posedrop-batch: -j: expected a whole number"},
         {"posedrop-batch -o", "posedrop-batch: -o needs a value"},
+        {"posedrop-batch -j -1 -- $R/parts/cap.off", "posedrop-batch: -j: expected a whole number"},
         {"posedrop-batch -o results -- a.stl", "posedrop-batch: a.stl: no such readable file"},
         {"posedrop-batch -o results -- $R/parts/cap.off $R/parts/cap.off", "two parts named 'cap'"},
         /* posedrop's options in the forms it takes (a prefix, '=', a letter
@@ -580,6 +649,7 @@ void suite_batch(void)
     test_mpi();
     test_script_refusals();
     test_batch_short_forms();
+    test_batch_keeps_results();
     char cmd[128];
     snprintf(cmd, sizeof cmd, "rm -rf %s", tmpdir);
     if (system(cmd) != 0)

@@ -7,8 +7,12 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "drops_scale.h"
+#include <stddef.h>
 #include "base/gsl_adapter.h"
+#include "engines/engine_contact.h"
+#include "sim/sim_model.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
 #include "suites.h"
@@ -39,6 +43,7 @@ static pd_sim_options drop_options(pd_engine_kind engine, long drops)
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.ndrops = drops;
     return o;
 }
@@ -274,13 +279,137 @@ static void pyramids_settle(long drops)
     CHECK(unsettled <= total / 200);
 }
 
+/* The automatic step (dt 0) of a 1 cm cube, its contact time T = 5e-4 s by
+ * the Hertz estimate's reference: T / PD_ENGINE_AUTO_STEPS; with rigid
+ * contacts a tenth of its thickness (1 cm) over its fastest fall, from the
+ * drop height plus its size (the model's), sqrt(2 g (h + L)); both to
+ * round-off (1e-12 relative: a few operations). */
+static void auto_step_closed_form(void)
+{
+    pd_part *part;
+    pd_static_result *poses;
+    int ok = solid_part(pts_cube, &part, &poses);
+    for (int rigid = 0; ok && rigid < 2; rigid++) {
+        pd_scene sc;
+        pd_scene_default(&sc);
+        if (rigid)
+            sc.contact_time = 0.0;
+        pd_sim_options o = drop_options(PD_ENGINE_ODE, 1);
+        o.dt = 0.0;
+        pd_sim_model *m = NULL;
+        CHECK_STATUS(pd_sim_model_build(part, poses, &sc, &o, &m, NULL), PD_OK);
+        if (!m)
+            continue;
+        double want = rigid ? PD_ENGINE_AUTO_TRAVEL_REL * 0.01 /
+                                  sqrt(2.0 * sc.gravity * (sc.height + m->body->size))
+                            : pd_contact_time_auto(pd_contact_time_auto_size(part)) /
+                                  PD_ENGINE_AUTO_STEPS;
+        CHECK_NEAR(m->dt, want, 1e-12 * want, "closed form, round-off");
+        if (!rigid)
+            CHECK_NEAR(want, 5e-4 / PD_ENGINE_AUTO_STEPS, 1e-12 * want,
+                       "the Hertz estimate's reference cube, round-off");
+        pd_sim_model_free(m);
+    }
+    release(NULL, poses, part);
+}
+
+/* At the automatic step on both stepping engines: every drop of a cube
+ * ends settled, none fails, and the records are the same bytes on one
+ * thread and on two. */
+static void auto_step_drops(pd_engine_kind engine)
+{
+    pd_part *part;
+    pd_static_result *poses;
+    int ok = solid_part(pts_cube, &part, &poses);
+    pd_sim_options o = drop_options(engine, 6);
+    o.dt = 0.0;
+    o.keep_trials = 1;
+    o.threads = 1;
+    pd_sim_result *a = run_drops(ok, part, poses, &o);
+    o.threads = 2;
+    pd_sim_result *b = run_drops(ok, part, poses, &o);
+    if (a && b) {
+        CHECK_INT(a->unsettled, 0);
+        CHECK_INT((int)a->n, 6);
+        CHECK(memcmp(a->trials, b->trials, sizeof *a->trials * (size_t)a->n) == 0);
+    }
+    pd_sim_result_free(b);
+    release(a, poses, part);
+}
+
+/* --trace's rows: collected in order. */
+typedef struct {
+    int n, cap;
+    pd_trace_row rows[4096];
+    int ends, releases, backwards;
+    double last_t;
+} trace_log;
+
+static void trace_collect(void *user, const pd_trace_row *r)
+{
+    trace_log *l = user;
+    if (l->n > 0 && r->t < l->last_t)
+        l->backwards++;
+    l->last_t = r->t;
+    l->ends += strcmp(r->event, "end") == 0;
+    l->releases += strcmp(r->event, "release") == 0;
+    if (l->n < (int)(sizeof l->rows / sizeof l->rows[0]))
+        l->rows[l->n] = *r;
+    l->n++;
+}
+
+/* One traced drop on each engine: one release, first, at t = 0 and the
+ * same state on every engine (the same release, exactly); time never runs
+ * back; a settled drop's last row is its end, at the drop's time; and
+ * tracing changes no record (the same bytes as untraced). */
+static void trace_drop(void)
+{
+    pd_part *part;
+    pd_static_result *poses;
+    int ok = solid_part(pts_cube, &part, &poses);
+    const pd_engine_kind engines[3] = {PD_ENGINE_IMPULSE, PD_ENGINE_ODE, PD_ENGINE_BULLET};
+    static trace_log logs[3];
+    for (int e = 0; ok && e < 3; e++) {
+        pd_sim_options o = drop_options(engines[e], 3);
+        o.keep_trials = 1;
+        pd_sim_result *plain = run_drops(ok, part, poses, &o);
+        memset(&logs[e], 0, sizeof logs[e]);
+        o.trace = trace_collect;
+        o.trace_user = &logs[e];
+        o.trace_drop = 2;
+        pd_sim_result *traced = run_drops(ok, part, poses, &o);
+        trace_log *l = &logs[e];
+        if (plain && traced) {
+            CHECK(memcmp(plain->trials, traced->trials, sizeof *plain->trials * 3) == 0);
+            CHECK(l->n >= 2);
+            CHECK_INT(l->releases, 1);
+            CHECK(strcmp(l->rows[0].event, "release") == 0 && l->rows[0].t == 0.0);
+            CHECK_INT(l->backwards, 0);
+            const pd_trial *t = &traced->trials[2];
+            CHECK_INT(l->ends, t->end == PD_END_SETTLED);
+            if (t->end == PD_END_SETTLED && l->n <= (int)(sizeof l->rows / sizeof l->rows[0]))
+                CHECK(strcmp(l->rows[l->n - 1].event, "end") == 0 &&
+                      l->rows[l->n - 1].t == t->time);
+            if (e > 0)
+                CHECK(memcmp(&l->rows[0], &logs[0].rows[0], offsetof(pd_trace_row, contacts)) == 0 &&
+                      l->rows[0].contacts == logs[0].rows[0].contacts);
+        }
+        pd_sim_result_free(traced);
+        pd_sim_result_free(plain);
+    }
+    release(NULL, poses, part);
+}
+
 void suite_drop_step(void)
 {
     const pd_engine_kind engines[] = {PD_ENGINE_ODE, PD_ENGINE_BULLET};
     /* As a program linked with libposedrop-bullet does (test_api checks the
      * status without it). */
     CHECK_STATUS(pd_bullet_register(), PD_OK);
+    auto_step_closed_form();
+    trace_drop();
     for (int e = 0; e < 2; e++) {
+        auto_step_drops(engines[e]);
         run_solid(engines[e], pts_cube, 300);
         run_solid(engines[e], pts_octahedron, 300);
         cube_uniform(engines[e]);

@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "posedrop/bullet.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
@@ -32,6 +33,7 @@ static void run_extreme(const char *part_name, const pd_part *part, const pd_sta
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.ndrops = EXTREME_DROPS;
     o.threads = 2;
     o.time_limit = EXTREME_TIME;

@@ -63,7 +63,8 @@ void suite_fuzz_replay(void)
         int parts; /* the shipped parts are seeds too */
     } targets[] = {{"off", pd_fuzz_off, 1},   {"stl", pd_fuzz_stl, 1},
                    {"obj", pd_fuzz_obj, 1},   {"scene", pd_fuzz_scene, 0},
-                   {"part", pd_fuzz_part, 1}, {"api", pd_fuzz_api, 0}};
+                   {"part", pd_fuzz_part, 1}, {"api", pd_fuzz_api, 0},
+                   {"measured", pd_fuzz_measured, 0}, {"shard", pd_fuzz_shard, 0}};
     for (size_t i = 0; i < sizeof targets / sizeof targets[0]; i++) {
         char dir[128];
         int n = 0;

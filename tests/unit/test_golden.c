@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "posedrop/posedrop.h"
 #include "suites.h"
 
@@ -183,6 +184,7 @@ static void run_case(golden_table *t, int writing, const char *part_name, const 
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.ndrops = ndrops;
     o.seed = 2026;
     o.threads = 2; /* any count gives the same bytes (test_sim); two exercises the split */

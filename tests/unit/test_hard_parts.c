@@ -22,6 +22,7 @@
 #include <string.h>
 #include <time.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
 #include "sim/drop.h"
@@ -195,6 +196,7 @@ static int run_case(const hard_case *c, const pd_part *part, const pd_static_res
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     pd_sim_model *model = NULL;
     pd_diag_init(why);
     pd_status built = pd_sim_model_build(part, poses, &sc, &o, &model, why);

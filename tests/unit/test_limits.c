@@ -6,6 +6,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "posedrop/posedrop.h"
 #include "shapes.h"
 #include "suites.h"
@@ -463,6 +464,7 @@ static void test_knife_warned_once(void)
         pd_sim_options o;
         pd_sim_options_default(&o);
         o.engine = e ? PD_ENGINE_ODE : PD_ENGINE_IMPULSE;
+        o.dt = test_engine_dt(o.engine);
         o.ndrops = 2;
         o.threads = 2;
         pd_sim_result *sr = NULL;

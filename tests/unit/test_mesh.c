@@ -159,6 +159,12 @@ static void test_off_bad(void)
                "neg.off:7:");
     expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n2 0 1\n", "two.off", PD_ERR_PARSE,
                "two.off:7: face with 2 vertices");
+    /* Faces too short for a triangle are said to be so, not taken for a
+     * file cut short ("truncated file?"). */
+    expect_bad("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 0\n1 1\n1 2\n1 3\n", "one.off",
+               PD_ERR_PARSE, "one.off:7: face with 1 vertices (at least 3 needed)");
+    expect_bad("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n2 0 1\n2 1 2\n2 2 3\n2 3 0\n", "two4.off",
+               PD_ERR_PARSE, "two4.off:7: face with 2 vertices");
     expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n4 0 1 2\n", "few.off", PD_ERR_PARSE,
                "few.off:7: expected 4 vertex indices, found 3");
     expect_bad("OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 1 z\n", "tok.off", PD_ERR_PARSE,
@@ -228,6 +234,10 @@ static void test_stl_ascii(void)
         CHECK_NEAR(m->verts[1].y, 1.0, 0.0, exact);
         pd_mesh_free(m);
     }
+    /* A non-finite coordinate named as what was expected there. */
+    expect_bad("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 nan\n"
+               "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n", "nan.stl", PD_ERR_NONFINITE,
+               "nan.stl:5: expected a z coordinate (a finite number), found 'nan'");
     /* Near-duplicates are for pd_mesh_weld, not the reader. */
     m = parse_ok("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
                  "endloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 0 0 1e-12\n"

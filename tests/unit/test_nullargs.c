@@ -463,7 +463,7 @@ DEFAULTS(fit_options_default, pd_fit_options)
 static pd_status cube_fit(const fixture *f, int k, pd_fit_result **r, pd_diag *diag)
 {
     static const long count[1] = {10};
-    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count};
+    pd_fit_part part = {f->part, f->res, f->class_of, f->nclasses, count, NULL, 0};
     pd_fit_param param = {"restitution", 0.1, 0.5, 0, 0};
     pd_fit_options fo;
     pd_fit_options_default(&fo);
@@ -505,6 +505,15 @@ static void c_fit_loglik(const fixture *f, int k, outcome *o)
     const double p[2] = {0.5, 0.5};
     const long c[2] = {1, 1};
     double l = pd_fit_loglik(2, P(0, c), P(1, p), 10, 0.5);
+    o->st = (k < 0 ? l < 0 : l == 0) ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_fit_loglik_dm(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    const double p[2] = {0.5, 0.5};
+    const long c[2] = {1, 1};
+    double l = pd_fit_loglik_dm(2, P(0, c), P(1, p), 10, 0.5);
     o->st = (k < 0 ? l < 0 : l == 0) ? PD_OK : PD_ERR_INTERNAL;
 }
 
@@ -558,6 +567,70 @@ static void c_sensitivity_free(const fixture *f, int k, outcome *o)
     pd_sim_result_free(r);
 }
 
+static const pd_change cube_change = {PD_CHANGE_SCALE, 2, 0, 0.0, 0.0, 0.5, 2.0};
+
+static void c_design_axes(const fixture *f, int k, outcome *o)
+{
+    pd_vec3 axes[3] = {{-7, -7, -7}, {-7, -7, -7}, {-7, -7, -7}};
+    o->st = pd_design_axes(P(0, f->part), P(1, axes), P(2, &o->diag));
+    o->touched = o->st != PD_OK && axes[0].x != -7;
+}
+
+static void c_design_apply(const fixture *f, int k, outcome *o)
+{
+    double v = 1.5;
+    pd_part *p = SENTINEL;
+    o->st = pd_design_apply(P(0, f->part), P(1, &cube_change), 1, P(2, &v), P(3, &p),
+                            P(4, &o->diag));
+    settle_output(o, p, pd_part_free);
+}
+
+static void c_design_sensitivity(const fixture *f, int k, outcome *o)
+{
+    pd_sim_options so;
+    few_drops(&so);
+    pd_design_sens *s = SENTINEL;
+    o->st = pd_design_sensitivity(P(0, f->part), P(1, f->res), P(2, (const pd_static_options *)NULL),
+                                  P(3, &cube_change), 1, P(4, f->class_of), f->nclasses,
+                                  P(5, (const pd_scene *)NULL), P(6, &so), P(7, &s), P(8, &o->diag));
+    settle_output(o, s, pd_design_sens_free);
+}
+
+static void c_design_sens_free(const fixture *f, int k, outcome *o)
+{
+    pd_design_sens *s = NULL;
+    o->st = pd_design_sensitivity(f->part, f->res, NULL, &cube_change, 1, NULL, 0, NULL, NULL, &s,
+                                  NULL);
+    free_unless_null(k, s, pd_design_sens_free);
+}
+
+DEFAULTS(design_options_default, pd_design_options)
+
+static pd_status cube_design(const fixture *f, int k, pd_design_result **r, pd_diag *diag)
+{
+    pd_design_options o;
+    pd_design_options_default(&o);
+    o.sim.ndrops = 0;
+    o.check_drops = 0;
+    pd_design_target t = {{0, 0, 1}, 0.3};
+    return pd_design_run(P(0, f->part), P(1, &cube_change), 1, PD_GOAL_TARGET, P(2, &t), 1,
+                         P(3, &o), P(4, r), P(5, diag));
+}
+
+static void c_design_run(const fixture *f, int k, outcome *o)
+{
+    pd_design_result *r = SENTINEL;
+    o->st = cube_design(f, k, &r, &o->diag);
+    settle_output(o, r, pd_design_result_free);
+}
+
+static void c_design_result_free(const fixture *f, int k, outcome *o)
+{
+    pd_design_result *r = NULL;
+    o->st = cube_design(f, -1, &r, NULL);
+    free_unless_null(k, r, pd_design_result_free);
+}
+
 static void c_scene_param_name(const fixture *f, int k, outcome *o)
 {
     (void)f, (void)k;
@@ -583,6 +656,14 @@ static void c_scene_ranged(const fixture *f, int k, outcome *o)
     pd_scene sc;
     pd_scene_default(&sc);
     o->st = pd_scene_ranged(P(0, &sc)) == 0 ? PD_OK : PD_ERR_INTERNAL;
+}
+
+static void c_scene_varies(const fixture *f, int k, outcome *o)
+{
+    (void)f;
+    pd_scene sc;
+    pd_scene_default(&sc);
+    o->st = pd_scene_varies(P(0, &sc), PD_PARAM_MU) == 0 ? PD_OK : PD_ERR_INTERNAL;
 }
 
 static void c_scene_draw(const fixture *f, int k, outcome *o)
@@ -691,12 +772,22 @@ static const entry table[] = {
     {"pd_fit_result_free", "?result", c_fit_result_free},
     {"pd_fit_smooth", "?p_sim ?out", c_fit_smooth},
     {"pd_fit_loglik", "?count ?p_sim", c_fit_loglik},
+    {"pd_fit_loglik_dm", "?count ?p_sim", c_fit_loglik_dm},
     {"pd_first_order_index", "x y index lo hi ?diag", c_first_order_index},
     {"pd_sim_sensitivity", "result scene ?class_of out ?diag", c_sim_sensitivity},
     {"pd_sensitivity_free", "?sensitivity", c_sensitivity_free},
+    {"pd_design_axes", "part axes ?diag", c_design_axes},
+    {"pd_design_apply", "part changes value changed ?diag", c_design_apply},
+    {"pd_design_sensitivity", "part res ?options changes ?class_of ?scene ?sim out ?diag",
+     c_design_sensitivity},
+    {"pd_design_sens_free", "?sensitivity", c_design_sens_free},
+    {"pd_design_options_default", "?options", c_design_options_default},
+    {"pd_design_run", "part changes targets options result ?diag", c_design_run},
+    {"pd_design_result_free", "?result", c_design_result_free},
     {"pd_scene_param_name", "", c_scene_param_name},
     {"pd_scene_format", "?scene ?buf", c_scene_format},
     {"pd_scene_ranged", "?scene", c_scene_ranged},
+    {"pd_scene_varies", "?scene", c_scene_varies},
     {"pd_scene_draw", "?scene ?values ?drawn", c_scene_draw},
     {"pd_scene_quantile", "?scene", c_scene_quantile},
     {"pd_drop_stage_name", "", c_drop_stage_name},

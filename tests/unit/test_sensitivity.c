@@ -93,26 +93,43 @@ static void test_given_data(void)
 static pd_pose two_pose_table[2];
 static const pd_static_result two_poses = {.nposes = 2, .poses = two_pose_table};
 
+/* A two-pose run of n settled drops made by hand, its scene sc with mu
+ * 0.2:0.8, restitution `e` and contact time 0.3x:3x ranged: each record
+ * holds its drop's drawn values; the caller sets the poses. NULL on
+ * failure. */
+static pd_sim_result *made_run(pd_scene *sc, const char *e, long n)
+{
+    pd_scene_default(sc);
+    CHECK_STATUS(pd_scene_set(sc, "mu", "0.2:0.8", NULL), PD_OK);
+    CHECK_STATUS(pd_scene_set(sc, "restitution", e, NULL), PD_OK);
+    CHECK_STATUS(pd_scene_set(sc, "contact_time", "0.3x:3x", NULL), PD_OK);
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.ndrops = n;
+    pd_sim_result *r = NULL;
+    CHECK_STATUS(pd_sim_result_new(&two_poses, sc, &o, &r, NULL), PD_OK);
+    if (!r)
+        return NULL;
+    r->trials = calloc((size_t)n, sizeof *r->trials);
+    r->n = r->trials ? n : 0;
+    for (long t = 0; t < r->n; t++) {
+        pd_scene_draw(sc, 0.01, o.seed, t, r->trials[t].param, NULL);
+        r->trials[t].end = PD_END_SETTLED;
+    }
+    return r;
+}
+
 static void test_records(void)
 {
     pd_scene sc;
-    pd_scene_default(&sc);
-    CHECK_STATUS(pd_scene_set(&sc, "mu", "0.2:0.8", NULL), PD_OK);
-    CHECK_STATUS(pd_scene_set(&sc, "restitution", "0.1:0.5", NULL), PD_OK);
-    CHECK_STATUS(pd_scene_set(&sc, "contact_time", "0.3x:3x", NULL), PD_OK);
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.ndrops = 3000;
-    pd_sim_result *r = NULL;
-    CHECK_STATUS(pd_sim_result_new(&two_poses, &sc, &o, &r, NULL), PD_OK);
+    pd_sim_result *r = made_run(&sc, "0.1:0.5", o.ndrops);
     if (!r)
         return;
-    r->trials = calloc((size_t)o.ndrops, sizeof *r->trials);
-    r->n = r->trials ? o.ndrops : 0;
     for (long t = 0; t < r->n; t++) {
         pd_trial *tr = &r->trials[t];
-        pd_scene_draw(&sc, 0.01, o.seed, t, tr->param, NULL);
-        tr->end = PD_END_SETTLED;
         tr->pose = tr->param[PD_PARAM_MU] > 0.5 ? 0 : 1;
     }
     pd_sensitivity *s = NULL;
@@ -161,6 +178,65 @@ static void test_records(void)
     }
     CHECK_STATUS(pd_sim_sensitivity(r, &sc, 0.01, NULL, 0, &s, NULL), PD_OK);
     CHECK(s && s->n == 1000 && r->pose_drops == 1000 && s->rows[0].index > 0.95);
+    pd_sensitivity_free(s);
+    free(r->trials);
+    r->trials = NULL;
+    pd_sim_result_free(r);
+}
+
+/* Effects and an interaction made to order: a drop ends in pose 1 with
+ * probability 0.3, or 0.7 when both the friction and the restitution fall
+ * in the upper thirds of their ranges. Each of the two then moves pose 1
+ * by 0.4 / 3 across its range (0.3 in the lower third, 0.3 + 0.4 / 3 in
+ * the upper), all of it in the other's upper third (effects 0, 0, 0.4 by
+ * the other's thirds); the contact time moves nothing. 6000 drops: about
+ * 2000 in a third, an effect's standard error about 0.015, a cell's
+ * (a ninth of the drops) about 0.037. */
+static void test_effects(void)
+{
+    pd_scene sc;
+    pd_sim_result *r = made_run(&sc, "0.1:0.7", 6000);
+    if (!r)
+        return;
+    pd_rng rng;
+    pd_rng_init(&rng, 5, 0);
+    for (long t = 0; t < r->n; t++) {
+        pd_trial *tr = &r->trials[t];
+        int both = tr->param[PD_PARAM_MU] > 0.6 && tr->param[PD_PARAM_RESTITUTION] > 0.5;
+        tr->pose = pd_rng_uniform(&rng) < (both ? 0.7 : 0.3) ? 0 : 1;
+    }
+    pd_sensitivity *s = NULL;
+    CHECK_STATUS(pd_sim_sensitivity(r, &sc, 0.01, NULL, 0, &s, NULL), PD_OK);
+    CHECK(s && s->nparams == 3 && s->interaction_tests == 2 * 3 * 2);
+    double widest = 0.0;
+    for (int k = 0; s && s->nparams == 3 && k < 2 * 3; k++) {
+        const pd_sensitivity_row *row = &s->rows[k];
+        int pose = k / 3, col = k % 3;
+        double sign = pose == 0 ? 1.0 : -1.0, truth = col < 2 ? sign * 0.4 / 3.0 : 0.0;
+        /* Within 4 standard errors of the truth (0.06). */
+        CHECK_NEAR(row->effect, truth, 0.06, "4 standard errors");
+        CHECK(row->effect == row->p_high - row->p_low);
+        /* The bootstrap's half-width against the binomial one, 1.96 times
+         * sqrt(p (1 - p) / n) of the two thirds summed: 200 resamples put
+         * its ends within some 10% (tolerance 20%). */
+        double se = sqrt(row->p_low * (1 - row->p_low) / (double)row->n_low +
+                         row->p_high * (1 - row->p_high) / (double)row->n_high);
+        CHECK_NEAR(0.5 * (row->effect_hi - row->effect_lo), 1.96 * se, 0.2 * 1.96 * se,
+                   "200 resamples' percentiles");
+        widest = fmax(widest, 0.5 * (row->effect_hi - row->effect_lo));
+        if (col < 2) {
+            /* 9 standard errors clear of 0: flagged, with the other as the
+             * partner, the change of about 0.4 within 4 of a cell's
+             * standard errors (0.05 each, two cells: 0.21). */
+            CHECK(sign * row->effect_lo > 0.0);
+            CHECK_INT(row->interacts, col == 0 ? PD_PARAM_RESTITUTION : PD_PARAM_MU);
+            CHECK_NEAR(row->effect_in[2] - row->effect_in[0], sign * 0.4, 0.21, "4 standard errors");
+            CHECK_NEAR(row->effect_in[0], 0.0, 0.15, "4 standard errors");
+            CHECK(row->interaction_lo <= row->interaction &&
+                  row->interaction <= row->interaction_hi);
+        }
+    }
+    CHECK(s && s->resolution == widest);
     pd_sensitivity_free(s);
     free(r->trials);
     r->trials = NULL;
@@ -227,8 +303,10 @@ static void test_command(void)
              "--report %s parts/canonical/coin_h0.5.off", csv, html);
     CHECK_INT(run(cmd, &out, &err), 0);
     char *c = slurp(csv), *r = slurp(html);
-    const char *head = "pose,parameter,n_low,p_low,p_low_lo,p_low_hi,n_high,p_high,p_high_lo,"
-                       "p_high_hi,index,index_lo,index_hi\n";
+    const char *head = "pose,parameter,effect,effect_lo,effect_hi,n_low,p_low,p_low_lo,p_low_hi,"
+                       "n_high,p_high,p_high_lo,p_high_hi,index,index_lo,index_hi,interacts,"
+                       "effect_in_low,effect_in_middle,effect_in_high,interaction,interaction_lo,"
+                       "interaction_hi,partial\n";
     CHECK(c && strncmp(c, head, strlen(head)) == 0);
     int rows = 0;
     for (char *p = c; p && *p; p++)
@@ -246,6 +324,36 @@ static void test_command(void)
     free(r);
     free(out);
     free(err);
+    /* --effect: drops until every effect's interval is within 0.08 on
+     * each side (from 200 drops, about 600 needed), the same bytes on one
+     * thread and two. */
+    char *once = NULL;
+    for (int threads = 1; threads <= 2; threads++) {
+        snprintf(cmd, sizeof cmd, "-n 200 -j %d --group --effect 0.08 --mu 0.05:0.8 "
+                 "--sensitivity %s parts/canonical/coin_h0.5.off", threads, csv);
+        CHECK_INT(run(cmd, &out, &err), 0);
+        c = slurp(csv);
+        int rows_ok = c != NULL, nrows = 0;
+        for (char *line = c ? strchr(c, '\n') : NULL; line && line[1];
+             line = strchr(line + 1, '\n')) {
+            double e, lo, hi;
+            rows_ok = rows_ok && sscanf(line + 1, "%*d,%*[^,],%lf,%lf,%lf", &e, &lo, &hi) == 3 &&
+                      lo <= e && e <= hi && hi - lo <= 2 * 0.08;
+            nrows++;
+        }
+        CHECK(rows_ok && nrows == 2);
+        CHECK(err && strstr(err, "resolve an effect to"));
+        if (threads == 1)
+            once = c;
+        else {
+            CHECK(once && c && strcmp(once, c) == 0);
+            free(c);
+        }
+        free(out);
+        free(err);
+    }
+    free(once);
+    expect_failure("-n 20 --effect 0.05 parts/cap.off", 2, "--effect needs a scene with a range");
     expect_failure("-n 20 --sensitivity /tmp/x.csv parts/cap.off", 2, "with a range");
     expect_failure("--mu 0.2:0.5 --sensitivity /tmp/x.csv parts/cap.off", 2, "needs drops");
     expect_failure("-n 20 --mu 0.2:0.5 --shard 1/2 --sensitivity /tmp/x.csv parts/cap.off", 2,
@@ -260,5 +368,6 @@ void suite_sensitivity(void)
     test_command();
     test_given_data();
     test_records();
+    test_effects();
     test_frictionless_belt();
 }

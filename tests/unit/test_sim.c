@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
+#include "engine_steps.h"
 #include "contact/compliant.h"
 #include "sim/drop.h"
 #include "base/gsl_adapter.h"
@@ -290,6 +291,7 @@ static int drop_model_build(drop_model *d, const part_fixture *f, const pd_scene
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     d->m = NULL;
     CHECK_STATUS(pd_sim_model_build(f->part, f->poses, sc, &o, &d->m, NULL), PD_OK);
     d->w = d->m ? pd_drop_work_alloc(d->m, sc) : NULL;
@@ -312,6 +314,7 @@ static pd_trial drop_one(const drop_model *d, const pd_scene *sc, pd_engine_kind
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.cancel = cancel;
     pd_trial t;
     long gain = 0, fallbacks = 0;
@@ -339,6 +342,7 @@ static void test_cancel_in_flight(pd_engine_kind engine)
     pd_sim_options o;
     pd_sim_options_default(&o);
     o.engine = engine;
+    o.dt = test_engine_dt(engine);
     o.ndrops = 200;
     o.keep_trials = 1;
     o.threads = 1;

@@ -392,7 +392,7 @@ static void test_placement(void)
         if (!parts[k])
             continue;
         CHECK_STATUS(pd_static_estimate(parts[k], NULL, &res, NULL), PD_OK);
-        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL};
+        viz_input in = {"box", parts[k], res, NULL, NULL, 0, NULL, NULL, NULL, NULL, NULL};
         CHECK_STATUS(viz_gallery(&in, 1, &b[k], NULL), PD_OK);
         CHECK_STATUS(viz_sphere(&in, 1, &b[k], NULL), PD_OK);
         pd_static_result_free(res);
@@ -494,6 +494,40 @@ static void test_measured(void)
     expect_measured_error("pose,count\n0,2\n", ":2: expected a pose number");
     expect_measured_error("pose,count\n1,2,3\n", ":2: expected 2 fields");
     expect_measured_error("pose,count\n", "no rows");
+    /* p of n drops that is no whole number of drops, to p's digits: 0.333
+     * of 10 is 3.33 drops (was rounded to 3 silently); 0.46 of 1036 is
+     * 476.56, within 1036 x 0.005 of 477, as the paper's rounded p are. */
+    expect_measured_error("pose,p,n\n1,0.333,10\n2,0.667,10\n", ":2: p 0.333 of n 10 drops is 3.33");
+    CHECK_STATUS(viz_measured_read(write_tmp("pn.csv", "pose,p,n\n1,0.46,1036\n2,0.54,1036\n"), &m,
+                                   NULL), PD_OK);
+    viz_measured_free(m);
+    m = NULL;
+    /* Counts whose sum passes 1e15 (10^4 rows of 1e15 overflowed n). */
+    char *many = malloc(10000 * 24 + 16);
+    if (many) {
+        int len = sprintf(many, "pose,count\n");
+        for (int i = 1; i <= 10000; i++)
+            len += sprintf(many + len, "%d,1e15\n", i);
+        expect_measured_error(many, "the counts add up to 1e+19, more than");
+        free(many);
+    }
+    /* A byte order mark before the header is skipped, as the other
+     * readers skip it; a NUL byte is binary data, not a long line. */
+    CHECK_STATUS(viz_measured_read(write_tmp("bom.csv", "\xEF\xBB\xBFpose,count\n1,3\n"), &m, NULL),
+                 PD_OK);
+    CHECK(m && m->n == 3);
+    viz_measured_free(m);
+    const char *nul = write_tmp("nul.csv", "pose,count\n1,3\n");
+    FILE *f = fopen(nul, "ab");
+    if (f) {
+        fwrite("2\0003\n", 1, 4, f);
+        fclose(f);
+    }
+    pd_diag d;
+    pd_diag_init(&d);
+    m = NULL;
+    CHECK(viz_measured_read(nul, &m, &d) == PD_ERR_PARSE && m == NULL);
+    CHECK(strstr(d.message, ":3: a NUL byte") != NULL);
 }
 
 /* Every file the command writes is well-formed (SVGs of SVG 1.1 elements
@@ -770,7 +804,8 @@ static void test_layout_checker(void)
 
 /* The gallery, chart and sphere of 1 to 40 entries, static only under a
  * short part name, and with drops and a measured distribution whose labels
- * are as wide as they get (100.0%, <0.1%, long file names): no text over other text or over the scale bar, none cut
+ * are as wide as they get (100.0%, <0.1%, long file names, the engines'
+ * band and its marks): no text over other text or over the scale bar, none cut
  * by the picture's edge, by DejaVu Sans's advance widths (the font the
  * pictures name first) with no further tolerance. The entries are classes
  * of the insulator cap's 98 poses, the last class holding the rest. */
@@ -791,6 +826,15 @@ static void test_layout(void)
         hi[i] = 1.0;
     }
     pd_sim_result sim = {.n = 100000, .p = p, .ci_lo = lo, .ci_hi = hi};
+    /* --crosscheck's band: a second engine far from the first on every
+     * entry, its interval apart (labels marked !), a third not run. */
+    double p2[40], lo2[40], hi2[40];
+    for (int i = 0; i < 40; i++) {
+        p2[i] = 1.0 - p[i];
+        lo2[i] = hi2[i] = p2[i];
+    }
+    pd_sim_result sim2 = {.n = 100000, .p = p2, .ci_lo = lo2, .ci_hi = hi2};
+    viz_engines xe = {{&sim, &sim2, NULL}};
     char mpath[] = "parts/a_measured_distribution_of_long_name.csv";
     viz_measured meas = {.p = p, .lo = lo, .hi = hi, .n = 123456, .path = mpath};
     pd_scene scene;
@@ -800,12 +844,12 @@ static void test_layout(void)
     for (int n = 1; n <= 40 && class_of; n++) {
         for (int i = 0; i < np; i++)
             class_of[i] = i < n ? i : n - 1;
-        sim.nposes = meas.npose = n;
+        sim.nposes = sim2.nposes = meas.npose = n;
         for (int dyn = 0; dyn < 2; dyn++) { /* the long name with the long labels */
             viz_input in = {.name = names[dyn], .part = part, .res = res,
                             .sim = dyn ? &sim : NULL, .class_of = class_of, .nclasses = n,
                             .engine = "impulse", .scene = dyn ? &scene : NULL,
-                            .measured = dyn ? &meas : NULL};
+                            .measured = dyn ? &meas : NULL, .engines = dyn ? &xe : NULL};
             pd_status (*const draw[3])(const viz_input *, int, vbuf *, pd_diag *) = {
                 viz_gallery, viz_chart, viz_sphere};
             static const char *const kind[3] = {"gallery", "chart", "sphere"};

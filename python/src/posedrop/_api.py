@@ -157,6 +157,13 @@ class Part:
                          "got %s%s" % (type(mesh).__name__, hint))
         return cls(mesh.vertices, mesh.faces, com=com, units=units)
 
+    @classmethod
+    def _wrap(cls, handle):
+        part = cls.__new__(cls)
+        part._h = handle
+        part._init()
+        return part
+
     def _init(self):
         info = self._h.info()
         self._info = info
@@ -269,6 +276,53 @@ class Part:
             self._poses = poses
         return poses
 
+    def design(self, changes, *, target=None, maximise=None, equalise=None, model="pqs",
+               group=False, n=20000, max_evals=12, check=20000, seed=1, threads=None):
+        """The part changed within ranges to land as asked (``posedrop design``).
+
+        Parameters
+        ----------
+        changes : sequence of tuples
+            ``("scale", axis, lo, hi)``: a stretch by a factor along the
+            principal axis nearest the file's axis ("x", "y", "z" or 0-2);
+            ``("stretch", axis, lo, hi, a, b)``: only the slab a <= u <= b (m)
+            along it; ``("com", axis, lo, hi)``: the centre of mass moved, m.
+        target : sequence of (nx, ny, nz, p)
+            Poses named by their facet's outward normal, and the probability
+            wanted; or
+        maximise : sequence of (nx, ny, nz)
+            the poses whose summed share to maximise; or
+        equalise : sequence of (nx, ny, nz)
+            the poses to make equally likely.
+        model : {"pqs", "qs"}
+            The static model searched first.
+        group : bool
+            A normal names its pose's class.
+        n, max_evals : int
+            Drops per refinement evaluation (0: the static answer only), and
+            the refinement's evaluations.
+        check : int
+            Fresh drops of the result (seed + 1).
+
+        Returns
+        -------
+        Design
+        """
+        goals = [(g, v) for g, v in (("target", target), ("maximise", maximise),
+                                     ("equalise", equalise)) if v is not None]
+        if len(goals) != 1:
+            raise _usage("design: give one of target, maximise, equalise")
+        goal, rows = goals[0]
+        rows = [tuple(float(x) for x in r) for r in rows]
+        width = 4 if goal == "target" else 3
+        if any(len(r) != width for r in rows):
+            raise _usage("design: %s rows have %d numbers" % (goal, width))
+        normals = [r[:3] for r in rows]
+        p = [r[3] for r in rows] if goal == "target" else None
+        d = self._h.design(_changes(changes), goal, normals, p, model, bool(group), int(n),
+                           int(max_evals), int(check), int(seed), _opt_int(threads) or 0)
+        return Design(d, normals)
+
     def drop(self, n=None, **options):
         """Monte Carlo drops from the default stable-pose table.
 
@@ -276,6 +330,101 @@ class Part:
         :meth:`StablePoses.drop`.
         """
         return self.stable_poses().drop(n, **options)
+
+
+_AXES = {"x": 0, "y": 1, "z": 2, 0: 0, 1: 1, 2: 2}
+
+
+def _changes(changes):
+    out = []
+    for c in changes:
+        c = tuple(c)
+        if len(c) < 4 or c[1] not in _AXES:
+            raise _usage("changes: expected (kind, axis, lo, hi[, a, b]), axis x, y, z or 0-2")
+        out.append((str(c[0]), _AXES[c[1]]) + tuple(float(x) for x in c[2:]))
+    return out
+
+
+class Design:
+    """The result of :meth:`Part.design`.
+
+    Attributes
+    ----------
+    part : Part
+        The changed part (metres).
+    value_before, value_static, value : (k,)
+        Each change's value (factor, or offset in m) as given, at the static
+        model's optimum, and after the drops.
+    normal : (t, 3)
+        The named poses.
+    p_target, qs_before, pqs_before, qs_static, pqs_static, qs_after, pqs_after,
+    p_refine, p_after, ci_lo, ci_hi : (t,)
+        Per named pose: the target (the mean for equalise, 1 for maximise),
+        the static estimates as given, at the static optimum and at the
+        result, the refinement drops' estimate and the fresh drops' with its
+        95% Wilson interval.
+    vanished, appeared : (t,) bool
+        The pose's facet no longer rests on the result / did not rest on
+        the part as given.
+    objective_static, objective_refine, objective_after : float
+    static_evals, drop_evals, drops, poses_before, poses_after : int
+    """
+
+    _COLUMNS = ("p_target", "qs_before", "pqs_before", "qs_static", "pqs_static", "qs_after",
+                "pqs_after", "p_refine", "p_after", "ci_lo", "ci_hi")
+
+    def __init__(self, d, normals):
+        self.part = Part._wrap(d["part"])
+        for k in ("value_before", "value_static", "value"):
+            setattr(self, k, _f64(d[k]))
+        self.normal = np.array(normals, dtype=np.float64).reshape(-1, 3)
+        t = _f64(d["targets"], -1, 14)
+        for k, name in enumerate(self._COLUMNS):
+            setattr(self, name, t[:, k])
+        self.vanished = t[:, 11] != 0
+        self.appeared = t[:, 12] != 0
+        for k in ("objective_static", "objective_refine", "objective_after", "static_evals",
+                  "drop_evals", "drops", "poses_before", "poses_after"):
+            setattr(self, k, d[k])
+
+    def __repr__(self):
+        return "<posedrop.Design: values %s, p_after %s>" % (
+            np.array2string(self.value, precision=5), np.array2string(self.p_after, precision=4))
+
+
+class DesignSensitivity:
+    """The derivatives of each pose's (class's) probability with respect to
+    each change, pose-major, as ``posedrop design --sensitivity`` writes
+    them (per unit factor, or per metre).
+
+    Attributes
+    ----------
+    pose : (rows,) int32
+    d_qs, d_pqs : (rows,)
+        Exact derivatives of QS and PQS.
+    d_p, ci_lo, ci_hi : (rows,)
+        Paired drops' central difference and its 95% interval (0 without drops).
+    qs_kink, pqs_kink : (rows,) bool
+        The static structure changes within a small step (one-sided derivative).
+    step : (changes,)
+        The drops' half step per change.
+    """
+
+    _COLUMNS = ("d_qs", "d_pqs", "d_p", "ci_lo", "ci_hi")
+
+    def __init__(self, d):
+        self.nposes = d["nposes"]
+        self.ndrops = d["ndrops"]
+        self.step = _f64(d["step"])
+        self.pose = _i32(d["pose"])
+        v = _f64(d["values"], -1, 7)
+        for k, name in enumerate(self._COLUMNS):
+            setattr(self, name, v[:, k])
+        self.qs_kink = v[:, 5] != 0
+        self.pqs_kink = v[:, 6] != 0
+
+    def __len__(self):
+        return len(self.pose)
 
 
 class _com_hint:
@@ -372,6 +521,21 @@ class StablePoses:
             self._classes = PoseClasses(self, _i32(class_of), n)
         return self._classes
 
+    def design_sensitivity(self, changes, classes=None, n=0, seed=1, threads=None):
+        """The exact derivatives of each pose's QS and PQS probabilities
+        with respect to each change (see :meth:`Part.design` for changes),
+        and with ``n`` > 0 paired drops' differences with 95% intervals;
+        per class with ``classes`` (a :class:`PoseClasses`).
+
+        Returns
+        -------
+        DesignSensitivity
+        """
+        cls = _class_array(classes) if classes is not None else None
+        return DesignSensitivity(self._h.design_sensitivity(
+            _changes(changes), cls, len(classes) if classes is not None else 0, int(n),
+            int(seed), _opt_int(threads) or 0))
+
     def drop(self, n=None, *, ci=None, seed=None, threads=None, engine=None, dt=None,
              scene=None, max_drops=None, time_limit=None, max_collisions=None, trials=False,
              cancel=None, progress=None, **settings):
@@ -435,7 +599,11 @@ class StablePoses:
         ------
         KeyboardInterrupt
             On Ctrl-C: the drops under way finish, no new one starts, and
-            the interrupt propagates (use ``cancel`` for a partial result).
+            the interrupt propagates (use ``cancel`` for a partial result);
+            on a thread other than the main one too, as long as Python's
+            own SIGINT handler was in place when posedrop was imported.
+        TypeError
+            ``cancel`` without an ``is_set()`` method.
         InputError
             A scene value or option the library refuses.
         """
@@ -632,10 +800,18 @@ class Sensitivity:
     params : list of str
         The ranged parameters, in ``pd_scene_param`` order; empty for a
         scene without a range of nonzero width.
+    resolution : float
+        The widest half-width of an effect's interval: what the drops
+        resolve.
+    interaction_tests : int
+        Pose and ordered parameter pairs tested for an interaction.
     pose : (rows,) int32
         The pose (or class) index, from 0 (the file's ``pose`` less 1).
     parameter : (rows,) str
         The parameter's name.
+    effect, effect_lo, effect_hi : (rows,)
+        ``p_high - p_low``, how far the pose moves across the range, and its
+        95% bootstrap interval.
     n_low, n_high : (rows,) int64
         Settled drops whose value fell in the lower, upper third of the
         range (thirds of the logarithm for a log-uniform range).
@@ -643,10 +819,18 @@ class Sensitivity:
         The pose's share of those and its 95% Wilson interval.
     index, index_lo, index_hi : (rows,)
         The first-order index S_i and its 95% bootstrap interval.
+    interacts : (rows,) str
+        The parameter across whose thirds the effect changes, or "".
+    effect_in_low, effect_in_middle, effect_in_high : (rows,)
+        With ``interacts``: the effect in that parameter's thirds.
+    interaction, interaction_lo, interaction_hi : (rows,)
+        With ``interacts``: the largest change of those and its interval.
     """
 
-    _COLUMNS = ("p_low", "p_low_lo", "p_low_hi", "p_high", "p_high_lo", "p_high_hi",
-                "index", "index_lo", "index_hi")
+    _COLUMNS = ("effect", "effect_lo", "effect_hi", "p_low", "p_low_lo", "p_low_hi", "p_high",
+                "p_high_lo", "p_high_hi", "index", "index_lo", "index_hi", "effect_in_low",
+                "effect_in_middle", "effect_in_high", "interaction", "interaction_lo",
+                "interaction_hi")
 
     def __init__(self, d):
         self.n = d["n"]
@@ -656,6 +840,9 @@ class Sensitivity:
         self.parameter = np.array(self.params * self.nposes, dtype=str)
         self.n_low = _i64(d["n_low"])
         self.n_high = _i64(d["n_high"])
+        self.resolution = d["resolution"]
+        self.interaction_tests = d["interaction_tests"]
+        self.interacts = np.array(list(d["interacts"]), dtype=str)
         values = _f64(d["values"], -1, len(self._COLUMNS))
         for k, name in enumerate(self._COLUMNS):
             setattr(self, name, values[:, k])

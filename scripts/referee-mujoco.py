@@ -1,0 +1,589 @@
+#!/usr/bin/env python3
+"""referee-mujoco.py: the cross-check corpus on posedrop's three engines and on MuJoCo.
+
+An outside referee for the engines' disagreements: the same parts dropped in
+MuJoCo (its Python package, not a posedrop dependency) with the scene's
+physical parameters, from the very releases posedrop drew, decided by the
+same rule and grouped into the same pose classes as posedrop's --group.
+
+  .venv/bin/python scripts/referee-mujoco.py [-n DROPS] [--seed S]
+      [--parts a,b,...] [--steps K,...] [--mj-n M] [--check-n M] [-o DIR]
+      [--doc FILE]
+
+The corpus (--parts picks some):
+  bushing   flanged bushing: a stepped solid of revolution, 32-gon, mm:
+            flange 20 dia x 3, body 12 dia x 15, no bore (written here from
+            those dimensions)
+  hexnut    parts/hexnut.obj (mm)
+  box       1 x 2 x 3 cm box (parts/canonical/box_1x2x3.off)
+  button    parts/white_button.off
+  cap       parts/insulator_cap.off
+  cube      1 cm cube (parts/canonical/cube.off) started resting on a face:
+            posedrop's --initial stationary resting drops (on a face, turned
+            at random about the vertical, tilted by the vibration, lowest
+            point at the drop height); the figure is the share that ends on
+            the face it started on
+
+posedrop: each engine at its defaults (build/opt/posedrop; whatever --dt its
+default is), -n DROPS, --seed S, --group, --trials (the releases and
+outcomes). MuJoCo, for every drop, from the release posedrop recorded (the
+orientation in --trials, lowest point at the scene's height, the belt's
+velocity, no spin):
+  - the part's mesh in metres with MuJoCo's exact volume inertia; MuJoCo
+    collides its convex hull, as posedrop does;
+  - each contact a push-only spring-dashpot with the scene's contact time T
+    (the part's automatic one) and restitution e, in acceleration units, as
+    the stepping engines' law (docs/engines-crosscheck.md): zeta from
+    e = exp(-zeta g(zeta)), omega = g(zeta) / T, given to MuJoCo as solref
+    (timeconst 1 / (zeta omega), dampratio zeta) with an impedance of 0.9999
+    throughout (solimp), so that the contact's acceleration is the spring's;
+  - Coulomb friction mu on an elliptic cone, and drilling friction as
+    posedrop's stepping engines have it (condim 4, torsional coefficient
+    (2/3) a mu, a = sqrt(R d): a corner of radius R = PD_CORNER_RADIUS_REL L
+    sunk d = g / omega^2);
+  - the first --mj-n releases (all by default; MuJoCo costs 10 to 100 times
+    posedrop's engines per drop);
+  - the step T / K for the first K of --steps (default 20,40): the table's;
+    each further (finer) step runs the first --check-n releases (200) again,
+    and the total variation between successive steps on those, against
+    its sampling noise, shows whether the table's step is converged;
+  - the drop is decided as posedrop's stepping engines decide it: the part
+    lies on a stable pose's facet, tilted less than 1 degree, and its energy
+    above that rest is below the least height it must rise to tip over one
+    of the facet's edges (a lower bound of the basin's barrier, so a decided
+    drop cannot leave); or it runs to posedrop's automatic time limit,
+    100 (sqrt(L/g) + sqrt(2h/g)), unsettled.
+
+Writes DIR/referee.csv (part,engine,class,n,count,p,ci_lo,ci_hi,unsettled,
+cpu_ms_per_drop), prints the corpus table in Markdown and, with --doc FILE,
+puts it between the lines '<!-- referee-mujoco begin -->' and
+'<!-- referee-mujoco end -->' of FILE with the command and commit.
+
+Needs the mujoco package (not a posedrop dependency; outside make check):
+  python3 -m venv .venv && .venv/bin/pip install mujoco numpy
+"""
+import argparse
+import json
+import math
+import os
+import resource
+import sys
+import time
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import script_util  # noqa: E402
+from script_util import ROOT, rows  # noqa: E402
+
+# PD_CORNER_RADIUS_REL (src/base/base_tol.h): the corner radius of a part of
+# size L that the automatic contact time assumes.
+CORNER_RADIUS_REL = 0.5e-3 / (0.01 * math.sqrt(3.0))
+REST_TILT = math.radians(1.0)   # PD_TOL_REST_TILT
+SOLIMP_D = 0.9999               # MuJoCo's highest impedance
+CHECK_S = 1e-3                  # simulated seconds between rest checks
+
+PARTS = {
+    "bushing": (None, "mm", "uniform"),
+    "hexnut": ("parts/hexnut.obj", "mm", "uniform"),
+    "box": ("parts/canonical/box_1x2x3.off", "m", "uniform"),
+    "button": ("parts/white_button.off", "m", "uniform"),
+    "cap": ("parts/insulator_cap.off", "m", "uniform"),
+    "cube": ("parts/canonical/cube.off", "m", "resting"),
+}
+# Cheapest in MuJoCo first, so that a run stopped early has the most parts.
+ORDER = ["cube", "box", "bushing", "hexnut", "button", "cap"]
+ENGINES = ["impulse", "ode", "bullet"]
+PARTS_SEEN = {}
+COMMIT = ["?", ""]
+
+
+# --- the part ----------------------------------------------------------------
+
+
+def bushing(path, n=32, flange_d=20.0, flange_h=3.0, body_d=12.0, body_h=15.0):
+    """The flanged bushing as an OFF in mm: two coaxial n-gon prisms, the
+    flange below the body, one closed surface (the flange's top an annulus)."""
+    rings = []
+    for r, z in ((flange_d / 2, 0.0), (flange_d / 2, flange_h), (body_d / 2, flange_h),
+                 (body_d / 2, flange_h + body_h)):
+        rings.append([(r * math.cos(2 * math.pi * i / n), r * math.sin(2 * math.pi * i / n), z)
+                      for i in range(n)])
+    v = [p for ring in rings for p in ring]
+    f = [tuple(range(n - 1, -1, -1))]                       # bottom, facing -z
+    # The flange's side, the annulus on its top (outer ring to inner, facing
+    # +z) and the body's side, each between two successive rings.
+    for k in range(3):
+        a, b = k * n, (k + 1) * n
+        f += [(a + i, a + (i + 1) % n, b + (i + 1) % n, b + i) for i in range(n)]
+    f.append(tuple(range(3 * n, 4 * n)))                    # top, facing +z
+    with open(path, "w") as o:
+        o.write("# flanged bushing: flange %g dia x %g, body %g dia x %g, %d-gon, no bore\n"
+                % (flange_d, flange_h, body_d, body_h, n))
+        o.write("# units: millimetres; generated by scripts/referee-mujoco.py\n")
+        o.write("OFF\n%d %d 0\n" % (len(v), len(f)))
+        for p in v:
+            o.write("%.17g %.17g %.17g\n" % p)
+        for face in f:
+            o.write("%d %s\n" % (len(face), " ".join(map(str, face))))
+
+
+def read_mesh(path):
+    """Vertices and triangles (fans of the polygons) of an OFF or OBJ file."""
+    v, tri = [], []
+    with open(path) as fh:
+        text = [ln.split("#")[0].strip() for ln in fh]
+    text = [ln for ln in text if ln]
+    if path.endswith(".obj"):
+        for ln in text:
+            w = ln.split()
+            if w[0] == "v":
+                v.append(tuple(float(x) for x in w[1:4]))
+            elif w[0] == "f":
+                idx = [int(x.split("/")[0]) for x in w[1:]]
+                idx = [i - 1 if i > 0 else len(v) + i for i in idx]
+                tri += [(idx[0], idx[k], idx[k + 1]) for k in range(1, len(idx) - 1)]
+        return v, tri
+    words = " ".join(text).split()
+    assert words[0] == "OFF", path
+    nv, nf = int(words[1]), int(words[2])
+    at = 4
+    for _ in range(nv):
+        v.append(tuple(float(x) for x in words[at:at + 3]))
+        at += 3
+    for _ in range(nf):
+        k = int(words[at])
+        idx = [int(x) for x in words[at + 1:at + 1 + k]]
+        at += 1 + k
+        tri += [(idx[0], idx[j], idx[j + 1]) for j in range(1, k - 1)]
+    return v, tri
+
+
+# --- posedrop ----------------------------------------------------------------
+
+
+def run(cmd):
+    return script_util.run(cmd, "referee-mujoco")
+
+
+def child_cpu():
+    r = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return r.ru_utime + r.ru_stime
+
+
+class Part:
+    """What posedrop says of the part: size, centre of mass, the automatic
+    contact time, the stable poses' facets and their classes."""
+
+    def __init__(self, exe, path, units, scene_opts):
+        self.exe, self.path, self.units = exe, path, units
+        j = json.loads(run([exe, "--format", "json", "-n", "1", "--units", units] + scene_opts
+                           + [path]))
+        self.size = j["part"]["size_m"]
+        self.com = j["part"]["centre_of_mass_m"]
+        self.scene = j["scene"]
+        self.poses = rows(run([exe, "--units", units, path]))
+        self.classes = rows(run([exe, "--group", "--units", units, path]))
+        self.class_of = {}
+        for c in self.classes:
+            for m in c["members"].split():
+                self.class_of[int(m)] = int(c["pose"])
+        scale = {"m": 1.0, "cm": 0.01, "mm": 0.001}[units]
+        v, self.tri = read_mesh(path)
+        self.verts = [tuple(scale * x for x in p) for p in v]   # file frame, metres
+        # Each pose's facet: outward normal n (file frame), height h of the
+        # centre of mass above it, and the least height b it rises to when
+        # tipped over one of the facet's edges.
+        rel = [tuple(p[k] - self.com[k] for k in range(3)) for p in self.verts]
+        self.facets = []
+        for r in self.poses:
+            n = (float(r["nx"]), float(r["ny"]), float(r["nz"]))
+            h = float(r["height"])
+            on = [p for p in rel if abs(dot(n, p) - h) < 1e-6 * self.size]
+            self.facets.append((n, h, barrier(n, h, on)))
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def barrier(n, h, pts):
+    """The least distance from the centre of mass (the origin) to an edge of
+    the convex polygon pts on the plane n.x = h: the height the centre of
+    mass rises to when the part tips over that edge. h when undefined."""
+    if len(pts) < 3:
+        return h
+    c = [sum(p[k] for p in pts) / len(pts) for k in range(3)]
+    a = (1.0, 0.0, 0.0) if abs(n[0]) < 0.9 else (0.0, 1.0, 0.0)
+    u = cross(n, a)
+    s = math.sqrt(dot(u, u))
+    u = tuple(x / s for x in u)
+    w = cross(n, u)
+    ring = sorted(pts, key=lambda p: math.atan2(dot(sub(p, c), w), dot(sub(p, c), u)))
+    best = math.inf
+    for i in range(len(ring)):
+        p, q = ring[i], ring[(i + 1) % len(ring)]
+        d = sub(q, p)
+        dd = dot(d, d)
+        t = 0.0 if dd == 0 else max(0.0, min(1.0, -dot(p, d) / dd))
+        x = tuple(p[k] + t * d[k] for k in range(3))
+        best = min(best, math.sqrt(dot(x, x)))
+    return best
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+def posedrop_engine(part, engine, n, seed, initial, tmp):
+    """Drops on one engine: the trials (release, outcome) and CPU ms per drop."""
+    trials = os.path.join(tmp, "trials.%s.csv" % engine)
+    cmd = [part.exe, "-n", str(n), "--seed", str(seed), "--engine", engine, "--units",
+           part.units, "--initial", initial, "--trials", trials, part.path]
+    c0 = child_cpu()
+    run(cmd)
+    cpu = child_cpu() - c0
+    return rows(open(trials).read()), 1000.0 * cpu / n
+
+
+# --- MuJoCo ------------------------------------------------------------------
+
+
+def contact_law(T, e):
+    """zeta and omega of a push-only spring-dashpot lasting T and rebounding
+    with e (docs/engines-crosscheck.md, as pd_engine_contact_law)."""
+    e = max(e, 0.01)
+
+    def g(z):
+        if z < 1:
+            return (math.pi - 2 * math.asin(z)) / math.sqrt(1 - z * z)
+        if z == 1:
+            return 2.0
+        return 2 * math.acosh(z) / math.sqrt(z * z - 1)
+
+    lo, hi = 0.0, 50.0   # e falls as zeta rises
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if math.exp(-mid * g(mid)) > e:
+            lo = mid
+        else:
+            hi = mid
+    z = 0.5 * (lo + hi)
+    return z, g(z) / T
+
+
+def mjcf(part, dt):
+    sc = part.scene
+    T, e, mu, grav = sc["contact_time_s"], sc["restitution"], sc["mu"], sc["gravity_m_s2"]
+    zeta, omega = contact_law(T, e)
+    sink = grav / omega ** 2
+    torsion = (2.0 / 3.0) * mu * math.sqrt(CORNER_RADIUS_REL * part.size * sink)
+    verts = " ".join("%.17g %.17g %.17g" % p for p in part.verts)
+    faces = " ".join("%d %d %d" % t for t in part.tri)
+    return """<mujoco>
+  <compiler angle="radian"/>
+  <option timestep="%.17g" gravity="0 0 %.17g" cone="elliptic">
+    <flag energy="enable"/>
+  </option>
+  <asset><mesh name="m" vertex="%s" face="%s" inertia="exact"/></asset>
+  <default><geom condim="4" friction="%.17g %.17g 0" solref="%.17g %.17g"
+    solimp="%g %g 0.001 0.5 2" margin="0"/></default>
+  <worldbody>
+    <geom type="plane" size="0 0 1"/>
+    <body name="part"><freejoint/><geom type="mesh" mesh="m" density="1000"/></body>
+  </worldbody>
+</mujoco>""" % (dt, -grav, verts, faces, mu, torsion, 1.0 / (zeta * omega), zeta, SOLIMP_D,
+                SOLIMP_D)
+
+
+class Referee:
+    def __init__(self, mujoco, part, dt):
+        import numpy
+        self.mj, self.np, self.part, self.dt = mujoco, numpy, part, dt
+        self.model = mujoco.MjModel.from_xml_string(mjcf(part, dt))
+        self.data = mujoco.MjData(self.model)
+        self.mass = self.model.body_mass[1]
+        sc = part.scene
+        self.g, self.h, self.v = sc["gravity_m_s2"], sc["height_m"], sc["belt_speed_m_s"]
+        self.limit = 100 * (math.sqrt(part.size / self.g) + math.sqrt(2 * self.h / self.g))
+        self.every = max(1, int(round(CHECK_S / dt)))
+        self.stable = [(i, f) for i, f in enumerate(part.facets) if f[2] > f[1]]
+        self.cos_tilt = math.cos(REST_TILT)
+
+    def drop(self, q):
+        """Pose number (1-based) the release q (file frame to world, w x y z)
+        rests in, or 0 at the time limit; and the simulated time."""
+        mj, np, d = self.mj, self.np, self.data
+        mj.mj_resetData(self.model, d)
+        mat = np.zeros(9)
+        mj.mju_quat2Mat(mat, np.asarray(q, dtype=float))
+        low = min(mat[6] * x + mat[7] * y + mat[8] * z for x, y, z in self.part.verts)
+        d.qpos[0:3] = (0.0, 0.0, self.h - low)
+        d.qpos[3:7] = q
+        d.qvel[:] = 0.0
+        d.qvel[0] = self.v
+        mg = self.mass * self.g
+        while d.time < self.limit:
+            mj.mj_step(self.model, d, self.every)
+            R = d.xmat[1]
+            zc = d.xipos[1][2]
+            energy = d.energy[1]
+            for i, (n, h, b) in self.stable:
+                down = -(R[6] * n[0] + R[7] * n[1] + R[8] * n[2])
+                if down > self.cos_tilt and energy + mg * (zc - h) < mg * (b - h):
+                    return i + 1, d.time
+        return 0, d.time
+
+
+def law_check(mujoco, exe):
+    """The contact law as MuJoCo realises it: the 1 cm cube (its automatic
+    contact time T, e 0.3) striking the floor flat at 1 m/s without gravity,
+    at T / K for several K: the rebound over the approach speed and how long
+    the floor pushed, over T. Markdown."""
+    part = Part(exe, os.path.join(ROOT, "parts/canonical/cube.off"), "m", [])
+    T, e = part.scene["contact_time_s"], part.scene["restitution"]
+    out = ["The law as MuJoCo realises it here: the 1 cm cube (T = %.3g s, e = %g) striking "
+           "the floor flat at 1 m/s, gravity off, rebound speed over approach speed and the "
+           "time the floor pushed over T, at steps of T / K:\n\n" % (T, e),
+           "| K | 10 | 20 | 40 | 80 |\n", "|---|---|---|---|---|\n"]
+    got = []
+    for K in (10, 20, 40, 80):
+        ref = Referee(mujoco, part, T / K)
+        m, d = ref.model, ref.data
+        m.opt.gravity[2] = 0.0
+        mujoco.mj_resetData(m, d)
+        d.qpos[3:7] = (1.0, 0.0, 0.0, 0.0)
+        d.qpos[2] = 0.005 + 1e-4
+        d.qvel[2] = -1.0
+        t_in = t_out = None
+        while d.time < 20 * T and t_out is None:
+            mujoco.mj_step(m, d)
+            pushing = d.efc_force.size > 0 and d.efc_force.max() > 0
+            if pushing and t_in is None:
+                t_in = d.time
+            if t_in is not None and not pushing and d.qvel[2] > 0:
+                t_out = d.time
+        got.append((d.qvel[2], (t_out - t_in) / T if t_out else float("nan")))
+    out.append("| rebound / approach | %s |\n" % " | ".join("%.4f" % g[0] for g in got))
+    out.append("| duration / T | %s |\n" % " | ".join("%.3f" % g[1] for g in got))
+    return "".join(out)
+
+
+# --- statistics and the table -------------------------------------------------
+
+
+def wilson(k, n, z=1.959963984540054):
+    if n == 0:
+        return 0.0, 0.0
+    p = k / n
+    c = (p + z * z / (2 * n)) / (1 + z * z / n)
+    w = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
+    return max(0.0, c - w), min(1.0, c + w)
+
+
+def outcome_table(part, outcomes, resting, starts):
+    """{class: count} over the drops, or for a resting start the drops that
+    end on the pose they started on (class 1) and elsewhere (class 2)."""
+    counts = {}
+    for i, pose in enumerate(outcomes):
+        if pose == 0:
+            continue
+        k = (1 if pose == starts[i] else 2) if resting else part.class_of[pose]
+        counts[k] = counts.get(k, 0) + 1
+    return counts
+
+
+def tvn(a, na, b, nb):
+    """Total variation between two count tables of na and nb drops."""
+    keys = set(a) | set(b)
+    return 0.5 * sum(abs(a.get(k, 0) / na - b.get(k, 0) / nb) for k in keys)
+
+
+def tv(a, b, n):
+    keys = set(a) | set(b)
+    return 0.5 * sum(abs(a.get(k, 0) - b.get(k, 0)) for k in keys) / n
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--posedrop", default=os.path.join(ROOT, "build/opt/posedrop"))
+    ap.add_argument("-n", type=int, default=1000, help="drops per engine and part (1000)")
+    ap.add_argument("--seed", type=int, default=3)
+    ap.add_argument("--parts", default=",".join(ORDER))
+    ap.add_argument("--steps", default="20,40",
+                    help="MuJoCo's steps per contact time: the table's, then finer ones "
+                    "for the convergence check (20,40)")
+    ap.add_argument("--mj-n", type=int,
+                    help="MuJoCo drops per part at the table's step: the first of the "
+                    "releases (default: all -n)")
+    ap.add_argument("--check-n", type=int, default=200,
+                    help="releases the finer steps run again (200)")
+    ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
+    ap.add_argument("--doc", help="Markdown file to put the table in, between the markers")
+    ap.add_argument("--doc-tag", default="referee-mujoco",
+                    help="the markers' name (referee-mujoco): several runs, several tables")
+    ap.add_argument("--law", action="store_true",
+                    help="only the contact law's check (a flat strike of the cube), into "
+                    "--doc between the referee-law markers")
+    a = ap.parse_args()
+    names = a.parts.split(",")
+    why = ["unknown part %r (%s)" % (x, ", ".join(PARTS)) for x in names if x not in PARTS]
+    if not os.access(a.posedrop, os.X_OK):
+        why.append("%s not found: run make all first" % a.posedrop)
+    try:
+        import mujoco
+    except ImportError:
+        why.append("the mujoco Python package is not installed:\n"
+                   "  python3 -m venv .venv && .venv/bin/pip install mujoco numpy")
+    if why:
+        sys.stderr.write("".join("referee-mujoco: %s\n" % w for w in why))
+        return 2
+    if a.law:
+        COMMIT[:] = script_util.commit_here()
+        text = ("Made by `scripts/referee-mujoco.py --law` on %s (commit %s%s); MuJoCo %s.\n\n"
+                % (time.strftime("%Y-%m-%d", time.gmtime()), COMMIT[0], COMMIT[1],
+                   mujoco.__version__) + law_check(mujoco, a.posedrop))
+        sys.stdout.write(text)
+        if a.doc:
+            script_util.put_between(a.doc, "referee-law", "\n" + text + "\n", "referee-mujoco")
+        return 0
+    steps = [int(k) for k in a.steps.split(",")]
+    # The code that ran: the commit at the start, and whether the tree
+    # differed from it.
+    COMMIT[:] = script_util.commit_here()
+    os.makedirs(a.o, exist_ok=True)
+    out_rows, table = [], []
+    for name in names:
+        path, units, initial = PARTS[name]
+        if path is None:
+            path = os.path.join(a.o, "flanged_bushing.off")
+            bushing(path)
+        else:
+            path = os.path.join(ROOT, path)
+        resting = initial == "resting"
+        init = "stationary" if resting else "uniform"
+        part = Part(a.posedrop, path, units, [])
+        PARTS_SEEN[name] = part
+        # A stationary run's drop i (from 0) is uniform when i mod (k + 1) is
+        # 0 and starts resting on pose i mod (k + 1) otherwise (sim.h); the
+        # resting ones are kept, n of them.
+        k1 = len(part.poses) + 1
+        # (at least 10 resting on each pose, as posedrop asks).
+        ndrops = max((a.n * k1 + k1 - 2) // (k1 - 1), 10 * k1) if resting else a.n
+        keep = [i for i in range(ndrops) if not resting or i % k1 != 0][:a.n]
+        starts = [i % k1 for i in range(ndrops)]
+        results = {}
+        releases = None
+        for engine in ENGINES:
+            sys.stderr.write("referee-mujoco: %s on %s, %d drops\n" % (name, engine, ndrops))
+            tr, ms = posedrop_engine(part, engine, ndrops, a.seed, init, a.o)
+            if releases is None:
+                releases = [tuple(float(t[c]) for c in ("qw", "qx", "qy", "qz")) for t in tr]
+            outcomes = [int(tr[i]["pose"]) for i in keep]
+            results[engine] = (outcomes, ms)
+        for s, K in enumerate(steps):
+            dt = part.scene["contact_time_s"] / K
+            ref = Referee(mujoco, part, dt)
+            these = keep[:a.mj_n or len(keep)] if s == 0 else keep[:a.check_n]
+            sys.stderr.write("referee-mujoco: %s on MuJoCo, dt = T/%d = %.3g s, %d drops\n"
+                             % (name, K, dt, len(these)))
+            outcomes = []
+            t0 = time.process_time()
+            for i in these:
+                outcomes.append(ref.drop(releases[i])[0])
+            ms = 1000.0 * (time.process_time() - t0) / len(these)
+            results["mujoco T/%d" % K] = (outcomes, ms)
+        st = [starts[i] for i in keep]
+        n = len(keep)
+        counts = {e: outcome_table(part, o, resting, st) for e, (o, _) in results.items()}
+        n_of = {e: len(o) for e, (o, _) in results.items()}
+        classes = [1] if resting else sorted(set(part.class_of.values()))
+        for e, (o, ms) in results.items():
+            unsettled = sum(1 for x in o if x == 0)
+            for c in classes:
+                cnt = counts[e].get(c, 0)
+                lo, hi = wilson(cnt, n_of[e])
+                out_rows.append([name, e, c, n_of[e], cnt, cnt / n_of[e], lo, hi, unsettled, ms])
+        table.append((name, resting, classes, counts, results, n, st))
+        # After each part, so that a run stopped half way leaves what it did.
+        write_csv(os.path.join(a.o, "referee.csv"), out_rows)
+        text = markdown(table, steps, a)
+        if a.doc:
+            script_util.put_between(a.doc, a.doc_tag, "\n" + text + "\n", "referee-mujoco")
+    sys.stdout.write(text)
+    return 0
+
+
+def write_csv(path, out_rows):
+    with open(path, "w") as f:
+        f.write("part,engine,class,n,count,p,ci_lo,ci_hi,unsettled,cpu_ms_per_drop\n")
+        for r in out_rows:
+            f.write("%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%d,%.4g\n" % tuple(r))
+
+
+def markdown(table, steps, a):
+    fine = "mujoco T/%d" % steps[0]
+    cols = ENGINES + [fine]
+    label = {"impulse": "impulse", "ode": "ODE", "bullet": "Bullet", fine: "MuJoCo"}
+    lines = []
+    cmd = "scripts/referee-mujoco.py " + " ".join(
+        w if not w.startswith(ROOT + "/") else os.path.relpath(w, ROOT) for w in sys.argv[1:])
+    lines.append("Made by `%s` on %s (commit %s%s), %s UTC; MuJoCo %s.\n\n"
+                 % (cmd.strip(), time.strftime("%Y-%m-%d", time.gmtime()), COMMIT[0],
+                    COMMIT[1], time.strftime("%H:%M", time.gmtime()),
+                    __import__("mujoco").__version__))
+    lines.append("Share of each pose class (posedrop's `--group` numbering) over %d drops "
+                 "per engine (MuJoCo: the first %d of them) from the same releases (seed %d), "
+                 "with the 95%% Wilson "
+                 "interval's half-width; the cube: the share that ends on the face it "
+                 "started resting on. TV: total variation from MuJoCo at T/%d. Unsettled "
+                 "drops are in no class.\n\n" % (a.n, a.mj_n or a.n, a.seed, steps[0]))
+    lines.append("| part | class | " + " | ".join(label[c] for c in cols) + " |\n")
+    lines.append("|---|---|" + "---|" * len(cols) + "\n")
+    for name, resting, classes, counts, results, n, st in table:
+        for c in classes:
+            cells = []
+            for e in cols:
+                k, ne = counts[e].get(c, 0), len(results[e][0])
+                lo, hi = wilson(k, ne)
+                cells.append("%.3f +- %.3f" % (k / ne, (hi - lo) / 2))
+            lines.append("| %s | %s | %s |\n" % (name, "same face" if resting else c,
+                                                  " | ".join(cells)))
+        nf = len(results[fine][0])
+        tvs = ["%.3f" % tvn(counts[e], n, counts[fine], nf) for e in ENGINES] + ["-"]
+        uns = [str(sum(1 for x in results[e][0] if x == 0)) for e in cols]
+        ms = ["%.3g" % results[e][1] for e in cols]
+        lines.append("| %s | TV to MuJoCo | %s |\n" % (name, " | ".join(tvs)))
+        lines.append("| %s | unsettled | %s |\n" % (name, " | ".join(uns)))
+        lines.append("| %s | CPU ms per drop | %s |\n" % (name, " | ".join(ms)))
+    if len(steps) < 2:
+        return "".join(lines)
+    m = a.check_n
+    lines.append("\nMuJoCo's step against the contact time T (each part's automatic one), "
+                 "on the first %d releases: the total variation between successive steps, "
+                 "and the share of drops whose outcome did not change. Two independent "
+                 "samples of %d from one distribution would differ by a TV of about "
+                 "sqrt((k - 1) / (pi %d)) for k classes of equal weight (%.3f for k = 2), "
+                 "and paired releases by less.\n\n" % (m, m, m, math.sqrt(1 / (math.pi * m))))
+    lines.append("| part | " + " | ".join("T/%d to T/%d" % (steps[i], steps[i + 1])
+                                          for i in range(len(steps) - 1)) + " |\n")
+    lines.append("|---|" + "---|" * (len(steps) - 1) + "\n")
+    for name, resting, classes, counts, results, n, st in table:
+        cells = []
+        for i in range(len(steps) - 1):
+            ea, eb = "mujoco T/%d" % steps[i], "mujoco T/%d" % steps[i + 1]
+            oa, ob = results[ea][0], results[eb][0]
+            k = min(len(oa), len(ob))
+            part = PARTS_SEEN[name]
+            ca = outcome_table(part, oa[:k], resting, st[:k])
+            cb = outcome_table(part, ob[:k], resting, st[:k])
+            same = sum(1 for x, y in zip(oa, ob) if x == y) / k
+            cells.append("TV %.3f, %.1f%% unchanged" % (tv(ca, cb, k), 100 * same))
+        lines.append("| %s | %s |\n" % (name, " | ".join(cells)))
+    return "".join(lines)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
