@@ -214,9 +214,11 @@ check check-full: deps lint
 	@$(MAKE) --no-print-directory test $(if $(filter check-full,$@),TEST_FULL=1)
 	$(if $(filter check-full,$@),@$(MAKE) --no-print-directory check-figures)
 
+# make demo builds as make check does (two jobs unless make was given its
+# own -j) and prints the pose classes in words (scripts/demo.sh).
 demo: deps
-	@$(MAKE) --no-print-directory all
-	$(CLI) -n 2000 -h 0.12 $(DEMO_PART)
+	@$(MAKE) --no-print-directory $(if $(filter -j%,$(MAKEFLAGS)),,-j2) all
+	@scripts/demo.sh $(CLI) $(DEMO_PART)
 
 # The report and the SVGs in a real browser and renderer (headless Chromium,
 # rsvg-convert; installed when missing): tests/browser/check.sh.
@@ -351,7 +353,8 @@ clean:
 help:
 	@echo "make            build libposedrop (.so, .a), libposedrop-bullet and the"
 	@echo "                posedrop command ($(BUILD)/)"
-	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times"
+	@echo "make demo       install missing packages, build, drop $(DEMO_PART) 2000 times:"
+	@echo "                its pose classes and a report (build/demo/)"
 	@echo "make check      install missing packages, build and run the tests"
 	@echo "                (SUITES='hull static' runs only those suites)"
 	@echo "make check-full make check with the long statistical runs (CI runs both)"

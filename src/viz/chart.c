@@ -8,6 +8,13 @@
 
 enum { BAR_W = 16, BAR_GAP = 2, GROUP_GAP = 22, THUMB = 80, PLOT_H = 300, LEFT = 58,
        RIGHT = 16, TOP = 40, LEGEND_LINE = 18 };
+/* Past this width the groups wrap onto rows, each with its own axis: a
+ * laptop's page (the report's body is at most 1240 px) shows the chart at
+ * full size, its 11-12 px text readable, where 34 poses in one row made it
+ * 3542 wide and a browser scaled its text to 4 px. */
+#define WRAP_W 1200.0
+/* A row: the plot, the pose numbers and thumbnails under it, a gap. */
+#define ROW_H (PLOT_H + 22.0 + THUMB + 14.0 + 16.0)
 
 typedef struct {
     const char *name;
@@ -33,10 +40,20 @@ static double axis_top(const viz_entry *e, int n, double *step)
     return fmin(1.0, ceil(top / *step - 1e-9) * *step);
 }
 
+/* A series' fill: greys, from light (QS) to dark (drops), and the measured
+ * distribution white with a dark outline. Colours in a report mean poses
+ * (the gallery's and the sphere map's, viz_entry_colour), so the series
+ * that stand beside them take none. */
+static void fill_attrs(const char *colour, char *attrs, size_t size)
+{
+    snprintf(attrs, size, "fill=\"%s\"%s", colour,
+             colour[1] == 'f' ? " stroke=\"#111111\" stroke-width=\"1\"" : "");
+}
+
 static void bar(vbuf *b, double x, double y0, double hpx, const char *colour)
 {
-    char attrs[32];
-    snprintf(attrs, sizeof attrs, "fill=\"%s\"", colour);
+    char attrs[80];
+    fill_attrs(colour, attrs, sizeof attrs);
     viz_rect(b, x, y0 - hpx, BAR_W, hpx, attrs);
 }
 
@@ -93,7 +110,7 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     pd_status st = viz_entries(in, &e, &n, diag);
     if (st != PD_OK)
         return st;
-    series s[4] = {{"QS", "#4e79a7"}, {"PQS", "#f28e2b"}, {NULL, "#59a14f"}, {"measured", "#3b3b3b"}};
+    series s[4] = {{"QS", "#c8c8c8"}, {"PQS", "#8e8e8e"}, {NULL, "#4a4a4a"}, {"measured", "#ffffff"}};
     char dyn_name[96];
     int has_dyn = e[0].has_dyn, has_meas = e[0].has_meas;
     if (has_dyn) {
@@ -131,21 +148,25 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     /* As wide as the bars need, or as the title and the whiskers' note, the
      * legend or the caption (centred under the plot), whichever is widest;
      * the groups then share the plot's width. */
-    double w = fmax(LEFT + n * (fmax(nser * (BAR_W + BAR_GAP), THUMB) + GROUP_GAP) + RIGHT, 640);
+    double group_min = fmax(nser * (BAR_W + BAR_GAP), THUMB) + GROUP_GAP;
+    int per_row = (int)fmax(1.0, floor((WRAP_W - LEFT - RIGHT) / group_min));
+    if (per_row > n)
+        per_row = n;
+    int nrows = (n + per_row - 1) / per_row;
+    double w = fmax(LEFT + per_row * group_min + RIGHT, 640);
     w = fmax(w, 10 + viz_text_width(title, 16, 1) + 20 + viz_text_width(whiskers, 11, 0) + RIGHT);
     for (int k = 0; k < nser + has_xc; k++)
         w = fmax(w, LEFT + 18 + viz_text_width(legend[k], 12, 0) + RIGHT);
     w = ceil(fmax(w, LEFT + viz_text_width(caption, 11, 0) + LEFT));
-    double plot_w = w - LEFT - RIGHT, group_w = plot_w / n;
-    double y_top = TOP + legend_h, y0 = y_top + PLOT_H;
-    double h = y0 + 22 + THUMB + 14;
+    double plot_w = w - LEFT - RIGHT, group_w = plot_w / per_row;
+    double h = TOP + legend_h + nrows * ROW_H - 16.0;
     viz_svg_open(b, standalone, w, h, title);
     vbuf_put(b, "<g class=\"chart\">\n");
     viz_text(b, 10, 22, 16, "start", 1, "#111111", title);
     for (int k = 0; k < nser; k++) {
         double y = TOP + k * LEGEND_LINE;
-        char attrs[32];
-        snprintf(attrs, sizeof attrs, "fill=\"%s\"", s[which[k]].colour);
+        char attrs[80];
+        fill_attrs(s[which[k]].colour, attrs, sizeof attrs);
         viz_rect(b, LEFT, y, 12, 12, attrs);
         viz_text(b, LEFT + 18, y + 10.5, 12, "start", 0, "#111111", legend[k]);
     }
@@ -156,23 +177,27 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     }
     if (whiskers[0])
         viz_text(b, w - RIGHT, 22, 11, "end", 0, "#555555", whiskers);
-    /* Axis and grid. */
+    /* Axis and grid, one per row, all at one scale. */
     double step, top = axis_top(e, n, &step);
     double ppu = PLOT_H / top;
-    for (int t = 0; t * step <= top + 1e-9; t++) {
-        double y = y0 - t * step * ppu;
-        viz_xy(b, "<path d=\"M", LEFT, y);
-        viz_xy(b, " L", LEFT + plot_w, y);
-        vbuf_printf(b, "\" stroke=\"%s\" stroke-width=\"1\"/>\n", t ? "#e3e3e3" : "#111111");
-        char lab[16];
-        snprintf(lab, sizeof lab, "%g%%", 100.0 * t * step);
-        viz_text(b, LEFT - 6, y + 4, 11, "end", 0, "#333333", lab);
+    for (int r = 0; r < nrows; r++) {
+        double y_top = TOP + legend_h + r * ROW_H, y0 = y_top + PLOT_H;
+        double row_w = (r + 1 < nrows ? per_row : n - r * per_row) * group_w;
+        for (int t = 0; t * step <= top + 1e-9; t++) {
+            double y = y0 - t * step * ppu;
+            viz_xy(b, "<path d=\"M", LEFT, y);
+            viz_xy(b, " L", LEFT + row_w, y);
+            vbuf_printf(b, "\" stroke=\"%s\" stroke-width=\"1\"/>\n", t ? "#e3e3e3" : "#111111");
+            char lab[16];
+            snprintf(lab, sizeof lab, "%g%%", 100.0 * t * step);
+            viz_text(b, LEFT - 6, y + 4, 11, "end", 0, "#333333", lab);
+        }
+        vbuf_put(b, "<text x=\"14\" y=\"");
+        vbuf_num(b, y_top + PLOT_H / 2.0);
+        vbuf_put(b, "\" font-size=\"12\" text-anchor=\"middle\" fill=\"#333333\" transform=\"rotate(-90 14 ");
+        vbuf_num(b, y_top + PLOT_H / 2.0);
+        vbuf_put(b, ")\">probability</text>\n");
     }
-    vbuf_put(b, "<text x=\"14\" y=\"");
-    vbuf_num(b, y_top + PLOT_H / 2.0);
-    vbuf_put(b, "\" font-size=\"12\" text-anchor=\"middle\" fill=\"#333333\" transform=\"rotate(-90 14 ");
-    vbuf_num(b, y_top + PLOT_H / 2.0);
-    vbuf_put(b, ")\">probability</text>\n");
     /* Thumbnails: every pose at one scale, like the gallery. */
     viz_view view;
     viz_view_default(&view);
@@ -180,7 +205,8 @@ pd_status viz_chart(const viz_input *in, int standalone, vbuf *b, pd_diag *diag)
     viz_pic *pics = viz_pics_build(in, e, n, &view, &ew, &eh);
     double tscale = fmin((THUMB - 4.0) / ew, (THUMB - 4.0) / eh);
     for (int i = 0; i < n; i++) {
-        double gx = LEFT + i * group_w + GROUP_GAP / 2.0;
+        double y0 = TOP + legend_h + (i / per_row) * ROW_H + PLOT_H;
+        double gx = LEFT + (i % per_row) * group_w + GROUP_GAP / 2.0;
         double inner = nser * (BAR_W + BAR_GAP) - BAR_GAP;
         double bx = gx + (group_w - GROUP_GAP - inner) / 2.0;
         vbuf_printf(b, "<g class=\"group\"><title>Pose %d</title>\n", e[i].number);

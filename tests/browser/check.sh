@@ -10,7 +10,8 @@
 # and renders each SVG with rsvg-convert, checking its size against the
 # file's own width and height and that it is not blank. Negative controls
 # first show that each check can fail: a page that logs to the console, and
-# a blank image. Last line "N passed, N failed"; exit status 1 on a failure.
+# a blank image. The report at 34 and 98 poses: every picture drawn at 0.8
+# of its size or more in a 1280 px window (text readable). Last line "N passed, N failed"; exit status 1 on a failure.
 set -u
 cd "$(dirname "$0")/../.."
 scripts/install-deps.sh browser || exit 1
@@ -82,6 +83,27 @@ for f in gallery chart sphere; do
     check 'awk -v c="$cov" -v n="$col" "BEGIN { exit !(c > 0.05 && n > 20) }"' \
         "$f.png looks blank: $cov of the pixels drawn, $col colours"
 done
+# The report at 34 and 98 poses (the cap and the insulator cap, not
+# grouped) in a laptop's 1280 px window: every picture drawn at 0.8 of its
+# size or more, so that its smallest text (11 px) is at least 8.8 px on the
+# screen (a 34-pose chart in one row was scaled to 0.34). A copy of the page
+# gets a script that measures each SVG's drawn width against its own, into
+# the DOM that --dump-dom prints.
+measure='<script>var o=[];document.querySelectorAll("section svg").forEach(function(s){o.push(s.closest("section").id+" "+(s.getBoundingClientRect().width/s.width.baseVal.value).toFixed(3))});var p=document.createElement("pre");p.id="measured";p.textContent=o.join(";");document.body.appendChild(p)</script>'
+for case in "cap 34" "insulator_cap 98"; do
+    read -r part want <<< "$case"
+    "$bin" -n 200 --report "$tmp/$part.r.html" "parts/$part.off" > "$tmp/$part.r.csv" 2> /dev/null
+    k=$(($(wc -l < "$tmp/$part.r.csv") - 1))
+    check '[ "$k" -eq "$want" ]' "parts/$part.off has $k poses, not $want"
+    sed "s|</body>|$measure</body>|" "$tmp/$part.r.html" > "$tmp/$part.m.html"
+    browse --dump-dom "file://$tmp/$part.m.html" "$tmp/$part.m.log" > "$tmp/$part.m.dom"
+    scales=$(sed -n 's|.*<pre id="measured">\([^<]*\)</pre>.*|\1|p' "$tmp/$part.m.dom")
+    check '[ "$(printf "%s" "$scales" | tr ";" "\n" | grep -c "^chart ")" -eq 1 ]' \
+        "$part: no chart measured in the rendered report: '$scales'"
+    small=$(printf '%s' "$scales" | tr ';' '\n' | awk '$2 < 0.8')
+    check '[ -z "$small" ]' "$part, $want poses: pictures drawn below 0.8 of their size: $small"
+done
+
 [ -n "${KEEP:-}" ] && cp "$tmp"/*.png "$tmp"/*.html "$tmp"/*.svg "$KEEP"/ 2>/dev/null
 echo "check-browser: $passed passed, $failed failed"
 [ "$failed" -eq 0 ]

@@ -551,6 +551,17 @@ static void test_eq16(void)
 static void test_scripts(void)
 {
     char cmd[512], *out, *err;
+    /* make demo's words: the classes with the three estimates, one row
+     * each (the cap: its sides and two ends), and where the report is. */
+    snprintf(cmd, sizeof cmd, "scripts/demo.sh " PD_CLI_PATH " parts/cap.off %s/demo", tmpdir);
+    CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+    CHECK(strstr(out, "  class poses      QS     PQS    drops   95% interval\n  1        32 ") &&
+          strstr(out, "\n  3         1 ") && !strstr(out, "\n  4 ") && strstr(out, "/demo/cap.html"));
+    free(out);
+    free(err);
+    char html[160];
+    snprintf(html, sizeof html, "%s/demo/cap.html", tmpdir);
+    CHECK(access(html, R_OK) == 0);
     snprintf(cmd, sizeof cmd, "scripts/posedrop-batch -o %s/batch -- parts/cap.off parts/button.off",
              tmpdir);
     int rc = run_cmd(cmd, 1, &out, &err);
