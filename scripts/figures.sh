@@ -12,7 +12,8 @@
 # the kept CSV instead of rerunning it. The paper numbers its poses by
 # physical frequency: its poses are paired with posedrop's classes by rank of
 # QS on both sides, as scripts/eq16.awk does, to write the measured file
-# (scripts/measured.awk).
+# (scripts/measured.awk). Last, the design demonstrations of docs/design.md
+# (scripts/design-demos.sh, into docs/figures/design/).
 set -eu
 . "$(dirname "$0")/args.sh"
 here=$(cd "$(dirname "$0")/.." && pwd)
@@ -23,7 +24,7 @@ while [ $# -gt 0 ]; do
     case "$1" in
         --chart-only) cost_args="--chart-only"; shift ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,15p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -62,3 +63,6 @@ echo "figures.sh: wrote $out/cap-gallery.svg, cap-chart.svg, cap-sphere.svg (row
 
 # shellcheck disable=SC2086
 "$here/scripts/cost-accuracy.sh" -o "$out" -d "$tables" $cost_args
+
+# The design demonstrations of docs/design.md (tens of minutes of CPU).
+"$here/scripts/design-demos.sh"

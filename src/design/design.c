@@ -479,13 +479,17 @@ static double nm_fn(const double *x, void *user)
     return f + out;
 }
 
-/* The objective that sampling error alone leaves at the answer. */
+/* Where the drops' search stops: a quarter of the objective that their
+ * sampling error gives at the answer, sum_t p_t (1 - p_t) / n, so that each
+ * residual is within about half a standard error of its own drops; at the
+ * full floor the answer still carried about one standard error of misfit
+ * beside the drops' own error, and fresh drops see both. */
 static double noise_floor(const run *R, const double *p)
 {
     double v = 0.0;
     for (int t = 0; t < R->nt; t++)
         v += p[t] * (1.0 - p[t]);
-    return v / (double)R->o->sim.ndrops;
+    return 0.25 * v / (double)R->o->sim.ndrops;
 }
 
 /* Stage 3 from x (overwritten by the best point the drops found); the
@@ -540,9 +544,8 @@ static double drop_stage(run *R, double *x, const double *J0, int m, double *bes
     double lambda = 1e-6;
     int misses = 0;
     /* Three steps in a row that do not lower the objective, or an
-     * objective below what the drops' own sampling error gives at the
-     * answer (sum_t p_t (1 - p_t) / n): the drops' answer is as good as
-     * their resolution lets it be. */
+     * objective below noise_floor: the drops' answer is as good as their
+     * resolution lets it be. */
     while (R->drop_evals < R->o->max_evals && isfinite(f) && f > noise_floor(R, best_p) &&
            R->st == PD_OK && !R->partial && misses < 3) {
         double x1[PD_DESIGN_MAX_CHANGES], r1[MAX_TARGETS], dx[PD_DESIGN_MAX_CHANGES];
