@@ -135,10 +135,11 @@ def test_trials_equal_command(tmp_path):
     trials = tmp_path / "trials.csv"
     run_cli("-n", "120", "--seed", "11", "--trials", trials, PARTS / "cap.off")
     rows, header = read_csv(trials)
-    assert header == ["drop", "qw", "qx", "qy", "qz", "pose", "collisions", "time", "end"]
+    assert header == ["drop", "qw", "qx", "qy", "qz", "pose", "collisions", "time", "end",
+                      "partial"]
     t = posedrop.Part.from_file(PARTS / "cap.off").drop(120, seed=11, trials=True).trials
     mine = [[str(i + 1), *map(g17, t.q0[i]), str(t.pose[i] + 1), str(t.collisions[i]),
-             g10(t.time[i]), END[t.end[i]]] for i in range(len(t))]
+             g10(t.time[i]), END[t.end[i]], "0"] for i in range(len(t))]
     assert mine == rows
 
 
