@@ -67,7 +67,9 @@ static void note(void *user, const char *stage, int round, double loglik)
     g->round = round;
     g->evaluation++;
     g->drops = m->drops;
-    if (strcmp(stage, "prediction") != 0 && loglik > g->best_loglik)
+    /* A prediction or a fresh check is not the search's likelihood. */
+    int scored = strcmp(stage, "prediction") != 0 && strcmp(stage, "fresh") != 0;
+    if (scored && loglik > g->best_loglik)
         g->best_loglik = loglik;
     if (m->progress)
         m->progress(g, m->progress_user);
