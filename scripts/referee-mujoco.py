@@ -217,7 +217,9 @@ def barrier(n, h, pts):
     s = math.sqrt(dot(u, u))
     u = tuple(x / s for x in u)
     w = cross(n, u)
-    ring = sorted(pts, key=lambda p: math.atan2(dot(sub(p, c), w), dot(sub(p, c), u)))
+    # The polygon's corners only: a vertex inside the facet (a fan's centre,
+    # a bore's rim) is not on an edge the part can tip over.
+    ring = hull2d(pts, c, u, w)
     best = math.inf
     for i in range(len(ring)):
         p, q = ring[i], ring[(i + 1) % len(ring)]
@@ -227,6 +229,25 @@ def barrier(n, h, pts):
         x = tuple(p[k] + t * d[k] for k in range(3))
         best = min(best, math.sqrt(dot(x, x)))
     return best
+
+
+def hull2d(pts, c, u, w):
+    """The convex hull of points on a plane (axes u, w about c), in order."""
+    key = sorted(set((dot(sub(p, c), u), dot(sub(p, c), w), i) for i, p in enumerate(pts)))
+
+    def turn(o, a, b):
+        return (a[0] - o[0]) * (b[1] - o[1]) - (a[1] - o[1]) * (b[0] - o[0])
+
+    def half(seq):
+        out = []
+        for q in seq:
+            while len(out) >= 2 and turn(out[-2], out[-1], q) <= 0:
+                out.pop()
+            out.append(q)
+        return out[:-1]
+
+    ring = half(key) + half(key[::-1])
+    return [pts[q[2]] for q in ring]
 
 
 def cross(a, b):
