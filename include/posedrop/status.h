@@ -36,6 +36,9 @@ typedef enum pd_status {
     PD_ERR_INTERNAL,       /* an internal consistency check failed: a bug */
     PD_ERR_UNAVAILABLE,    /* asked for something this program was not linked with
                               (the Bullet engine without libposedrop-bullet) */
+    PD_ERR_CANCELLED,      /* stopped by the caller's cancel flag before it had a
+                              result (pd_fit_run; pd_sim_run instead returns PD_OK
+                              with the drops done, marked partial) */
     PD_STATUS_COUNT
 } pd_status;
 

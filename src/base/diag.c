@@ -58,6 +58,7 @@ const char *pd_status_str(pd_status status)
         [PD_ERR_NOMEM] = "out of memory",
         [PD_ERR_INTERNAL] = "internal error",
         [PD_ERR_UNAVAILABLE] = "not available in this program",
+        [PD_ERR_CANCELLED] = "cancelled",
     };
     if ((unsigned)status >= PD_STATUS_COUNT)
         return "unknown status";
@@ -71,6 +72,7 @@ int pd_status_is_input_error(pd_status status)
     case PD_ERR_NOMEM:
     case PD_ERR_INTERNAL:
     case PD_ERR_NO_CONVERGENCE:
+    case PD_ERR_CANCELLED:
         return 0;
     default:
         return (unsigned)status < PD_STATUS_COUNT;
