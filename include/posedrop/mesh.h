@@ -51,6 +51,7 @@ typedef struct pd_mesh {
 typedef struct pd_mesh_read_options {
     pd_mesh_format format; /* default PD_FORMAT_AUTO */
     pd_units units;        /* unit of the file's coordinates; default metres */
+    pd_cancel_flag *cancel; /* may be NULL (the default); see pd_mesh_read */
 } pd_mesh_read_options;
 
 PD_API void pd_mesh_read_options_default(pd_mesh_read_options *options);
@@ -60,7 +61,10 @@ PD_API void pd_mesh_read_options_default(pd_mesh_read_options *options);
  * mesh owned by the caller (pd_mesh_free). Returns PD_ERR_IO, PD_ERR_FORMAT,
  * PD_ERR_PARSE (malformed or truncated content, wrong counts), PD_ERR_NONFINITE,
  * PD_ERR_RANGE (index out of range, count too large), PD_ERR_NOMEM; the diag
- * message names the file and, for text formats, the line. */
+ * message names the file and, for text formats, the line. PD_ERR_CANCELLED
+ * when options->cancel is set (non-zero, by another thread or a signal
+ * handler) before the mesh is read: text formats read it every few
+ * thousand lines. */
 PD_API pd_status pd_mesh_read(const char *path, const pd_mesh_read_options *options,
                               pd_mesh **mesh, pd_diag *diag);
 

@@ -21,6 +21,12 @@ extern "C" {
 typedef struct pd_part_options {
     int com_given;  /* 1: use com below instead of the mesh's own centre of mass */
     pd_vec3 com;    /* metres, in the mesh's frame; read only when com_given */
+    pd_cancel_flag *cancel; /* may be NULL (the default): see pd_part_build */
+    /* May be NULL (the default): called from the calling thread as each
+     * stage of the build starts ("welding", "convex hull", "orienting",
+     * "mass properties", "self-crossing check"), for a progress line. */
+    void (*stage)(void *user, const char *name);
+    void *stage_user;
 } pd_part_options;
 
 PD_API void pd_part_options_default(pd_part_options *options);
@@ -49,6 +55,9 @@ typedef struct pd_part {
  * the part's origin (above); weld at
  * PD_TOL_WELD_REL of the size; orient (faces flipped are reported by a warning);
  * mass properties; convex hull; centre of mass strictly inside the hull.
+ * PD_ERR_CANCELLED when options->cancel is found set (non-zero, by another
+ * thread or a signal handler): read between the stages of the build and
+ * every few thousand steps of the self-crossing check.
  * A mesh that is not closed is accepted only with options->com_given.
  * options may be NULL. A mesh with a negative count or missing arrays, or
  * options with com_given other than 0 or 1, is PD_ERR_USAGE; a vertex index

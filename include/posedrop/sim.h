@@ -18,20 +18,6 @@
 #include "posedrop/static.h"
 #include "posedrop/status.h"
 
-/* The cancel flag of pd_sim_options: a C11 atomic_int, which C++23 spells
- * std::atomic<int> (the same object, so a C++ caller can share it). The
- * extern "C++" keeps <atomic> working when a caller wraps this header in
- * extern "C". */
-#ifdef __cplusplus
-extern "C++" {
-#include <atomic>
-}
-typedef std::atomic<int> pd_cancel_flag;
-#else
-#include <stdatomic.h>
-typedef atomic_int pd_cancel_flag;
-#endif
-
 #ifdef __cplusplus
 extern "C" {
 #endif

@@ -49,6 +49,9 @@ typedef struct pd_static_options {
     double epsilon;         /* PQS perturbation angle, radians; default 20 deg */
     pd_pqs_compare compare; /* default PD_PQS_COMPARE_RAW */
     pd_pqs_band band;       /* default PD_PQS_BAND_RECT */
+    pd_cancel_flag *cancel; /* may be NULL (the default): when found set (read
+                               between the estimators' stages),
+                               pd_static_estimate returns PD_ERR_CANCELLED */
 } pd_static_options;
 
 PD_API void pd_static_options_default(pd_static_options *options);

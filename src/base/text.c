@@ -73,6 +73,14 @@ static int skip_space(pd_text *t)
 
 int pd_text_next_line(pd_text *t)
 {
+    /* A cancelled read ends its input: the reader stops at its next line,
+     * and its caller, seeing cancelled, reports the cancel rather than
+     * what the reader made of the short input. */
+    if (t->cancel && ++t->lines % 4096 == 0 &&
+        atomic_load_explicit(t->cancel, memory_order_relaxed))
+        t->cancelled = 1;
+    if (t->cancelled)
+        return 0;
     /* The rest of a joined line belongs to the record being left. */
     while (t->cont && load_raw(t)) {
     }

@@ -8,6 +8,7 @@
 #define PD_TEXT_H
 
 #include <stddef.h>
+#include "posedrop/types.h"
 #include "base/fail.h"
 #include "base/number.h" /* pd_parse_double and its outcomes */
 
@@ -25,6 +26,10 @@ typedef struct pd_text {
     char comment;        /* character starting a comment to end of line, or 0 */
     int join;            /* a trailing backslash joins the next line (OBJ) */
     int cont;            /* the current raw line ends with such a backslash */
+    pd_cancel_flag *cancel; /* may be NULL: read every few thousand lines; once
+                               found set, the input ends there (cancelled = 1) */
+    unsigned lines;
+    int cancelled;
 } pd_text;
 
 void pd_text_init(pd_text *t, const void *data, size_t size, const char *name, char comment,

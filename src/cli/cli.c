@@ -30,7 +30,8 @@ enum { OPT_UNITS = 256, OPT_FORMAT, OPT_COM, OPT_TOPPLE, OPT_EPSILON, OPT_PQS_CO
        OPT_MU, OPT_RESTITUTION, OPT_LAW, OPT_VIBRATION, OPT_INITIAL, OPT_SCENE, OPT_TRIALS,
        OPT_ENGINE, OPT_DT, OPT_GROUP, OPT_TRANSITIONS, OPT_CONTACT_TIME,
        OPT_SVG, OPT_CHART, OPT_SPHERE, OPT_REPORT, OPT_MEASURED, OPT_SHARD, OPT_TUMBLE,
-       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT, OPT_TRACE, OPT_TRACE_DROP };
+       OPT_SENSITIVITY, OPT_TIME_LIMIT, OPT_CROSSCHECK, OPT_EFFECT, OPT_TRACE, OPT_TRACE_DROP,
+       OPT_PROGRESS };
 
 typedef enum {
     ARG_HEADING, /* not an option: a heading of the help */
@@ -230,6 +231,10 @@ static const cli_option options[] = {
      "geometry of its first member, p_qs, p_pqs, count and p\n"
      "summed, the class's own interval, and a last column\n"
      "members: the member poses' numbers, space-separated"},
+    {OPT_PROGRESS, "progress", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
+     "a progress line on stderr even when it is not a terminal\n"
+     "(on a terminal it is drawn anyway): the drops done, and\n"
+     "the stage of a part whose static estimate passes 2 s"},
     {OPT_VERBOSE, "verbose", ARG_FLAG, NULL, NO_RULE, NULL, NULL,
      "a summary of the part (and of the drops) on stderr"},
     HEADING("pictures (docs/figures.md):"),
@@ -482,6 +487,7 @@ static int apply(cli_args *a, const cli_option *o, const char *arg, double x, lo
     case OPT_GROUP: a->group = 1; break;
     case OPT_CROSSCHECK: a->crosscheck = 1; break;
     case OPT_VERBOSE: a->verbose = 1; break;
+    case OPT_PROGRESS: progress_force(); break;
     case OPT_SVG: a->pictures[VIZ_GALLERY] = arg; break;
     case OPT_CHART: a->pictures[VIZ_CHART] = arg; break;
     case OPT_SPHERE: a->pictures[VIZ_SPHERE] = arg; break;

@@ -81,10 +81,23 @@ void signals_install(void);
 void signals_catch(pd_sim_options *options);
 void signals_catch_fit(pd_fit_options *options);
 int signals_caught(void);
+/* The same for the static estimate: reading, the part build, QS and PQS
+ * return PD_ERR_CANCELLED soon after a signal. */
+void signals_catch_static(cli_args *a);
 
 /* progress.c: when stderr is a terminal, options->progress draws a line. */
 void progress_attach(pd_sim_options *options);
 void progress_clear(void);
+/* --progress: the lines are drawn even when stderr is not a terminal. */
+void progress_force(void);
+/* The static estimate's line: once it has run STATIC_QUIET_S, a line on
+ * stderr names the stage under way and the seconds so far, redrawn by a
+ * thread of its own (a stage may be one long call); stage_begin names the
+ * command's own stages, and the part build's come through
+ * options->stage. static_progress_end clears the line. */
+void static_progress_begin(pd_part_options *options);
+void static_progress_stage(const char *name);
+void static_progress_end(void);
 
 /* plausible.c: warns on stderr when the part's size, or the drop height
  * against it, suggests a unit mistaken (a file in millimetres read as

@@ -672,20 +672,28 @@ int cli_run(cli_args *a)
     viz_engines xe_store, *xe = NULL;
     pd_sensitivity *sens = NULL;
     int *class_of = NULL, nclasses = 0;
+    signals_catch_static(a);
+    static_progress_begin(&a->part);
     st = pd_mesh_read(a->path, &a->read, &mesh, &diag);
-    if (st != PD_OK) {
+    if (st != PD_OK && st != PD_ERR_CANCELLED) {
+        static_progress_end();
         code = fail_status(st, &diag, NULL);
         goto done;
     }
-    st = pd_part_build(mesh, &a->part, &part, &diag);
+    if (st == PD_OK)
+        st = pd_part_build(mesh, &a->part, &part, &diag);
     if (st == PD_OK && !a->merge && cli_writer())
         plausible_warn(a, part);
+    static_progress_stage("quasi-static and perturbed estimates");
     if (st == PD_OK)
         st = pd_static_estimate(part, &a->estimate, &res, &diag);
+    static_progress_end();
     t_static = cli_wall_seconds() - t0;
     /* A signal before the drops (or, without drops, before the output)
-     * ends the run here, nothing printed. */
-    if (st == PD_OK && cli_any(signals_caught())) {
+     * ends the run here, nothing printed; one during the static estimate
+     * stops it there (PD_ERR_CANCELLED). */
+    if ((st == PD_OK || st == PD_ERR_CANCELLED) &&
+        cli_any(st == PD_ERR_CANCELLED || signals_caught())) {
         code = cli_interrupt_code();
         goto done;
     }

@@ -41,6 +41,13 @@ void signals_catch_fit(pd_fit_options *options)
     options->cancel = &caught;
 }
 
+void signals_catch_static(cli_args *a)
+{
+    a->read.cancel = &caught;
+    a->part.cancel = &caught;
+    a->estimate.cancel = &caught;
+}
+
 int signals_caught(void)
 {
     return atomic_load(&caught) != 0;

@@ -91,6 +91,7 @@ void pd_mesh_read_options_default(pd_mesh_read_options *options)
         return;
     options->format = PD_FORMAT_AUTO;
     options->units = PD_UNITS_M;
+    options->cancel = NULL;
 }
 
 /* --- format detection ----------------------------------------------------- */
@@ -213,18 +214,32 @@ pd_status pd_mesh_parse(const void *data, size_t size, const char *name,
     pd_mesh_format f = options->format;
     if (f == PD_FORMAT_AUTO)
         f = detect(d, size, size, name);
+    pd_status st;
     switch (f) {
     case PD_FORMAT_OFF:
-        return pd_off_read((const char *)d, size, name, scale, mesh, diag);
+        st = pd_off_read((const char *)d, size, name, scale, mesh, diag, options->cancel);
+        break;
     case PD_FORMAT_STL:
-        return pd_stl_read(d, size, name, scale, mesh, diag);
+        st = pd_stl_read(d, size, name, scale, mesh, diag, options->cancel);
+        break;
     case PD_FORMAT_OBJ:
-        return pd_obj_read((const char *)d, size, name, scale, mesh, diag);
+        st = pd_obj_read((const char *)d, size, name, scale, mesh, diag, options->cancel);
+        break;
     case PD_FORMAT_AUTO:
     default:
-        break;
+        return unknown_format(size, name, diag);
     }
-    return unknown_format(size, name, diag);
+    /* A reader stopped by the cancel flag saw its input end early and may
+     * have called that a parse error, or (the flag set after its last
+     * line) finished: either way the caller asked to stop. */
+    if (options->cancel && atomic_load(options->cancel)) {
+        if (st == PD_OK) {
+            pd_mesh_free(*mesh);
+            *mesh = NULL;
+        }
+        return pd_fail(diag, PD_ERR_CANCELLED, "%s: reading cancelled", name);
+    }
+    return st;
 }
 
 /* The bytes read first from a regular file, before the rest: far more than

@@ -16,10 +16,13 @@ pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag);
  * without crossing, is not crossing; coplanar pairs are not examined).
  * *ta < *tb are their indices and *at a point of the crossing (rounded), or
  * *ta = *tb = -1 when there is none; *tested (when not NULL) the number of
- * pairs that reached the exact test. PD_OK or PD_ERR_NOMEM. Pairs sharing a
+ * pairs that reached the exact test. PD_OK, PD_ERR_NOMEM, or
+ * PD_ERR_CANCELLED when *cancel (may be NULL) is found non-zero (read
+ * before the search and every few thousand steps of it). Pairs sharing a
  * vertex are found from the directions about it, the others by a tree of
  * oriented boxes: about n log n for the usual surfaces, long thin triangles
  * across the axes and fans of them about one corner included. */
-pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at, size_t *tested);
+pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *ta, int *tb,
+                                pd_vec3 *at, size_t *tested);
 
 #endif

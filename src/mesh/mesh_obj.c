@@ -153,10 +153,12 @@ pd_status pd_obj_check_head(const char *head, size_t n, const char *name, pd_dia
 }
 
 pd_status pd_obj_read(const char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag)
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel)
 {
     pd_text t;
     pd_text_init(&t, data, size, name, '#', 1);
+    t.cancel = cancel;
     pd_build b = {0};
     pd_status st = PD_OK;
     while (st == PD_OK && pd_text_next_line(&t)) {

@@ -216,10 +216,12 @@ static pd_status read_face(pd_text *t, pd_diag *diag, int nverts, pd_build *b)
 }
 
 pd_status pd_off_read(const char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag)
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel)
 {
     pd_text t;
     pd_text_init(&t, data, size, name, '#', 0);
+    t.cancel = cancel;
     long long nv, nf;
     pd_status st = read_header(&t, diag, &nv, &nf);
     if (st != PD_OK)

@@ -93,10 +93,13 @@ pd_status pd_stl_check_head(const unsigned char *head, size_t n, size_t size, co
 /* Each reads the whole input, scaling coordinates by scale. On failure *mesh
  * is untouched and diag says what and where. */
 pd_status pd_off_read(const char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag);
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel);
 pd_status pd_stl_read(const unsigned char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag);
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel);
 pd_status pd_obj_read(const char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag);
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel);
 
 #endif

@@ -10,9 +10,9 @@
  * crossing. Coplanar pairs are not examined (they touch, or overlap within
  * one plane, which the moment checks see as area, not as volume). */
 #include <math.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
-#include "base/mat3.h"
 #include "base/predicates.h"
 #include "base/vec3.h"
 #include "mesh/mesh_internal.h"
@@ -155,6 +155,48 @@ static int degenerate(const pd_mesh *m, int t)
     return 1;
 }
 
+/* The search's boxes hold finite numbers only (the mesh's coordinates are
+ * finite), so the comparisons below are min and max, inline where libm's
+ * fmin and fmax, which also order NaNs, are calls through the PLT. */
+static inline double dmin(double a, double b)
+{
+    return a < b ? a : b;
+}
+
+static inline double dmax(double a, double b)
+{
+    return a > b ? a : b;
+}
+
+/* How many steps of a long loop run between two reads of the cancel flag:
+ * each step is at most a few microseconds, so a few thousand of them keep a
+ * cancelled search's answer within a millisecond or so. */
+enum { POLL_EVERY = 4096 };
+
+typedef struct search {
+    const pd_mesh *m;
+    int *patch;            /* the flat patch of each triangle */
+    int *start, *list;     /* the triangles about vertex v: list[start[v] .. start[v + 1]) */
+    double pad;            /* widening of every projection (PD_SELFX_PAD_REL) */
+    size_t tested;         /* pairs given to the exact test */
+    int ta, tb;
+    pd_vec3 at;
+    pd_cancel_flag *cancel; /* may be NULL */
+    unsigned polls;
+    int cancelled;
+} search;
+
+/* 1 when the caller's flag says stop (read every POLL_EVERY calls). */
+static int stop(search *s)
+{
+    if (s->cancelled)
+        return 1;
+    if (!s->cancel || ++s->polls % POLL_EVERY)
+        return 0;
+    s->cancelled = atomic_load_explicit(s->cancel, memory_order_relaxed) != 0;
+    return s->cancelled;
+}
+
 static int root(int *up, int t)
 {
     while (up[t] != t)
@@ -162,94 +204,150 @@ static int root(int *up, int t)
     return t;
 }
 
+/* The triangles about each vertex, in increasing order of triangle. */
+static int build_stars(search *s)
+{
+    const pd_mesh *m = s->m;
+    int nv = m->nverts;
+    size_t n3 = 3 * (size_t)m->ntris;
+    s->start = calloc((size_t)nv + 1, sizeof *s->start);
+    s->list = malloc(sizeof *s->list * n3);
+    if (!s->start || !s->list)
+        return -1;
+    for (int t = 0; t < m->ntris; t++)
+        for (int k = 0; k < 3; k++)
+            s->start[m->tris[t][k] + 1]++;
+    for (int v = 0; v < nv; v++)
+        s->start[v + 1] += s->start[v];
+    /* Filled from the end of each vertex's range, which leaves start[v + 1]
+     * at the start of v's range: the ranges shift down by one. */
+    for (int t = m->ntris - 1; t >= 0; t--)
+        for (int k = 2; k >= 0; k--)
+            s->list[--s->start[m->tris[t][k] + 1]] = t;
+    memmove(s->start, s->start + 1, sizeof *s->start * (size_t)nv);
+    s->start[nv] = (int)n3;
+    return 0;
+}
+
 typedef struct edge {
-    int a, b, t;
+    int b, t;
 } edge;
+
+static int edge_less(const edge *x, const edge *y)
+{
+    return x->b < y->b || (x->b == y->b && x->t < y->t);
+}
 
 static int edge_cmp(const void *pa, const void *pb)
 {
-    const edge *x = pa, *y = pb;
-    if (x->a != y->a)
-        return x->a < y->a ? -1 : 1;
-    if (x->b != y->b)
-        return x->b < y->b ? -1 : 1;
-    return (x->t > y->t) - (x->t < y->t);
+    return edge_less(pa, pb) ? -1 : edge_less(pb, pa);
+}
+
+/* Sorts the few edges about one vertex: by insertion when they are few (the
+ * usual star), by qsort otherwise (a fan of thousands about one corner). */
+static void sort_edges(edge *e, int n)
+{
+    if (n > 24) {
+        qsort(e, (size_t)n, sizeof *e, edge_cmp);
+        return;
+    }
+    for (int i = 1; i < n; i++) {
+        edge x = e[i];
+        int j = i;
+        for (; j > 0 && edge_less(&x, &e[j - 1]); j--)
+            e[j] = e[j - 1];
+        e[j] = x;
+    }
 }
 
 /* Flat patches: triangles joined through shared edges to neighbours in
  * their plane, exactly (neither of the two degenerate, the fourth corner on
- * the plane of the other three); *up[t] names t's patch. Two triangles of
+ * the plane of the other three); patch[t] names t's patch. Two triangles of
  * one patch lie in one plane (each step keeps the plane: two corners of the
  * edge and a third not on their line), and coplanar pairs are never found
- * crossing, so the sweep skips them: a flat face fanned into many triangles
- * about one corner would otherwise test every pair of them, each sign an
- * exact zero. */
-static pd_status flat_patches(const pd_mesh *m, int *up)
+ * crossing, so the search skips them: a flat face fanned into many
+ * triangles about one corner would otherwise test every pair of them, each
+ * sign an exact zero. The edges are taken vertex by vertex from the stars
+ * (each edge at its lower vertex, the triangles along it in increasing
+ * order, consecutive ones joined), not from one sort of all edges, which
+ * cost a log more and a copy of them all. */
+static int flat_patches(search *s)
 {
-    size_t ne = 3 * (size_t)m->ntris;
-    edge *e = malloc(sizeof *e * ne);
+    const pd_mesh *m = s->m;
+    int *up = s->patch, maxdeg = 0;
     char *flat = malloc((size_t)m->ntris);
-    if (!e || !flat) {
-        free(e);
+    if (!flat)
+        return -1;
+    for (int v = 0; v < m->nverts; v++)
+        maxdeg = s->start[v + 1] - s->start[v] > maxdeg ? s->start[v + 1] - s->start[v] : maxdeg;
+    edge *e = malloc(sizeof *e * (2 * (size_t)maxdeg + 1));
+    if (!e) {
         free(flat);
-        return PD_ERR_NOMEM;
+        return -1;
     }
     for (int t = 0; t < m->ntris; t++) {
         up[t] = t;
         flat[t] = !degenerate(m, t);
-        for (int k = 0; k < 3; k++) {
-            int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
-            e[3 * (size_t)t + (size_t)k] = (edge){a < b ? a : b, a < b ? b : a, t};
-        }
+        if (stop(s))
+            break;
     }
-    qsort(e, ne, sizeof *e, edge_cmp);
-    for (size_t i = 0; i + 1 < ne; i++) {
-        const edge *x = &e[i], *y = &e[i + 1];
-        if (x->a != y->a || x->b != y->b || !flat[x->t] || !flat[y->t])
-            continue;
-        int c = -1, d = -1;
-        for (int k = 0; k < 3; k++) {
-            int vx = m->tris[x->t][k], vy = m->tris[y->t][k];
-            if (vx != x->a && vx != x->b)
-                c = vx;
-            if (vy != x->a && vy != x->b)
-                d = vy;
+    for (int a = 0; a < m->nverts && !stop(s); a++) {
+        int n = 0;
+        for (int i = s->start[a]; i < s->start[a + 1]; i++) {
+            int t = s->list[i];
+            for (int k = 0; k < 3; k++)
+                if (m->tris[t][k] == a) {
+                    /* The edges of t from a: to the corners after and before it. */
+                    int b1 = m->tris[t][(k + 1) % 3], b2 = m->tris[t][(k + 2) % 3];
+                    if (b1 > a)
+                        e[n++] = (edge){b1, t};
+                    if (b2 > a && b2 != b1)
+                        e[n++] = (edge){b2, t};
+                    break;
+                }
         }
-        if (c < 0 || d < 0 || c == d)
-            continue;
-        if (orient(&m->verts[x->a], &m->verts[x->b], &m->verts[c], &m->verts[d]) == 0) {
-            int rx = root(up, x->t), ry = root(up, y->t);
-            up[rx > ry ? rx : ry] = rx > ry ? ry : rx;
+        sort_edges(e, n);
+        for (int i = 0; i + 1 < n; i++) {
+            const edge *x = &e[i], *y = &e[i + 1];
+            if (x->b != y->b || !flat[x->t] || !flat[y->t])
+                continue;
+            int c = -1, d = -1, b = x->b;
+            for (int k = 0; k < 3; k++) {
+                int vx = m->tris[x->t][k], vy = m->tris[y->t][k];
+                if (vx != a && vx != b)
+                    c = vx;
+                if (vy != a && vy != b)
+                    d = vy;
+            }
+            if (c < 0 || d < 0 || c == d)
+                continue;
+            if (orient(&m->verts[a], &m->verts[b], &m->verts[c], &m->verts[d]) == 0) {
+                int rx = root(up, x->t), ry = root(up, y->t);
+                up[rx > ry ? rx : ry] = rx > ry ? ry : rx;
+            }
         }
     }
     free(e);
     free(flat);
-    return PD_OK;
+    /* Each triangle's root, once: the tests below compare patches directly. */
+    for (int t = 0; t < m->ntris; t++)
+        up[t] = root(up, t);
+    return 0;
 }
 
 static int shared(const int a[3], const int b[3])
 {
     int n = 0;
     for (int i = 0; i < 3; i++)
-        for (int j = 0; j < 3; j++)
-            n += a[i] == b[j];
+        n += (a[i] == b[0]) + (a[i] == b[1]) + (a[i] == b[2]);
     return n;
 }
-
-typedef struct search {
-    const pd_mesh *m;
-    int *up;        /* flat patches */
-    double pad;     /* widening of every projection (PD_SELFX_PAD_REL) */
-    size_t tested;  /* pairs given to the exact test */
-    int ta, tb;
-    pd_vec3 at;
-} search;
 
 /* The exact test of triangles a and b (not of one flat patch); records them
  * when they cross. */
 static int test_pair(search *s, int a, int b)
 {
-    if (root(s->up, a) == root(s->up, b))
+    if (s->patch[a] == s->patch[b])
         return 0;
     const int *A = s->m->tris[a], *B = s->m->tris[b];
     const pd_vec3 *v = s->m->verts;
@@ -280,12 +378,14 @@ typedef struct arc {
     int t;
 } arc;
 
+static int arc_less(const arc *a, const arc *b)
+{
+    return a->key < b->key || (a->key == b->key && a->t < b->t);
+}
+
 static int arc_cmp(const void *pa, const void *pb)
 {
-    const arc *a = pa, *b = pb;
-    if (a->key != b->key)
-        return a->key < b->key ? -1 : 1;
-    return (a->t > b->t) - (a->t < b->t);
+    return arc_less(pa, pb) ? -1 : arc_less(pb, pa);
 }
 
 static void arc_box(const pd_mesh *m, int t, int v, arc *b)
@@ -309,8 +409,8 @@ static void arc_box(const pd_mesh *m, int t, int v, arc *b)
     pd_vec3 tip = v3_scale(v3_add(u, w), 1.0 / (1.0 + c));
     double p[3][3] = {{u.x, u.y, u.z}, {w.x, w.y, w.z}, {tip.x, tip.y, tip.z}};
     for (int i = 0; i < 3; i++) {
-        b->lo[i] = fmin(fmin(p[0][i], p[1][i]), p[2][i]) - PD_SELFX_ARC_PAD;
-        b->hi[i] = fmax(fmax(p[0][i], p[1][i]), p[2][i]) + PD_SELFX_ARC_PAD;
+        b->lo[i] = dmin(dmin(p[0][i], p[1][i]), p[2][i]) - PD_SELFX_ARC_PAD;
+        b->hi[i] = dmax(dmax(p[0][i], p[1][i]), p[2][i]) + PD_SELFX_ARC_PAD;
     }
 }
 
@@ -324,8 +424,8 @@ static int sweep(search *s, arc *bx, int n)
     for (int k = 0; k < 3; k++) {
         double lo = HUGE_VAL, hi = -HUGE_VAL, ext = 0.0;
         for (int i = 0; i < n; i++) {
-            lo = fmin(lo, bx[i].lo[k]);
-            hi = fmax(hi, bx[i].hi[k]);
+            lo = dmin(lo, bx[i].lo[k]);
+            hi = dmax(hi, bx[i].hi[k]);
             ext += bx[i].hi[k] - bx[i].lo[k];
         }
         double r = hi > lo ? ext / (hi - lo) : HUGE_VAL;
@@ -336,7 +436,17 @@ static int sweep(search *s, arc *bx, int n)
     }
     for (int i = 0; i < n; i++)
         bx[i].key = bx[i].lo[ax];
-    qsort(bx, (size_t)n, sizeof *bx, arc_cmp);
+    if (n > 16) {
+        qsort(bx, (size_t)n, sizeof *bx, arc_cmp);
+    } else {
+        for (int i = 1; i < n; i++) {
+            arc x = bx[i];
+            int j = i;
+            for (; j > 0 && arc_less(&x, &bx[j - 1]); j--)
+                bx[j] = bx[j - 1];
+            bx[j] = x;
+        }
+    }
     for (int a = 0; a < n; a++)
         for (int b = a + 1; b < n && bx[b].key <= bx[a].hi[ax]; b++) {
             if (bx[b].lo[0] > bx[a].hi[0] || bx[b].hi[0] < bx[a].lo[0] ||
@@ -351,415 +461,586 @@ static int sweep(search *s, arc *bx, int n)
 }
 
 /* Every pair that shares exactly one vertex, by the star of each vertex.
- * 1 when a crossing is found, -1 when out of memory. */
+ * 1 when a crossing is found (or the search is cancelled), -1 when out of
+ * memory. */
 static int star_pairs(search *s)
 {
     const pd_mesh *m = s->m;
-    int nv = m->nverts, found = 0;
-    size_t n3 = 3 * (size_t)m->ntris;
-    int *start = calloc((size_t)nv + 1, sizeof *start), *list = malloc(sizeof *list * n3);
-    arc *bx = malloc(sizeof *bx * n3);
-    if (!start || !list || !bx) {
-        free(start);
-        free(list);
-        free(bx);
-        return -1;
-    }
-    for (int t = 0; t < m->ntris; t++)
-        for (int k = 0; k < 3; k++)
-            start[m->tris[t][k] + 1]++;
+    int nv = m->nverts, found = 0, maxdeg = 0;
     for (int v = 0; v < nv; v++)
-        start[v + 1] += start[v];
-    /* Filled from the end of each vertex's range, which leaves start[v + 1]
-     * at the start of v's range: the ranges shift down by one. */
-    for (int t = m->ntris - 1; t >= 0; t--)
-        for (int k = 2; k >= 0; k--)
-            list[--start[m->tris[t][k] + 1]] = t;
-    memmove(start, start + 1, sizeof *start * (size_t)nv);
-    start[nv] = (int)n3;
+        maxdeg = s->start[v + 1] - s->start[v] > maxdeg ? s->start[v + 1] - s->start[v] : maxdeg;
+    arc *bx = malloc(sizeof *bx * ((size_t)maxdeg + 1));
+    if (!bx)
+        return -1;
     for (int v = 0; v < nv && !found; v++) {
-        int n = start[v + 1] - start[v];
+        int n = s->start[v + 1] - s->start[v];
         for (int i = 0; i < n; i++)
-            arc_box(m, list[start[v] + i], v, &bx[i]);
-        found = sweep(s, bx, n);
+            arc_box(m, s->list[s->start[v] + i], v, &bx[i]);
+        found = sweep(s, bx, n) || stop(s);
     }
-    free(start);
-    free(list);
     free(bx);
     return found;
 }
 
-/* Pairs that share no vertex: a tree of bounding boxes, each oriented along
- * the principal axes of the corners it bounds (one triangle's along its
- * longest edge and its normal) and also kept along the coordinate axes
- * (tried first: cheap and exact). Boxes along the coordinate axes alone do
- * not separate long thin triangles that lie across the axes (a rod turned
- * off them: every pair of its side slivers' boxes meets); oriented ones do.
- * Two boxes are apart when their projections on one of their six axes are
- * apart, a triangle projecting its corners and a box its centre and
- * half-widths; every projection is widened by pad, far above the round-off
- * of the frames and dot products, so a pair that may cross is never
- * dropped: the exact test decides. A node's corners common to all its
+/* Pairs that share no vertex: a tree of boxes over the triangles in the
+ * order of their centroids along a Morton curve, each box oriented along
+ * the longest edge of its triangles and the normal of that edge's triangle
+ * (a spike of a noisy scan, a sliver of a rod turned off the axes: its box
+ * is as thin as it is, where a box along the coordinate axes would span the
+ * part). Two boxes are apart when their projections on one of their six
+ * axes are apart, a triangle projecting its corners and a box its centre
+ * and half-widths; every projection is widened by pad, far above the
+ * round-off of the frames and dot products, so a pair that may cross is
+ * never dropped: the exact test decides. A node's corners common to all its
  * triangles, and its flat patch, skip a pair of nodes whose triangles all
- * share a vertex (taken by the stars) or a plane. */
-typedef struct obox {
-    pd_vec3 ax[3];
-    double lo[3], hi[3];   /* the corners' projections on ax, widened by pad */
-    double blo[3], bhi[3]; /* and on the coordinate axes */
-} obox;
+ * share a vertex (taken by the stars) or a plane.
+ *
+ * The order is one sort of 63-bit keys (a radix sort, linear), the tree
+ * splits it into halves of whole leaves (balanced, built in linear time),
+ * and a node's box is fitted to its children's boxes, not to its corners:
+ * the whole build is linear in the triangles, and the traversal, which
+ * visits the pairs of nodes whose boxes meet, about n log n on surfaces
+ * whose triangles' neighbours are few, whatever their shapes. */
+enum { LEAF_TRIS = 8, REFIT_TRIS = 64 };
 
-/* Triangles per leaf: its pairs, and those with another leaf, are taken
- * triangle by triangle; fewer nodes to visit than with one per leaf. */
-enum { LEAF_TRIS = 4 };
+typedef struct bnode {
+    pd_vec3 ax[3];       /* orthonormal to round-off */
+    double lo[3], hi[3]; /* the projections on ax of its corners, widened */
+    int cv[3];           /* corners common to all its triangles, -1 for none */
+    int patch;           /* the flat patch of all its triangles, or -1 */
+    int first, count;    /* its triangles: order[first .. first + count) */
+    int left;            /* children left and left + 1; -1 for a leaf */
+} bnode;
 
-typedef struct node {
-    obox box;
-    int first, count;     /* its triangles: order[first .. first + count) */
-    int left, right;      /* children; left < 0 for a leaf */
-    int cv[3], ncv;       /* corners common to all its triangles */
-    int patch;            /* the flat patch of all its triangles, or -1 */
-} node;
-
-typedef struct keyed {
-    double key;
+/* A triangle's box along the coordinate axes, in floats: it only guides
+ * the split (a split that rounding makes worse is still a split), never
+ * decides a pair. */
+typedef struct item {
+    float lo[3], hi[3];
     int t;
-} keyed;
+} item;
 
-typedef struct tree {
-    node *nodes;
-    int nn, *order;
-    pd_vec3 *cen; /* centroids, times 3 */
-    keyed *tmp;
-    obox *tbox;   /* each triangle's own box */
-} tree;
-
-static int keyed_less(const keyed *a, const keyed *b)
-{
-    return a->key < b->key || (a->key == b->key && a->t < b->t);
-}
-
-/* Reorders k[0 .. n) so that k[h] is the one a sort would put there, those
- * before it not after it and those after not before (Hoare's selection):
- * linear on average, where a sort at every level of the tree costs a log
- * more. */
-static void select_nth(keyed *k, int n, int h)
-{
-    int lo = 0, hi = n - 1;
-    while (lo < hi) {
-        int mid = lo + (hi - lo) / 2;
-        /* The median of three as pivot, against sorted or mirrored input. */
-        if (keyed_less(&k[mid], &k[lo])) {
-            keyed t = k[mid]; k[mid] = k[lo]; k[lo] = t;
-        }
-        if (keyed_less(&k[hi], &k[lo])) {
-            keyed t = k[hi]; k[hi] = k[lo]; k[lo] = t;
-        }
-        if (keyed_less(&k[hi], &k[mid])) {
-            keyed t = k[hi]; k[hi] = k[mid]; k[mid] = t;
-        }
-        keyed pivot = k[mid];
-        int i = lo, j = hi;
-        while (i <= j) {
-            while (keyed_less(&k[i], &pivot))
-                i++;
-            while (keyed_less(&pivot, &k[j]))
-                j--;
-            if (i <= j) {
-                keyed t = k[i]; k[i] = k[j]; k[j] = t;
-                i++;
-                j--;
-            }
-        }
-        if (h <= j)
-            hi = j;
-        else if (h >= i)
-            lo = i;
-        else
-            return;
-    }
-}
+typedef struct bvh {
+    bnode *nodes;
+    int nn, cap, *order;
+    item *items;
+} bvh;
 
 /* An orthonormal frame (to round-off) with ax[0] along d, ax[1] in the
- * plane of d and e; the coordinate axes when d and e do not span a plane. */
+ * plane of d and e (or across d from the coordinate axis least along it,
+ * when e is along d: a degenerate triangle); the coordinate axes when d has
+ * no direction. Every box below is sound in any orthonormal frame, and in
+ * no other: a frame whose axes came out parallel (the unit vector of a
+ * remainder that was round-off) once set apart two triangles that cross. */
 static void frame(pd_vec3 ax[3], pd_vec3 d, pd_vec3 e)
 {
-    pd_vec3 a = v3_unit(d), b = v3_sub(e, v3_scale(a, v3_dot(a, e)));
+    pd_vec3 a = v3_unit(d);
+    if (!(v3_dot(a, a) > 0.5) || !v3_isfinite(a)) {
+        ax[0] = v3(1, 0, 0);
+        ax[1] = v3(0, 1, 0);
+        ax[2] = v3(0, 0, 1);
+        return;
+    }
+    pd_vec3 b = v3_sub(e, v3_scale(a, v3_dot(a, e)));
+    if (!(v3_dot(b, b) > 1e-12 * v3_dot(e, e)) || !v3_isfinite(b)) {
+        double c[3] = {fabs(a.x), fabs(a.y), fabs(a.z)};
+        int k = c[0] <= c[1] && c[0] <= c[2] ? 0 : c[1] <= c[2] ? 1 : 2;
+        pd_vec3 u = v3(k == 0, k == 1, k == 2);
+        b = v3_sub(u, v3_scale(a, v3_dot(a, u)));
+    }
     b = v3_unit(b);
-    if (v3_dot(a, a) == 0.0 || v3_dot(b, b) == 0.0 || !v3_isfinite(a) || !v3_isfinite(b)) {
+    b = v3_unit(v3_sub(b, v3_scale(a, v3_dot(a, b))));
+    pd_vec3 c = v3_cross(a, b);
+    if (!(fabs(v3_dot(a, b)) < 1e-12) || !(fabs(v3_dot(c, c) - 1.0) < 1e-12)) {
         ax[0] = v3(1, 0, 0);
         ax[1] = v3(0, 1, 0);
         ax[2] = v3(0, 0, 1);
         return;
     }
     ax[0] = a;
-    ax[1] = v3_unit(v3_sub(b, v3_scale(a, v3_dot(a, b))));
-    ax[2] = v3_cross(ax[0], ax[1]);
+    ax[1] = b;
+    ax[2] = c;
 }
 
-/* The box of triangles ts[0 .. n): one along its longest edge and normal,
- * several along the principal axes of their corners. */
-static void fit(const search *s, const tree *tr, const int *ts, int n, obox *b)
+/* The surface area of a box, half of it: the chance, for a box of
+ * random lines or boxes passing through the parent, to be met (the
+ * surface-area heuristic). */
+static double half_area(const float lo[3], const float hi[3])
+{
+    double e0 = (double)hi[0] - (double)lo[0], e1 = (double)hi[1] - (double)lo[1],
+           e2 = (double)hi[2] - (double)lo[2];
+    return e0 * e1 + e1 * e2 + e2 * e0;
+}
+
+static void box_grow(float lo[3], float hi[3], const item *x)
+{
+    for (int k = 0; k < 3; k++) {
+        lo[k] = x->lo[k] < lo[k] ? x->lo[k] : lo[k];
+        hi[k] = x->hi[k] > hi[k] ? x->hi[k] : hi[k];
+    }
+}
+
+/* Splits it[0 .. n) in two, by the surface-area heuristic over SPLIT_BINS
+ * bins of the boxes' centres along each axis: the plane that leaves the
+ * least summed area times count on its two sides. Returns the count of the
+ * first part, 0 < it < n (the middle when every centre is in one bin). A
+ * split by centres alone, along the longest spread, cuts a noisy scan's
+ * radial spikes across their length: both halves then span the whole
+ * shell, and every box meets its neighbours along the radius. */
+enum { SPLIT_BINS = 12, SAMPLE = 2048 };
+
+static int sah_split(item *it, int n)
+{
+    /* A large node's plane is chosen from a sample of its boxes (one in
+     * stride, about SAMPLE of them): the binning of every box at every level
+     * was most of the build. The partition then takes them all. */
+    int stride = n > 2 * SAMPLE ? n / SAMPLE : 1;
+    float cl[3] = {HUGE_VALF, HUGE_VALF, HUGE_VALF}, ch[3] = {-HUGE_VALF, -HUGE_VALF, -HUGE_VALF};
+    for (int i = 0; i < n; i += stride)
+        for (int k = 0; k < 3; k++) {
+            float c = it[i].lo[k] + it[i].hi[k];
+            cl[k] = c < cl[k] ? c : cl[k];
+            ch[k] = c > ch[k] ? c : ch[k];
+        }
+    int best_ax = -1, best_bin = 0;
+    double best = HUGE_VAL;
+    for (int k = 0; k < 3; k++) {
+        if (!(ch[k] > cl[k]))
+            continue;
+        float blo[SPLIT_BINS][3], bhi[SPLIT_BINS][3];
+        int cnt[SPLIT_BINS] = {0};
+        for (int b = 0; b < SPLIT_BINS; b++)
+            for (int j = 0; j < 3; j++) {
+                blo[b][j] = HUGE_VALF;
+                bhi[b][j] = -HUGE_VALF;
+            }
+        double scale = SPLIT_BINS / ((double)ch[k] - (double)cl[k]) * (1.0 - 1e-6);
+        for (int i = 0; i < n; i += stride) {
+            int b = (int)(((double)(it[i].lo[k] + it[i].hi[k]) - (double)cl[k]) * scale);
+            b = b < 0 ? 0 : b >= SPLIT_BINS ? SPLIT_BINS - 1 : b;
+            cnt[b]++;
+            box_grow(blo[b], bhi[b], &it[i]);
+        }
+        /* Areas of the bins left of each plane, then sweep from the right. */
+        double left[SPLIT_BINS];
+        float lo[3] = {HUGE_VALF, HUGE_VALF, HUGE_VALF}, hi[3] = {-HUGE_VALF, -HUGE_VALF, -HUGE_VALF};
+        int nl = 0, nleft[SPLIT_BINS];
+        for (int b = 0; b < SPLIT_BINS - 1; b++) {
+            if (cnt[b]) {
+                item x = {{blo[b][0], blo[b][1], blo[b][2]}, {bhi[b][0], bhi[b][1], bhi[b][2]}, 0};
+                box_grow(lo, hi, &x);
+            }
+            nl += cnt[b];
+            nleft[b] = nl;
+            left[b] = nl ? half_area(lo, hi) * nl : 0.0;
+        }
+        for (int j = 0; j < 3; j++) {
+            lo[j] = HUGE_VALF;
+            hi[j] = -HUGE_VALF;
+        }
+        int nr = 0;
+        for (int b = SPLIT_BINS - 1; b > 0; b--) {
+            if (cnt[b]) {
+                item x = {{blo[b][0], blo[b][1], blo[b][2]}, {bhi[b][0], bhi[b][1], bhi[b][2]}, 0};
+                box_grow(lo, hi, &x);
+            }
+            nr += cnt[b];
+            if (nr == 0 || nleft[b - 1] == 0)
+                continue;
+            double cost = left[b - 1] + half_area(lo, hi) * nr;
+            if (cost < best) {
+                best = cost;
+                best_ax = k;
+                best_bin = b;
+            }
+        }
+    }
+    if (best_ax < 0)
+        return n / 2;
+    int k = best_ax;
+    double scale = SPLIT_BINS / ((double)ch[k] - (double)cl[k]) * (1.0 - 1e-6);
+    int i = 0, j = n - 1;
+    while (i <= j) {
+        int b = (int)(((double)(it[i].lo[k] + it[i].hi[k]) - (double)cl[k]) * scale);
+        if (b < best_bin) {
+            i++;
+        } else {
+            item x = it[i];
+            it[i] = it[j];
+            it[j--] = x;
+        }
+    }
+    return i > 0 && i < n ? i : n / 2;
+}
+
+/* The projection of node b's box on the unit axis w, widened by pad. */
+static void box_on(const bnode *b, pd_vec3 w, double pad, double *lo, double *hi)
+{
+    double c = 0.0, r = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double wk = v3_dot(w, b->ax[k]);
+        c += 0.5 * (b->lo[k] + b->hi[k]) * wk;
+        r += 0.5 * (b->hi[k] - b->lo[k]) * fabs(wk);
+    }
+    *lo = c - r - pad;
+    *hi = c + r + pad;
+}
+
+/* Node nd's box in its frame, fitted to its triangles' corners. */
+static void fit_corners(const search *s, const bvh *tr, bnode *nd)
 {
     const pd_mesh *m = s->m;
-    if (n == 1) {
-        const int *T = m->tris[ts[0]];
-        pd_vec3 e[3];
-        int l = 0;
-        for (int k = 0; k < 3; k++) {
-            e[k] = v3_sub(m->verts[T[(k + 1) % 3]], m->verts[T[k]]);
-            if (v3_dot(e[k], e[k]) > v3_dot(e[l], e[l]))
-                l = k;
-        }
-        frame(b->ax, e[l], e[(l + 1) % 3]);
-    } else {
-        pd_vec3 mean = v3(0, 0, 0);
-        for (int i = 0; i < n; i++)
-            mean = v3_add(mean, tr->cen[ts[i]]);
-        mean = v3_scale(mean, 1.0 / (3.0 * n));
-        double C[3][3] = {{0}}, ev[3], V[3][3];
-        for (int i = 0; i < n; i++)
-            for (int k = 0; k < 3; k++) {
-                pd_vec3 d = v3_sub(m->verts[m->tris[ts[i]][k]], mean);
-                double x[3] = {d.x, d.y, d.z};
-                for (int r = 0; r < 3; r++)
-                    for (int c = 0; c < 3; c++)
-                        C[r][c] += x[r] * x[c];
-            }
-        pd_sym_eigen3(CONST_M3(C), ev, V);
-        frame(b->ax, v3(V[0][2], V[1][2], V[2][2]), v3(V[0][1], V[1][1], V[2][1]));
-    }
+    const int *ts = tr->order + nd->first;
     for (int k = 0; k < 3; k++) {
-        b->lo[k] = b->blo[k] = HUGE_VAL;
-        b->hi[k] = b->bhi[k] = -HUGE_VAL;
+        nd->lo[k] = HUGE_VAL;
+        nd->hi[k] = -HUGE_VAL;
     }
-    for (int i = 0; i < n; i++)
+    for (int i = 0; i < nd->count; i++)
         for (int j = 0; j < 3; j++) {
             pd_vec3 p = m->verts[m->tris[ts[i]][j]];
-            double c[3] = {p.x, p.y, p.z};
             for (int k = 0; k < 3; k++) {
-                double x = v3_dot(b->ax[k], p);
-                b->lo[k] = fmin(b->lo[k], x);
-                b->hi[k] = fmax(b->hi[k], x);
-                b->blo[k] = fmin(b->blo[k], c[k]);
-                b->bhi[k] = fmax(b->bhi[k], c[k]);
+                double x = v3_dot(nd->ax[k], p);
+                nd->lo[k] = dmin(nd->lo[k], x);
+                nd->hi[k] = dmax(nd->hi[k], x);
             }
         }
     for (int k = 0; k < 3; k++) {
-        b->lo[k] -= s->pad;
-        b->hi[k] += s->pad;
+        nd->lo[k] -= s->pad;
+        nd->hi[k] += s->pad;
     }
 }
 
-/* Builds the node over order[first .. first + count), split at the median
- * of the centroids along the axis of their widest spread; returns its
- * index. */
-static int build(search *s, tree *tr, int first, int count)
+/* A leaf: its frame along its longest edge and the normal of that edge's
+ * triangle. */
+static void fit_leaf(search *s, const bvh *tr, bnode *nd)
 {
     const pd_mesh *m = s->m;
-    int id = tr->nn++, *ts = tr->order + first;
-    node *nd = &tr->nodes[id];
+    const int *ts = tr->order + nd->first;
+    int n = nd->count, lt = ts[0], lk = 0;
+    double best = -1.0;
+    for (int i = 0; i < n; i++) {
+        const int *T = m->tris[ts[i]];
+        for (int k = 0; k < 3; k++) {
+            pd_vec3 e = v3_sub(m->verts[T[(k + 1) % 3]], m->verts[T[k]]);
+            if (v3_dot(e, e) > best) {
+                best = v3_dot(e, e);
+                lt = ts[i];
+                lk = k;
+            }
+        }
+    }
+    const int *T = m->tris[lt];
+    frame(nd->ax, v3_sub(m->verts[T[(lk + 1) % 3]], m->verts[T[lk]]),
+          v3_sub(m->verts[T[(lk + 2) % 3]], m->verts[T[(lk + 1) % 3]]));
+    fit_corners(s, tr, nd);
+    int nc = 0;
+    for (int k = 0; k < 3; k++) {
+        int v = m->tris[ts[0]][k], all = 1;
+        for (int i = 1; i < n && all; i++)
+            all = m->tris[ts[i]][0] == v || m->tris[ts[i]][1] == v || m->tris[ts[i]][2] == v;
+        if (all)
+            nd->cv[nc++] = v;
+    }
+    while (nc < 3)
+        nd->cv[nc++] = -1;
+    nd->patch = s->patch[ts[0]];
+    for (int i = 1; i < n; i++)
+        if (s->patch[ts[i]] != nd->patch)
+            nd->patch = -1;
+}
+
+/* Builds node id over order[first .. first + count): a leaf of at most
+ * LEAF_TRIS triangles, or two children that split them between whole
+ * leaves, half of the leaves each. */
+static int build(search *s, bvh *tr, int id, int first, int count)
+{
+    bnode *nd = &tr->nodes[id];
     nd->first = first;
     nd->count = count;
-    fit(s, tr, ts, count, &nd->box);
     if (count <= LEAF_TRIS) {
-        nd->left = nd->right = -1;
-        nd->ncv = 0;
-        for (int k = 0; k < 3; k++) {
-            int v = m->tris[ts[0]][k], all = 1;
-            for (int i = 1; i < count && all; i++)
-                all = m->tris[ts[i]][0] == v || m->tris[ts[i]][1] == v || m->tris[ts[i]][2] == v;
-            if (all)
-                nd->cv[nd->ncv++] = v;
-        }
-        nd->patch = root(s->up, ts[0]);
-        for (int i = 1; i < count; i++)
-            if (root(s->up, ts[i]) != nd->patch)
-                nd->patch = -1;
-        return id;
+        nd->left = -1;
+        for (int i = 0; i < count; i++)
+            tr->order[first + i] = tr->items[first + i].t;
+        fit_leaf(s, tr, nd);
+        return 0;
     }
-    int ax = 0;
-    double spread = -1.0;
-    for (int k = 0; k < 3; k++) {
-        double lo = HUGE_VAL, hi = -HUGE_VAL;
-        for (int i = 0; i < count; i++) {
-            double x = v3_dot(nd->box.ax[k], tr->cen[ts[i]]);
-            lo = fmin(lo, x);
-            hi = fmax(hi, x);
-        }
-        if (hi - lo > spread) {
-            spread = hi - lo;
-            ax = k;
-        }
+    if (tr->nn + 2 > tr->cap) {
+        size_t cap = 2 * (size_t)tr->cap;
+        bnode *more = realloc(tr->nodes, sizeof *more * cap);
+        if (!more)
+            return -1;
+        tr->nodes = more;
+        tr->cap = (int)cap;
     }
-    for (int i = 0; i < count; i++)
-        tr->tmp[i] = (keyed){v3_dot(nd->box.ax[ax], tr->cen[ts[i]]), ts[i]};
-    int half = count / 2;
-    select_nth(tr->tmp, count, half);
-    for (int i = 0; i < count; i++)
-        ts[i] = tr->tmp[i].t;
-    int l = build(s, tr, first, half), r = build(s, tr, first + half, count - half);
+    int nl = sah_split(tr->items + first, count), l = tr->nn;
+    tr->nn += 2;
+    tr->nodes[id].left = l;
+    if (build(s, tr, l, first, nl) != 0 || build(s, tr, l + 1, first + nl, count - nl) != 0)
+        return -1;
     nd = &tr->nodes[id];
-    const node *L = &tr->nodes[l], *R = &tr->nodes[r];
-    nd->left = l;
-    nd->right = r;
-    nd->ncv = 0;
-    for (int i = 0; i < L->ncv; i++)
-        for (int j = 0; j < R->ncv; j++)
-            if (L->cv[i] == R->cv[j]) {
-                nd->cv[nd->ncv++] = L->cv[i];
-                break;
-            }
-    nd->patch = L->patch == R->patch ? L->patch : -1;
-    return id;
-}
-
-/* The projection on the unit axis w, widened by pad, of triangle t's
- * corners, or (t < 0) of box b by its centre and half-widths. */
-static void project(const search *s, const obox *b, int t, pd_vec3 w, double *lo, double *hi)
-{
-    if (t >= 0) {
-        const int *T = s->m->tris[t];
-        *lo = HUGE_VAL;
-        *hi = -HUGE_VAL;
-        for (int j = 0; j < 3; j++) {
-            double x = v3_dot(w, s->m->verts[T[j]]);
-            *lo = fmin(*lo, x);
-            *hi = fmax(*hi, x);
-        }
-    } else {
-        double c = 0.0, r = 0.0;
+    const bnode *c[2] = {&tr->nodes[l], &tr->nodes[l + 1]};
+    /* The frame of either child, or the coordinate axes, whichever holds
+     * both children's boxes in the least surface: a frame kept from the
+     * children alone would, level after level, hold boxes turned against it
+     * and grow them (on a noisy sphere the root's box came out 30 times the
+     * sphere). */
+    pd_vec3 cand[3][3] = {{c[0]->ax[0], c[0]->ax[1], c[0]->ax[2]},
+                          {c[1]->ax[0], c[1]->ax[1], c[1]->ax[2]},
+                          {v3(1, 0, 0), v3(0, 1, 0), v3(0, 0, 1)}};
+    double best = HUGE_VAL;
+    for (int f = 0; f < 3; f++) {
+        double lo[3], hi[3], e[3];
         for (int k = 0; k < 3; k++) {
-            double wk = v3_dot(w, b->ax[k]);
-            c += 0.5 * (b->lo[k] + b->hi[k]) * wk;
-            r += 0.5 * (b->hi[k] - b->lo[k]) * fabs(wk);
+            double lo0, hi0, lo1, hi1;
+            box_on(c[0], cand[f][k], s->pad, &lo0, &hi0);
+            box_on(c[1], cand[f][k], s->pad, &lo1, &hi1);
+            lo[k] = dmin(lo0, lo1);
+            hi[k] = dmax(hi0, hi1);
+            e[k] = hi[k] - lo[k];
         }
-        *lo = c - r;
-        *hi = c + r;
+        double area = e[0] * e[1] + e[1] * e[2] + e[2] * e[0];
+        if (area < best) {
+            best = area;
+            for (int k = 0; k < 3; k++) {
+                nd->ax[k] = cand[f][k];
+                nd->lo[k] = lo[k];
+                nd->hi[k] = hi[k];
+            }
+        }
     }
-    *lo -= s->pad;
-    *hi += s->pad;
+    /* Near the leaves, the box fitted to the corners themselves: a few
+     * levels of them cost a few passes over the corners. */
+    if (count <= REFIT_TRIS)
+        fit_corners(s, tr, nd);
+    int nc = 0;
+    for (int i = 0; i < 3; i++) {
+        int v = c[0]->cv[i];
+        if (v >= 0 && (v == c[1]->cv[0] || v == c[1]->cv[1] || v == c[1]->cv[2]))
+            nd->cv[nc++] = v;
+    }
+    while (nc < 3)
+        nd->cv[nc++] = -1;
+    nd->patch = c[0]->patch == c[1]->patch ? c[0]->patch : -1;
+    return 0;
 }
 
-/* Are boxes a and b (each of triangle ta or tb, or of a node when < 0)
- * apart? */
-static int apart(const search *s, const obox *a, int ta, const obox *b, int tb)
+/* Are the boxes of nodes a and b apart along one of their six axes? R[i][j]
+ * = a.ax[i] . b.ax[j] takes each box's centre and half-widths onto the
+ * other's axes. */
+static int boxes_apart(const bnode *a, const bnode *b, double pad)
+{
+    double R[3][3], ca[3], ra[3], cb[3], rb[3];
+    for (int i = 0; i < 3; i++) {
+        for (int j = 0; j < 3; j++)
+            R[i][j] = v3_dot(a->ax[i], b->ax[j]);
+        ca[i] = 0.5 * (a->lo[i] + a->hi[i]);
+        ra[i] = 0.5 * (a->hi[i] - a->lo[i]);
+        cb[i] = 0.5 * (b->lo[i] + b->hi[i]);
+        rb[i] = 0.5 * (b->hi[i] - b->lo[i]);
+    }
+    for (int i = 0; i < 3; i++) {
+        double c = cb[0] * R[i][0] + cb[1] * R[i][1] + cb[2] * R[i][2];
+        double r = rb[0] * fabs(R[i][0]) + rb[1] * fabs(R[i][1]) + rb[2] * fabs(R[i][2]) + pad;
+        if (c + r < a->lo[i] || c - r > a->hi[i])
+            return 1;
+    }
+    for (int j = 0; j < 3; j++) {
+        double c = ca[0] * R[0][j] + ca[1] * R[1][j] + ca[2] * R[2][j];
+        double r = ra[0] * fabs(R[0][j]) + ra[1] * fabs(R[1][j]) + ra[2] * fabs(R[2][j]) + pad;
+        if (c + r < b->lo[j] || c - r > b->hi[j])
+            return 1;
+    }
+    return 0;
+}
+
+/* Is triangle t apart from node b's box along one of its axes? */
+static int tri_apart(const search *s, int t, const bnode *b)
+{
+    const int *T = s->m->tris[t];
+    const pd_vec3 *v = s->m->verts;
+    for (int k = 0; k < 3; k++) {
+        double x0 = v3_dot(b->ax[k], v[T[0]]), x1 = v3_dot(b->ax[k], v[T[1]]),
+               x2 = v3_dot(b->ax[k], v[T[2]]);
+        if (dmax(dmax(x0, x1), x2) + s->pad < b->lo[k] ||
+            dmin(dmin(x0, x1), x2) - s->pad > b->hi[k])
+            return 1;
+    }
+    return 0;
+}
+
+/* A triangle's box along the coordinate axes (exact: its corners' own
+ * coordinates). */
+typedef struct tbox {
+    double lo[3], hi[3];
+    int t;
+} tbox;
+
+static void tri_box(const search *s, int t, tbox *b)
+{
+    const int *T = s->m->tris[t];
+    const pd_vec3 *v = s->m->verts;
+    b->t = t;
+    b->lo[0] = dmin(dmin(v[T[0]].x, v[T[1]].x), v[T[2]].x);
+    b->hi[0] = dmax(dmax(v[T[0]].x, v[T[1]].x), v[T[2]].x);
+    b->lo[1] = dmin(dmin(v[T[0]].y, v[T[1]].y), v[T[2]].y);
+    b->hi[1] = dmax(dmax(v[T[0]].y, v[T[1]].y), v[T[2]].y);
+    b->lo[2] = dmin(dmin(v[T[0]].z, v[T[1]].z), v[T[2]].z);
+    b->hi[2] = dmax(dmax(v[T[0]].z, v[T[1]].z), v[T[2]].z);
+}
+
+/* Triangles a and b (boxes x and y), sharing no vertex, unless their
+ * boxes are apart. */
+static int tri_pair(search *s, const tbox *x, const tbox *y)
 {
     for (int k = 0; k < 3; k++)
-        if (a->bhi[k] < b->blo[k] || b->bhi[k] < a->blo[k])
+        if (x->hi[k] < y->lo[k] || y->hi[k] < x->lo[k])
+            return 0;
+    if (shared(s->m->tris[x->t], s->m->tris[y->t]) > 0)
+        return 0;
+    return test_pair(s, x->t, y->t);
+}
+
+static int common_corner(const bnode *a, const bnode *b)
+{
+    for (int i = 0; i < 3 && a->cv[i] >= 0; i++)
+        if (a->cv[i] == b->cv[0] || a->cv[i] == b->cv[1] || a->cv[i] == b->cv[2])
             return 1;
-    for (int side = 0; side < 2; side++) {
-        const obox *x = side ? b : a, *y = side ? a : b;
-        int ty = side ? ta : tb;
-        for (int k = 0; k < 3; k++) {
-            double lo, hi;
-            project(s, y, ty, x->ax[k], &lo, &hi);
-            if (hi < x->lo[k] || lo > x->hi[k])
-                return 1;
-        }
+    return 0;
+}
+
+/* Two leaves: each one's triangles not apart from the other's box, then
+ * their pairs. */
+static int leaf_pair(search *s, const bvh *tr, const bnode *a, const bnode *b)
+{
+    tbox xa[LEAF_TRIS], xb[LEAF_TRIS];
+    int na = 0, nb = 0;
+    for (int i = 0; i < a->count; i++) {
+        int t = tr->order[a->first + i];
+        if (!tri_apart(s, t, b))
+            tri_box(s, t, &xa[na++]);
     }
-    return 0;
-}
-
-/* Triangles a and b, sharing no vertex, unless their boxes are apart. */
-static int tri_pair(search *s, const tree *tr, int a, int b)
-{
-    if (shared(s->m->tris[a], s->m->tris[b]) > 0 || apart(s, &tr->tbox[a], a, &tr->tbox[b], b))
+    if (na == 0)
         return 0;
-    return test_pair(s, a, b);
-}
-
-static int common_corner(const node *a, const node *b)
-{
-    for (int i = 0; i < a->ncv; i++)
-        for (int j = 0; j < b->ncv; j++)
-            if (a->cv[i] == b->cv[j])
+    for (int j = 0; j < b->count; j++) {
+        int t = tr->order[b->first + j];
+        if (!tri_apart(s, t, a))
+            tri_box(s, t, &xb[nb++]);
+    }
+    for (int i = 0; i < na; i++)
+        for (int j = 0; j < nb; j++)
+            if (tri_pair(s, &xa[i], &xb[j]))
                 return 1;
     return 0;
 }
 
-static int node_pair(search *s, const tree *tr, int ia, int ib)
+static int node_pair(search *s, const bvh *tr, int ia, int ib)
 {
-    const node *a = &tr->nodes[ia], *b = &tr->nodes[ib];
+    const bnode *a = &tr->nodes[ia], *b = &tr->nodes[ib];
     if (common_corner(a, b) || (a->patch >= 0 && a->patch == b->patch) ||
-        apart(s, &a->box, -1, &b->box, -1))
+        boxes_apart(a, b, s->pad))
         return 0;
-    if (a->left < 0 && b->left < 0) {
-        for (int i = 0; i < a->count; i++)
-            for (int j = 0; j < b->count; j++)
-                if (tri_pair(s, tr, tr->order[a->first + i], tr->order[b->first + j]))
-                    return 1;
-        return 0;
-    }
+    if (stop(s))
+        return 1;
+    if (a->left < 0 && b->left < 0)
+        return leaf_pair(s, tr, a, b);
     if (b->left < 0 || (a->left >= 0 && a->count >= b->count))
-        return node_pair(s, tr, a->left, ib) || node_pair(s, tr, a->right, ib);
-    return node_pair(s, tr, ia, b->left) || node_pair(s, tr, ia, b->right);
+        return node_pair(s, tr, a->left, ib) || node_pair(s, tr, a->left + 1, ib);
+    return node_pair(s, tr, ia, b->left) || node_pair(s, tr, ia, b->left + 1);
 }
 
-static int node_self(search *s, const tree *tr, int id)
+static int node_self(search *s, const bvh *tr, int id)
 {
-    const node *nd = &tr->nodes[id];
-    if (nd->ncv > 0 || nd->patch >= 0)
+    const bnode *nd = &tr->nodes[id];
+    if (nd->cv[0] >= 0 || nd->patch >= 0)
         return 0;
+    if (stop(s))
+        return 1;
     if (nd->left < 0) {
+        tbox x[LEAF_TRIS];
+        for (int i = 0; i < nd->count; i++)
+            tri_box(s, tr->order[nd->first + i], &x[i]);
         for (int i = 0; i < nd->count; i++)
             for (int j = i + 1; j < nd->count; j++)
-                if (tri_pair(s, tr, tr->order[nd->first + i], tr->order[nd->first + j]))
+                if (tri_pair(s, &x[i], &x[j]))
                     return 1;
         return 0;
     }
-    return node_self(s, tr, nd->left) || node_self(s, tr, nd->right) ||
-           node_pair(s, tr, nd->left, nd->right);
+    return node_self(s, tr, nd->left) || node_self(s, tr, nd->left + 1) ||
+           node_pair(s, tr, nd->left, nd->left + 1);
 }
 
-/* 1 when a crossing is found, -1 when out of memory. */
+/* 1 when a crossing is found (or the search is cancelled), -1 when out of
+ * memory. */
 static int apart_pairs(search *s)
 {
     const pd_mesh *m = s->m;
     size_t n = (size_t)m->ntris;
-    tree tr = {malloc(sizeof *tr.nodes * 2 * n), 0, malloc(sizeof *tr.order * n),
-               malloc(sizeof *tr.cen * n), malloc(sizeof *tr.tmp * n), malloc(sizeof *tr.tbox * n)};
+    bvh tr = {NULL, 1, (int)(n / 2 + 1), malloc(sizeof *tr.order * n), malloc(sizeof *tr.items * n)};
+    tr.nodes = malloc(sizeof *tr.nodes * (size_t)tr.cap);
     int found = -1;
-    if (tr.nodes && tr.order && tr.cen && tr.tmp && tr.tbox) {
-        for (int t = 0; t < m->ntris; t++) {
+    if (tr.order && tr.items && tr.nodes) {
+        for (size_t t = 0; t < n; t++) {
             const int *T = m->tris[t];
-            tr.order[t] = t;
-            tr.cen[t] = v3_add(v3_add(m->verts[T[0]], m->verts[T[1]]), m->verts[T[2]]);
+            const pd_vec3 *v = m->verts;
+            item *x = &tr.items[t];
+            double lo[3] = {dmin(dmin(v[T[0]].x, v[T[1]].x), v[T[2]].x),
+                            dmin(dmin(v[T[0]].y, v[T[1]].y), v[T[2]].y),
+                            dmin(dmin(v[T[0]].z, v[T[1]].z), v[T[2]].z)};
+            double hi[3] = {dmax(dmax(v[T[0]].x, v[T[1]].x), v[T[2]].x),
+                            dmax(dmax(v[T[0]].y, v[T[1]].y), v[T[2]].y),
+                            dmax(dmax(v[T[0]].z, v[T[1]].z), v[T[2]].z)};
+            for (int k = 0; k < 3; k++) {
+                x->lo[k] = (float)lo[k];
+                x->hi[k] = (float)hi[k];
+            }
+            x->t = (int)t;
         }
-        for (int t = 0; t < m->ntris; t++)
-            fit(s, &tr, &t, 1, &tr.tbox[t]);
-        build(s, &tr, 0, m->ntris);
-        found = node_self(s, &tr, 0);
+        if (stop(s))
+            found = 1;
+        else if (build(s, &tr, 0, 0, (int)n) == 0) {
+            free(tr.items);
+            tr.items = NULL;
+            found = node_self(s, &tr, 0);
+        }
     }
     free(tr.nodes);
     free(tr.order);
-    free(tr.cen);
-    free(tr.tmp);
-    free(tr.tbox);
+    free(tr.items);
     return found;
 }
 
-pd_status pd_mesh_self_crossing(const pd_mesh *m, int *ta, int *tb, pd_vec3 *at, size_t *tested)
+pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *ta, int *tb,
+                                pd_vec3 *at, size_t *tested)
 {
     *ta = *tb = -1;
     if (tested)
         *tested = 0;
+    if (cancel && atomic_load_explicit(cancel, memory_order_relaxed))
+        return PD_ERR_CANCELLED;
     if (m->ntris < 2)
         return PD_OK;
-    int *up = malloc(sizeof *up * (size_t)m->ntris);
-    if (!up || flat_patches(m, up) != PD_OK) {
-        free(up);
-        return PD_ERR_NOMEM;
-    }
     double R = 0.0;
     for (int i = 0; i < m->nverts; i++)
-        R = fmax(R, fmax(fabs(m->verts[i].x), fmax(fabs(m->verts[i].y), fabs(m->verts[i].z))));
-    search s = {m, up, PD_SELFX_PAD_REL * R, 0, -1, -1, {0, 0, 0}};
-    int found = star_pairs(&s);
-    if (found == 0)
-        found = apart_pairs(&s);
-    free(up);
+        R = dmax(R, dmax(fabs(m->verts[i].x), dmax(fabs(m->verts[i].y), fabs(m->verts[i].z))));
+    search s = {m, malloc(sizeof *s.patch * (size_t)m->ntris), NULL, NULL, PD_SELFX_PAD_REL * R,
+                0, -1, -1, {0, 0, 0}, cancel, 0, 0};
+    int found = -1;
+    if (s.patch && build_stars(&s) == 0 && flat_patches(&s) == 0) {
+        found = s.cancelled ? 1 : star_pairs(&s);
+        /* The stars are not needed by the tree: their memory goes first. */
+        free(s.start);
+        free(s.list);
+        s.start = s.list = NULL;
+        if (found == 0)
+            found = apart_pairs(&s);
+    }
+    free(s.patch);
+    free(s.start);
+    free(s.list);
     if (tested)
         *tested = s.tested;
+    if (s.cancelled)
+        return PD_ERR_CANCELLED;
     if (found < 0)
         return PD_ERR_NOMEM;
     if (found) {

@@ -272,7 +272,8 @@ static pd_status read_facet(pd_text *t, pd_diag *diag, double scale, pd_build *b
     return st;
 }
 
-static pd_status read_ascii(const unsigned char *d, size_t size, const char *name, double scale,
+static pd_status read_ascii(pd_cancel_flag *cancel, const unsigned char *d, size_t size,
+                            const char *name, double scale,
                             pd_build *b, pd_vmap *map, pd_diag *diag)
 {
     /* Text has no NUL byte; one (a damaged file) is named with its line
@@ -289,6 +290,7 @@ static pd_status read_ascii(const unsigned char *d, size_t size, const char *nam
      * "solid"; the format detection skips them too. */
     pd_text t;
     pd_text_init(&t, d, size, name, '#', 0);
+    t.cancel = cancel;
     pd_status st = pd_vmap_init(map, 0);
     if (st != PD_OK)
         return pd_fail(diag, st, "%s: out of memory", name);
@@ -323,13 +325,14 @@ static pd_status read_ascii(const unsigned char *d, size_t size, const char *nam
 }
 
 pd_status pd_stl_read(const unsigned char *data, size_t size, const char *name, double scale,
-                      pd_mesh **mesh, pd_diag *diag)
+                      pd_mesh **mesh, pd_diag *diag,
+                      pd_cancel_flag *cancel)
 {
     pd_build b = {0};
     pd_vmap map = {0};
     pd_status st = pd_stl_is_binary(data, size)
                        ? read_binary(data, size, name, scale, &b, &map, diag)
-                       : read_ascii(data, size, name, scale, &b, &map, diag);
+                       : read_ascii(cancel, data, size, name, scale, &b, &map, diag);
     pd_vmap_free(&map);
     if (st == PD_OK && (st = pd_build_finish(&b, mesh)) != PD_OK)
         pd_fail(diag, st, "%s: out of memory", name);

@@ -27,6 +27,19 @@ void pd_part_options_default(pd_part_options *options)
         return;
     options->com_given = 0;
     options->com = v3(0.0, 0.0, 0.0);
+    options->cancel = NULL;
+    options->stage = NULL;
+    options->stage_user = NULL;
+}
+
+/* 1 when the caller asked to stop; otherwise says which stage starts. */
+static int next_stage(const pd_part_options *opt, const char *name)
+{
+    if (opt->cancel && atomic_load(opt->cancel))
+        return 1;
+    if (opt->stage)
+        opt->stage(opt->stage_user, name);
+    return 0;
 }
 
 void pd_part_free(pd_part *part)
@@ -153,12 +166,13 @@ static pd_status check_solid(const pd_part *p, pd_status st, pd_diag *diag)
  * leave the moments within the hull's (two cubes offset along a diagonal
  * count their common part twice): refused, naming the two triangles (of the
  * welded mesh) and a point of their crossing in the file's frame. */
-static pd_status check_no_crossing(const pd_part *p, pd_diag *diag)
+static pd_status check_no_crossing(const pd_part *p, pd_cancel_flag *cancel, pd_diag *diag)
 {
     int ta, tb;
     pd_vec3 at;
-    if (pd_mesh_self_crossing(p->mesh, &ta, &tb, &at, NULL) != PD_OK)
-        return PD_ERR_NOMEM;
+    pd_status st = pd_mesh_self_crossing(p->mesh, cancel, &ta, &tb, &at, NULL);
+    if (st != PD_OK)
+        return st;
     if (ta < 0)
         return PD_OK;
     at = v3_add(at, p->origin);
@@ -236,14 +250,20 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     pd_vec3 com_given = v3_sub(opt->com, p->origin);
     int nbefore = m->nverts;
     double size0 = p->size;
+    if (next_stage(opt, "welding"))
+        return PD_ERR_CANCELLED;
     if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
         return PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
+    if (next_stage(opt, "convex hull"))
+        return PD_ERR_CANCELLED;
     st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
     if (st != PD_OK)
         return weld_explains(st, nbefore, p->mesh->nverts, size0, diag);
 
     int flipped = 0;
+    if (next_stage(opt, "orienting"))
+        return PD_ERR_CANCELLED;
     st = pd_mesh_orient(p->mesh, &flipped, diag);
     if (st == PD_OK) {
         p->closed = 1;
@@ -262,10 +282,13 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     }
 
     if (p->closed) {
+        if (next_stage(opt, "mass properties"))
+            return PD_ERR_CANCELLED;
         st = check_solid(p, pd_mass_compute(p->mesh, &p->mass, diag), diag);
         if (st == PD_OK)
-            st = check_no_crossing(p, diag);
-        if (st == PD_ERR_NOMEM)
+            st = next_stage(opt, "self-crossing check") ? PD_ERR_CANCELLED
+                                                         : check_no_crossing(p, opt->cancel, diag);
+        if (st == PD_ERR_NOMEM || st == PD_ERR_CANCELLED)
             return st;
         if (st == PD_OK)
             p->mass_known = 1;
@@ -315,6 +338,8 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
             pd_fail(diag, st, "out of memory building the part");
+        if (st == PD_ERR_CANCELLED)
+            pd_fail(diag, st, "building the part cancelled");
         pd_part_free(p);
         return st;
     }

@@ -19,6 +19,12 @@ void pd_static_options_default(pd_static_options *options)
     options->epsilon = 20.0 * M_PI / 180.0;
     options->compare = PD_PQS_COMPARE_RAW;
     options->band = PD_PQS_BAND_RECT;
+    options->cancel = NULL;
+}
+
+static int cancelled(const pd_static_options *opt)
+{
+    return opt->cancel && atomic_load(opt->cancel);
 }
 
 pd_status pd_static_options_check(const pd_static_options *o, pd_diag *diag)
@@ -107,11 +113,15 @@ static pd_status estimate(const pd_part *part, const pd_static_options *opt,
 {
     const pd_hull *hull = part->hull;
     pd_facet_result *fr = res->facets;
+    if (cancelled(opt))
+        return PD_ERR_CANCELLED;
     for (int f = 0; f < hull->nfacets; f++) {
         pd_facet_classify(hull, part->com, f, &geom[f], &fr[f]);
         fr[f].solid_angle = pd_solid_angle_facet(hull, part->com, f, geom[f].nearest);
         fr[f].p_raw = fr[f].solid_angle / (4.0 * M_PI);
     }
+    if (cancelled(opt))
+        return PD_ERR_CANCELLED;
     pd_status st = pd_topple_graph(hull, part->com, geom, opt->topple, res, diag);
     if (st != PD_OK)
         return st;
@@ -120,6 +130,8 @@ static pd_status estimate(const pd_part *part, const pd_static_options *opt,
     warn_knives(hull, res, diag);
     for (int f = 0; f < hull->nfacets; f++)
         fr[fr[f].rest].p_qs += fr[f].p_raw;
+    if (cancelled(opt))
+        return PD_ERR_CANCELLED;
     st = pd_pqs_perturb(hull, part->com, geom, opt, res, pert, diag);
     if (st != PD_OK)
         return st;
@@ -179,6 +191,8 @@ pd_status pd_static_estimate(const pd_part *part, const pd_static_options *optio
     if (st != PD_OK) {
         if (st == PD_ERR_NOMEM)
             pd_fail(diag, st, "out of memory in the static estimators (%d facets)", n);
+        if (st == PD_ERR_CANCELLED)
+            pd_fail(diag, st, "the static estimate cancelled");
         pd_static_result_free(res);
         return st;
     }

@@ -80,6 +80,17 @@ static double time_qhull(const pd_vec3 *p, int n, int reps, int *nfacets)
     return best;
 }
 
+static void time_qhull_once(const pd_vec3 *p, int n, int *nfacets)
+{
+    qhull_ref q;
+    if (qhull_ref_build(p, n, &q) != 0) {
+        fprintf(stderr, "bench: qhull failed\n");
+        exit(1);
+    }
+    *nfacets = q.nfacets;
+    qhull_ref_free(&q);
+}
+
 static void points_cube(test_rng *rng, pd_vec3 *p, int n)
 {
     for (int i = 0; i < n; i++)
@@ -200,6 +211,86 @@ static void bench_static(void)
         pd_part_free(part);
         pd_mesh_free(m);
         free(p);
+    }
+}
+
+/* The noisy latitude-longitude sphere of scripts/make-big-meshes.py
+ * (m x m vertices and two poles at random radii in [0.5, 1], 2 m^2
+ * triangles): closed, star-shaped, many long thin triangles. */
+static pd_mesh *latlong_mesh(int m, test_rng *rng)
+{
+    pd_mesh *me = malloc(sizeof *me);
+    int nv = m * m + 2, nt = 2 * m * m, t = 0;
+    me->nverts = nv;
+    me->ntris = nt;
+    me->verts = malloc(sizeof *me->verts * (size_t)nv);
+    me->tris = malloc(sizeof *me->tris * (size_t)nt);
+    for (int i = 0; i < m; i++)
+        for (int j = 0; j < m; j++) {
+            double th = M_PI * (i + 1) / (m + 1), ph = 2.0 * M_PI * j / m;
+            double r = 0.5 + 0.5 * rng_uniform(rng);
+            me->verts[i * m + j] = v3(r * sin(th) * cos(ph), r * sin(th) * sin(ph), r * cos(th));
+        }
+    me->verts[m * m] = v3(0, 0, 0.5 + 0.5 * rng_uniform(rng));
+    me->verts[m * m + 1] = v3(0, 0, -(0.5 + 0.5 * rng_uniform(rng)));
+    for (int j = 0; j < m; j++) {
+        int jn = (j + 1) % m, a = (m - 1) * m;
+        int cap[2][3] = {{m * m, j, jn}, {m * m + 1, a + jn, a + j}};
+        for (int c = 0; c < 2; c++, t++)
+            for (int k = 0; k < 3; k++)
+                me->tris[t][k] = cap[c][k];
+        for (int i = 0; i + 1 < m; i++) {
+            int p = i * m, q = (i + 1) * m;
+            int quad[2][3] = {{p + j, q + j, q + jn}, {p + j, q + jn, p + jn}};
+            for (int c = 0; c < 2; c++, t++)
+                for (int k = 0; k < 3; k++)
+                    me->tris[t][k] = quad[c][k];
+        }
+    }
+    return me;
+}
+
+/* The whole static pipeline of a large noisy scan (part build: weld, hull,
+ * orientation, mass properties, self-crossing check; then QS and PQS)
+ * against qhull's hull of the same vertices, one run each: a regression in
+ * any stage that grows faster than the hull shows here as a ratio. */
+static void bench_big_mesh(void)
+{
+    printf("\nstatic pipeline of a noisy latitude-longitude sphere (scripts/make-big-meshes.py)\n");
+    printf("reference: qhull's hull of the same vertices, same process; CPU seconds\n");
+    printf("%-10s %10s %10s %10s %10s %12s\n", "triangles", "build s", "estimate s", "qhull s",
+           "all/qhull", "check");
+    const int ms[] = {300, 1000};
+    for (size_t s = 0; s < sizeof ms / sizeof ms[0]; s++) {
+        test_rng rng = {20261207};
+        pd_mesh *m = latlong_mesh(ms[s], &rng);
+        pd_part_options po;
+        pd_part_options_default(&po);
+        po.com_given = 1;
+        pd_part *part = NULL;
+        pd_diag d;
+        pd_diag_init(&d);
+        double t0 = cpu_now();
+        if (pd_part_build(m, &po, &part, &d) != PD_OK) {
+            fprintf(stderr, "bench: part failed: %s\n", d.message);
+            exit(1);
+        }
+        double t1 = cpu_now();
+        pd_static_result *res = NULL;
+        if (pd_static_estimate(part, NULL, &res, NULL) != PD_OK) {
+            fprintf(stderr, "bench: estimate failed\n");
+            exit(1);
+        }
+        double t2 = cpu_now();
+        int nfq;
+        double tq0 = cpu_now();
+        time_qhull_once(m->verts, m->nverts, &nfq);
+        double tq = cpu_now() - tq0;
+        printf("%-10d %10.3f %10.3f %10.3f %9.2fx %12s\n", m->ntris, t1 - t0, t2 - t1, tq,
+               (t2 - t0) / tq, part->mass_known ? "solid" : "refused");
+        pd_static_result_free(res);
+        pd_part_free(part);
+        pd_mesh_free(m);
     }
 }
 
@@ -805,6 +896,7 @@ int main(int argc, char **argv)
     }
     if (wanted(argc, argv, "static")) {
         bench_static();
+        bench_big_mesh();
         bench_symmetry();
     }
     if (wanted(argc, argv, "hull"))

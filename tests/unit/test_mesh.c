@@ -901,7 +901,7 @@ static int agrees_with_ref(ll (*c)[3], pd_vec3 *v, int nv, int (*tri)[3], int nt
     pd_mesh m = {nv, v, nt, tri};
     int ta, tb;
     pd_vec3 at;
-    if (pd_mesh_self_crossing(&m, &ta, &tb, &at, NULL) != PD_OK || (ta >= 0) != *any)
+    if (pd_mesh_self_crossing(&m, NULL, &ta, &tb, &at, NULL) != PD_OK || (ta >= 0) != *any)
         return 0;
     return ta < 0 || (ta < tb && cross_ref_tris(c, tri, ta, tb));
 }
@@ -938,7 +938,7 @@ static void test_self_crossing(void)
         pd_mesh m = {6, v, 2, tri};
         int ta, tb;
         pd_vec3 at;
-        pd_status st = pd_mesh_self_crossing(&m, &ta, &tb, &at, NULL);
+        pd_status st = pd_mesh_self_crossing(&m, NULL, &ta, &tb, &at, NULL);
         int want = cross_ref(p, q);
         crossings += want;
         agree += st == PD_OK && (ta >= 0) == want;
@@ -1008,6 +1008,35 @@ static void test_self_crossing_many(void)
     /* Both answers occur. */
     pd_note("self-crossing, %d of %d meshes of 12 triangles on 40 vertices cross\n", found, cases);
     CHECK(found > 0 && found < cases);
+
+    /* Larger walks, whose tree has levels of oriented boxes above its
+     * leaves of 8, many of them about degenerate triangles (repeated
+     * corners: a frame along an edge with no plane). */
+    found = agree = 0;
+    cases = 300;
+    for (int it = 0; it < cases; it++) {
+        enum { NV = 300, NT = 30 };
+        pd_vec3 v[NV];
+        ll c[NV][3];
+        int tri[NT][3];
+        for (int i = 0; i < NV; i++) {
+            for (int k = 0; k < 3; k++)
+                c[i][k] = (i ? c[i - 1][k] : 0) + (ll)(rng_uniform(&rng) * 5.0) - 2;
+            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
+        }
+        for (int t = 0; t < NT; t++) {
+            int base = (int)(rng_uniform(&rng) * NV);
+            for (int k = 0; k < 3; k++)
+                tri[t][k] = k == 0 ? base : (base + 1 + (int)(rng_uniform(&rng) * 4)) % NV;
+        }
+        int any;
+        agree += agrees_with_ref(c, v, NV, tri, NT, &any);
+        found += any;
+    }
+    CHECK_INT(agree, cases);
+    pd_note("self-crossing, %d of %d meshes of 30 triangles on 300 vertices cross\n", found,
+            cases);
+    CHECK(found > 0 && found < cases);
 }
 
 /* A rod of the given number of sides, radius 0.05 and length 1, capped by
@@ -1061,7 +1090,7 @@ static void test_self_crossing_rod(void)
         int ta, tb;
         pd_vec3 at;
         size_t tested;
-        CHECK_STATUS(pd_mesh_self_crossing(&m, &ta, &tb, &at, &tested), PD_OK);
+        CHECK_STATUS(pd_mesh_self_crossing(&m, NULL, &ta, &tb, &at, &tested), PD_OK);
         CHECK_INT(ta, -1);
         per[r] = (double)tested / nt;
         pd_note("self-crossing, turned rod of %d sides (%d triangles): %zu pairs tested, %.2f "
@@ -1069,7 +1098,7 @@ static void test_self_crossing_rod(void)
         if (r == 0) {
             turned_rod(n, 0.025, v, 2 * n, tri, nt);
             pd_mesh two = {4 * n, v, 2 * nt, tri};
-            CHECK_STATUS(pd_mesh_self_crossing(&two, &ta, &tb, &at, NULL), PD_OK);
+            CHECK_STATUS(pd_mesh_self_crossing(&two, NULL, &ta, &tb, &at, NULL), PD_OK);
             CHECK(ta >= 0 && ta < nt && tb >= nt);
         }
         free(v);

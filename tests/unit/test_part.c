@@ -1,5 +1,6 @@
 /* test_part.c: building the part model: what is accepted, what is refused
  * and with which status, and that the model is placed where the mesh is. */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include "check.h"
@@ -8,6 +9,7 @@
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"
+#include "mesh/mesh_internal.h"
 #include "part/part_tol.h"
 
 static pd_part *const SENTINEL = (pd_part *)&SENTINEL;
@@ -488,8 +490,135 @@ static void test_thin_rod(void)
     pd_mesh_free(m);
 }
 
+/* The static pipeline stopped by its cancel flag: a flag already set
+ * makes reading (a text of more lines than the reader reads between two
+ * looks at the flag, and one of fewer), the part build, the self-crossing
+ * check and the static estimate each return PD_ERR_CANCELLED, with nothing
+ * made; a flag present but clear changes no result (the same poses, bit for
+ * bit, as without one). */
+static void test_cancel(void)
+{
+    pd_cancel_flag set, clear;
+    atomic_init(&set, 2);
+    atomic_init(&clear, 0);
+    /* The hull of 3000 random points on a sphere: over 4096 lines. */
+    enum { NP = 3000 };
+    pd_vec3 *pts = malloc(sizeof *pts * NP);
+    test_rng rng = {20261207};
+    for (int i = 0; pts && i < NP; i++)
+        pts[i] = rng_unit_vector(&rng);
+    pd_hull *h = NULL;
+    pd_mesh *m = pts && pd_hull_build(pts, NP, &h, NULL) == PD_OK ? mesh_of_hull(h) : NULL;
+    pd_hull_free(h);
+    free(pts);
+    if (!m)
+        return;
+    size_t size = 64 + 80 * ((size_t)m->nverts + (size_t)m->ntris), len = 0;
+    char *off = malloc(size);
+    if (!off) {
+        pd_mesh_free(m);
+        return;
+    }
+    len += (size_t)snprintf(off + len, size - len, "OFF\n%d %d 0\n", m->nverts, m->ntris);
+    for (int i = 0; i < m->nverts; i++)
+        len += (size_t)snprintf(off + len, size - len, "%.17g %.17g %.17g\n", m->verts[i].x,
+                                m->verts[i].y, m->verts[i].z);
+    for (int t = 0; t < m->ntris; t++)
+        len += (size_t)snprintf(off + len, size - len, "3 %d %d %d\n", m->tris[t][0],
+                                m->tris[t][1], m->tris[t][2]);
+    pd_mesh_read_options ro;
+    pd_mesh_read_options_default(&ro);
+    CHECK(ro.cancel == NULL);
+    pd_diag d;
+    const char *tiny = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+    const char *texts[2] = {off, tiny};
+    size_t sizes[2] = {len, strlen(tiny)};
+    for (int k = 0; k < 2; k++) {
+        pd_mesh *got = NULL;
+        ro.cancel = &set;
+        pd_diag_init(&d);
+        CHECK_STATUS(pd_mesh_parse(texts[k], sizes[k], "c.off", &ro, &got, &d), PD_ERR_CANCELLED);
+        CHECK(got == NULL);
+        CHECK(strstr(d.message, "c.off") != NULL);
+        ro.cancel = &clear;
+        CHECK_STATUS(pd_mesh_parse(texts[k], sizes[k], "c.off", &ro, &got, &d), PD_OK);
+        pd_mesh_free(got);
+    }
+    free(off);
+
+    pd_part_options po;
+    pd_part_options_default(&po);
+    CHECK(po.cancel == NULL && po.stage == NULL);
+    pd_part *p = NULL;
+    po.cancel = &set;
+    pd_diag_init(&d);
+    CHECK_STATUS(pd_part_build(m, &po, &p, &d), PD_ERR_CANCELLED);
+    CHECK(p == NULL);
+    /* Cancelled at the check itself, the stages before it run. */
+    int ta, tb;
+    pd_vec3 at;
+    CHECK_STATUS(pd_mesh_self_crossing(m, &set, &ta, &tb, &at, NULL), PD_ERR_CANCELLED);
+    CHECK_STATUS(pd_mesh_self_crossing(m, &clear, &ta, &tb, &at, NULL), PD_OK);
+    CHECK_INT(ta, -1);
+
+    po.cancel = &clear;
+    pd_part *p1 = NULL, *p2 = NULL;
+    CHECK_STATUS(pd_part_build(m, &po, &p1, &d), PD_OK);
+    CHECK_STATUS(pd_part_build(m, NULL, &p2, &d), PD_OK);
+    if (p1 && p2) {
+        pd_static_options so;
+        pd_static_options_default(&so);
+        CHECK(so.cancel == NULL);
+        pd_static_result *r1 = NULL, *r2 = NULL;
+        so.cancel = &set;
+        CHECK_STATUS(pd_static_estimate(p1, &so, &r1, &d), PD_ERR_CANCELLED);
+        CHECK(r1 == NULL);
+        so.cancel = &clear;
+        CHECK_STATUS(pd_static_estimate(p1, &so, &r1, &d), PD_OK);
+        CHECK_STATUS(pd_static_estimate(p2, NULL, &r2, &d), PD_OK);
+        if (r1 && r2) {
+            CHECK_INT(r1->nposes, r2->nposes);
+            for (int i = 0; i < r1->nposes && i < r2->nposes; i++)
+                CHECK(r1->poses[i].p_qs == r2->poses[i].p_qs &&
+                      r1->poses[i].p_pqs == r2->poses[i].p_pqs);
+        }
+        pd_static_result_free(r1);
+        pd_static_result_free(r2);
+    }
+    pd_part_free(p1);
+    pd_part_free(p2);
+    pd_mesh_free(m);
+}
+
+/* The build's stages named, in order, to a stage callback. */
+static void note_stage(void *user, const char *name)
+{
+    char *seen = user;
+    size_t n = strlen(seen);
+    snprintf(seen + n, 256 - n, "%s;", name);
+}
+
+static void test_stages(void)
+{
+    pd_mesh *m = mesh_box(1, 2, 3);
+    if (!m)
+        return;
+    char seen[256] = "";
+    pd_part_options po;
+    pd_part_options_default(&po);
+    po.stage = note_stage;
+    po.stage_user = seen;
+    pd_part *p = NULL;
+    CHECK_STATUS(pd_part_build(m, &po, &p, NULL), PD_OK);
+    CHECK(strcmp(seen, "welding;convex hull;orienting;mass properties;self-crossing check;") == 0);
+    pd_part_free(p);
+    pd_mesh_free(m);
+}
+
 void suite_part(void)
 {
+    test_cancel();
+    test_stages();
     test_thin_rod();
     test_shipped_parts_are_solids();
     test_folded_through();
