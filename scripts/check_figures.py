@@ -8,7 +8,8 @@ Each FILE is a CSV of posedrop rows (pose,...,n,count,p,...) after '#'
 lines, the first naming the command that made it ("# posedrop ARGS...",
 part paths relative to the repository). The
 command is run again, without its output files, and each pose's p
-compared with the file's: moved when
+compared with the file's (rows matched by their resting normal, not their
+number): moved when
 |p_new - p_old| > z sqrt(v_old + v_new), v = p (1 - p) / n, z the two-sided
 5% point Bonferroni-shared by all the numbers checked (so that a rerun of
 unchanged physics fails 5% of the time at most; the same code gives the
@@ -28,6 +29,12 @@ def read(text):
     lines = text.splitlines()
     heads = [l[2:] for l in lines if l.startswith("# ")]
     return heads, list(csv.DictReader(io.StringIO("\n".join(l for l in lines if not l.startswith("#")))))
+
+
+def normal(row):
+    """A pose's resting normal, to 1e-6 (the CSV's 10 digits, well clear of
+    round-off): what identifies a pose whatever its number."""
+    return tuple(round(float(row[c]), 6) + 0.0 for c in ("nx", "ny", "nz"))
 
 
 def main():
@@ -57,11 +64,19 @@ def main():
         if run.returncode != 0:
             sys.exit(f"check_figures.py: {path}: {' '.join(cmd)} failed: {run.stderr.strip()}")
         _, new = read(run.stdout)
-        for a, b in zip(old, new):
-            pairs.append((path, a["pose"], float(a["p"]), float(a["n"]), float(b["p"]),
-                          float(b["n"])))
         if len(old) != len(new):
             sys.exit(f"check_figures.py: {path}: {len(new)} rows now, {len(old)} in the file")
+        # A row is the same pose (class) when its resting normal is: the
+        # numbering follows the probabilities and may change while no
+        # number moves (classes numbered most probable first, for one).
+        by_normal = {normal(b): b for b in new}
+        for a in old:
+            b = by_normal.get(normal(a))
+            if b is None:
+                sys.exit(f"check_figures.py: {path}: pose {a['pose']}'s normal "
+                         f"({a['nx']}, {a['ny']}, {a['nz']}) is no pose's now")
+            pairs.append((path, a["pose"], float(a["p"]), float(a["n"]), float(b["p"]),
+                          float(b["n"])))
     z = NormalDist().inv_cdf(1 - 0.05 / (2 * max(len(pairs), 1)))
     moved = 0
     for path, pose, p0, n0, p1, n1 in pairs:
