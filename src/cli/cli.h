@@ -42,6 +42,9 @@ typedef struct {
     char *tmp;    /* NULL when path is written directly */
     FILE *f;
 } out_file;
+/* A failure to read or build the part of path on stderr, naming the file
+ * once: the library's message already starts with it when it says where. */
+void cli_say_failure(const char *path, pd_status st, const pd_diag *diag);
 int out_open(out_file *o, const char *path);
 int out_close(out_file *o);
 int out_place(out_file *o);

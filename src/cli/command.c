@@ -171,6 +171,15 @@ static int out_fail(const char *path, const char *why)
     return 0;
 }
 
+void cli_say_failure(const char *path, pd_status st, const pd_diag *diag)
+{
+    const char *msg = diag->message[0] ? diag->message : pd_status_str(st);
+    if (strncmp(msg, path, strlen(path)) == 0)
+        fprintf(stderr, "%s: %s\n", prog, msg);
+    else
+        fprintf(stderr, "%s: %s: %s\n", prog, path, msg);
+}
+
 int out_open(out_file *o, const char *path)
 {
     memset(o, 0, sizeof *o);

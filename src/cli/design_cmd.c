@@ -515,11 +515,7 @@ static int load(design_in *in, pd_mesh **mesh, pd_part **part, pd_static_result 
         st = *class_of ? pd_pose_classes(*part, *res, *class_of, nclasses, &diag) : PD_ERR_NOMEM;
     }
     if (st != PD_OK) {
-        const char *msg = diag.message[0] ? diag.message : pd_status_str(st);
-        if (strncmp(msg, in->path, strlen(in->path)) == 0)
-            fprintf(stderr, "%s: %s\n", prog, msg);
-        else
-            fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
+        cli_say_failure(in->path, st, &diag);
         return 0;
     }
     return 1;

@@ -251,11 +251,7 @@ static int load_part(fit_input *in, const pd_mesh_read_options *read, int group)
         in->nclasses = in->res->nposes;
     }
     if (st != PD_OK) {
-        const char *msg = diag.message[0] ? diag.message : pd_status_str(st);
-        if (strncmp(msg, in->path, strlen(in->path)) == 0)
-            fprintf(stderr, "%s: %s\n", prog, msg);
-        else
-            fprintf(stderr, "%s: %s: %s\n", prog, in->path, msg);
+        cli_say_failure(in->path, st, &diag);
         return 0;
     }
     return !in->measured || read_counts(in->measured, in->path, in->nclasses, group,
