@@ -369,8 +369,8 @@ static int thread_count(const pd_sim_options *o)
 
 /* With effect_halfwidth: the drops the effects ask for, given the widest
  * half-width res now at r->n drops; a half-width goes as 1 / sqrt(n), so
- * n (res / delta)^2, a tenth more for the estimate's own noise, and at
- * least a batch more. 0 once res is within delta. */
+ * n (res / delta)^2, PD_EFFECT_ROUND_MARGIN more for the estimate's own
+ * noise, and at least a batch more. 0 once res is within delta. */
 static pd_status effect_want(const pd_sim_model *model, const pd_scene *scene,
                              const pd_sim_options *o, const pd_sim_result *r, long *want,
                              pd_diag *diag)
@@ -384,8 +384,8 @@ static pd_status effect_want(const pd_sim_model *model, const pd_scene *scene,
     pd_sensitivity_free(s);
     *want = 0;
     if (res > delta) {
-        double more = 1.1 * (double)r->n * (res * res / (delta * delta) - 1.0);
-        *want = r->n + (more > CI_BATCH ? (more < 1e15 ? (long)more : (long)1e15) : CI_BATCH);
+        double more = PD_EFFECT_ROUND_MARGIN * (double)r->n * (res * res / (delta * delta) - 1.0);
+        *want = r->n + (more > CI_BATCH ? (long)fmin(more, PD_EFFECT_ROUND_MAX) : CI_BATCH);
     }
     return PD_OK;
 }

@@ -99,4 +99,16 @@
  * own size in under 7 ms, so a longer step would pass through contacts. */
 #define PD_SIM_DT_MAX 0.01
 
+/* --effect's next round asks for n (res / delta)^2 drops in all, res the
+ * widest effect half-width at n drops: this factor more, because res is
+ * itself estimated from the drops so far and a round sized on a lucky low
+ * res would stop just short of delta and need another whole round. Why
+ * 1.1: a bootstrap half-width from a few thousand drops is good to some
+ * 5-10%; larger rounds overshoot the drops asked for. */
+#define PD_EFFECT_ROUND_MARGIN 1.1
+
+/* The most drops one --effect round may ask for, only so that the product
+ * above fits a long; the run's own max_drops bounds it far lower. */
+#define PD_EFFECT_ROUND_MAX 1e15
+
 #endif
