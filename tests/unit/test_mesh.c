@@ -979,32 +979,41 @@ static void test_self_crossing(void)
  * finds a crossing exactly when the brute-force reference finds one, and
  * the pair it names crosses. Larger than the meshes above, so that the tree
  * of boxes has levels above its leaves. */
+/* Random walks of nv vertices in steps of [-2, 2], with nt triangles on
+ * nearby indices (small against the whole, many pairs far apart), each
+ * mesh's answer against the reference; *found counts the meshes that
+ * cross. Returns how many of cases agreed. */
+static int walk_cases(test_rng *rng, int nv, int nt, int cases, int *found)
+{
+    enum { NV_MAX = 300, NT_MAX = 30 };
+    static pd_vec3 v[NV_MAX];
+    static ll c[NV_MAX][3];
+    static int tri[NT_MAX][3];
+    int agree = 0;
+    *found = 0;
+    for (int it = 0; it < cases; it++) {
+        for (int i = 0; i < nv; i++) {
+            for (int k = 0; k < 3; k++)
+                c[i][k] = (i ? c[i - 1][k] : 0) + (ll)(rng_uniform(rng) * 5.0) - 2;
+            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
+        }
+        for (int t = 0; t < nt; t++) {
+            int base = (int)(rng_uniform(rng) * nv);
+            for (int k = 0; k < 3; k++)
+                tri[t][k] = k == 0 ? base : (base + 1 + (int)(rng_uniform(rng) * 4)) % nv;
+        }
+        int any;
+        agree += agrees_with_ref(c, v, nv, tri, nt, &any);
+        *found += any;
+    }
+    return agree;
+}
+
 static void test_self_crossing_many(void)
 {
     test_rng rng = {20261128};
-    int found = 0, cases = 1000, agree = 0;
-    for (int it = 0; it < cases; it++) {
-        enum { NV = 40, NT = 12 };
-        pd_vec3 v[NV];
-        ll c[NV][3];
-        int tri[NT][3];
-        /* A random walk of steps in [-2, 2]: triangles on nearby indices are
-         * small against the whole, and many pairs far apart. */
-        for (int i = 0; i < NV; i++) {
-            for (int k = 0; k < 3; k++)
-                c[i][k] = (i ? c[i - 1][k] : 0) + (ll)(rng_uniform(&rng) * 5.0) - 2;
-            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
-        }
-        for (int t = 0; t < NT; t++) {
-            int base = (int)(rng_uniform(&rng) * NV);
-            for (int k = 0; k < 3; k++)
-                tri[t][k] = k == 0 ? base : (base + 1 + (int)(rng_uniform(&rng) * 4)) % NV;
-        }
-        int any;
-        agree += agrees_with_ref(c, v, NV, tri, NT, &any);
-        found += any;
-    }
-    CHECK_INT(agree, cases);
+    int found, cases = 1000;
+    CHECK_INT(walk_cases(&rng, 40, 12, cases, &found), cases);
     /* Both answers occur. */
     pd_note("self-crossing, %d of %d meshes of 12 triangles on 40 vertices cross\n", found, cases);
     CHECK(found > 0 && found < cases);
@@ -1012,28 +1021,8 @@ static void test_self_crossing_many(void)
     /* Larger walks, whose tree has levels of oriented boxes above its
      * leaves of 8, many of them about degenerate triangles (repeated
      * corners: a frame along an edge with no plane). */
-    found = agree = 0;
     cases = 300;
-    for (int it = 0; it < cases; it++) {
-        enum { NV = 300, NT = 30 };
-        pd_vec3 v[NV];
-        ll c[NV][3];
-        int tri[NT][3];
-        for (int i = 0; i < NV; i++) {
-            for (int k = 0; k < 3; k++)
-                c[i][k] = (i ? c[i - 1][k] : 0) + (ll)(rng_uniform(&rng) * 5.0) - 2;
-            v[i] = v3((double)c[i][0], (double)c[i][1], (double)c[i][2]);
-        }
-        for (int t = 0; t < NT; t++) {
-            int base = (int)(rng_uniform(&rng) * NV);
-            for (int k = 0; k < 3; k++)
-                tri[t][k] = k == 0 ? base : (base + 1 + (int)(rng_uniform(&rng) * 4)) % NV;
-        }
-        int any;
-        agree += agrees_with_ref(c, v, NV, tri, NT, &any);
-        found += any;
-    }
-    CHECK_INT(agree, cases);
+    CHECK_INT(walk_cases(&rng, 300, 30, cases, &found), cases);
     pd_note("self-crossing, %d of %d meshes of 30 triangles on 300 vertices cross\n", found,
             cases);
     CHECK(found > 0 && found < cases);
