@@ -59,7 +59,8 @@ def measure(exe, name, n, seed, tmp):
     meas = rows(run(["awk", "-F,", "-v", "part=" + name, "-v", "tag=trust.py", "-f",
                      os.path.join(ROOT, "scripts/measured.awk"),
                      os.path.join(ROOT, "parts/paper-tables.csv"), grouped]))
-    m = {int(r["pose"]): float(r["p"]) for r in meas}
+    total = sum(int(r["count"]) for r in meas)
+    m = {int(r["pose"]): int(r["count"]) / total for r in meas}
     half = max((float(r["ci_hi"]) - float(r["ci_lo"])) / 2 for r in xc)
     spread = max(float(r["p_engine_max"]) - float(r["p_engine_min"]) for r in xc)
     apart = sum(int(r["engines_disagree"]) for r in xc)
