@@ -129,12 +129,14 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
     for engine in impulse ode bullet; do
         runs=$((runs + 1))
         echo "paper.sh: $part on $engine, run $runs of 12, $((SECONDS - start_s)) s so far" >&2
-        start=$(date +%s.%N)
-        "$bin" --group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"} \
-            --engine "$engine" "$file" \
-            > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
-        end=$(date +%s.%N)
-        awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f\n", b - a }' > "$outdir/$part.$engine.seconds"
+        # CPU seconds (user + sys, all threads): wall time says more of the
+        # machine's other load than of the run.
+        TIMEFORMAT='%3U %3S'
+        { time "$bin" --group -n "$n" --initial "$initial" \
+            ${contact_time:+--contact-time "$contact_time"} --engine "$engine" "$file" \
+            > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1; } \
+            2> "$outdir/$part.$engine.time"
+        awk '{ printf "%.3f\n", $1 + $2 }' "$outdir/$part.$engine.time" > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
     awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" '
@@ -211,7 +213,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
         function abs(x) { return x < 0 ? -x : x }
     ' "$tables" | tee "$outdir/$part.table.txt"
 done
-printf '\nseconds per run (%d drops):' "$n"
+printf '\nCPU seconds per run (user + sys, %d drops):' "$n"
 for part in insulator_cap white_button rect_black_button square_black_button; do
     for engine in impulse ode bullet; do
         [ -f "$outdir/$part.$engine.seconds" ] && printf ' %s/%s %s' "$part" "$engine" "$(cat "$outdir/$part.$engine.seconds")"
