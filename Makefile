@@ -232,25 +232,25 @@ check-readme: deps
 	@$(MAKE) --no-print-directory all
 	tests/readme/check.sh
 
-# The insulator cap's gallery, chart against the paper's physical tests and
-# gauss-sphere map, and the cost-accuracy chart, into docs/figures/
-# (docs/figures.md); the table of docs/uncertainty.md, ranged runs beside
-# sweeps (docs/figures/uncertainty/); make paper's tables, whose eq. (16)
-# errors README quotes (docs/figures/paper.txt). CHART_ONLY=1 redraws the
-# cost-accuracy chart from its kept CSV instead of rerunning its several
-# minutes of drops.
+# Every figure behind docs/ that a script makes (docs/figures.md lists them
+# with their cost): the insulator cap's gallery, chart and gauss-sphere map
+# and make paper's tables on the impulse engine (docs/figures/paper.txt),
+# the cost-accuracy chart, the design demonstrations, and the table of
+# docs/uncertainty.md. CHART_ONLY=1 redraws the cost-accuracy chart from its
+# kept CSV instead of rerunning it; CHEAP=1 makes only the cap's pictures
+# and paper.txt (seconds).
 figures: deps
 	@$(MAKE) --no-print-directory all
-	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHART_ONLY),--chart-only)
-	POSEDROP=$(CLI) scripts/uncertainty.sh
-	{ echo "# scripts/paper.sh (POSEDROP=$(CLI); make figures), commit $$(git rev-parse --short HEAD), $$(date -u +%F)"; \
-	  POSEDROP=$(CLI) scripts/paper.sh; } > docs/figures/paper.txt
+	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))
+	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 
-# The cheap measured files behind docs/ rerun: fails when a number moved
-# beyond its drops' noise (make check-full runs it).
+# The cheap measured files behind docs/ rerun, after the check's own
+# controls: fails when a number moved beyond its drops' noise (make
+# check-full runs it; about 1.5 CPU minutes, docs/figures.md).
 check-figures:
 	@$(MAKE) --no-print-directory $(CLI)
-	python3 scripts/check_figures.py -b $(CLI) docs/figures/uncertainty/*-ranged.csv
+	python3 scripts/check_figures.py -b $(CLI) --self-test docs/figures/cap.csv \
+	    docs/figures/paper/*.csv docs/figures/uncertainty/*-ranged.csv
 
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
 """bench-mujoco.py: the cost of a drop, posedrop's impulse engine against MuJoCo.
 
-Issue 23, item 7: the same three parts dropped the same way on both, in one
-run, and the ratio of their costs per drop:
+The same three parts dropped the same way on both, in one run, and the ratio
+of their costs per drop:
 
   cube   1 cm cube
   box    1 x 2 x 3 cm box

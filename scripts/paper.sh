@@ -2,7 +2,7 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-e ENGINES] [-o DIR] [-d PAPER_TABLES_CSV]
 #   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-s SEED]
 #                       [-P JOBS] [-H PART] [-t CONTACT_TIME] [-o DIR]
 #
@@ -15,14 +15,18 @@
 # CONTACT_TIME, s, the duration of one contact (posedrop's default when not
 # given; 0: the rigid model): --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
-# (default results/) and prints a legend, then each table: the paper's QS, PQS, dynamic and
+# (default results/; each engine's starts with '#' lines giving its command
+# and the commit it ran on) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
 # poses never observed costs nothing there; total variation counts it).
 # posedrop's classes are matched to the paper's poses by rank of their QS
 # probability on both sides, the column the parts were fitted on (the paper
-# numbers its poses by physical frequency).
+# numbers its poses by physical frequency). -e runs only ENGINES (comma-
+# separated, of impulse, ode and bullet; the others' columns print '-'):
+# make figures runs the impulse engine alone, as ODE and Bullet at their
+# automatic step cost 0.2-0.6 s of CPU per drop of the cap.
 #
 # -L: leave-one-out cross-validation of the calibration (posedrop fit,
 # docs/calibration.md). The paper's physical counts (its percentages times
@@ -58,6 +62,7 @@ n_given=
 seed=1
 jobs=2
 held=
+engines=impulse,ode,bullet
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
@@ -67,6 +72,7 @@ while [ $# -gt 0 ]; do
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
         -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
         -t) args_value "$@"; contact_time=$2; shift 2 ;;
+        -e) args_value "$@"; engines=$2; shift 2 ;;
         -s) args_value "$@"; seed=$2; shift 2 ;;
         -P) args_value "$@"; args_count -P "$2"; jobs=$2; shift 2 ;;
         -H) args_value "$@"; held=$2; shift 2 ;;
@@ -81,6 +87,9 @@ case " insulator_cap white_button rect_black_button square_black_button " in
     *) [ -z "$held" ] || args_die "-H: expected one of insulator_cap, white_button, \
 rect_black_button, square_black_button, got '$held'" ;;
 esac
+for e in ${engines//,/ }; do
+    case "$e" in impulse|ode|bullet) ;; *) args_die "-e: expected impulse, ode or bullet, got '$e'" ;; esac
+done
 case "$seed" in
     *[!0-9]*) args_die "-s: expected a whole number, got '$seed'" ;;
 esac
@@ -111,7 +120,7 @@ Experiments", with posedrop's columns beside the paper's; every figure in percen
   left block, the paper's:  QS and PQS estimates, Dyn its dynamic simulation,
                             Phys the physical tests (the reference)
   right block, posedrop's:  QS and PQS estimates, and $n drops (initial $initial)
-                            on posedrop's impulse engine, ODE and Bullet
+                            on posedrop's impulse engine, ODE and Bullet ('-': not run)
   pose  numbered as the paper numbers them (by physical frequency); posedrop's
         pose classes are paired with them by rank of their QS probability
   e16   the paper's eq. (16) error against the physical tests: the sum over poses
@@ -121,28 +130,36 @@ Experiments", with posedrop's columns beside the paper's; every figure in percen
 EOF
 status=0
 runs=0
+commit=$(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)
+nengines=$(echo "$engines" | tr ',' '\n' | grep -c .)
 start_s=$SECONDS
 for part in insulator_cap white_button rect_black_button square_black_button; do
     file="$here/parts/$part.off"
     [ -f "$file" ] || { echo "paper.sh: $file missing" >&2; status=1; continue; }
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
+        rm -f "$outdir/$part.$engine.csv" "$outdir/$part.$engine.seconds"
+        case ",$engines," in *",$engine,"*) ;; *) continue ;; esac
         runs=$((runs + 1))
-        echo "paper.sh: $part on $engine, run $runs of 12, $((SECONDS - start_s)) s so far" >&2
+        echo "paper.sh: $part on $engine, run $runs of $((4 * nengines)), $((SECONDS - start_s)) s so far" >&2
+        args=(--group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"}
+              --engine "$engine")
         # CPU seconds (user + sys, all threads): wall time says more of the
         # machine's other load than of the run.
         TIMEFORMAT='%3U %3S'
-        { time "$bin" --group -n "$n" --initial "$initial" \
-            ${contact_time:+--contact-time "$contact_time"} --engine "$engine" "$file" \
+        { time { printf '# posedrop %s parts/%s.off\n# commit %s, %s\n' "${args[*]}" "$part" "$commit" \
+                   "$(date -u +%Y-%m-%d)"
+                 "$bin" "${args[@]}" "$file"; } \
             > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1; } \
             2> "$outdir/$part.$engine.time"
         awk '{ printf "%.3f\n", $1 + $2 }' "$outdir/$part.$engine.time" > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
-    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" '
+    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" -v engines="$engines" '
         function load(file, key,    line, i, c, k) {
             k = 0
             while ((getline line < file) > 0) {
+                if (line ~ /^#/) continue
                 split(line, f, ",")
                 if (!c["pose"]) { for (i = 1; i in f; i++) c[f[i]] = i; continue }
                 k++
@@ -162,7 +179,10 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
         BEGIN {
             ks = load(outdir "/" part ".static.csv", "s"); rank("s", ks)
             split("impulse ode bullet", eng, " ")
-            for (e = 1; e <= 3; e++) { ke[e] = load(outdir "/" part "." eng[e] ".csv", eng[e]); rank(eng[e], ke[e]) }
+            for (e = 1; e <= 3; e++) {
+                ran[e] = index("," engines ",", "," eng[e] ",") > 0
+                ke[e] = ran[e] ? load(outdir "/" part "." eng[e] ".csv", eng[e]) : 0; rank(eng[e], ke[e])
+            }
         }
         NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
         $col["part"] == part {
@@ -188,9 +208,10 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 ours[p, 2] = r <= ks ? pqs["s", order["s", r]] : 0
                 # The engines rank their own classes by QS too: same order.
                 for (e = 1; e <= 3; e++) ours[p, 2 + e] = r <= ke[e] ? dyn[eng[e], order[eng[e], r]] : 0
-                printf "%4d | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f %7.1f %6.1f %6.1f\n", p,
-                       100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p],
-                       100 * ours[p, 1], 100 * ours[p, 2], 100 * ours[p, 3], 100 * ours[p, 4], 100 * ours[p, 5]
+                printf "%4d | %6.1f %6.1f %6.1f %6.1f |", p,
+                       100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p]
+                for (c = 1; c <= 5; c++) cell(c, 100 * ours[p, c])
+                printf "\n"
             }
             # Mass posedrop puts on classes beyond the paper count goes to TV.
             for (c = 1; c <= 5; c++) { extra[c] = 0 }
@@ -201,12 +222,17 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             printf "%4s |", "e16"
             for (c = 1; c <= 3; c++) printf " %6.1f", err16(paper, c, np)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), err16(ours, c, np)
+            for (c = 1; c <= 5; c++) cell(c, err16(ours, c, np))
             printf "\n%4s |", "TV"
             for (c = 1; c <= 3; c++) printf " %6.1f", tv(paper, c, np, 0)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), tv(ours, c, np, extra[c])
+            for (c = 1; c <= 5; c++) cell(c, tv(ours, c, np, extra[c]))
             printf "\n"
+        }
+        # Column c of posedrop block: QS, PQS, then the engines ("-" when not run).
+        function cell(c, v) {
+            if (c >= 3 && !ran[c - 2]) printf (c == 3 ? " %7s" : " %6s"), "-"
+            else printf (c == 3 ? " %7.1f" : " %6.1f"), v
         }
         function err16(a, c, n,    p, s) { s = 0; for (p = 1; p <= n; p++) s += phys[p] * abs(a[p, c] - phys[p]); return 100 * s }
         function tv(a, c, n, rest,    p, s) { s = rest; for (p = 1; p <= n; p++) s += abs(a[p, c] - phys[p]); return 50 * s }

@@ -116,7 +116,7 @@ def test_sensitivity_needs_trials_and_ranges():
 
 
 def test_zero_width_range_is_the_fixed_value():
-    """Issue 24: a range of zero width runs byte for byte as the fixed value."""
+    """A range of zero width runs byte for byte as the fixed value."""
     poses = posedrop.Part.from_file(CAP).stable_poses()
     a = poses.drop(150, seed=7, mu="0.4:0.4", trials=True)
     b = poses.drop(150, seed=7, mu=0.4, trials=True)

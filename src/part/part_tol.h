@@ -25,7 +25,7 @@
  * (t = PD_TOL_PLANE_REL L) carry ~1e-10 of the largest (measured: flat
  * pyramids of t = 3e-7 L, turned and moved off the origin, reach -3e-11);
  * 1e-9 leaves a margin of 10. A fold through the part gives moments of
- * order the largest (-65 times it for issue 22's button). Smaller: flat
+ * order the largest (-65 times it for a button of the paper's). Smaller: flat
  * parts would be refused for their round-off; larger: rods of radius
  * 1e-4 L (a 10 cm pin of 10 um) would be. */
 #define PD_TOL_INERTIA_REL 1e-9

@@ -221,7 +221,7 @@ static pd_mesh *read_part(const char *path)
 
 /* A static result belongs to the part it was computed from: the cube's
  * drops with the cap's pose table wrote past the end of a 6-facet array
- * (issue 22), and the cap with the cube's table read the wrong facets. */
+ * once, and the cap with the cube's table read the wrong facets. */
 static void test_result_of_another_part(void)
 {
     pd_part *cube = NULL, *cap = NULL;

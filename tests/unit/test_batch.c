@@ -597,6 +597,8 @@ static void test_script_refusals(void)
         {"paper.sh -L -H cap", "paper.sh: -H: expected one of insulator_cap"},
         {"paper.sh -L -P 0", "paper.sh: -P: expected a whole number"},
         {"paper.sh -L -s 1x", "paper.sh: -s: expected a whole number"},
+        {"paper.sh -e odes", "paper.sh: -e: expected impulse, ode or bullet, got 'odes'"},
+        {"figures.sh --cheap --x", "figures.sh: unknown argument '--x'"},
         {"slurm-array.sh -N", "slurm-array.sh: -N needs a value"},
         {"sensitivity.sh -n", "sensitivity.sh: -n needs a value"},
         {"sensitivity.sh -i foo $R/parts/cap.off", "sensitivity.sh: posedrop: --initial: initial"},

@@ -1,4 +1,4 @@
-/* test_hard_parts.c: the hard-part corpus of issue 23, generated here, on
+/* test_hard_parts.c: the hard-part corpus (docs/limits.md), generated here, on
  * every engine: shallow ridges, flat pyramids, needles, a tenth-of-a-
  * millimetre cube (which often ends up spinning on a corner, a top) and a
  * 1000 m one, a 1 mm cube released spinning (another top), a 64-gon coin
@@ -10,8 +10,8 @@
  *   - the poses a rotation of the part maps onto each other (mirror-image
  *     facets: the roof's two halves, a needle's four sides, a coin's faces)
  *     sharing their drops within the binomial bound.
- * The cases that fail today are listed in expected_failures, with the item
- * of the issue whose fix they wait for; such a case is checked the other
+ * The cases that fail today are listed in expected_failures, with a nonzero
+ * tag for the defect whose fix they wait for; such a case is checked the other
  * way, so that it fails the suite once it passes and the table cannot go
  * stale. It runs only until it fails (a failed drop, or more unsettled drops
  * than its full run allows: the full run would fail too), so the cases
@@ -94,8 +94,8 @@ enum { NCASES = sizeof cases / sizeof cases[0] };
 static const pd_engine_kind engines[] = {PD_ENGINE_IMPULSE, PD_ENGINE_ODE, PD_ENGINE_BULLET};
 static const char *const engine_names[] = {"impulse", "ode", "bullet"};
 
-/* The cases that fail today, each with the item of issue 23 that is to fix
- * it. A case listed here must fail (one of its checks); one that passes is
+/* The cases that fail today, each with a nonzero tag for the defect that is
+ * to fix it. A case listed here must fail (one of its checks); one that passes is
  * reported as a failure, to be taken out of the table. The last line ends
  * the table. */
 static const struct {
@@ -306,8 +306,8 @@ static void check_case(const hard_case *c, const pd_part *part, const pd_static_
     if (ran == 2) {
         pd_note("%-24s %-7s refused: %s\n", c->name, engine_names[e], why.message);
         if (item)
-            printf("     %s on %s is refused: take it out of expected_failures (issue 23 item "
-                   "%d)\n", c->name, engine_names[e], item);
+            printf("     %s on %s is refused: take it out of expected_failures "
+                   "(tag %d)\n", c->name, engine_names[e], item);
         CHECK(!item);
         return;
     }
@@ -326,7 +326,7 @@ static void check_case(const hard_case *c, const pd_part *part, const pd_static_
             r.mirror_bad, (double)(clock() - t0) / CLOCKS_PER_SEC);
     if (item) {
         if (no_failed && settled && mirrored)
-            printf("     %s on %s passes: take it out of expected_failures (issue 23 item %d)\n",
+            printf("     %s on %s passes: take it out of expected_failures (tag %d)\n",
                    c->name, engine_names[e], item);
         CHECK(!(no_failed && settled && mirrored));
     } else {

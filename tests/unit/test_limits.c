@@ -199,7 +199,7 @@ static int cube_with_face_points(test_rng *rng, int m, pd_vec3 *p)
 }
 
 /* A 1 um cube with points on its faces, turned at random and placed 1e6 m
- * from the origin (1e12 times its size), as in issue 18: its coordinates are
+ * from the origin (1e12 times its size), a case once reported: its coordinates are
  * rounded in steps of 1.2e-10 m, 1e-4 of its size, so its faces carry bumps
  * of that size, but its heights must not carry that much again: computed in
  * the file's frame they did (links "rising" by one step, exit 1). In the
@@ -390,7 +390,7 @@ static void test_size_range(void)
     }
 }
 
-/* A coordinate of 1e308 (issue 15): the size is finite but beyond the range,
+/* A coordinate of 1e308: the size is finite but beyond the range,
  * and its products overflow; coordinates of -1e308 and 1e308 make the size
  * itself overflow. Both say so, not "within 0 of a line". */
 static void test_size_overflow(void)
@@ -408,7 +408,7 @@ static void test_size_overflow(void)
     pd_hull_free(h);
 }
 
-/* A 1 x 1e-9 x 1e-9 needle (issue 18): welding at 1e-6 of its size merges
+/* A 1 x 1e-9 x 1e-9 needle: welding at 1e-6 of its size merges
  * the ends of its every short edge and leaves no triangle with area; the
  * refusal says so and at what distance, not only "0 points". A plate 1e-9
  * thick likewise; a flat mesh that welding did not touch keeps the hull's
@@ -447,7 +447,7 @@ static void test_weld_collapse(void)
 /* A prism over the parallelogram (0,0) (1,0) (2,1) (1,1) (x, z), depth 1:
  * its centroid projects exactly onto an edge of its bottom and of its top,
  * two knife edges, each warned once by the estimate. A drop run on the same
- * part (any engine: issue 15 saw them twice with ode) repeats none. */
+ * part (any engine: ode was once seen to give them twice) repeats none. */
 static void test_knife_warned_once(void)
 {
     pd_vec3 p[8];

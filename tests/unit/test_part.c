@@ -178,7 +178,7 @@ static void test_orientation(void)
 }
 
 /* parts/square_black_button.off with one top corner of its flange moved through
- * the part to y = -1 m (issue 22): a spike folded back through the body,
+ * the part to y = -1 m (a case once reported): a spike folded back through the body,
  * whose far side counts negatively. The static estimate took it, the drops
  * refused it; now the part build refuses it, saying why (docs/limits.md
  * gives its moments), and with a given centre of mass both take it. */

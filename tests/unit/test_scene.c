@@ -145,7 +145,7 @@ static void test_ranges(void)
     bad = s;
     bad.range[PD_PARAM_HEIGHT] = (pd_dist){PD_DIST_UNIFORM, 0.1, 0.2, 1};
     CHECK_STATUS(pd_scene_check(&bad, NULL), PD_ERR_RANGE);
-    /* Issue 22: 1e-320 is refused in a program's scene as in the text. */
+    /* 1e-320 is refused in a program's scene as in the text. */
     const char *const tiny_keys[] = {"height", "mu", "restitution", "contact_time", "tumble"};
     for (int k = 0; k < 5; k++) {
         pd_scene t;
