@@ -57,7 +57,8 @@ typedef struct pd_part {
  * mass properties; convex hull; centre of mass strictly inside the hull.
  * PD_ERR_CANCELLED when options->cancel is found set (non-zero, by another
  * thread or a signal handler): read between the stages of the build and
- * every few thousand steps of the self-crossing check.
+ * every few thousand steps of the weld, the orientation, the convex hull
+ * and the self-crossing check.
  * A mesh that is not closed is accepted only with options->com_given.
  * options may be NULL. A mesh with a negative count or missing arrays, or
  * options with com_given other than 0 or 1, is PD_ERR_USAGE; a vertex index

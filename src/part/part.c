@@ -13,6 +13,7 @@
 #include "base/hash.h"
 #include "base/mat3.h"
 #include "base/size_range.h"
+#include "hull/hull_internal.h"
 #include "hull/hull_mass.h"
 #include "mesh/mesh_internal.h"
 #include "posedrop/part.h"
@@ -252,19 +253,24 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     double size0 = p->size;
     if (next_stage(opt, "welding"))
         return PD_ERR_CANCELLED;
-    if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
-        return PD_ERR_NOMEM;
+    st = pd_mesh_weld_cancel(p->mesh, PD_TOL_WELD_REL * p->size, NULL, opt->cancel);
+    if (st != PD_OK)
+        return st == PD_ERR_CANCELLED ? st : PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
     if (next_stage(opt, "convex hull"))
         return PD_ERR_CANCELLED;
-    st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
+    st = pd_hull_build_cancel(p->mesh->verts, p->mesh->nverts, opt->cancel, &p->hull, diag);
+    if (st == PD_ERR_CANCELLED)
+        return st;
     if (st != PD_OK)
         return weld_explains(st, nbefore, p->mesh->nverts, size0, diag);
 
     int flipped = 0;
     if (next_stage(opt, "orienting"))
         return PD_ERR_CANCELLED;
-    st = pd_mesh_orient(p->mesh, &flipped, diag);
+    st = pd_mesh_orient_cancel(p->mesh, &flipped, opt->cancel, diag);
+    if (st == PD_ERR_CANCELLED || st == PD_ERR_NOMEM)
+        return st;
     if (st == PD_OK) {
         p->closed = 1;
         if (flipped > 0)
