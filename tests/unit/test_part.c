@@ -642,6 +642,34 @@ static void note_stage(void *user, const char *name)
     snprintf(seen + n, 256 - n, "%s;", name);
 }
 
+/* pd_part_build_take: the same part as pd_part_build, the mesh taken (the
+ * caller's pointer NULL) on success and on failure alike. */
+static void test_take(void)
+{
+    pd_mesh *m = mesh_roof_box(0.03, 0.02, 0.01, 0.004), *copy = pd_mesh_clone(m);
+    pd_part *a = NULL, *b = NULL;
+    CHECK_STATUS(pd_part_build(m, NULL, &a, NULL), PD_OK);
+    CHECK_STATUS(pd_part_build_take(&copy, NULL, &b, NULL), PD_OK);
+    CHECK(copy == NULL);
+    if (a && b) {
+        /* Bit for bit: the same stages on the same numbers. */
+        CHECK(a->mass.volume == b->mass.volume && a->com.x == b->com.x && a->com.z == b->com.z &&
+              a->hull->nfacets == b->hull->nfacets && a->mesh->ntris == b->mesh->ntris);
+    }
+    pd_part_free(a);
+    pd_part_free(b);
+    b = NULL;
+    /* Refused (an open mesh without a given centre of mass): taken too. */
+    copy = pd_mesh_clone(m);
+    if (copy)
+        copy->ntris--;
+    pd_diag d;
+    pd_diag_init(&d);
+    CHECK(pd_part_build_take(&copy, NULL, &b, &d) != PD_OK);
+    CHECK(copy == NULL && b == NULL);
+    pd_mesh_free(m);
+}
+
 static void test_stages(void)
 {
     pd_mesh *m = mesh_box(1, 2, 3);
@@ -662,6 +690,7 @@ static void test_stages(void)
 void suite_part(void)
 {
     test_cancel();
+    test_take();
     test_stages();
     test_thin_rod();
     test_shipped_parts_are_solids();
