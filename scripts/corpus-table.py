@@ -7,7 +7,7 @@ and engine's run at the engine's default step (k "auto"; the impulse
 engine's k "-"; of several, the last DIR's), and prints in Markdown:
 
   - per part and stepping engine, the total variation (TV) to the impulse
-    engine's run, its sampling noise (the 95th percentile of the TV two
+    engine's run (and between the two stepping engines), its sampling noise (the 95th percentile of the TV two
     samples of these sizes drawn from one distribution show, by multinomial
     redraws from the two runs' pooled shares: what sampling alone gives
     were the engines to agree), the CPU seconds per drop of each engine, and the
@@ -59,6 +59,14 @@ ENGINE = {"impulse": "impulse", "ode": "ODE", "bullet": "Bullet"}
 def wilson_half(p, n, z=1.959963984540054):
     w = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / (1 + z * z / n)
     return w
+
+
+def pooled_noise(a, b):
+    """The 95th percentile of the TV between two runs of a's and b's sizes
+    drawn from their pooled shares."""
+    pooled = {c: (a["n"] * a["p"].get(c, 0.0) + b["n"] * b["p"].get(c, 0.0)) / (a["n"] + b["n"])
+              for c in set(a["p"]) | set(b["p"])}
+    return ec.noise_tv(pooled, a["n"], b["n"], redraws=1000)
 
 
 def load(dirs):
@@ -117,12 +125,16 @@ def tables(runs, labels, tvs):
                                % (LABEL[part], ENGINE[engine], " | ".join(old)))
                 continue
             t = ec.tv(r["p"], imp["p"])
-            pooled = {c: (r["n"] * r["p"].get(c, 0.0) + imp["n"] * imp["p"].get(c, 0.0))
-                      / (r["n"] + imp["n"]) for c in set(r["p"]) | set(imp["p"])}
-            noise = ec.noise_tv(pooled, r["n"], imp["n"], redraws=1000)
+            noise = pooled_noise(r, imp)
             out.append("| %s | %s | %s | %.3f (%d) | %.3f | %s | %.2g, %.2g |\n"
                        % (LABEL[part], ENGINE[engine], " | ".join(old), t, r["n"], noise,
                           "yes" if t > noise else "no", imp["cpu"], r["cpu"]))
+        a, b = runs.get((part, "ode")), runs.get((part, "bullet"))
+        if a and b:
+            t, noise = ec.tv(a["p"], b["p"]), pooled_noise(a, b)
+            out.append("| %s | Bullet to ODE | %s | %.3f (%d, %d) | %.3f | %s | |\n"
+                       % (LABEL[part], " | ".join("-" for _ in labels), t, b["n"], a["n"], noise,
+                          "yes" if t > noise else "no"))
     out.append("\nEach engine's share of each class (`--group` numbering, most probable "
                "first; the cube: 1 ended on the face it started on, 2 on another), "
                "with the 95% Wilson interval's half-width; unsettled drops are in no "
