@@ -245,6 +245,7 @@ figures: deps
 	POSEDROP=$(CLI) scripts/uncertainty.sh
 	{ echo "# scripts/paper.sh (POSEDROP=$(CLI); make figures), commit $$(git rev-parse --short HEAD), $$(date -u +%F)"; \
 	  POSEDROP=$(CLI) scripts/paper.sh; } > docs/figures/paper.txt
+	scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt
 
 # The cheap measured files behind docs/ rerun: fails when a number moved
 # beyond its drops' noise (make check-full runs it).
