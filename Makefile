@@ -236,13 +236,14 @@ check-readme: deps
 # with their cost): the insulator cap's gallery, chart and gauss-sphere map
 # and make paper's tables on the impulse engine (docs/figures/paper.txt),
 # the cost-accuracy chart, the design demonstrations, and the table of
-# docs/uncertainty.md. CHART_ONLY=1 redraws the cost-accuracy chart from its
+# docs/uncertainty.md, and the big-mesh table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart from its
 # kept CSV instead of rerunning it; CHEAP=1 makes only the cap's pictures
 # and paper.txt (seconds).
 figures: deps
 	@$(MAKE) --no-print-directory all
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
+	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 
 # The cheap measured files behind docs/ rerun, after the check's own
 # controls: fails when a number moved beyond its drops' noise (make

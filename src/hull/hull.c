@@ -130,6 +130,10 @@ static pd_status hull_build(const pd_vec3 *pts, int npts, pd_cancel_flag *cancel
         return st;
     pd_trihull th = {0, NULL, NULL};
     st = pd_trihull_build(pts, npts, seed, cancel, &th, diag);
+    if (st == PD_OK && cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
+        pd_trihull_free(&th);
+        st = pd_fail(diag, PD_ERR_CANCELLED, "convex hull: cancelled");
+    }
     if (st != PD_OK)
         return st;
     pd_hull *h = calloc(1, sizeof *h);

@@ -18,7 +18,7 @@ typedef struct {
 
 /* Quickhull of pts from the non-degenerate tetrahedron seed[0..3];
  * PD_ERR_CANCELLED when *cancel (may be NULL) is found non-zero, read every
- * thousand or so points added. */
+ * few points added. */
 pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_cancel_flag *cancel,
                            pd_trihull *out, pd_diag *diag);
 

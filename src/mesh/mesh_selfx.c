@@ -783,6 +783,10 @@ static void fit_leaf(search *s, const bvh *tr, bnode *nd)
  * leaves, half of the leaves each. */
 static int build(search *s, bvh *tr, int id, int first, int count)
 {
+    /* A cancelled build stops as one out of memory does; the caller tells
+     * them apart by s->cancelled. */
+    if (stop(s))
+        return -1;
     bnode *nd = &tr->nodes[id];
     nd->first = first;
     nd->count = count;
