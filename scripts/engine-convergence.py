@@ -13,6 +13,11 @@ steps and its sampling noise (the TV two runs of the same distribution show
 at these n, by multinomial redraws), and the TV to the impulse engine's run of
 the same drops (engine "impulse", k ignored). k "auto" runs --dt auto.
 
+The part cube_resting is the 1 cm cube (parts/canonical/cube.off) started
+resting on a face (--initial stationary's resting drops, the uniform ones
+left out, n of them kept): class 1 is the share that ends on the face it
+started on, class 2 on another face; it is run only when --parts names it.
+
 Usage:
   scripts/engine-convergence.py -o DIR [-n DROPS] [--seed S] [--engines ode,bullet]
       [--k 10,20,40] [--parts NAME,...] [--summary-only]
@@ -47,7 +52,12 @@ def corpus():
         "box_1x2x3cm": [os.path.join(parts, "canonical", "box_1x2x3.off")],
         "white_button": [os.path.join(parts, "white_button.off")],
         "insulator_cap": [os.path.join(parts, "insulator_cap.off")],
+        "cube_resting": ["--initial", "stationary", os.path.join(parts, "canonical", "cube.off")],
     }
+
+
+# Parts started resting on a pose: classes are "kept the pose" (1) or not (2).
+RESTING = {"cube_resting"}
 
 
 def posedrop():
@@ -66,7 +76,10 @@ def run(args):
 
 
 def contact_time(part_args):
-    out, _, _ = run(["-n", "1", "-j", "1", "--format", "json"] + part_args)
+    args = list(part_args)
+    if "--initial" in args:   # one drop is too few for a stationary start
+        del args[args.index("--initial"):args.index("--initial") + 2]
+    out, _, _ = run(["-n", "1", "-j", "1", "--format", "json"] + args)
     return json.loads(out)["scene"]["contact_time_s"]
 
 
@@ -74,6 +87,25 @@ def classes(out):
     """{class: share} and the unsettled drops of a posedrop output."""
     rows = list(csv.DictReader(io.StringIO(out)))
     return {int(r["pose"]): float(r["p"]) for r in rows}, int(rows[0]["unsettled"])
+
+
+def resting_run(n, extra, part_args, outdir):
+    """Drops started resting: posedrop's --initial stationary run's drop i
+    (from 0) is uniform when i mod (k + 1) is 0 and starts resting on pose
+    i mod (k + 1) otherwise, k stable poses; the first n resting ones are
+    kept. {1: share ending on the pose it started on, 2: elsewhere}, the
+    unsettled among them and the CPU seconds per drop run."""
+    k1 = len(list(csv.DictReader(io.StringIO(run(part_args)[0])))) + 1
+    ndrops = max((n * k1 + k1 - 2) // (k1 - 1), 10 * k1)
+    trials = os.path.join(outdir, "trials.tmp.csv")
+    _, _, cpu = run(["-n", str(ndrops), "--trials", trials] + extra + part_args)
+    rows = list(csv.DictReader(open(trials)))
+    os.remove(trials)
+    kept = [r for i, r in enumerate(rows) if i % k1 != 0][:n]
+    starts = [i % k1 for i in range(len(rows)) if i % k1 != 0][:n]
+    lost = sum(1 for r in kept if int(r["pose"]) == 0)
+    same = sum(1 for r, s in zip(kept, starts) if int(r["pose"]) == s)
+    return {1: same / n, 2: (n - same - lost) / n}, lost, cpu / ndrops
 
 
 def tv(p, q):
@@ -112,7 +144,7 @@ def main():
     a = ap.parse_args()
     os.makedirs(a.outdir, exist_ok=True)
     parts = corpus()
-    names = a.parts.split(",") if a.parts else list(parts)
+    names = a.parts.split(",") if a.parts else [x for x in parts if x not in RESTING]
     table = os.path.join(a.outdir, "convergence.csv")
     if not a.summary_only:
         commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
@@ -138,14 +170,19 @@ def main():
                         else:
                             dt = T / float(k)
                             extra = ["--engine", engine, "--dt", "%.9g" % dt]
-                        out, _, cpu = run(base + extra + pa)
-                        shares, lost = classes(out)
+                        if name in RESTING:
+                            shares, lost, per = resting_run(
+                                a.n, ["-j", "1", "--seed", a.seed] + extra, pa, a.outdir)
+                        else:
+                            out, _, cpu = run(base + extra + pa)
+                            shares, lost = classes(out)
+                            per = cpu / a.n
                         for c, p in sorted(shares.items()):
                             w.writerow([name, engine, k, "%.6g" % dt, a.n, c, "%.6g" % p,
-                                        "%.4g" % (cpu / a.n), lost])
+                                        "%.4g" % per, lost])
                         f.flush()
-                        print("engine-convergence.py: %s %s k=%s done, %.1f s CPU" %
-                              (name, engine, k, cpu), file=sys.stderr)
+                        print("engine-convergence.py: %s %s k=%s done, %.4g s CPU per drop" %
+                              (name, engine, k, per), file=sys.stderr)
     summarize(table)
 
 

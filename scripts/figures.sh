@@ -8,7 +8,7 @@
 # paper's physical tests and the gauss-sphere map, from 2000 drops with the
 # paper's scene and the belt's long run as initial poses (as scripts/paper.sh
 # runs them); make paper's tables on the impulse engine (paper.txt, its runs
-# in paper/, and the tables in docs/validation.md); then the cost-accuracy chart of scripts/cost-accuracy.sh (its
+# in paper/); then the cost-accuracy chart of scripts/cost-accuracy.sh (its
 # CSVs kept beside it; several minutes). --chart-only redraws that chart from
 # the kept CSV instead of rerunning it. The paper numbers its poses by
 # physical frequency: parts/insulator_cap-measured.csv pairs its poses with
@@ -74,19 +74,6 @@ mkdir -p "$out/paper"
 cp "$paper_tmp"/*.impulse.csv "$out/paper/"
 rm -rf "$paper_tmp"
 mv "$out/paper.txt.tmp" "$out/paper.txt"
-# The same tables in docs/validation.md, between its paper-tables markers
-# (the wall-clock line left out: it depends on the machine's load).
-awk -v table="$out/paper.txt" '
-    /<!-- paper-tables end -->/ { skip = 0 }
-    !skip { print }
-    /<!-- paper-tables begin -->/ {
-        print "```"
-        while ((getline line < table) > 0) if (line !~ /^seconds per run/) print line
-        print "```"
-        skip = 1
-    }
-' "$here/docs/validation.md" > "$here/docs/validation.md.tmp"
-mv "$here/docs/validation.md.tmp" "$here/docs/validation.md"
 
 [ "$cheap" = 0 ] || exit 0
 # shellcheck disable=SC2086

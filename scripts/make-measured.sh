@@ -28,11 +28,7 @@ status=0
 for part in insulator_cap white_button rect_black_button square_black_button; do
     "$bin" --group "$here/parts/$part.off" > "$tmp/$part.grouped.csv" || exit 1
     awk -F, -v part="$part" -v tag=make-measured.sh -f "$here/scripts/measured.awk" \
-        "$here/parts/paper-tables.csv" "$tmp/$part.grouped.csv" > "$tmp/$part.p.csv" || exit 1
-    # The paper prints percentages to 0.1 of its trials: each times n, to the
-    # nearest drop, is the count it rounded (fit wants whole drops).
-    awk -F, 'NR == 1 { print "pose,count"; next } { printf "%d,%d\n", $1, int($2 * $3 + 0.5) }' \
-        "$tmp/$part.p.csv" > "$tmp/$part-measured.csv" || exit 1
+        "$here/parts/paper-tables.csv" "$tmp/$part.grouped.csv" > "$tmp/$part-measured.csv" || exit 1
     shipped="$here/parts/$part-measured.csv"
     if [ $check = 1 ]; then
         cmp -s "$tmp/$part-measured.csv" "$shipped" ||

@@ -1,5 +1,8 @@
 # measured.awk: the paper's physical column of one part in posedrop's class
-# numbering, as a file --measured and posedrop fit read (pose,p,n).
+# numbering, as a file --measured and posedrop fit read (pose,count). The
+# paper prints percentages to 0.1 of its trials, which times n are not whole
+# drops (13.8% of 545 is 75.2) and a pose,p,n file of them is refused; each
+# to the nearest drop is the count the paper rounded.
 #
 #   awk -F, -v part=NAME -v tag=SCRIPT -f scripts/measured.awk PAPER_TABLES.csv GROUPED.csv
 #
@@ -21,6 +24,6 @@ END {
     for (i = 1; i <= k; i++) for (j = i + 1; j <= k; j++)
         if (qs[ord[j]] > qs[ord[i]]) { t = ord[i]; ord[i] = ord[j]; ord[j] = t }
     if (n > k) { print tag ": the paper has more poses than posedrop classes" > "/dev/stderr"; exit 1 }
-    print "pose,p,n"
-    for (r = 1; r <= n; r++) printf "%d,%.4f,%d\n", num[ord[r]], phys[pr[r]], trials
+    print "pose,count"
+    for (r = 1; r <= n; r++) printf "%d,%d\n", num[ord[r]], int(phys[pr[r]] * trials + 0.5)
 }

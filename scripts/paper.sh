@@ -2,7 +2,7 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-e ENGINES] [-o DIR] [-d PAPER_TABLES_CSV]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-e ENGINES] [-o DIR] [-d PAPER_TABLES_CSV] [-r]
 #   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-s SEED]
 #                       [-P JOBS] [-H PART] [-t CONTACT_TIME] [-o DIR]
 #
@@ -16,7 +16,9 @@
 # given; 0: the rigid model): --contact-time),
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
 # (default results/; each engine's starts with '#' lines giving its command
-# and the commit it ran on) and prints a legend, then each table: the paper's QS, PQS, dynamic and
+# and the commit it ran on; -r keeps a run whose CSV is already there, whole,
+# of DROPS drops, as an interrupted run or one run apart left it: it cannot
+# tell the other options, so give the same) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
@@ -63,11 +65,13 @@ seed=1
 jobs=2
 held=
 engines=impulse,ode,bullet
+reuse=0
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
         -i) args_value "$@"; initial=$2; shift 2 ;;
         -L) loo=1; shift ;;
+        -r) reuse=1; shift ;;
         -f) args_value "$@"; spec=$2; shift 2 ;;
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
         -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
@@ -78,7 +82,7 @@ while [ $# -gt 0 ]; do
         -H) args_value "$@"; held=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,45p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,47p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -138,19 +142,29 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
     [ -f "$file" ] || { echo "paper.sh: $file missing" >&2; status=1; continue; }
     "$bin" --group "$file" > "$outdir/$part.static.csv" || { status=1; continue; }
     for engine in impulse ode bullet; do
-        rm -f "$outdir/$part.$engine.csv" "$outdir/$part.$engine.seconds"
         case ",$engines," in *",$engine,"*) ;; *) continue ;; esac
         runs=$((runs + 1))
+        if [ "$reuse" = 1 ] && awk -F, -v n="$n" '
+                /^#/ { next }
+                !ncol { ncol = NF; for (i = 1; i <= NF; i++) c[$i] = i; next }
+                { rows++; if ($c["n"] != n || $c["partial"] != 0) bad = 1 }
+                END { exit !(rows > 0 && !bad) }' "$outdir/$part.$engine.csv" 2>/dev/null; then
+            echo "paper.sh: $part on $engine, run $runs of $((4 * nengines)): kept $outdir/$part.$engine.csv" >&2
+            continue
+        fi
+        rm -f "$outdir/$part.$engine.csv" "$outdir/$part.$engine.seconds"
         echo "paper.sh: $part on $engine, run $runs of $((4 * nengines)), $((SECONDS - start_s)) s so far" >&2
-        start=$(date +%s.%N)
         args=(--group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"}
               --engine "$engine")
-        { printf '# posedrop %s parts/%s.off\n# commit %s, %s\n' "${args[*]}" "$part" "$commit" \
-              "$(date -u +%Y-%m-%d)"
-          "$bin" "${args[@]}" "$file"; } \
-            > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1
-        end=$(date +%s.%N)
-        awk -v a="$start" -v b="$end" 'BEGIN { printf "%.3f\n", b - a }' > "$outdir/$part.$engine.seconds"
+        # CPU seconds (user + sys, all threads): wall time says more of the
+        # machine's other load than of the run.
+        TIMEFORMAT='%3U %3S'
+        { time { printf '# posedrop %s parts/%s.off\n# commit %s, %s\n' "${args[*]}" "$part" "$commit" \
+                   "$(date -u +%Y-%m-%d)"
+                 "$bin" "${args[@]}" "$file"; } \
+            > "$outdir/$part.$engine.csv" 2> "$outdir/$part.$engine.err" || status=1; } \
+            2> "$outdir/$part.$engine.time"
+        awk '{ printf "%.3f\n", $1 + $2 }' "$outdir/$part.$engine.time" > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
     awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" -v engines="$engines" '
@@ -237,7 +251,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
         function abs(x) { return x < 0 ? -x : x }
     ' "$tables" | tee "$outdir/$part.table.txt"
 done
-printf '\nseconds per run (%d drops):' "$n"
+printf '\nCPU seconds per run (user + sys, %d drops):' "$n"
 for part in insulator_cap white_button rect_black_button square_black_button; do
     for engine in impulse ode bullet; do
         [ -f "$outdir/$part.$engine.seconds" ] && printf ' %s/%s %s' "$part" "$engine" "$(cat "$outdir/$part.$engine.seconds")"

@@ -7,8 +7,8 @@ physical parameters, from the very releases posedrop drew, decided by the
 same rule and grouped into the same pose classes as posedrop's --group.
 
   .venv/bin/python scripts/referee-mujoco.py [-n DROPS] [--seed S]
-      [--parts a,b,...] [--steps K,...] [--mj-n M] [--check-n M] [-o DIR]
-      [--doc FILE]
+      [--parts a,b,...] [--engines impulse,...] [--steps K,...] [--mj-n M]
+      [--check-n M] [--jobs J] [-o DIR] [--doc FILE]
 
 The corpus (--parts picks some):
   bushing   flanged bushing: a stepped solid of revolution, 32-gon, mm:
@@ -24,7 +24,8 @@ The corpus (--parts picks some):
             point at the drop height); the figure is the share that ends on
             the face it started on
 
-posedrop: each engine at its defaults (build/opt/posedrop; whatever --dt its
+posedrop: each engine of --engines (impulse, ode, bullet; impulse always,
+first: its trials give the releases) at its defaults (build/opt/posedrop; whatever --dt its
 default is), -n DROPS, --seed S, --group, --trials (the releases and
 outcomes). MuJoCo, for every drop, from the release posedrop recorded (the
 orientation in --trials, lowest point at the scene's height, the belt's
@@ -42,7 +43,9 @@ velocity, no spin):
     (2/3) a mu, a = sqrt(R d): a corner of radius R = PD_CORNER_RADIUS_REL L
     sunk d = g / omega^2);
   - the first --mj-n releases (all by default; MuJoCo costs 10 to 100 times
-    posedrop's engines per drop);
+    posedrop's engines per drop), in --jobs processes (1), each drop's
+    outcome written to DIR/mujoco.PART.T<K>.csv as it ends, so a run
+    stopped early leaves what it did;
   - the step T / K for the first K of --steps (default 20,40): the table's;
     each further (finer) step runs the first --check-n releases (200) again,
     and the total variation between successive steps on those, against
@@ -433,6 +436,11 @@ def main():
     ap.add_argument("-n", type=int, default=1000, help="drops per engine and part (1000)")
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--parts", default=",".join(ORDER))
+    ap.add_argument("--engines", default=",".join(ENGINES),
+                    help="posedrop's engines to run beside MuJoCo (impulse,ode,bullet; "
+                    "impulse is always run, first)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="processes for MuJoCo's drops (1)")
     ap.add_argument("--steps", default="20,40",
                     help="MuJoCo's steps per contact time: the table's, then finer ones "
                     "for the convergence check (20,40)")
@@ -451,6 +459,10 @@ def main():
     a = ap.parse_args()
     names = a.parts.split(",")
     why = ["unknown part %r (%s)" % (x, ", ".join(PARTS)) for x in names if x not in PARTS]
+    engines = ["impulse"] + [e for e in a.engines.split(",") if e != "impulse"]
+    why += ["unknown engine %r (%s)" % (e, ", ".join(ENGINES)) for e in engines
+            if e not in ENGINES]
+    ENGINES[:] = engines
     if not os.access(a.posedrop, os.X_OK):
         why.append("%s not found: run make all first" % a.posedrop)
     try:
@@ -510,11 +522,11 @@ def main():
             these = keep[:a.mj_n or len(keep)] if s == 0 else keep[:a.check_n]
             sys.stderr.write("referee-mujoco: %s on MuJoCo, dt = T/%d = %.3g s, %d drops\n"
                              % (name, K, dt, len(these)))
-            outcomes = []
             t0 = time.process_time()
-            for i in these:
-                outcomes.append(ref.drop(releases[i])[0])
-            ms = 1000.0 * (time.process_time() - t0) / len(these)
+            c0 = child_cpu()
+            log = os.path.join(a.o, "mujoco.%s.T%d.csv" % (name, K))
+            outcomes = mujoco_drops(ref, [releases[i] for i in these], these, a.jobs, log)
+            ms = 1000.0 * (time.process_time() - t0 + child_cpu() - c0) / len(these)
             results["mujoco T/%d" % K] = (outcomes, ms)
         st = [starts[i] for i in keep]
         n = len(keep)
@@ -535,6 +547,41 @@ def main():
             script_util.put_between(a.doc, a.doc_tag, "\n" + text + "\n", "referee-mujoco")
     sys.stdout.write(text)
     return 0
+
+
+_WORKER = {}
+
+
+def _worker_init(part, dt):
+    import mujoco
+    _WORKER["ref"] = Referee(mujoco, part, dt)
+
+
+def _worker_drop(q):
+    return _WORKER["ref"].drop(q)[0]
+
+
+def mujoco_drops(ref, qs, index, jobs, log):
+    """The outcome of each release in qs (drops index), in order, in jobs
+    processes; each written to log (drop,pose) as it ends."""
+    with open(log, "w") as f:
+        f.write("drop,pose\n")
+        if jobs <= 1:
+            out = []
+            for i, q in zip(index, qs):
+                out.append(ref.drop(q)[0])
+                f.write("%d,%d\n" % (i, out[-1]))
+                f.flush()
+            return out
+        import multiprocessing
+        ctx = multiprocessing.get_context("fork")
+        with ctx.Pool(jobs, _worker_init, (ref.part, ref.dt)) as pool:
+            out = []
+            for i, pose in zip(index, pool.imap(_worker_drop, qs, chunksize=4)):
+                out.append(pose)
+                f.write("%d,%d\n" % (i, pose))
+                f.flush()
+            return out
 
 
 def write_csv(path, out_rows):

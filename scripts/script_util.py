@@ -21,7 +21,9 @@ def run(cmd, tag):
 
 
 def rows(text):
-    return list(csv.DictReader(text.splitlines()))
+    # Lines starting '#' are provenance (scripts/paper.sh heads its runs with
+    # their command and commit), not rows.
+    return list(csv.DictReader(l for l in text.splitlines() if not l.startswith("#")))
 
 
 def git(*args):

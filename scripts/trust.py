@@ -18,12 +18,19 @@ paper's belt (--initial stationary, the paper's scene), -n drops (2000):
             paper's physical tests (parts/paper-tables.csv, paired with
             posedrop's classes as scripts/measured.awk pairs them).
 
+--runs DIR takes the three engines' runs from scripts/paper.sh's output
+directory (the same drops: paper.sh runs each engine at seed 1 on the
+belt, -n as given here) instead of running --crosscheck again: the stepping
+engines' runs are most of the cost. The code that made them is paper.sh's
+commit, not necessarily this one's.
+
 Prints a table; --doc FILE puts it, with the command and commit, between
 '<!-- trust-table begin -->' and '<!-- trust-table end -->' of FILE, and
 --readme FILE a short paragraph between '<!-- trust begin -->' and
 '<!-- trust end -->'.
 
-  scripts/trust.py [-n DROPS] [--seed S] [--doc docs/validation.md] [--readme README.md]
+  scripts/trust.py [-n DROPS] [--seed S] [--runs DIR] [--doc docs/validation.md]
+      [--readme README.md]
 
 Python 3 standard library only; posedrop must be built (make all).
 """
@@ -46,10 +53,38 @@ def run(cmd):
     return script_util.run(cmd, "trust.py")
 
 
-def measure(exe, name, n, seed, tmp):
+def engines_from(runs, name, n, seed):
+    """--crosscheck's rows rebuilt from make paper's three runs of the part
+    (RUNS/NAME.ENGINE.csv, the same drops: --group, the belt, the seed it
+    printed): p and its interval the impulse engine's, the engines' range
+    and whether two engines' 95% intervals are apart."""
+    got = {}
+    for e in ("impulse", "ode", "bullet"):
+        path = os.path.join(runs, "%s.%s.csv" % (name, e))
+        if not os.path.exists(path):
+            sys.exit("trust.py: %s missing (run scripts/paper.sh -o %s)" % (path, runs))
+        got[e] = {r["pose"]: r for r in rows(open(path).read())}
+        if any(int(r["n"]) != n for r in got[e].values()):
+            sys.exit("trust.py: %s is not of %d drops (give -n as paper.sh had it)" % (path, n))
+    if seed != 1:
+        sys.exit("trust.py: --runs: paper.sh's runs are of seed 1")
+    xc = []
+    for pose, r in got["impulse"].items():
+        ps = [float(got[e][pose]["p"]) for e in got]
+        lo = [float(got[e][pose]["ci_lo"]) for e in got]
+        hi = [float(got[e][pose]["ci_hi"]) for e in got]
+        xc.append(dict(r, p_engine_min=min(ps), p_engine_max=max(ps),
+                       engines_disagree=int(min(hi) < max(lo))))
+    return xc
+
+
+def measure(exe, name, n, seed, tmp, runs):
     part = os.path.join(ROOT, "parts", name + ".off")
     base = [exe, "--group", "--initial", "stationary", "-n", str(n), "--seed", str(seed)]
-    xc = rows(run(base + ["--crosscheck", part]))
+    if runs:
+        xc = engines_from(runs, name, n, seed)
+    else:
+        xc = rows(run(base + ["--crosscheck", part]))
     sens_file = os.path.join(tmp, name + ".sens.csv")
     run(base + RANGES + ["--sensitivity", sens_file, part])
     sens = rows(open(sens_file).read())
@@ -59,7 +94,8 @@ def measure(exe, name, n, seed, tmp):
     meas = rows(run(["awk", "-F,", "-v", "part=" + name, "-v", "tag=trust.py", "-f",
                      os.path.join(ROOT, "scripts/measured.awk"),
                      os.path.join(ROOT, "parts/paper-tables.csv"), grouped]))
-    m = {int(r["pose"]): float(r["p"]) for r in meas}
+    total = sum(int(r["count"]) for r in meas)
+    m = {int(r["pose"]): int(r["count"]) / total for r in meas}
     half = max((float(r["ci_hi"]) - float(r["ci_lo"])) / 2 for r in xc)
     spread = max(float(r["p_engine_max"]) - float(r["p_engine_min"]) for r in xc)
     apart = sum(int(r["engines_disagree"]) for r in xc)
@@ -77,6 +113,8 @@ def main():
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--doc")
     ap.add_argument("--readme")
+    ap.add_argument("--runs", help="make paper's output directory (scripts/paper.sh -o DIR, "
+                    "the same -n): its three engines' runs instead of --crosscheck's")
     a = ap.parse_args()
     if not os.access(a.posedrop, os.X_OK):
         sys.exit("trust.py: %s not found: run make all first" % a.posedrop)
@@ -85,7 +123,7 @@ def main():
         res = []
         for name in PARTS:
             sys.stderr.write("trust.py: %s\n" % name)
-            res.append(measure(a.posedrop, name, a.n, a.seed, tmp))
+            res.append(measure(a.posedrop, name, a.n, a.seed, tmp, a.runs))
     cmd = "scripts/trust.py " + " ".join(sys.argv[1:])
     when = time.strftime("%Y-%m-%d", time.gmtime())
     made = "Made by `%s` on %s (commit %s%s)." % (cmd.strip(), when, commit, dirty)

@@ -83,16 +83,60 @@ static void exp_add_triple(expansion *e, double sign, const pd_vec3 *p, const pd
     exp_add_prod3(e, -sign, p->z, q->y, r->x);
 }
 
+/* The differences b - a, c - a, d - a when all nine are exact (a rounded
+ * difference is exact when its error-free remainder is zero; by Sterbenz's
+ * lemma always so for coordinates within a factor of two of each other, the
+ * usual case of near neighbours far from the origin's planes). 0 when one
+ * is not, or is of a scale whose products of three could leave the range
+ * of normal doubles. */
+static int exact_differences(const pd_vec3 *a, const pd_vec3 *b, const pd_vec3 *c, const pd_vec3 *d,
+                             double u[3][3])
+{
+    const pd_vec3 *p[3] = {b, c, d};
+    for (int i = 0; i < 3; i++) {
+        double x[3] = {p[i]->x - a->x, p[i]->y - a->y, p[i]->z - a->z};
+        double in[3] = {p[i]->x, p[i]->y, p[i]->z}, o[3] = {a->x, a->y, a->z};
+        for (int k = 0; k < 3; k++) {
+            double s, err;
+            two_sum(in[k], -o[k], &s, &err);
+            /* Products of differences far below or above the inputs'
+             * own could underflow or overflow where those of the inputs
+             * do not: such scales take the full expansion. */
+            double ax = fabs(x[k]);
+            if (err != 0.0 || (ax != 0.0 && (ax < 0x1p-250 || ax > 0x1p250)))
+                return 0;
+            u[i][k] = x[k];
+        }
+    }
+    return 1;
+}
+
+static int expansion_sign(const expansion *e)
+{
+    if (e->n == 0)
+        return 0;
+    double top = e->c[e->n - 1];
+    return (top > 0.0) - (top < 0.0);
+}
+
 int pd_orient3d_exact(const pd_vec3 *a, const pd_vec3 *b, const pd_vec3 *c, const pd_vec3 *d)
 {
     expansion e;
     e.n = 0;
+    /* A first stage: with the differences exact, the determinant of u, v, w
+     * is 6 products of three (24 doubles), not the 24 of the inputs (96
+     * doubles). Near-coplanar neighbours of a mesh turned off the axes reach
+     * the fallback by the million, and almost all have exact differences. */
+    double u[3][3];
+    if (exact_differences(a, b, c, d, u)) {
+        pd_vec3 U = {u[0][0], u[0][1], u[0][2]}, V = {u[1][0], u[1][1], u[1][2]},
+                W = {u[2][0], u[2][1], u[2][2]};
+        exp_add_triple(&e, 1.0, &U, &V, &W);
+        return expansion_sign(&e);
+    }
     exp_add_triple(&e, 1.0, b, c, d);
     exp_add_triple(&e, -1.0, a, b, c);
     exp_add_triple(&e, 1.0, a, b, d);
     exp_add_triple(&e, -1.0, a, c, d);
-    if (e.n == 0)
-        return 0;
-    double top = e.c[e.n - 1];
-    return (top > 0.0) - (top < 0.0);
+    return expansion_sign(&e);
 }

@@ -689,8 +689,10 @@ int cli_run(cli_args *a)
         code = fail_status(st, &diag, NULL);
         goto done;
     }
+    /* The part takes the file's mesh: two copies of a large one would be
+     * held through the whole build. */
     if (st == PD_OK)
-        st = pd_part_build(mesh, &a->part, &part, &diag);
+        st = pd_part_build_take(&mesh, &a->part, &part, &diag);
     if (st == PD_OK && !a->merge && cli_writer())
         plausible_warn(a, part);
     static_progress_stage("quasi-static and perturbed estimates");

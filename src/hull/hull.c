@@ -103,8 +103,23 @@ pd_status pd_hull_build(const pd_vec3 *pts, int npts, pd_hull **hull, pd_diag *d
     return pd_hull_build_stats(pts, npts, hull, NULL, diag);
 }
 
+static pd_status hull_build(const pd_vec3 *pts, int npts, pd_cancel_flag *cancel, pd_hull **hull,
+                            pd_hull_merge_stats *stats, pd_diag *diag);
+
 pd_status pd_hull_build_stats(const pd_vec3 *pts, int npts, pd_hull **hull, pd_hull_merge_stats *stats,
                               pd_diag *diag)
+{
+    return hull_build(pts, npts, NULL, hull, stats, diag);
+}
+
+pd_status pd_hull_build_cancel(const pd_vec3 *pts, int npts, pd_cancel_flag *cancel, pd_hull **hull,
+                               pd_diag *diag)
+{
+    return hull_build(pts, npts, cancel, hull, NULL, diag);
+}
+
+static pd_status hull_build(const pd_vec3 *pts, int npts, pd_cancel_flag *cancel, pd_hull **hull,
+                            pd_hull_merge_stats *stats, pd_diag *diag)
 {
     if (!hull || (!pts && npts > 0) || npts < 0)
         return pd_fail(diag, PD_ERR_USAGE, "pd_hull_build: NULL argument or negative count");
@@ -114,7 +129,7 @@ pd_status pd_hull_build_stats(const pd_vec3 *pts, int npts, pd_hull **hull, pd_h
     if (st != PD_OK)
         return st;
     pd_trihull th = {0, NULL, NULL};
-    st = pd_trihull_build(pts, npts, seed, &th, diag);
+    st = pd_trihull_build(pts, npts, seed, cancel, &th, diag);
     if (st != PD_OK)
         return st;
     pd_hull *h = calloc(1, sizeof *h);

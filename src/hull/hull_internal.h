@@ -16,9 +16,17 @@ typedef struct {
     int (*nb)[3];  /* nb[t][i]: triangle across edge tri[t][i] -> tri[t][(i+1)%3] */
 } pd_trihull;
 
-/* Quickhull of pts from the non-degenerate tetrahedron seed[0..3]. */
-pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_trihull *out,
-                           pd_diag *diag);
+/* Quickhull of pts from the non-degenerate tetrahedron seed[0..3];
+ * PD_ERR_CANCELLED when *cancel (may be NULL) is found non-zero, read every
+ * thousand or so points added. */
+pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_cancel_flag *cancel,
+                           pd_trihull *out, pd_diag *diag);
+
+/* pd_hull_build, PD_ERR_CANCELLED when *cancel (may be NULL) is found
+ * non-zero during the triangulated hull, where the time of a large part's
+ * hull goes. */
+pd_status pd_hull_build_cancel(const pd_vec3 *pts, int npts, pd_cancel_flag *cancel, pd_hull **hull,
+                               pd_diag *diag);
 void pd_trihull_free(pd_trihull *th);
 
 /* What the merge had to repair (hull_merge.c): how often the plane test

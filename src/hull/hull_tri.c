@@ -241,6 +241,8 @@ static int twin_edge(const qtri *t, int a, int b)
     return -1;
 }
 
+enum { HULL_POLL_EVERY = 1024 };
+
 /* Adds the furthest point of triangle f to the hull. */
 static int add_point(qhull *q, int f, size_t mincap)
 {
@@ -323,7 +325,8 @@ static int add_point(qhull *q, int f, size_t mincap)
     return distribute(q, m, nvis, nhor, mincap);
 }
 
-pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_trihull *out, pd_diag *diag)
+pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_cancel_flag *cancel,
+                           pd_trihull *out, pd_diag *diag)
 {
     qhull q;
     memset(&q, 0, sizeof q);
@@ -364,10 +367,18 @@ pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_t
             m++;
         }
     rc = distribute(&q, m, 0, 4, mincap);
-    while (rc == 0 && q.nstack > 0) {
+    /* The flag read every HULL_POLL_EVERY points added: each is a few
+     * microseconds on the usual hull, so a cancelled build stops within
+     * milliseconds (the first few, which share out all the points, take
+     * longer; they come before the first read). */
+    for (unsigned added = 0; rc == 0 && q.nstack > 0;) {
         int f = q.stack[--q.nstack];
-        if (q.t[f].alive && q.t[f].oc > 0)
+        if (q.t[f].alive && q.t[f].oc > 0) {
             rc = add_point(&q, f, mincap);
+            if (cancel && ++added % HULL_POLL_EVERY == 0 &&
+                atomic_load_explicit(cancel, memory_order_relaxed))
+                rc = -3;
+        }
     }
     if (rc == 0) {
         /* Compact the live triangles into the output. */
@@ -407,6 +418,8 @@ done:
     free(q.stack);
     free(q.cone_at);
     free(q.cnt);
+    if (rc == -3)
+        return pd_fail(diag, PD_ERR_CANCELLED, "convex hull: cancelled");
     if (rc == -2)
         return pd_fail(diag, PD_ERR_INTERNAL, "convex hull: horizon edge without a twin (corrupt adjacency)");
     if (rc != 0)

@@ -11,6 +11,14 @@
  * PD_ERR_RANGE or PD_ERR_NONFINITE. */
 pd_status pd_mesh_validate(const pd_mesh *m, const char *who, pd_diag *diag);
 
+/* pd_mesh_weld and pd_mesh_orient, PD_ERR_CANCELLED (the mesh as it was)
+ * when *cancel (may be NULL) is found non-zero: read every few thousand
+ * steps of their loops, so that a large part's build stops within a
+ * millisecond or so of the flag. */
+pd_status pd_mesh_weld_cancel(pd_mesh *mesh, double tol, int *nmerged, pd_cancel_flag *cancel);
+pd_status pd_mesh_orient_cancel(pd_mesh *mesh, int *nflipped, pd_cancel_flag *cancel,
+                                pd_diag *diag);
+
 /* Finds two triangles of a welded mesh whose relative interiors cross
  * (exact signs of orientation: sharing a vertex or an edge, or touching
  * without crossing, is not crossing; coplanar pairs are not examined).

@@ -3,7 +3,8 @@
  * Three steps, none of which touches the mesh until all have succeeded, so a
  * failure leaves it as it was:
  *  1. Edge adjacency. Every directed edge of every triangle is keyed by its
- *     unordered vertex pair and the keys are sorted (O(n log n), and
+ *     unordered vertex pair and the keys are sorted (by a count of the lower
+ *     vertex, then within its few edges: linear on the usual meshes, and
  *     deterministic, unlike a hash whose order depends on its size). A closed
  *     2-manifold has every key exactly twice.
  *  2. Relative orientation. Two triangles sharing an edge agree when they
@@ -155,9 +156,31 @@ static int nesting_depth(const pd_mesh *m, const component *comps, int ncomps, i
  * when that neighbour traverses the edge in the same direction (so exactly one
  * of the two must flip). Fails on the first edge, in sorted order, that is not
  * used by exactly two triangles. */
-static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned char *same,
-                            pd_diag *diag)
+/* 1 when *cancel (may be NULL) is set, read every 4,096 calls: each step
+ * of the loops that call it is well under a microsecond. */
+static int poll_cancel(pd_cancel_flag *cancel, unsigned *n)
 {
+    return cancel && ++*n % 4096 == 0 && atomic_load_explicit(cancel, memory_order_relaxed);
+}
+
+static int half_edge_less(const half_edge *a, const half_edge *b)
+{
+    return cmp_half_edge(a, b) < 0;
+}
+
+static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned char *same,
+                            pd_cancel_flag *cancel, pd_diag *diag)
+{
+    unsigned polls = 0;
+    /* The order of one sort by (lo, hi, tri, k), made in linear time: the
+     * edges counted and placed by lo in order of triangle and corner (so
+     * each lo's run is already in (tri, k) order), then each run sorted by
+     * hi, stably by insertion when short (the usual star), by qsort on the
+     * whole key when long (a fan about one corner): no log factor over all
+     * the edges, and the same order, so the same edge is reported first. */
+    int *at = calloc((size_t)m->nverts + 1, sizeof *at);
+    if (!at)
+        return pd_fail(diag, PD_ERR_NOMEM, "orient: out of memory for %d vertices", m->nverts);
     int nh = 0;
     for (int t = 0; t < m->ntris; t++) {
         for (int k = 0; k < 3; k++)
@@ -166,14 +189,53 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
             continue;
         for (int k = 0; k < 3; k++) {
             int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
-            he[nh].lo = a < b ? a : b;
-            he[nh].hi = a < b ? b : a;
-            he[nh].tri = t;
-            he[nh].k = k;
+            at[(a < b ? a : b)]++;
             nh++;
         }
     }
-    qsort(he, (size_t)nh, sizeof *he, cmp_half_edge);
+    for (int v = 0, sum = 0; v <= m->nverts; v++) {
+        int c = at[v];
+        at[v] = sum;
+        sum += c;
+    }
+    for (int t = 0; t < m->ntris; t++) {
+        if (poll_cancel(cancel, &polls)) {
+            free(at);
+            return PD_ERR_CANCELLED;
+        }
+        if (tri_degenerate(m->tris[t]))
+            continue;
+        for (int k = 0; k < 3; k++) {
+            int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
+            half_edge *h = &he[at[a < b ? a : b]++];
+            h->lo = a < b ? a : b;
+            h->hi = a < b ? b : a;
+            h->tri = t;
+            h->k = k;
+        }
+    }
+    /* at[v] is now the end of v's run. */
+    for (int v = 0, first = 0; v < m->nverts; v++) {
+        if (poll_cancel(cancel, &polls)) {
+            free(at);
+            return PD_ERR_CANCELLED;
+        }
+        int n = at[v] - first;
+        half_edge *r = he + first;
+        if (n > 32) {
+            qsort(r, (size_t)n, sizeof *r, cmp_half_edge);
+        } else {
+            for (int i = 1; i < n; i++) {
+                half_edge x = r[i];
+                int j = i;
+                for (; j > 0 && half_edge_less(&x, &r[j - 1]); j--)
+                    r[j] = r[j - 1];
+                r[j] = x;
+            }
+        }
+        first = at[v];
+    }
+    free(at);
     for (int i = 0; i < nh;) {
         int j = i + 1;
         while (j < nh && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
@@ -198,6 +260,12 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
 
 pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
 {
+    return pd_mesh_orient_cancel(mesh, nflipped, NULL, diag);
+}
+
+pd_status pd_mesh_orient_cancel(pd_mesh *mesh, int *nflipped, pd_cancel_flag *cancel, pd_diag *diag)
+{
+    unsigned polls = 0;
     pd_status st = pd_mesh_validate(mesh, "orient", diag);
     if (st != PD_OK)
         return st;
@@ -215,7 +283,7 @@ pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
         st = pd_fail(diag, PD_ERR_NOMEM, "orient: out of memory for %d triangles", n);
         goto done;
     }
-    st = pair_edges(mesh, he, nbr, same, diag);
+    st = pair_edges(mesh, he, nbr, same, cancel, diag);
     if (st != PD_OK)
         goto done;
 
@@ -233,6 +301,10 @@ pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
         comp[seed] = ncomps;
         list[nlist++] = seed;
         for (int head = nlist - 1; head < nlist; head++) {
+            if (poll_cancel(cancel, &polls)) {
+                st = PD_ERR_CANCELLED;
+                goto done;
+            }
             int t = list[head];
             for (int k = 0; k < 3; k++) {
                 int u = nbr[3 * t + k];
@@ -261,6 +333,10 @@ pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
         goto done;
     }
     for (int i = 0, c = -1; i < nlist; i++) {
+        if (poll_cancel(cancel, &polls)) {
+            st = PD_ERR_CANCELLED;
+            goto done;
+        }
         int t = list[i];
         if (comp[t] != c) {
             c = comp[t];
@@ -282,6 +358,11 @@ pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)
         }
     }
     for (int c = 0; c < ncomps; c++) {
+        /* Each nesting test is a pass over the other components. */
+        if (cancel && atomic_load_explicit(cancel, memory_order_relaxed)) {
+            st = PD_ERR_CANCELLED;
+            goto done;
+        }
         if (comps[c].vol6 == 0.0)
             continue; /* flat: no sign to fix; pd_mass_compute will refuse it if alone */
         int outer = ncomps == 1 || nesting_depth(mesh, comps, ncomps, c, list, flip) % 2 == 0;

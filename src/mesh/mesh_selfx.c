@@ -510,6 +510,10 @@ typedef struct bnode {
     int patch;           /* the flat patch of all its triangles, or -1 */
     int first, count;    /* its triangles: order[first .. first + count) */
     int left;            /* children left and left + 1; -1 for a leaf */
+    float alo[3], ahi[3]; /* its box along the coordinate axes, widened by pad and
+                             rounded outwards: six comparisons that settle
+                             many pairs (most, on smooth surfaces) before the
+                             27 products of the oriented test */
 } bnode;
 
 /* A triangle's box along the coordinate axes, in floats: it only guides
@@ -710,6 +714,30 @@ static void fit_corners(const search *s, const bvh *tr, bnode *nd)
     }
 }
 
+/* A leaf's box along the coordinate axes, in floats rounded outwards (a
+ * float beyond the double's bound stepped back by one), so that it holds
+ * the corners whatever the rounding. */
+static void fit_axis_box(const search *s, const bvh *tr, bnode *nd)
+{
+    const pd_mesh *m = s->m;
+    const int *ts = tr->order + nd->first;
+    double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+    for (int i = 0; i < nd->count; i++)
+        for (int j = 0; j < 3; j++) {
+            pd_vec3 p = m->verts[m->tris[ts[i]][j]];
+            double c[3] = {p.x, p.y, p.z};
+            for (int k = 0; k < 3; k++) {
+                lo[k] = dmin(lo[k], c[k]);
+                hi[k] = dmax(hi[k], c[k]);
+            }
+        }
+    for (int k = 0; k < 3; k++) {
+        float l = (float)(lo[k] - s->pad), h = (float)(hi[k] + s->pad);
+        nd->alo[k] = (double)l > lo[k] - s->pad ? nextafterf(l, -HUGE_VALF) : l;
+        nd->ahi[k] = (double)h < hi[k] + s->pad ? nextafterf(h, HUGE_VALF) : h;
+    }
+}
+
 /* A leaf: its frame along its longest edge and the normal of that edge's
  * triangle. */
 static void fit_leaf(search *s, const bvh *tr, bnode *nd)
@@ -733,6 +761,7 @@ static void fit_leaf(search *s, const bvh *tr, bnode *nd)
     frame(nd->ax, v3_sub(m->verts[T[(lk + 1) % 3]], m->verts[T[lk]]),
           v3_sub(m->verts[T[(lk + 2) % 3]], m->verts[T[(lk + 1) % 3]]));
     fit_corners(s, tr, nd);
+    fit_axis_box(s, tr, nd);
     int nc = 0;
     for (int k = 0; k < 3; k++) {
         int v = m->tris[ts[0]][k], all = 1;
@@ -821,6 +850,10 @@ static int build(search *s, bvh *tr, int id, int first, int count)
     while (nc < 3)
         nd->cv[nc++] = -1;
     nd->patch = c[0]->patch == c[1]->patch ? c[0]->patch : -1;
+    for (int k = 0; k < 3; k++) {
+        nd->alo[k] = c[0]->alo[k] < c[1]->alo[k] ? c[0]->alo[k] : c[1]->alo[k];
+        nd->ahi[k] = c[0]->ahi[k] > c[1]->ahi[k] ? c[0]->ahi[k] : c[1]->ahi[k];
+    }
     return 0;
 }
 
@@ -936,7 +969,9 @@ static int leaf_pair(search *s, const bvh *tr, const bnode *a, const bnode *b)
 static int node_pair(search *s, const bvh *tr, int ia, int ib)
 {
     const bnode *a = &tr->nodes[ia], *b = &tr->nodes[ib];
-    if (common_corner(a, b) || (a->patch >= 0 && a->patch == b->patch) ||
+    if (a->ahi[0] < b->alo[0] || b->ahi[0] < a->alo[0] || a->ahi[1] < b->alo[1] ||
+        b->ahi[1] < a->alo[1] || a->ahi[2] < b->alo[2] || b->ahi[2] < a->alo[2] ||
+        common_corner(a, b) || (a->patch >= 0 && a->patch == b->patch) ||
         boxes_apart(a, b, s->pad))
         return 0;
     if (stop(s))

@@ -13,6 +13,7 @@
 #include "base/hash.h"
 #include "base/mat3.h"
 #include "base/size_range.h"
+#include "hull/hull_internal.h"
 #include "hull/hull_mass.h"
 #include "mesh/mesh_internal.h"
 #include "posedrop/part.h"
@@ -252,19 +253,24 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     double size0 = p->size;
     if (next_stage(opt, "welding"))
         return PD_ERR_CANCELLED;
-    if (pd_mesh_weld(p->mesh, PD_TOL_WELD_REL * p->size, NULL) != PD_OK)
-        return PD_ERR_NOMEM;
+    st = pd_mesh_weld_cancel(p->mesh, PD_TOL_WELD_REL * p->size, NULL, opt->cancel);
+    if (st != PD_OK)
+        return st == PD_ERR_CANCELLED ? st : PD_ERR_NOMEM;
     p->size = pd_mesh_size(p->mesh);
     if (next_stage(opt, "convex hull"))
         return PD_ERR_CANCELLED;
-    st = pd_hull_build(p->mesh->verts, p->mesh->nverts, &p->hull, diag);
+    st = pd_hull_build_cancel(p->mesh->verts, p->mesh->nverts, opt->cancel, &p->hull, diag);
+    if (st == PD_ERR_CANCELLED)
+        return st;
     if (st != PD_OK)
         return weld_explains(st, nbefore, p->mesh->nverts, size0, diag);
 
     int flipped = 0;
     if (next_stage(opt, "orienting"))
         return PD_ERR_CANCELLED;
-    st = pd_mesh_orient(p->mesh, &flipped, diag);
+    st = pd_mesh_orient_cancel(p->mesh, &flipped, opt->cancel, diag);
+    if (st == PD_ERR_CANCELLED || st == PD_ERR_NOMEM)
+        return st;
     if (st == PD_OK) {
         p->closed = 1;
         if (flipped > 0)
@@ -308,31 +314,40 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     return check_com_inside(p, diag);
 }
 
-pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_part **part,
-                        pd_diag *diag)
+/* The build of pd_part_build and pd_part_build_take: mesh is the caller's
+ * (copied) or, when owned is not NULL, *owned, taken over and set NULL
+ * whatever the outcome. */
+static pd_status part_build(const pd_mesh *mesh, pd_mesh **owned, const pd_part_options *options,
+                            pd_part **part, pd_diag *diag, const char *who)
 {
     pd_part_options opt;
     if (options)
         opt = *options;
     else
         pd_part_options_default(&opt);
+    pd_mesh *take = owned ? *owned : NULL;
+    if (owned)
+        *owned = NULL;
+    pd_status st = PD_OK;
     if (!mesh || !part)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: NULL %s", mesh ? "part" : "mesh");
+        st = pd_fail(diag, PD_ERR_USAGE, "%s: NULL %s", who, mesh ? "part" : "mesh");
     /* A mesh made by hand gets an input error, not an out-of-memory from
      * copying a negative count or a crash from an index off its end. */
-    pd_status st = pd_mesh_validate(mesh, "pd_part_build", diag);
-    if (st != PD_OK)
-        return st;
-    if (opt.com_given != 0 && opt.com_given != 1)
-        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build: option com_given is %d: expected 0 "
-                       "or 1", opt.com_given);
-    if (opt.com_given && !v3_isfinite(opt.com))
-        return pd_fail(diag, PD_ERR_NONFINITE, "pd_part_build: the given centre of mass is not "
-                       "finite");
-    pd_part *p = calloc(1, sizeof *p);
-    if (!p || !(p->mesh = pd_mesh_clone(mesh))) {
+    if (st == PD_OK)
+        st = pd_mesh_validate(mesh, who, diag);
+    if (st == PD_OK && opt.com_given != 0 && opt.com_given != 1)
+        st = pd_fail(diag, PD_ERR_USAGE, "%s: option com_given is %d: expected 0 or 1", who,
+                     opt.com_given);
+    if (st == PD_OK && opt.com_given && !v3_isfinite(opt.com))
+        st = pd_fail(diag, PD_ERR_NONFINITE, "%s: the given centre of mass is not finite", who);
+    pd_part *p = st == PD_OK ? calloc(1, sizeof *p) : NULL;
+    if (st == PD_OK && (!p || !(p->mesh = take ? take : pd_mesh_clone(mesh)))) {
         free(p);
-        return pd_fail(diag, PD_ERR_NOMEM, "out of memory copying the mesh");
+        st = pd_fail(diag, PD_ERR_NOMEM, "out of memory copying the mesh");
+    }
+    if (st != PD_OK) {
+        pd_mesh_free(take);
+        return st;
     }
     st = build(p, &opt, diag);
     if (st != PD_OK) {
@@ -345,6 +360,20 @@ pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_
     }
     *part = p;
     return PD_OK;
+}
+
+pd_status pd_part_build(const pd_mesh *mesh, const pd_part_options *options, pd_part **part,
+                        pd_diag *diag)
+{
+    return part_build(mesh, NULL, options, part, diag, "pd_part_build");
+}
+
+pd_status pd_part_build_take(pd_mesh **mesh, const pd_part_options *options, pd_part **part,
+                             pd_diag *diag)
+{
+    if (!mesh)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_part_build_take: NULL mesh");
+    return part_build(*mesh, mesh, options, part, diag, "pd_part_build_take");
 }
 
 pd_status pd_part_check(const pd_part *part, const char *who, pd_diag *diag)

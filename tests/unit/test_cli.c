@@ -548,6 +548,31 @@ static void test_eq16(void)
         }
 }
 
+/* measured.awk's file of each of the paper's parts (what scripts/paper.sh -L
+ * and scripts/figures.sh feed to posedrop fit and --measured) is read as
+ * counts: the paper's percentages times its trials are not whole drops, and
+ * a pose,p,n file of them was refused. Its counts are the shipped
+ * parts/<part>-measured.csv's, and a fit of one evaluation reads it. */
+static void test_measured_awk(void)
+{
+    const char *parts[] = {"insulator_cap", "white_button", "rect_black_button",
+                           "square_black_button"};
+    for (int i = 0; i < 4; i++) {
+        char cmd[1024], *out, *err;
+        snprintf(cmd, sizeof cmd,
+                 PD_CLI_PATH " --group parts/%s.off > %s/grouped.csv && awk -F, -v part=%s "
+                 "-v tag=test -f scripts/measured.awk parts/paper-tables.csv %s/grouped.csv > "
+                 "%s/m.csv && cmp %s/m.csv parts/%s-measured.csv && " PD_CLI_PATH
+                 " fit --fit mu=0.1:0.8 -n 10 --max-evals 1 --points 1 -j 1 --part parts/%s.off "
+                 "--measured %s/m.csv",
+                 parts[i], tmpdir, parts[i], tmpdir, tmpdir, tmpdir, parts[i], parts[i], tmpdir);
+        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        CHECK(out && strncmp(out, "part,role,pose,count,", 21) == 0);
+        free(out);
+        free(err);
+    }
+}
+
 static void test_scripts(void)
 {
     char cmd[512], *out, *err;
@@ -1412,6 +1437,7 @@ void suite_cli(void)
     test_same_file();
     test_early_signal();
     test_eq16();
+    test_measured_awk();
     test_scripts();
     test_group();
     test_group_trials();

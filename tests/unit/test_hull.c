@@ -121,10 +121,17 @@ static int orient_ref(pd_vec3 a, pd_vec3 b, pd_vec3 c, pd_vec3 d)
     return big_sign(det);
 }
 
+/* Is x - a exact? (Knuth's two-sum remainder of x and -a is zero.) */
+static int diff_exact(double x, double a)
+{
+    double s = x - a, bv = s - x, av = s - bv;
+    return (x - av) + (-a - bv) == 0.0;
+}
+
 static void test_predicate(void)
 {
     test_rng rng = {1};
-    int mismatches = 0, antisym = 0, zeros = 0, pos = 0, neg = 0;
+    int mismatches = 0, antisym = 0, zeros = 0, pos = 0, neg = 0, staged = 0;
     for (int i = 0; i < 3000; i++) {
         double off = i % 3 == 0 ? 0.0 : i % 3 == 1 ? 1e6 : 0.1;
         double sc = i % 2 ? 1.0 : 1e-3;
@@ -151,6 +158,16 @@ static void test_predicate(void)
         pd_vec3 np = v3(fabs(u.y * w.z) + fabs(u.z * w.y), fabs(u.z * w.x) + fabs(u.x * w.z),
                         fabs(u.x * w.y) + fabs(u.y * w.x));
         mismatches += pd_orient3d_plane(&n, &np, &a, &b, &c, &d) != want;
+        /* the exact fallback on every case, whether its differences are
+         * exact (its first stage: offset 0 and 1e6 mostly) or not (0.1,
+         * points straddling it, mostly the full expansion) */
+        mismatches += pd_orient3d_exact(&a, &b, &c, &d) != want;
+        int exact_diff = 1;
+        const pd_vec3 *pt[3] = {&b, &c, &d};
+        for (int k = 0; k < 3; k++)
+            exact_diff &= diff_exact(pt[k]->x, a.x) && diff_exact(pt[k]->y, a.y) &&
+                          diff_exact(pt[k]->z, a.z);
+        staged += exact_diff;
         antisym += pd_orient3d(&b, &a, &c, &d) != -got || pd_orient3d(&a, &b, &d, &c) != -got;
         zeros += want == 0;
         pos += want > 0;
@@ -160,6 +177,8 @@ static void test_predicate(void)
     CHECK_INT(antisym, 0);
     /* the cases must exercise all three answers, or the test proves little */
     CHECK(zeros > 100 && pos > 100 && neg > 100);
+    /* both stages of the fallback ran on hundreds of cases */
+    CHECK(staged > 300 && 3000 - staged > 300);
     /* tiny determinants decided by the exact path alone */
     pd_vec3 a = v3(0.5, 0.5, 0.5), b = v3(12, 12, 12), c = v3(24, 24, 24.0), d = v3(0.5, 0.5, 0.5);
     c.y = nextafter(24.0, 25.0);

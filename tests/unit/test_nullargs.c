@@ -227,6 +227,20 @@ static void c_part_build(const fixture *f, int k, outcome *o)
     settle_output(o, p, pd_part_free);
 }
 
+static void c_part_build_take(const fixture *f, int k, outcome *o)
+{
+    pd_part_options po;
+    pd_part_options_default(&po);
+    pd_part *p = SENTINEL;
+    pd_mesh *m = pd_mesh_clone(f->mesh);
+    o->st = pd_part_build_take(P(0, &m), P(1, &po), P(2, &p), P(3, &o->diag));
+    /* Taken whatever the outcome, unless the pointer to it was NULL. */
+    if (k != 0 && m != NULL)
+        o->st = PD_ERR_INTERNAL;
+    pd_mesh_free(m);
+    settle_output(o, p, pd_part_free);
+}
+
 static void c_part_free(const fixture *f, int k, outcome *o)
 {
     pd_part *p = NULL;
@@ -737,6 +751,7 @@ static const entry table[] = {
     {"pd_mesh_free", "?mesh", c_mesh_free},
     {"pd_part_options_default", "?options", c_part_options_default},
     {"pd_part_build", "mesh ?options part ?diag", c_part_build},
+    {"pd_part_build_take", "mesh ?options part ?diag", c_part_build_take},
     {"pd_part_free", "?part", c_part_free},
     {"pd_contact_time_auto", "", c_contact_time_auto},
     {"pd_scene_default", "?scene", c_scene_default},

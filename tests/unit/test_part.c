@@ -9,6 +9,7 @@
 #include "shapes.h"
 #include "suites.h"
 #include "base/vec3.h"
+#include "hull/hull_internal.h"
 #include "mesh/mesh_internal.h"
 #include "part/part_tol.h"
 
@@ -501,8 +502,9 @@ static void test_cancel(void)
     pd_cancel_flag set, clear;
     atomic_init(&set, 2);
     atomic_init(&clear, 0);
-    /* The hull of 3000 random points on a sphere: over 4096 lines. */
-    enum { NP = 3000 };
+    /* The hull of 5000 random points on a sphere: over 4096 lines, and
+     * over 4096 vertices. */
+    enum { NP = 5000 };
     pd_vec3 *pts = malloc(sizeof *pts * NP);
     test_rng rng = {20261207};
     for (int i = 0; pts && i < NP; i++)
@@ -554,6 +556,48 @@ static void test_cancel(void)
     pd_diag_init(&d);
     CHECK_STATUS(pd_part_build(m, &po, &p, &d), PD_ERR_CANCELLED);
     CHECK(p == NULL);
+    /* Weld, orientation and the hull read the flag inside their loops
+     * (over 4,096 vertices and triangles here, the steps between reads):
+     * set, each returns PD_ERR_CANCELLED and leaves the mesh as it was;
+     * clear, each does what it does without a flag. */
+    {
+        pd_mesh *w = pd_mesh_clone(m), *w0 = pd_mesh_clone(m);
+        if (w && w0) {
+            double tol = PD_TOL_WELD_REL * pd_mesh_size(m);
+            CHECK(m->nverts > 4096);
+            CHECK_STATUS(pd_mesh_weld_cancel(w, tol, NULL, &set), PD_ERR_CANCELLED);
+            CHECK(w->nverts == m->nverts && w->ntris == m->ntris &&
+                  memcmp(w->tris, m->tris, sizeof *m->tris * (size_t)m->ntris) == 0);
+            int n1 = -1, n0 = -2;
+            CHECK_STATUS(pd_mesh_weld_cancel(w, tol, &n1, &clear), PD_OK);
+            CHECK_STATUS(pd_mesh_weld(w0, tol, &n0), PD_OK);
+            CHECK_INT(n1, n0);
+            /* Turned over, so that orientation has triangles to flip. */
+            for (int t = 0; t < w->ntris; t++) {
+                int x = w->tris[t][1];
+                w->tris[t][1] = w->tris[t][2];
+                w->tris[t][2] = x;
+            }
+            int f1 = -1, f0 = -2;
+            pd_diag_init(&d);
+            CHECK_STATUS(pd_mesh_orient_cancel(w, &f1, &set, &d), PD_ERR_CANCELLED);
+            CHECK(f1 == -1 && w->tris[0][1] != w0->tris[0][1]);
+            CHECK_STATUS(pd_mesh_orient_cancel(w, &f1, &clear, &d), PD_OK);
+            CHECK_INT(f1, w->ntris);
+            CHECK_STATUS(pd_mesh_orient(w0, &f0, &d), PD_OK);
+            CHECK_INT(f0, 0);
+            pd_hull *hs = NULL, *hc = NULL, *h0 = NULL;
+            CHECK_STATUS(pd_hull_build_cancel(w->verts, w->nverts, &set, &hs, &d), PD_ERR_CANCELLED);
+            CHECK(hs == NULL);
+            CHECK_STATUS(pd_hull_build_cancel(w->verts, w->nverts, &clear, &hc, &d), PD_OK);
+            CHECK_STATUS(pd_hull_build(w->verts, w->nverts, &h0, &d), PD_OK);
+            CHECK(hc && h0 && hc->nfacets == h0->nfacets && hc->nverts == h0->nverts);
+            pd_hull_free(hc);
+            pd_hull_free(h0);
+        }
+        pd_mesh_free(w);
+        pd_mesh_free(w0);
+    }
     /* Cancelled at the check itself, the stages before it run. */
     int ta, tb;
     pd_vec3 at;
@@ -598,6 +642,34 @@ static void note_stage(void *user, const char *name)
     snprintf(seen + n, 256 - n, "%s;", name);
 }
 
+/* pd_part_build_take: the same part as pd_part_build, the mesh taken (the
+ * caller's pointer NULL) on success and on failure alike. */
+static void test_take(void)
+{
+    pd_mesh *m = mesh_roof_box(0.03, 0.02, 0.01, 0.004), *copy = pd_mesh_clone(m);
+    pd_part *a = NULL, *b = NULL;
+    CHECK_STATUS(pd_part_build(m, NULL, &a, NULL), PD_OK);
+    CHECK_STATUS(pd_part_build_take(&copy, NULL, &b, NULL), PD_OK);
+    CHECK(copy == NULL);
+    if (a && b) {
+        /* Bit for bit: the same stages on the same numbers. */
+        CHECK(a->mass.volume == b->mass.volume && a->com.x == b->com.x && a->com.z == b->com.z &&
+              a->hull->nfacets == b->hull->nfacets && a->mesh->ntris == b->mesh->ntris);
+    }
+    pd_part_free(a);
+    pd_part_free(b);
+    b = NULL;
+    /* Refused (an open mesh without a given centre of mass): taken too. */
+    copy = pd_mesh_clone(m);
+    if (copy)
+        copy->ntris--;
+    pd_diag d;
+    pd_diag_init(&d);
+    CHECK(pd_part_build_take(&copy, NULL, &b, &d) != PD_OK);
+    CHECK(copy == NULL && b == NULL);
+    pd_mesh_free(m);
+}
+
 static void test_stages(void)
 {
     pd_mesh *m = mesh_box(1, 2, 3);
@@ -618,6 +690,7 @@ static void test_stages(void)
 void suite_part(void)
 {
     test_cancel();
+    test_take();
     test_stages();
     test_thin_rod();
     test_shipped_parts_are_solids();
