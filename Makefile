@@ -235,19 +235,21 @@ check-readme: deps
 # Every figure behind docs/ that a script makes (docs/figures.md lists them
 # with their cost): the insulator cap's gallery, chart and gauss-sphere map
 # and make paper's tables on the impulse engine (docs/figures/paper.txt),
-# the cost-accuracy chart, the design demonstrations, and the table of
-# docs/uncertainty.md, and the big-mesh table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart from its
-# kept CSV instead of rerunning it; CHEAP=1 makes only the cap's pictures
-# and paper.txt (seconds).
+# the cost-accuracy chart, the design demonstrations, the small tables of
+# scripts/doc_tables.py, the table of docs/uncertainty.md and the big-mesh
+# table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart
+# from its kept CSV instead of rerunning it; CHEAP=1 makes only the cap's
+# pictures, paper.txt and doc_tables.py's tables (seconds).
 figures: deps
 	@$(MAKE) --no-print-directory all
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))
+	python3 scripts/doc_tables.py -b $(CLI)
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 
 # The cheap measured files behind docs/ rerun, after the check's own
 # controls: fails when a number moved beyond its drops' noise (make
-# check-full runs it; about 1.5 CPU minutes, docs/figures.md).
+# check-full runs it; about 1 CPU minute, docs/figures.md).
 check-figures:
 	@$(MAKE) --no-print-directory $(CLI)
 	python3 scripts/check_figures.py -b $(CLI) --self-test docs/figures/cap.csv \

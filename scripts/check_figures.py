@@ -156,7 +156,8 @@ def main():
     here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
     binary = os.path.join(here, "build/opt/posedrop")
     if args[:1] == ["-b"]:
-        binary, args = args[1], args[2:]
+        # Absolute: each file's run is made in that file's folder.
+        binary, args = os.path.abspath(args[1]), args[2:]
     if args[:1] == ["--self-test"]:
         self_test(binary, here)
         args = args[1:]

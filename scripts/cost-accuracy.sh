@@ -10,7 +10,8 @@
 # stationary; budgets below its 10 (k + 1) drops for k poses are skipped),
 # grouped into pose classes; records CPU seconds (user + system, all threads) and the eq. (16)
 # error (and total variation) against the physical tests in
-# DIR/cost-accuracy.csv (default results/), and draws error against time on a
+# DIR/cost-accuracy.csv (default results/; '#' lines first give the command
+# and the commit it ran on), and draws error against time on a
 # log axis, one series per estimator, error bars over seeds, in
 # DIR/cost-accuracy.png and .svg (gnuplot; installed if missing), beside the
 # paper's own points (its errors at its reported times on a SPARC20: QS and
@@ -28,7 +29,7 @@ while [ $# -gt 0 ]; do
         -s) args_value "$@"; args_count -s "$2"; seeds=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
         --chart-only) chart_only=1; shift ;;
-        --help) sed -n '2,18p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -68,7 +69,15 @@ run() {
     echo "$part,$est,$budget,$seed,$cpu,${err% *},${err#* }" >> "$csv"
 }
 
-[ "$chart_only" = 1 ] || echo "part,estimator,budget,seed,cpu_s,e16,tv" > "$csv"
+# The CSV starts with what made it: the command, the commit, the date.
+if [ "$chart_only" = 0 ]; then
+    {
+        echo "# scripts/cost-accuracy.sh -s $seeds"
+        echo "# commit $(git -C "$here" rev-parse --short HEAD 2>/dev/null || echo unknown)," \
+            "$(date -u +%Y-%m-%d)"
+        echo "part,estimator,budget,seed,cpu_s,e16,tv"
+    } > "$csv"
+fi
 for part in insulator_cap white_button rect_black_button square_black_button; do
     [ "$chart_only" = 1 ] && break
     run "$part" QS 0 1 p_qs || { done_runs=$((done_runs + total / 4 - 1)); continue; }
@@ -88,10 +97,11 @@ done
 rm -f "$tmp"
 
 # Mean and spread over seeds per (part, estimator, budget), then the chart.
-awk -F, 'NR > 1 { k = $1 FS $2 FS $3; n[k]++; t[k] += $5; e[k] += $6; e2[k] += $6 * $6 }
+grep '^#' "$csv" > "$outdir/cost-accuracy-mean.csv"
+awk -F, '/^#/ || $1 == "part" { next } { k = $1 FS $2 FS $3; n[k]++; t[k] += $5; e[k] += $6; e2[k] += $6 * $6 }
     END { for (k in n) { m = e[k] / n[k]; v = e2[k] / n[k] - m * m
           printf "%s,%.6g,%.6g,%.6g\n", k, t[k] / n[k], m, sqrt(v > 0 ? v : 0) } }' "$csv" |
-    sort -t, -k1,1 -k2,2 -k4,4g > "$outdir/cost-accuracy-mean.csv"
+    sort -t, -k1,1 -k2,2 -k4,4g >> "$outdir/cost-accuracy-mean.csv"
 # The paper's own points: its columns' eq. (16) errors at its reported times.
 for part in insulator_cap white_button rect_black_button square_black_button; do
     awk -F, -v part="$part" 'NR == 1 { print "pose,p_qs,p_pqs,p" }

@@ -14,7 +14,9 @@ five swept values, with its 95% binomial interval), in points. Prints
 Markdown on stdout.
 """
 import csv
+import glob
 import math
+import shlex
 import sys
 
 PARAMS = [("mu", "friction"), ("restitution", "restitution"), ("height", "height"),
@@ -82,6 +84,46 @@ def main():
     for part in parts:
         for line in header(f"{d}/{part}-ranged.csv"):
             print(f"    {line}")
+    for line in notes:
+        print(f"    {line}")
+    confirm(d, parts)
+
+
+def confirm(d, parts):
+    """The sweeps of one parameter with another held in one third of its
+    range (PART-sweeps-PARAM-at-*.csv): their effect beside the ranged run's
+    effect in each third of the other parameter."""
+    files = [(part, f) for part in parts
+             for f in sorted(glob.glob(f"{d}/{part}-sweeps-*-at-*.csv"))]
+    if not files:
+        return
+    print()
+    print("| part | class | parameter | swept with | sweeps | ranged run, in the lower / middle "
+          "/ upper third of the other |")
+    print("|---|---|---|---|---|---|")
+    notes = []
+    for part, f in files:
+        cmd = shlex.split(header(f)[0])
+        notes += header(f)[:2]
+        param = cmd[cmd.index("-p") + 1]
+        held = cmd[cmd.index("--") + 1:-1]
+        other = held[0].lstrip("-")
+        sens = {(r["pose"], r["parameter"]): r for r in rows(f"{d}/{part}-sensitivity.csv")}
+        sweeps = rows(f)
+        for r in rows(f"{d}/{part}-ranged.csv"):
+            if float(r["p"]) < 0.01:
+                continue
+            sw = sweep_effect(sweeps, param, r["pose"])
+            s = sens[(r["pose"], param)]
+            if s["interacts"] == other:
+                thirds = " / ".join(f"{100 * float(s[k]):+.1f}" for k in
+                                    ("effect_in_low", "effect_in_middle", "effect_in_high"))
+            else:
+                thirds = f"no interaction with {other} flagged"
+            label = dict(PARAMS)[param]
+            print(f"| {NAMES.get(part, part)} | {r['pose']} | {label} | {' '.join(held)} | "
+                  f"{100 * sw[0]:+.1f} ± {100 * sw[1]:.1f} | {thirds} |")
+    print()
     for line in notes:
         print(f"    {line}")
 

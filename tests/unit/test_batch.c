@@ -599,6 +599,8 @@ static void test_script_refusals(void)
         {"paper.sh -L -s 1x", "paper.sh: -s: expected a whole number"},
         {"paper.sh -e odes", "paper.sh: -e: expected impulse, ode or bullet, got 'odes'"},
         {"figures.sh --cheap --x", "figures.sh: unknown argument '--x'"},
+        {"doc_tables.py nosuch", "doc_tables.py: no table 'nosuch'"},
+        {"sweeps.sh -p foo", "sweeps.sh: -p: expected mu, restitution, height or contact_time, got 'foo'"},
         {"slurm-array.sh -N", "slurm-array.sh: -N needs a value"},
         {"sensitivity.sh -n", "sensitivity.sh: -n needs a value"},
         {"sensitivity.sh -i foo $R/parts/cap.off", "sensitivity.sh: posedrop: --initial: initial"},
