@@ -2,7 +2,7 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV] [-r]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-o DIR] [-d PAPER_TABLES_CSV] [-r | -T]
 #   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-s SEED]
 #                       [-P JOBS] [-H PART] [-t CONTACT_TIME] [-o DIR]
 #
@@ -17,7 +17,8 @@
 # grouped into pose classes as the paper counts them, writes the CSVs under DIR
 # (default results/; -r keeps a run whose CSV is already there, whole, of
 # DROPS drops, as an interrupted run or one run apart left it: it cannot
-# tell the other options, so give the same) and prints a legend, then each table: the paper's QS, PQS, dynamic and
+# tell the other options, so give the same; -T runs nothing and prints the
+# tables of the runs there, '-' for a run missing) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
@@ -61,12 +62,14 @@ seed=1
 jobs=2
 held=
 reuse=0
+tables_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
         -i) args_value "$@"; initial=$2; shift 2 ;;
         -L) loo=1; shift ;;
         -r) reuse=1; shift ;;
+        -T) tables_only=1; reuse=1; shift ;;
         -f) args_value "$@"; spec=$2; shift 2 ;;
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
         -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
@@ -76,7 +79,7 @@ while [ $# -gt 0 ]; do
         -H) args_value "$@"; held=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,47p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,48p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -139,6 +142,12 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             echo "paper.sh: $part on $engine, run $runs of 12: kept $outdir/$part.$engine.csv" >&2
             continue
         fi
+        if [ "$tables_only" = 1 ]; then
+            echo "paper.sh: $part on $engine: no whole run of $n drops in $outdir (-T: none made)" >&2
+            rm -f "$outdir/$part.$engine.seconds"
+            status=1
+            continue
+        fi
         echo "paper.sh: $part on $engine, run $runs of 12, $((SECONDS - start_s)) s so far" >&2
         # CPU seconds (user + sys, all threads): wall time says more of the
         # machine's other load than of the run.
@@ -150,7 +159,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
         awk '{ printf "%.3f\n", $1 + $2 }' "$outdir/$part.$engine.time" > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
-    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" '
+    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" -v n="$n" '
         function load(file, key,    line, i, c, k) {
             k = 0
             while ((getline line < file) > 0) {
@@ -174,6 +183,8 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             ks = load(outdir "/" part ".static.csv", "s"); rank("s", ks)
             split("impulse ode bullet", eng, " ")
             for (e = 1; e <= 3; e++) { ke[e] = load(outdir "/" part "." eng[e] ".csv", eng[e]); rank(eng[e], ke[e]) }
+            # A run missing (or cut short) has no column: "-", not zeros.
+            for (c = 1; c <= 5; c++) have[c] = c < 3 || whole(outdir "/" part "." eng[c - 2] ".csv")
         }
         NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
         $col["part"] == part {
@@ -199,9 +210,10 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 ours[p, 2] = r <= ks ? pqs["s", order["s", r]] : 0
                 # The engines rank their own classes by QS too: same order.
                 for (e = 1; e <= 3; e++) ours[p, 2 + e] = r <= ke[e] ? dyn[eng[e], order[eng[e], r]] : 0
-                printf "%4d | %6.1f %6.1f %6.1f %6.1f | %6.1f %6.1f %7.1f %6.1f %6.1f\n", p,
-                       100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p],
-                       100 * ours[p, 1], 100 * ours[p, 2], 100 * ours[p, 3], 100 * ours[p, 4], 100 * ours[p, 5]
+                printf "%4d | %6.1f %6.1f %6.1f %6.1f |", p,
+                       100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p]
+                for (c = 1; c <= 5; c++) printf " %s", cell(c, 100 * ours[p, c])
+                printf "\n"
             }
             # Mass posedrop puts on classes beyond the paper count goes to TV.
             for (c = 1; c <= 5; c++) { extra[c] = 0 }
@@ -212,16 +224,28 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             printf "%4s |", "e16"
             for (c = 1; c <= 3; c++) printf " %6.1f", err16(paper, c, np)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), err16(ours, c, np)
+            for (c = 1; c <= 5; c++) printf " %s", cell(c, err16(ours, c, np))
             printf "\n%4s |", "TV"
             for (c = 1; c <= 3; c++) printf " %6.1f", tv(paper, c, np, 0)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) printf (c == 3 ? " %7.1f" : " %6.1f"), tv(ours, c, np, extra[c])
+            for (c = 1; c <= 5; c++) printf " %s", cell(c, tv(ours, c, np, extra[c]))
             printf "\n"
         }
         function err16(a, c, n,    p, s) { s = 0; for (p = 1; p <= n; p++) s += phys[p] * abs(a[p, c] - phys[p]); return 100 * s }
         function tv(a, c, n, rest,    p, s) { s = rest; for (p = 1; p <= n; p++) s += abs(a[p, c] - phys[p]); return 50 * s }
         function abs(x) { return x < 0 ? -x : x }
+        function cell(c, v,    w) { w = c == 3 ? 7 : 6; return have[c] ? sprintf("%" w ".1f", v) : sprintf("%" w "s", "-") }
+        # A run of n drops, whole: rows, each of n drops and not partial.
+        function whole(file,    line, f, c, i, rows, bad) {
+            while ((getline line < file) > 0) {
+                split(line, f, ",")
+                if (!c["pose"]) { for (i = 1; i in f; i++) c[f[i]] = i; continue }
+                rows++
+                if (f[c["n"]] != n || f[c["partial"]] != 0) bad = 1
+            }
+            close(file)
+            return rows > 0 && !bad
+        }
     ' "$tables" | tee "$outdir/$part.table.txt"
 done
 printf '\nCPU seconds per run (user + sys, %d drops):' "$n"
