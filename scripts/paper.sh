@@ -2,7 +2,7 @@
 # paper.sh: reproduce Tables 1-4 of Goldberg, Mirtich et al. with posedrop's
 # columns beside the paper's.
 #
-#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-e ENGINES] [-o DIR] [-d PAPER_TABLES_CSV] [-r]
+#   scripts/paper.sh [-n DROPS] [-i INITIAL] [-t CONTACT_TIME] [-e ENGINES] [-o DIR] [-d PAPER_TABLES_CSV] [-r | -T]
 #   scripts/paper.sh -L [-f SPEC] [-n DROPS] [-i INITIAL] [-m EVALS] [-p POINTS] [-s SEED]
 #                       [-P JOBS] [-H PART] [-t CONTACT_TIME] [-o DIR]
 #
@@ -18,7 +18,8 @@
 # (default results/; each engine's starts with '#' lines giving its command
 # and the commit it ran on; -r keeps a run whose CSV is already there, whole,
 # of DROPS drops, as an interrupted run or one run apart left it: it cannot
-# tell the other options, so give the same) and prints a legend, then each table: the paper's QS, PQS, dynamic and
+# tell the other options, so give the same; -T runs nothing and prints the
+# tables of the runs there, '-' for a run missing) and prints a legend, then each table: the paper's QS, PQS, dynamic and
 # physical columns, posedrop's QS, PQS, impulse, ODE and Bullet, then the
 # eq. (16) error of every column against the physical tests and the total
 # variation distance beside it (eq. 16 weights by the measured p, so mass on
@@ -66,12 +67,14 @@ jobs=2
 held=
 engines=impulse,ode,bullet
 reuse=0
+tables_only=0
 while [ $# -gt 0 ]; do
     case "$1" in
         -n) args_value "$@"; args_count -n "$2"; n=$2; n_given=1; shift 2 ;;
         -i) args_value "$@"; initial=$2; shift 2 ;;
         -L) loo=1; shift ;;
         -r) reuse=1; shift ;;
+        -T) tables_only=1; reuse=1; shift ;;
         -f) args_value "$@"; spec=$2; shift 2 ;;
         -m) args_value "$@"; args_count -m "$2"; evals=$2; shift 2 ;;
         -p) args_value "$@"; args_count -p "$2"; points=$2; shift 2 ;;
@@ -82,7 +85,7 @@ while [ $# -gt 0 ]; do
         -H) args_value "$@"; held=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
         -d) args_value "$@"; tables=$2; shift 2 ;;
-        --help) sed -n '2,47p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,48p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -152,6 +155,12 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             echo "paper.sh: $part on $engine, run $runs of $((4 * nengines)): kept $outdir/$part.$engine.csv" >&2
             continue
         fi
+        if [ "$tables_only" = 1 ]; then
+            echo "paper.sh: $part on $engine: no whole run of $n drops in $outdir (-T: none made)" >&2
+            rm -f "$outdir/$part.$engine.seconds"
+            status=1
+            continue
+        fi
         rm -f "$outdir/$part.$engine.csv" "$outdir/$part.$engine.seconds"
         echo "paper.sh: $part on $engine, run $runs of $((4 * nengines)), $((SECONDS - start_s)) s so far" >&2
         args=(--group -n "$n" --initial "$initial" ${contact_time:+--contact-time "$contact_time"}
@@ -167,7 +176,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
         awk '{ printf "%.3f\n", $1 + $2 }' "$outdir/$part.$engine.time" > "$outdir/$part.$engine.seconds"
     done
     # One table: paper columns by pose number, posedrop's by class rank in QS.
-    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" -v engines="$engines" '
+    awk -F, -v part="$part" -v outdir="$outdir" -v initial="$initial" -v engines="$engines" -v n="$n" '
         function load(file, key,    line, i, c, k) {
             k = 0
             while ((getline line < file) > 0) {
@@ -195,6 +204,9 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 ran[e] = index("," engines ",", "," eng[e] ",") > 0
                 ke[e] = ran[e] ? load(outdir "/" part "." eng[e] ".csv", eng[e]) : 0; rank(eng[e], ke[e])
             }
+            # An engine not asked for, or a run missing or cut short, has no
+            # column: "-", not zeros.
+            for (c = 1; c <= 5; c++) have[c] = c < 3 || (ran[c - 2] && whole(outdir "/" part "." eng[c - 2] ".csv"))
         }
         NR == 1 { for (i = 1; i <= NF; i++) col[$i] = i; next }
         $col["part"] == part {
@@ -222,7 +234,7 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
                 for (e = 1; e <= 3; e++) ours[p, 2 + e] = r <= ke[e] ? dyn[eng[e], order[eng[e], r]] : 0
                 printf "%4d | %6.1f %6.1f %6.1f %6.1f |", p,
                        100 * paper[p, 1], 100 * paper[p, 2], 100 * paper[p, 3], 100 * phys[p]
-                for (c = 1; c <= 5; c++) cell(c, 100 * ours[p, c])
+                for (c = 1; c <= 5; c++) printf " %s", cell(c, 100 * ours[p, c])
                 printf "\n"
             }
             # Mass posedrop puts on classes beyond the paper count goes to TV.
@@ -234,21 +246,29 @@ for part in insulator_cap white_button rect_black_button square_black_button; do
             printf "%4s |", "e16"
             for (c = 1; c <= 3; c++) printf " %6.1f", err16(paper, c, np)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) cell(c, err16(ours, c, np))
+            for (c = 1; c <= 5; c++) printf " %s", cell(c, err16(ours, c, np))
             printf "\n%4s |", "TV"
             for (c = 1; c <= 3; c++) printf " %6.1f", tv(paper, c, np, 0)
             printf " %6s |", "-"
-            for (c = 1; c <= 5; c++) cell(c, tv(ours, c, np, extra[c]))
+            for (c = 1; c <= 5; c++) printf " %s", cell(c, tv(ours, c, np, extra[c]))
             printf "\n"
-        }
-        # Column c of posedrop block: QS, PQS, then the engines ("-" when not run).
-        function cell(c, v) {
-            if (c >= 3 && !ran[c - 2]) printf (c == 3 ? " %7s" : " %6s"), "-"
-            else printf (c == 3 ? " %7.1f" : " %6.1f"), v
         }
         function err16(a, c, n,    p, s) { s = 0; for (p = 1; p <= n; p++) s += phys[p] * abs(a[p, c] - phys[p]); return 100 * s }
         function tv(a, c, n, rest,    p, s) { s = rest; for (p = 1; p <= n; p++) s += abs(a[p, c] - phys[p]); return 50 * s }
         function abs(x) { return x < 0 ? -x : x }
+        function cell(c, v,    w) { w = c == 3 ? 7 : 6; return have[c] ? sprintf("%" w ".1f", v) : sprintf("%" w "s", "-") }
+        # A run of n drops, whole: rows, each of n drops and not partial.
+        function whole(file,    line, f, c, i, rows, bad) {
+            while ((getline line < file) > 0) {
+                if (line ~ /^#/) continue
+                split(line, f, ",")
+                if (!c["pose"]) { for (i = 1; i in f; i++) c[f[i]] = i; continue }
+                rows++
+                if (f[c["n"]] != n || f[c["partial"]] != 0) bad = 1
+            }
+            close(file)
+            return rows > 0 && !bad
+        }
     ' "$tables" | tee "$outdir/$part.table.txt"
 done
 printf '\nCPU seconds per run (user + sys, %d drops):' "$n"
