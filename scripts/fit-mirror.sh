@@ -7,7 +7,10 @@
 # simulated again with 20,000 drops of another seed. Prints, per seed, the
 # in-sample TV (the counts against p_best, from the fit's own drops), the
 # fresh TV the fit reports (its own check: -n drops of a seed no evaluation
-# used) and the TV of the 20,000 fresh drops, with the binary's commit.
+# used) and the TV of the 20,000 fresh drops, with the binary's commit; with
+# two or more seeds, the columns' means over the seeds with their standard
+# errors, and the mean of in-sample minus fresh (the fit's own check): the
+# search's flattery, zero when its best point's drops are an honest draw.
 #
 #   scripts/fit-mirror.sh [-n DROPS] [-s "SEEDS"] [-o DIR]
 #
@@ -23,7 +26,7 @@ while [ $# -gt 0 ]; do
         -n) args_value "$@"; args_count -n "$2"; n=$2; shift 2 ;;
         -s) args_value "$@"; seeds=$2; shift 2 ;;
         -o) args_value "$@"; outdir=$2; shift 2 ;;
-        --help) sed -n '2,16p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+        --help) sed -n '2,19p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
         *) args_die "unknown argument '$1'" ;;
     esac
 done
@@ -34,6 +37,7 @@ part=$here/parts/canonical/box_1x2x3.off
 mkdir -p "$outdir" || exit 2
 printf 'pose,count\n1,180\n2,140\n3,30\n4,20\n5,18\n6,12\n' > "$outdir/pairs.csv"
 echo "fit-mirror.sh: $bin at $(git -C "$here" rev-parse --short HEAD 2>/dev/null), -n $n"
+rows=
 echo "seed | in-sample TV | fresh TV (fit's own check) | fresh TV (20000 drops)"
 for s in $seeds; do
     case "$s" in *[!0-9]*|'') args_die "-s: expected whole numbers, got '$s'" ;; esac
@@ -53,4 +57,15 @@ for s in $seeds; do
         { d = m[$1] - $c["p"]; s += d < 0 ? -d : d } END { printf "%.3f", s / 2 }' \
         "$outdir/pairs.csv" "$outdir/fresh.$s.csv")
     echo "$s | $ins | $own | $big"
+    rows="$rows$ins $own $big
+"
 done
+printf '%s' "$rows" | awk 'NF == 3 && $2 != "-" {
+        n++; for (i = 1; i <= 3; i++) { s[i] += $i; q[i] += $i * $i }
+        d = $1 - $2; sd += d; qd += d * d }
+    function se(s, q) { return n > 1 ? sqrt((q - s * s / n) / (n - 1) / n) : 0 }
+    END { if (n < 2) exit
+        printf "mean of %d seeds | %.3f +- %.3f | %.3f +- %.3f | %.3f +- %.3f\n", n,
+               s[1] / n, se(s[1], q[1]), s[2] / n, se(s[2], q[2]), s[3] / n, se(s[3], q[3])
+        printf "in-sample minus fresh (own check): %.3f +- %.3f (mean +- standard error)\n",
+               sd / n, se(sd, qd) }'

@@ -74,7 +74,8 @@ typedef struct pd_fit_part {
 /* Where a fit stands, after each evaluation (and once before the first, with
  * evaluation 0): for a progress line, never needed for the result. */
 typedef struct pd_fit_progress {
-    const char *stage;     /* "design", "search", "weighting", "prediction", "fresh",
+    const char *stage;     /* "design", "search", "final" (the search's best points on
+                              the full drops), "weighting", "prediction", "fresh",
                               and "start" before the first evaluation */
     const char *initial;   /* the initial mode being searched */
     int held_out;          /* choosing the initial mode: the part left out (1..), else 0 */
@@ -91,7 +92,9 @@ typedef void (*pd_fit_progress_fn)(const pd_fit_progress *progress, void *user);
 
 typedef struct pd_fit_options {
     long ndrops;        /* simulated drops per part and evaluation, >= 10; 1000
-                           (raised to what --initial stationary needs) */
+                           (raised to what --initial stationary needs). The
+                           search's design runs a quarter of them and its simplex
+                           half (docs/calibration.md, "The optimiser") */
     uint64_t seed;      /* 1: every evaluation's drops use it (common random numbers) */
     int threads;        /* 0: all cores */
     pd_engine_kind engine; /* PD_ENGINE_IMPULSE */
@@ -100,9 +103,10 @@ typedef struct pd_fit_options {
                            one of highest maximised likelihood kept; 0 */
     int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150. The simplex
                            stops once it has spent them, finishing its step (up to
-                           max_evals + d + 1); each search's design (4 d + 1), the
-                           weighting, the predicted parts and the fresh drops come
-                           on top (pd_fit_progress's max_evaluations adds them up) */
+                           max_evals + d + 1); each search's design (4 d + 1) and
+                           final d + 1, the weighting, the predicted parts and the
+                           fresh drops come on top (pd_fit_progress's
+                           max_evaluations adds them up) */
     int npoints;        /* likelihood-weighted points per round (3 to 6 rounds),
                            >= 1; 0: 8 (d + 1) for d parameters */
     double alpha;       /* pseudo-count added to every class's simulated count
@@ -119,8 +123,7 @@ typedef struct pd_fit_options {
 PD_API void pd_fit_options_default(pd_fit_options *options);
 
 /* The counts against drops simulated afresh (a seed no evaluation used), so
- * that the fit's own drops, which the search tuned the values to, do not
- * flatter it: Pearson's X^2 of the 2 x K table of measured and simulated
+ * that the fit's own drops, which chose the values, do not flatter it: Pearson's X^2 of the 2 x K table of measured and simulated
  * counts (the test that both come from one distribution, which counts the
  * simulation's error), its degrees of freedom, p, and the total variation
  * distance between the measured and the simulated frequencies. */
@@ -167,8 +170,8 @@ typedef struct pd_fit_result {
     int initial_untested; /* 1: the initial mode was chosen on one part's own
                              counts, which cannot test it */
     double loglik;      /* at the maximum, all fitted parts: sum_k count_k log p_k */
-    double chi2;        /* the parts' X^2 summed: in-sample, a diagnostic (the
-                           search tuned the values to these drops) */
+    double chi2;        /* the parts' X^2 summed: in-sample, a diagnostic (these
+                           drops chose the best values among the search's last d + 1) */
     int df;             /* sum of (nclasses - 1) over the fitted parts, minus nparams;
                            <= 0: the data cannot test the fit */
     double pvalue;      /* 1 when df <= 0 */

@@ -49,8 +49,8 @@ static void fit_usage(FILE *out)
         "fresh drops (the fitted scene, at its best and at its weighted-mean values,\n"
         "simulated with a seed no evaluation used: Pearson's X^2 of the measured and\n"
         "simulated counts, p, and the total variation distance TV; the in-sample\n"
-        "figures, which the search tuned, only as a diagnostic) and the cost\n"
-        "(evaluations, drops, wall and CPU seconds).\n"
+        "figures, from the drops that chose the best values, only as a diagnostic) and\n"
+        "the cost (evaluations, drops, wall and CPU seconds).\n"
         "\n", prog);
     fprintf(out,
         "  --fit SPEC       the parameters to fit and their ranges, comma-separated:\n"
@@ -76,14 +76,16 @@ static void fit_usage(FILE *out)
         "  --scene FILE     the values not fitted ('key = value' lines, as for\n"
         "                   'posedrop --scene'; default the paper's scene)\n"
         "  -n N             simulated drops per part and evaluation, 10..10^7 (default\n"
-        "                   1000; raised to 10 (k+1) for the stationary start of a\n"
-        "                   part of k poses)\n"
+        "                   1000; raised to 10 (K+1) for the stationary start of a\n"
+        "                   part of K classes of symmetric poses); the search's design\n"
+        "                   runs N/4 and its simplex N/2, the weighting's points N/2\n"
         "  --seed S         the drops' seed, the same at every evaluation (default 1)\n"
         "  -j THREADS       threads (default: all cores); never changes results\n"
         "  --engine E       impulse (default), ode or bullet\n"
         "  --max-evals N    Nelder-Mead evaluations per search (default 150): the\n"
         "                   simplex stops once it has spent N, finishing its step (up\n"
-        "                   to N + d + 1); each search's design of 4d+1 points, the\n"
+        "                   to N + d + 1); each search's design of 4d+1 points and\n"
+        "                   its d+1 best points on N drops, the\n"
         "                   weighting (1 + 3 to 6 rounds of --points), the predicted\n"
         "                   parts' --points and the 2 fresh-drop checks come on top,\n"
         "                   and 'initial' runs 3 searches (3 (parts + 1) with two or\n"
@@ -408,8 +410,9 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
         print_quality(what, &q->fresh_best);
         snprintf(what, sizeof what, "%s: fresh drops at the weighted means", in[i].path);
         print_quality(what, &q->fresh_mean);
-        fprintf(stderr, "%s: fit: %s: in-sample (the drops the search was tuned to, a "
-                "diagnostic): X^2 = %.2f, TV %.3f\n", prog, in[i].path, q->chi2, q->tv);
+        fprintf(stderr, "%s: fit: %s: in-sample (the drops that chose the best values among "
+                "the search's last few, a diagnostic): X^2 = %.2f, TV %.3f\n", prog, in[i].path,
+                q->chi2, q->tv);
     }
     print_quality("all parts: fresh drops at the best values", &r->fresh_best);
     print_quality("all parts: fresh drops at the weighted means", &r->fresh_mean);
@@ -446,10 +449,13 @@ static void fit_progress(const pd_fit_progress *g, void *user)
         return;
     }
     double cpu = cli_cpu_seconds() - k->c0;
-    double left = (double)(g->max_evaluations - g->evaluation) * cpu / g->evaluation;
+    /* By drops, not evaluations: the search's evaluations run fewer drops
+     * than the later ones. */
+    double per_drop = g->drops > 0 ? cpu / (double)g->drops : 0.0;
+    double left = (double)(g->max_drops - g->drops) * per_drop;
     if (g->evaluation == 1) {
         fprintf(stderr, "%s: fit: the first evaluation took %.2f s of CPU: at most about %.0f s "
-                "of CPU in all\n", prog, cpu, cpu * g->max_evaluations);
+                "of CPU in all\n", prog, cpu, per_drop * (double)g->max_drops);
         k->last = t;
         return;
     }

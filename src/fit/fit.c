@@ -38,17 +38,30 @@ typedef struct {
     int d;
     pd_scene base;
     pd_sim_options sim;
-    long *ndrops;  /* per part */
+    long *ndrops;  /* per part, at FIT_LEVEL_FULL */
+    long *need;    /* per part: the fewest drops its initial mode runs */
+    int *nsym;     /* per part: its classes of symmetric poses (the stationary chain's states) */
     long drops;    /* simulated so far */
     long failed;   /* of them, drops that failed */
     double *pose_p; /* scratch, the largest part's poses */
+    /* The last point simulated at FIT_LEVEL_FULL and the parts simulated
+     * there (memo_have), so that the search's best point, evaluated again
+     * with every part by the weighting, runs only the parts it has not. */
+    double memo_theta[PD_FIT_MAX_PARAMS];
+    int *memo_have;
+    double **memo_p, *memo_nsim;
     pd_fit_progress_fn progress;
     void *progress_user;
     pd_fit_progress prog;
 } model;
 
-/* The fresh drops' seed: any seed but the evaluations' own. */
-static const uint64_t FRESH_SEED = 0x9e3779b97f4a7c15u;
+/* Two points closer than this relative to their size are the same point:
+ * a few units of round-off of theta -> z -> theta. */
+static const double MEMO_ROUNDOFF = 1e-13;
+
+/* The seeds of FIT_LEVEL_FULL and of the fresh drops: any but the search's
+ * own, and not each other. */
+static const uint64_t FULL_SEED = 0x6a09e667f3bcc908u, FRESH_SEED = 0x9e3779b97f4a7c15u;
 
 static const char *mode_name(pd_initial i)
 {
@@ -75,17 +88,36 @@ static void note(void *user, const char *stage, int round, double loglik)
         m->progress(g, m->progress_user);
 }
 
-/* Drops per part for an initial mode: the stationary start needs
- * PD_STATIONARY_MIN_POSE_DROPS per pose and as many uniform ones. */
+/* Drops per part for an initial mode: the stationary start, on the chain of
+ * classes of symmetric poses, needs PD_STATIONARY_MIN_POSE_DROPS per class
+ * and as many uniform ones. */
 static void set_ndrops(model *m, long ndrops, pd_initial mode)
 {
     m->base.initial = mode;
+    for (int i = 0; m->memo_have && i < m->nparts; i++)
+        m->memo_have[i] = 0;
     for (int i = 0; i < m->nparts; i++) {
-        long need = mode == PD_INITIAL_STATIONARY
-                        ? (long)(m->parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS
-                        : 0;
-        m->ndrops[i] = ndrops > need ? ndrops : need;
+        m->need[i] = mode == PD_INITIAL_STATIONARY
+                         ? (long)(m->nsym[i] + 1) * PD_STATIONARY_MIN_POSE_DROPS
+                         : 10;
+        m->ndrops[i] = ndrops > m->need[i] ? ndrops : m->need[i];
     }
+}
+
+/* Part i's drops at a level: the search and the weighting's points a
+ * quarter of the full drops (at least what the mode needs). */
+static long level_drops(const model *m, int i, fit_level level)
+{
+    long n = level == FIT_LEVEL_SEARCH || level == FIT_LEVEL_WEIGH ? m->ndrops[i] / 4
+                                                                   : m->ndrops[i];
+    return n > m->need[i] ? n : m->need[i];
+}
+
+static uint64_t level_seed(const model *m, fit_level level)
+{
+    return level == FIT_LEVEL_FRESH                                  ? m->sim.seed ^ FRESH_SEED
+           : level == FIT_LEVEL_FULL || level == FIT_LEVEL_WEIGH ? m->sim.seed ^ FULL_SEED
+                                                                 : m->sim.seed;
 }
 
 /* A value of q as pd_scene_set reads it: a multiple of auto as the
@@ -119,20 +151,37 @@ static int cancelled(const pd_sim_options *o)
     return o->cancel && atomic_load(o->cancel) != 0;
 }
 
-static pd_status run_model(void *user, const double *theta, int all, double *const *p,
-                           double *nsim, pd_diag *diag)
+static pd_status run_model(void *user, const double *theta, int all, fit_level level,
+                           double *const *p, double *nsim, pd_diag *diag)
 {
     model *m = user;
     pd_scene sc;
     if (cancelled(&m->sim))
         return pd_fail(diag, PD_ERR_CANCELLED, "pd_fit_run: cancelled");
     pd_status st = scene_at(m, theta, &sc, diag);
+    int memo = level == FIT_LEVEL_FULL, same = 1;
+    /* The weighting gets the best point back through the unit cube: the
+     * same point to a few units of round-off. */
+    for (int j = 0; j < m->d; j++)
+        same &= fabs(theta[j] - m->memo_theta[j]) <=
+                MEMO_ROUNDOFF * (fabs(theta[j]) + fabs(m->memo_theta[j]));
+    if (memo && !same) {
+        memcpy(m->memo_theta, theta, sizeof *theta * (size_t)m->d);
+        for (int i = 0; i < m->nparts; i++)
+            m->memo_have[i] = 0;
+    }
     for (int i = 0; st == PD_OK && i < m->nparts; i++) {
         const pd_fit_part *fp = &m->parts[i];
         if ((all == 0 && !m->count[i]) || (all == 2 && m->count[i]))
             continue;
+        if (memo && m->memo_have[i]) { /* the same drops: the same counts */
+            memcpy(p[i], m->memo_p[i], sizeof **p * (size_t)fp->nclasses);
+            nsim[i] = m->memo_nsim[i];
+            continue;
+        }
         pd_sim_options o = m->sim;
-        o.ndrops = m->ndrops[i];
+        o.ndrops = level_drops(m, i, level);
+        o.seed = level_seed(m, level);
         pd_sim_result *r = NULL;
         if ((st = pd_sim_run(fp->part, fp->poses, &sc, &o, &r, diag)) != PD_OK)
             break;
@@ -171,6 +220,11 @@ static pd_status run_model(void *user, const double *theta, int all, double *con
             p[i][c] = sum > 0 ? p[i][c] / sum : 1.0 / fp->nclasses;
         nsim[i] = sum > 0 ? (double)settled : 0.0;
         pd_sim_result_free(r);
+        if (memo) {
+            memcpy(m->memo_p[i], p[i], sizeof **p * (size_t)fp->nclasses);
+            m->memo_nsim[i] = nsim[i];
+            m->memo_have[i] = 1;
+        }
     }
     return st;
 }
@@ -394,15 +448,12 @@ static int part_cells(const pd_fit_part *fp)
 
 /* Each fitted part's fresh-drop quality at theta (the problem's scale), and
  * all parts' together (df less the d fitted parameters). */
-static pd_status fresh(model *m, const fit_problem *pb, const double *theta, uint64_t seed,
+static pd_status fresh(model *m, const fit_problem *pb, const double *theta,
                        double *const *p, double *nsim, pd_fit_result *r, int at_mean,
                        pd_diag *diag)
 {
-    uint64_t seed0 = m->sim.seed;
-    m->sim.seed = seed;
     m->prog.stage = "fresh";
-    pd_status st = run_model(m, theta, 0, p, nsim, diag);
-    m->sim.seed = seed0;
+    pd_status st = run_model(m, theta, 0, FIT_LEVEL_FRESH, p, nsim, diag);
     if (st != PD_OK)
         return st;
     note(m, "fresh", 0, 0.0);
@@ -436,10 +487,11 @@ static pd_status fresh(model *m, const fit_problem *pb, const double *theta, uin
     return PD_OK;
 }
 
-/* Every search's most evaluations: the design, the simplex and its last step. */
+/* Every search's most evaluations: the design, the simplex and its last
+ * step, and its finalists on the full drops. */
 static int search_max_evals(int d, int max_evals)
 {
-    return 4 * d + 1 + max_evals + d + 1;
+    return 4 * d + 1 + max_evals + d + 1 + FIT_FINALISTS;
 }
 
 pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *params,
@@ -476,7 +528,16 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     m.sim.threads = o.threads;
     m.sim.engine = o.engine;
     m.sim.cancel = o.cancel;
+    m.sim.stationary_by_class = 1;
+    m.memo_have = calloc((size_t)nparts, sizeof *m.memo_have);
+    m.memo_p = calloc((size_t)nparts, sizeof *m.memo_p);
+    m.memo_nsim = calloc((size_t)nparts, sizeof *m.memo_nsim);
+    for (int i = 0; m.memo_p && i < nparts; i++)
+        m.memo_p[i] = malloc(sizeof **m.memo_p * (size_t)parts[i].nclasses);
     m.ndrops = malloc(sizeof *m.ndrops * (size_t)nparts);
+    m.need = malloc(sizeof *m.need * (size_t)nparts);
+    m.nsym = malloc(sizeof *m.nsym * (size_t)nparts);
+    int *sym_of = malloc(sizeof *sym_of * (size_t)maxposes);
     m.pose_p = malloc(sizeof *m.pose_p * (size_t)maxposes);
     double lo[PD_FIT_MAX_PARAMS], hi[PD_FIT_MAX_PARAMS];
     int *kk = malloc(sizeof *kk * (size_t)nparts);
@@ -495,12 +556,19 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     for (int i = 0; i < nparts; i++)
         ksum += (size_t)parts[i].nclasses;
     double *pbuf = malloc(sizeof *pbuf * ksum);
-    if (!m.ndrops || !m.pose_p || !kk || !count || !one || !cell_of || !ncells || !r || !pb_best || !pp || !plo || !phi ||
+    int memo_ok = m.memo_have && m.memo_p && m.memo_nsim;
+    for (int i = 0; memo_ok && i < nparts; i++)
+        memo_ok = m.memo_p[i] != NULL;
+    if (!memo_ok || !m.ndrops || !m.need || !m.nsym || !sym_of || !m.pose_p || !kk || !count || !one || !cell_of || !ncells || !r || !pb_best || !pp || !plo || !phi ||
         !nsim || !ps || !ns || !pbuf) {
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
         goto done;
     }
     m.count = count;
+    for (int i = 0; st == PD_OK && i < nparts; i++)
+        st = pd_pose_classes(parts[i].part, parts[i].poses, sym_of, &m.nsym[i], diag);
+    if (st != PD_OK)
+        goto done;
     for (int i = 0; i < d; i++) {
         lo[i] = params[i].log ? log(params[i].lo) : params[i].lo;
         hi[i] = params[i].log ? log(params[i].hi) : params[i].hi;
@@ -533,16 +601,27 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         r->loglik_initial[i] = -HUGE_VAL;
     /* The plan, before the first evaluation. */
     int searches = nmodes * (holdout ? nfit + 1 : 1) - (holdout ? nmodes - 1 : 0);
-    long per_eval = 0;
-    for (int i = 0; i < nparts; i++) {
-        long need = (long)(parts[i].poses->nposes + 1) * PD_STATIONARY_MIN_POSE_DROPS;
-        int stat = o.fit_initial || sc0.initial == PD_INITIAL_STATIONARY;
-        per_eval += stat && need > o.ndrops ? need : o.ndrops;
-    }
+    /* Drops per evaluation at each level, the fitted parts' and the
+     * predicted ones', for the costliest mode (the stationary start needs
+     * the most). */
+    set_ndrops(&m, o.ndrops, o.fit_initial ? PD_INITIAL_STATIONARY : sc0.initial);
+    long per[FIT_LEVEL_FRESH + 1] = {0}, pred = 0;
+    for (int i = 0; i < nparts; i++)
+        for (int l = 0; l <= FIT_LEVEL_FRESH; l++) {
+            if (parts[i].count)
+                per[l] += level_drops(&m, i, (fit_level)l);
+            else if (l == FIT_LEVEL_FULL)
+                pred += level_drops(&m, i, FIT_LEVEL_FULL);
+        }
+    int weigh_points = fit_weigh_max_evals(&set) - 1 - set.npoints;
     m.prog = (pd_fit_progress){"start", mode_name(modes[0]), 0, 0, 0, 0, 0, 0, -HUGE_VAL};
     m.prog.max_evaluations = searches * search_max_evals(d, o.max_evals) +
                              (holdout ? nmodes * nfit : 0) + fit_weigh_max_evals(&set) + 2;
-    m.prog.max_drops = (long)m.prog.max_evaluations * per_eval;
+    m.prog.max_drops = searches * ((4 * d + 1 + o.max_evals + d + 1) * per[FIT_LEVEL_SEARCH] +
+                                   FIT_FINALISTS * per[FIT_LEVEL_FULL]) +
+                       (holdout ? nmodes * nfit : 0) * per[FIT_LEVEL_FULL] +
+                       per[FIT_LEVEL_FULL] + pred + weigh_points * per[FIT_LEVEL_WEIGH] +
+                       set.npoints * pred + 2 * per[FIT_LEVEL_FRESH];
     if (m.progress)
         m.progress(&m.prog, m.progress_user);
     pd_initial chosen = modes[0];
@@ -563,7 +642,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
                 one[i] = i == j ? parts[j].count : NULL;
             m.count = one;
             if (st == PD_OK)
-                st = run_model(&m, theta, 0, ps, ns, diag);
+                st = run_model(&m, theta, 0, FIT_LEVEL_FULL, ps, ns, diag);
             m.count = count;
             if (st == PD_OK) {
                 r->evaluations++;
@@ -634,9 +713,9 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         r->npoints = w.npoints;
         /* The fit's quality from drops it was not tuned to, at the best
          * values and at the weighted means. */
-        st = fresh(&m, &pb, best_theta, o.seed ^ FRESH_SEED, ps, ns, r, 0, diag);
+        st = fresh(&m, &pb, best_theta, ps, ns, r, 0, diag);
         if (st == PD_OK)
-            st = fresh(&m, &pb, r->mean, o.seed ^ FRESH_SEED, ps, ns, r, 1, diag);
+            st = fresh(&m, &pb, r->mean, ps, ns, r, 1, diag);
     }
     if (st == PD_OK) {
         for (int i = 0; i < d; i++) {
@@ -661,7 +740,15 @@ done:
     free(ps);
     free(ns);
     free(pbuf);
+    for (int i = 0; m.memo_p && i < nparts; i++)
+        free(m.memo_p[i]);
+    free(m.memo_p);
+    free(m.memo_have);
+    free(m.memo_nsim);
     free(m.ndrops);
+    free(m.need);
+    free(m.nsym);
+    free(sym_of);
     free(m.pose_p);
     free(kk);
     free(count);

@@ -43,6 +43,10 @@ typedef struct {
     int evals;
     const char *stage; /* for fit_problem's note */
     int round;
+    fit_level level;
+    /* The simplex's best points so far, best first. */
+    int ntop;
+    double top_z[FIT_FINALISTS][PD_FIT_MAX_PARAMS], top_l[FIT_FINALISTS];
 } ctx;
 
 /* Part i's cells of counts. */
@@ -67,7 +71,7 @@ static pd_status evaluate(ctx *c, const double *z, int all, double *loglik)
     const fit_problem *pb = c->pb;
     to_theta(pb, z, c->theta);
     c->evals++;
-    pd_status st = pb->model(pb->user, c->theta, all, c->p, c->nsim, c->diag);
+    pd_status st = pb->model(pb->user, c->theta, all, c->level, c->p, c->nsim, c->diag);
     if (st != PD_OK)
         return st;
     double l = 0.0;
@@ -83,6 +87,25 @@ static pd_status evaluate(ctx *c, const double *z, int all, double *loglik)
     return PD_OK;
 }
 
+/* Keeps z among the FIT_FINALISTS best distinct points of the simplex. */
+static void keep_top(ctx *c, const double *z, double l)
+{
+    int d = c->pb->d, n = c->ntop;
+    for (int j = 0; j < n; j++)
+        if (memcmp(c->top_z[j], z, sizeof *z * (size_t)d) == 0)
+            return;
+    if (n == FIT_FINALISTS && !(l > c->top_l[n - 1]))
+        return;
+    int at = n < FIT_FINALISTS ? n++ : n - 1;
+    for (; at > 0 && l > c->top_l[at - 1]; at--) {
+        memcpy(c->top_z[at], c->top_z[at - 1], sizeof *z * (size_t)d);
+        c->top_l[at] = c->top_l[at - 1];
+    }
+    memcpy(c->top_z[at], z, sizeof *z * (size_t)d);
+    c->top_l[at] = l;
+    c->ntop = n;
+}
+
 static double objective(const double *u, void *user)
 {
     ctx *c = user;
@@ -92,6 +115,8 @@ static double objective(const double *u, void *user)
         z[i] = 1.0 / (1.0 + exp(-v));
     }
     c->st = evaluate(c, z, 0, &l);
+    if (c->st == PD_OK)
+        keep_top(c, z, l);
     return c->st == PD_OK ? -l : HUGE_VAL;
 }
 
@@ -125,7 +150,8 @@ pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta
         free(nsim);
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
     }
-    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "design"};
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "design",
+             .level = FIT_LEVEL_SEARCH};
     int d = pb->d;
     /* The design: the middle of the box and 4 d Halton points; the search
      * starts from the best, so a maximum away from the middle is not left
@@ -157,15 +183,31 @@ pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta
         else if (st != PD_OK)
             st = pd_fail(diag, st, "the Nelder-Mead search failed: %s", pd_status_str(st));
     }
-    if (st == PD_OK) {
-        /* The simplex keeps its best vertex, which is never worse than the
-         * design's best it started from. */
-        for (int j = 0; j < d; j++) {
-            double v = u[j] > U_MAX ? U_MAX : u[j] < -U_MAX ? -U_MAX : u[j];
-            z[j] = 1.0 / (1.0 + exp(-v));
+    /* The simplex's two best points on the full drops of another seed:
+     * on its own drops the simplex ends where their noise happens to favour
+     * the counts, and a choice between two points on fresh drops keeps little
+     * of that luck (successive halving: Jamieson and Talwalkar 2016, AISTATS,
+     * "Non-stochastic best arm identification and hyperparameter
+     * optimization"). */
+    c.stage = "final";
+    c.level = FIT_LEVEL_FULL;
+    double lbest = -HUGE_VAL;
+    /* The simplex's best last: the likelier winner is then the point a
+     * model that remembers its last evaluation has at hand. */
+    for (int t = c.ntop - 1; st == PD_OK && t >= 0; t--) {
+        double l;
+        st = evaluate(&c, c.top_z[t], 0, &l);
+        if (st == PD_OK && l > lbest) {
+            lbest = l;
+            memcpy(zbest, c.top_z[t], sizeof z[0] * (size_t)d);
         }
-        to_theta(pb, z, theta);
-        *loglik = -fmin;
+    }
+    (void)fmin;
+    if (st == PD_OK && c.ntop == 0) /* a simplex of no evaluation: the design's best */
+        st = evaluate(&c, zbest, 0, &lbest);
+    if (st == PD_OK) {
+        to_theta(pb, zbest, theta);
+        *loglik = lbest;
     }
     *evals += c.evals;
     free_arrays(pb, p);
@@ -266,7 +308,8 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
     double *bb = malloc(sizeof *bb * (size_t)total), *wp = malloc(sizeof *wp * (size_t)total);
     int *order = malloc(sizeof *order * (size_t)total);
     int *pick = malloc(sizeof *pick * (size_t)(s->npoints > 0 ? s->npoints : 1));
-    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "weighting"};
+    ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "weighting",
+             .level = FIT_LEVEL_FULL};
     pd_status st = PD_OK;
     if (!p || !nsim || !z || !lt || !w || !store || !sims || !x || !a || !bb || !wp || !order ||
         !pick)
@@ -333,6 +376,7 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             b[r].hi[i] = zhat[i] + h > 1 ? 1.0 : zhat[i] + h;
         }
         b[r].npoints = s->npoints;
+        c.level = FIT_LEVEL_WEIGH;
         for (int j = 0; st == PD_OK && j < s->npoints; j++, n++, index++) {
             double *zj = z + (size_t)n * (size_t)d;
             for (int i = 0; i < d; i++)
@@ -363,6 +407,7 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
         resample(n, w, s->npoints, pick);
         c.stage = "prediction";
         c.round = 0;
+        c.level = FIT_LEVEL_FULL;
         for (int t = 0; st == PD_OK && t < s->npoints; t++) {
             int j = pick[t];
             wp[j] += 1.0 / (double)s->npoints;

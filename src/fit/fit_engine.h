@@ -8,12 +8,29 @@
 #include "posedrop/diag.h"
 #include "posedrop/status.h"
 
+/* How much simulation an evaluation gets (docs/calibration.md, "The
+ * optimiser"): the search's design and simplex compare many points on few
+ * drops, all of one seed (common random numbers); the two best points of the
+ * search are then compared, and everything after (the intervals, the
+ * predictions, the quality at the best point) computed, on drops of another
+ * seed, so that the search's choice among the noise of its own drops does
+ * not carry into what the fit reports. A simulated model sizes its drops by
+ * the level; a closed form may ignore it. */
+typedef enum fit_level {
+    FIT_LEVEL_SEARCH = 0, /* a quarter of the drops, the search's seed */
+    FIT_LEVEL_FULL,       /* all the drops, another seed */
+    FIT_LEVEL_WEIGH,      /* a quarter of the drops, FIT_LEVEL_FULL's seed: the
+                             weighting's points, whose likelihood (the Dirichlet-
+                             multinomial) counts their larger simulation error */
+    FIT_LEVEL_FRESH       /* all the drops, a seed no other level uses (fit.c's check) */
+} fit_level;
+
 /* Fills p[i][0..k[i]) (summing to 1) and nsim[i] (the simulated drops behind
  * them) for every part i with counts when all is 0, for every part when all
  * is 1, and for the parts without counts alone when all is 2 (a model may
  * fill more). theta is in the problem's scale (lo..hi). */
-typedef pd_status (*fit_model_fn)(void *user, const double *theta, int all, double *const *p,
-                                  double *nsim, pd_diag *diag);
+typedef pd_status (*fit_model_fn)(void *user, const double *theta, int all, fit_level level,
+                                  double *const *p, double *nsim, pd_diag *diag);
 
 typedef struct fit_problem {
     int d;                    /* parameters, 1..PD_FIT_MAX_PARAMS */
@@ -40,9 +57,14 @@ typedef struct fit_settings {
     int npoints;   /* weighted points per round */
 } fit_settings;
 
+/* The number of the search's best points compared at FIT_LEVEL_FULL. */
+#define FIT_FINALISTS 2
+
 /* The search: a quasi-random design over the box, then Nelder-Mead from its
- * best point. theta (d) receives the best point, *loglik its log-likelihood
- * (the parts with counts), *evals is increased by the evaluations spent. */
+ * best point (both at FIT_LEVEL_SEARCH), then the FIT_FINALISTS best points
+ * the simplex saw evaluated at FIT_LEVEL_FULL. theta (d) receives the
+ * best of those, *loglik its log-likelihood at FIT_LEVEL_FULL (the parts with
+ * counts), *evals is increased by the evaluations spent. */
 pd_status fit_search(const fit_problem *pb, const fit_settings *s, double *theta, double *loglik,
                      int *evals, pd_diag *diag);
 
@@ -60,7 +82,7 @@ typedef struct fit_weighed {
     int npoints;
 } fit_weighed;
 
-/* Evaluates theta (the search's maximum) with every part (and its
+/* At FIT_LEVEL_FULL, evaluates theta (the search's maximum) with every part (and its
  * dispersion from there), then rounds of s->npoints quasi-random points
  * with the fitted parts: the whole box, then boxes around theta shrunk to
  * the weighted spread (at least 3 rounds, at most 6, stopping once the

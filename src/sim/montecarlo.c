@@ -22,6 +22,7 @@
 #include "sim/markov.h"
 #include "sim/scene.h"
 #include "posedrop/sensitivity.h"
+#include "posedrop/symmetry.h"
 #include "sim/sim_tol.h"
 #include "posedrop/tolerances.h"
 #include "base/stats.h"
@@ -128,6 +129,7 @@ void pd_sim_result_free(pd_sim_result *r)
     free(r->trials);
     free(r->first_count);
     free(r->transitions);
+    free(r->chain_class_of);
     free(r->added);
     free(r);
 }
@@ -142,7 +144,9 @@ typedef struct batch {
                                point-mass cdf is that row of pose_cdfs (instead
                                of init_cdf) */
     long pose_drops;
-    int nposes;
+    int nposes;             /* the chain's states (pd_stationary_start's k) */
+    const int *state_first, *state_poses; /* with pose_cdfs: state s's poses are
+                               state_poses[state_first[s] .. state_first[s + 1]) */
     const pd_sim_result *r; /* its shard (run_index) */
     long first, last;       /* the shard's drop numbers [first, last) */
     pd_trial *out;          /* out[i - first] */
@@ -187,8 +191,12 @@ static void *worker(void *arg)
         long drop = run_index(b->r, i);
         const double *cdf = b->init_cdf;
         int pose = b->pose_cdfs ? pd_stationary_start(drop, b->pose_drops, b->nposes) : -1;
-        if (pose >= 0)
-            cdf = b->pose_cdfs + (size_t)b->nposes * (size_t)pose;
+        if (pose >= 0) {
+            /* A state's drops go round its poses. */
+            int first = b->state_first[pose], size = b->state_first[pose + 1] - first;
+            pose = b->state_poses[first + (int)((drop / (b->nposes + 1)) % size)];
+            cdf = b->pose_cdfs + (size_t)b->r->nposes * (size_t)pose;
+        }
         /* The drop's own scene values: its ranges drawn from the parameters'
          * stream, which leaves the drop's orientation stream as it is. */
         pd_trial *out = &b->out[i - b->first];
@@ -263,11 +271,13 @@ static void tally(pd_sim_result *r, const pd_trial *t, long n)
         r->count[t[i].pose]++;
         if (!r->transitions)
             continue;
-        int from = pd_stationary_start(run_index(r, r->n + i), r->pose_drops, r->nposes);
+        int states = r->chain_class_of ? r->chain_states : r->nposes;
+        int from = pd_stationary_start(run_index(r, r->n + i), r->pose_drops, states);
+        int to = r->chain_class_of ? r->chain_class_of[t[i].pose] : t[i].pose;
         if (from < 0)
-            r->first_count[t[i].pose]++;
+            r->first_count[to]++;
         else
-            r->transitions[(size_t)from * (size_t)r->nposes + (size_t)t[i].pose]++;
+            r->transitions[(size_t)from * (size_t)states + (size_t)to]++;
     }
     r->n += n;
 }
@@ -451,30 +461,50 @@ static pd_status drive(const pd_sim_model *model, const pd_scene *scene, const p
 static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *scene,
                                   const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)
 {
-    int k = r->nposes;
+    int k = r->nposes, states = r->chain_class_of ? r->chain_states : k;
     size_t K = (size_t)k;
     pd_trial *buf = malloc(sizeof *buf * BATCH_MAX);
     /* Row i: the cumulative distribution of a point mass on pose i, so the
      * bootstrap's own release (drop.c) starts the drop resting on pose i. */
     double *point = malloc(sizeof *point * K * K);
+    /* Each state's poses, in pose order (a pose is its own state without
+     * classes). */
+    int *first = calloc((size_t)states + 1, sizeof *first), *poses = malloc(sizeof *poses * K);
     pd_status st = PD_OK;
-    if (!buf || !point)
+    if (!buf || !point || !first || !poses)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
     for (size_t i = 0; point && i < K; i++)
         for (size_t j = 0; j < K; j++)
             point[i * K + j] = j >= i ? 1.0 : 0.0;
+    if (st == PD_OK) {
+        for (int j = 0; j < k; j++)
+            first[(r->chain_class_of ? r->chain_class_of[j] : j) + 1]++;
+        for (int c = 0; c < states; c++)
+            first[c + 1] += first[c];
+        int *at = calloc((size_t)states, sizeof *at);
+        if (!at)
+            st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the drop records");
+        for (int j = 0; at && j < k; j++) {
+            int c = r->chain_class_of ? r->chain_class_of[j] : j;
+            poses[first[c] + at[c]++] = j;
+        }
+        free(at);
+    }
     int nthreads = thread_count(o);
     long want = pd_shard_drops(o->ndrops, r->shard, r->nshards);
     while (st == PD_OK && r->n < want && !r->partial) {
         long size = want - r->n > BATCH_MAX ? BATCH_MAX : want - r->n;
         batch b = {.model = model, .scene = scene, .opt = o, .pose_cdfs = point,
-                   .pose_drops = r->pose_drops, .nposes = k, .r = r, .first = r->n,
-                   .last = r->n + size, .out = buf, .planned = want};
+                   .pose_drops = r->pose_drops, .nposes = states, .state_first = first,
+                   .state_poses = poses, .r = r, .first = r->n, .last = r->n + size,
+                   .out = buf, .planned = want};
         if (run_recorded(&b, nthreads, o, r, &st, diag) < 0)
             break;
     }
     free(buf);
     free(point);
+    free(first);
+    free(poses);
     return st;
 }
 
@@ -483,9 +513,42 @@ static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *sce
  * and Wilson's (closed_classes 0 says which). */
 static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
 {
-    pd_markov_counts c = {r->nposes, r->first_count, r->transitions};
-    pd_markov_summary s = {r->p, r->ci_lo, r->ci_hi, 0, 0.0};
-    pd_status st = pd_markov_estimate(&c, NULL, r->nposes, r->seed, &s);
+    if (!r->chain_class_of) {
+        pd_markov_counts c = {r->nposes, r->first_count, r->transitions};
+        pd_markov_summary s = {r->p, r->ci_lo, r->ci_hi, 0, 0.0};
+        pd_status st = pd_markov_estimate(&c, NULL, r->nposes, r->seed, &s);
+        if (st != PD_OK)
+            return pd_fail(diag, st, "the long-run distribution of the pose chain: %s",
+                           pd_status_str(st));
+        r->closed_classes = s.nclosed;
+        r->stationary_shift = s.shift;
+        return PD_OK;
+    }
+    /* The chain of classes; each class's share split equally among its
+     * poses, which the part's symmetry makes equally likely. */
+    int K = r->chain_states;
+    double *buf = malloc(sizeof *buf * 3 * (size_t)K);
+    int *size = calloc((size_t)K, sizeof *size);
+    if (!buf || !size) {
+        free(buf);
+        free(size);
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the pose chain");
+    }
+    pd_markov_counts c = {K, r->first_count, r->transitions};
+    pd_markov_summary s = {buf, buf + K, buf + 2 * K, 0, 0.0};
+    pd_status st = pd_markov_estimate(&c, NULL, K, r->seed, &s);
+    if (st == PD_OK && s.nclosed > 0) {
+        for (int j = 0; j < r->nposes; j++)
+            size[r->chain_class_of[j]]++;
+        for (int j = 0; j < r->nposes; j++) {
+            int cl = r->chain_class_of[j];
+            r->p[j] = s.p[cl] / size[cl];
+            r->ci_lo[j] = s.lo[cl] / size[cl];
+            r->ci_hi[j] = s.hi[cl] / size[cl];
+        }
+    }
+    free(buf);
+    free(size);
     if (st != PD_OK)
         return pd_fail(diag, st, "the long-run distribution of the pose chain: %s",
                        pd_status_str(st));
@@ -524,7 +587,8 @@ pd_status pd_sim_result_finish(pd_sim_result *r, pd_diag *diag)
 }
 
 /* The stationary estimator's split of the drops, refused when it cannot
- * give every pose its minimum or --ci asks for a stopping rule. */
+ * give every state (pose, or class) its minimum or --ci asks for a stopping
+ * rule. */
 static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
 {
     if (o->ci_halfwidth > 0)
@@ -534,8 +598,9 @@ static pd_status check_stationary(const pd_sim_options *o, int k, pd_diag *diag)
     long need = (long)(k + 1) * PD_STATIONARY_MIN_POSE_DROPS;
     if (o->ndrops < need)
         return pd_fail(diag, PD_ERR_USAGE, "initial stationary: %ld drops are too few for %d "
-                       "stable poses: each pose needs %d drops started resting on it and the "
+                       "stable %s: each needs %d drops started resting on it and the "
                        "uniform start as many, at least %ld drops in all", o->ndrops, k,
+                       o->stationary_by_class ? "classes of poses" : "poses",
                        PD_STATIONARY_MIN_POSE_DROPS, need);
     return PD_OK;
 }
@@ -569,12 +634,14 @@ static uint64_t run_fingerprint(const pd_static_result *poses, const pd_scene *s
     pd_hash_u64(&s, (uint64_t)o->ndrops);
     if (o->effect_halfwidth > 0) /* runs before it existed keep their identity */
         pd_hash_doubles(&s, &o->effect_halfwidth, 1);
+    if (o->stationary_by_class && sc->initial == PD_INITIAL_STATIONARY)
+        pd_hash_ints(&s, &o->stationary_by_class, 1);
     pd_hash_u64(&s, (uint64_t)o->max_drops);
     pd_hash_u64(&s, o->seed);
     return s.h;
 }
 
-pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene,
+static pd_status result_new(const pd_static_result *poses, const pd_scene *scene,
                             const pd_sim_options *o, pd_sim_result **result, pd_diag *diag)
 {
     pd_scene scene_default;
@@ -611,6 +678,7 @@ pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene
             r->transitions = calloc((size_t)k * (size_t)k, sizeof *r->transitions);
             r->pose_drops = o->ndrops / (k + 1);
             r->first_drops = o->ndrops - k * r->pose_drops;
+            r->chain_states = k;
         }
     }
     if (!r || !r->count || !r->p || !r->ci_lo || !r->ci_hi ||
@@ -619,6 +687,43 @@ pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene
         return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the results");
     }
     *result = r;
+    return PD_OK;
+}
+
+pd_status pd_sim_result_new(const pd_static_result *poses, const pd_scene *scene,
+                            const pd_sim_options *o, pd_sim_result **result, pd_diag *diag)
+{
+    /* A sum of shards: the chain of classes needs the part, and pd_sim_run. */
+    if (o && o->stationary_by_class && scene && scene->initial == PD_INITIAL_STATIONARY)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_new: option stationary_by_class is "
+                       "for whole runs (pd_sim_run), not sums of shards");
+    return result_new(poses, scene, o, result, diag);
+}
+
+/* The chain of classes of symmetric poses in place of the poses' (r made
+ * for a stationary run, no drop run yet). */
+static pd_status chain_by_class(const pd_part *part, const pd_static_result *poses,
+                                const pd_sim_options *o, pd_sim_result *r, pd_diag *diag)
+{
+    int k = r->nposes, nc = 0;
+    int *class_of = malloc(sizeof *class_of * (size_t)k);
+    if (!class_of)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the pose classes");
+    pd_status st = pd_pose_classes(part, poses, class_of, &nc, diag);
+    if (st != PD_OK) {
+        free(class_of);
+        return st;
+    }
+    free(r->first_count);
+    free(r->transitions);
+    r->first_count = calloc((size_t)nc, sizeof *r->first_count);
+    r->transitions = calloc((size_t)nc * (size_t)nc, sizeof *r->transitions);
+    r->chain_class_of = class_of;
+    r->chain_states = nc;
+    r->pose_drops = o->ndrops / (nc + 1);
+    r->first_drops = o->ndrops - nc * r->pose_drops;
+    if (!r->first_count || !r->transitions)
+        return pd_fail(diag, PD_ERR_NOMEM, "out of memory for the pose chain");
     return PD_OK;
 }
 
@@ -724,6 +829,12 @@ pd_status pd_sim_options_check(const pd_sim_options *o, pd_diag *diag)
     if (o->keep_trials != 0 && o->keep_trials != 1)
         return pd_fail(diag, PD_ERR_USAGE, "option keep_trials is %d: expected 0 or 1",
                        o->keep_trials);
+    if (o->stationary_by_class != 0 && o->stationary_by_class != 1)
+        return pd_fail(diag, PD_ERR_USAGE, "option stationary_by_class is %d: expected 0 or 1",
+                       o->stationary_by_class);
+    if (o->stationary_by_class && o->nshards > 0)
+        return pd_fail(diag, PD_ERR_USAGE, "option stationary_by_class with nshards: the chain "
+                       "of classes is for whole runs");
     if (o->nshards < 0 || (o->nshards > 0 && (o->shard < 0 || o->shard >= o->nshards)))
         return pd_fail(diag, PD_ERR_USAGE, "options nshards %d, shard %d: expected nshards 0 "
                        "(the whole run), or shard from 0 to nshards - 1", o->nshards, o->shard);
@@ -784,14 +895,25 @@ pd_status pd_sim_run(const pd_part *part, const pd_static_result *poses, const p
         return pd_fail(diag, PD_ERR_USAGE, "option effect_halfwidth goes with the uniform start "
                        "only");
     int stationary = sc.initial == PD_INITIAL_STATIONARY;
-    if (stationary && check_stationary(&o, poses->nposes, diag) != PD_OK)
+    int by_class = stationary && o.stationary_by_class;
+    pd_sim_result *r = NULL;
+    st = result_new(poses, &sc, &o, &r, diag);
+    if (st == PD_OK && by_class)
+        st = chain_by_class(part, poses, &o, r, diag);
+    if (st != PD_OK) {
+        pd_sim_result_free(r);
+        return st;
+    }
+    if (stationary && check_stationary(&o, r->chain_states, diag) != PD_OK) {
+        pd_sim_result_free(r);
         return PD_ERR_USAGE;
+    }
     pd_sim_model *model = NULL;
     st = pd_sim_model_build(part, poses, &sc, &o, &model, diag);
-    if (st != PD_OK)
+    if (st != PD_OK) {
+        pd_sim_result_free(r);
         return st;
-    pd_sim_result *r = NULL;
-    st = pd_sim_result_new(poses, &sc, &o, &r, diag);
+    }
     if (st == PD_OK) {
         r->time_limit = model->time_limit;
         r->nshards = o.nshards;

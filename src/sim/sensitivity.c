@@ -235,7 +235,9 @@ static long used_drops(const pd_sim_result *r, const pd_scene *sc, double size,
         long drop = r->nshards > 0 ? r->shard + t * r->nshards : t;
         if (tr->end != PD_END_SETTLED || tr->pose < 0)
             continue;
-        if (r->transitions && pd_stationary_start(drop, r->pose_drops, r->nposes) >= 0)
+        if (r->transitions &&
+            pd_stationary_start(drop, r->pose_drops,
+                                r->chain_class_of ? r->chain_states : r->nposes) >= 0)
             continue;
         cat[n] = class_of ? class_of[tr->pose] : tr->pose;
         for (int i = 0; i < PD_NPARAMS; i++)

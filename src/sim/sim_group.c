@@ -18,6 +18,9 @@ pd_status pd_sim_result_grouped(const pd_sim_result *sim, const int *class_of, i
     if (sim->nposes < 0 || (sim->nposes > 0 && !sim->count) || !sim->first_count != !sim->transitions)
         return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: the result has not the arrays "
                        "of its %d poses", sim->nposes);
+    if (sim->chain_class_of)
+        return pd_fail(diag, PD_ERR_USAGE, "pd_sim_result_grouped: the result's chain is over "
+                       "classes already (stationary_by_class)");
     /* At most a class per pose: more would only be empty classes, and a
      * count of the chain's class-to-class transitions for each pair. */
     if (nclasses < 0 || nclasses > sim->nposes || (nclasses == 0 && sim->nposes > 0))

@@ -1,6 +1,7 @@
 /* test_markov.c: the long-run distribution of a pose-to-pose chain against
  * closed forms, its resampling intervals, and --initial stationary end to end
  * on the cube. */
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -409,6 +410,110 @@ static void test_cube(void)
     pd_part_free(part);
 }
 
+/* The chain of classes of symmetric poses (stationary_by_class): on a coin
+ * of height half its diameter, whose 66 poses fall into 2 classes (the faces,
+ * the rim's 64 sides) and whose chain moves between them, its long-run
+ * distribution is the pose chain's summed over the classes (lumpability), so
+ * the two estimates of each class agree within their drops' noise; each pose
+ * gets an equal part of its class; the rows rest on n / 3 drops; threads
+ * change no byte; and what cannot use it is refused. */
+static void test_by_class(void)
+{
+    enum { K = 66 };
+    pd_diag d;
+    pd_diag_init(&d);
+    pd_mesh *m = NULL;
+    pd_part *part = NULL;
+    pd_static_result *poses = NULL;
+    CHECK_STATUS(pd_mesh_read("parts/canonical/coin_h0.5.off", NULL, &m, &d), PD_OK);
+    part = part_of(m, NULL, &d);
+    if (!part || pd_static_estimate(part, NULL, &poses, &d) != PD_OK || poses->nposes != K) {
+        CHECK(0);
+        pd_static_result_free(poses);
+        pd_part_free(part);
+        return;
+    }
+    int class_of[K], nc = 0;
+    CHECK_STATUS(pd_pose_classes(part, poses, class_of, &nc, &d), PD_OK);
+    CHECK_INT(nc, 2);
+    pd_scene sc;
+    pd_scene_default(&sc);
+    sc.initial = PD_INITIAL_STATIONARY;
+    pd_sim_options o;
+    pd_sim_options_default(&o);
+    o.seed = 11;
+    o.ndrops = 900;
+    o.stationary_by_class = 1;
+    pd_sim_result *a = NULL, *b = NULL, *poses_chain = NULL;
+    o.threads = 1;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &a, &d), PD_OK);
+    o.threads = 2;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &b, &d), PD_OK);
+    pd_sim_options q = o;
+    q.stationary_by_class = 0;
+    q.ndrops = 2010; /* 30 drops a pose */
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &q, &poses_chain, &d), PD_OK);
+    if (a && b && poses_chain) {
+        CHECK_INT(a->chain_states, 2);
+        CHECK_INT(a->pose_drops, 300);
+        CHECK_INT(a->first_drops, 300);
+        CHECK(a->closed_classes >= 1);
+        long moves = 0, firsts = a->first_count[0] + a->first_count[1];
+        for (int i = 0; i < 4; i++)
+            moves += a->transitions[i];
+        /* Every settled drop is one count of its phase. */
+        CHECK_INT(moves + firsts, 900 - a->unsettled);
+        CHECK(memcmp(a->p, b->p, K * sizeof *a->p) == 0);
+        CHECK(memcmp(a->transitions, b->transitions, 4 * sizeof *a->transitions) == 0);
+        double pc[2][2] = {{0}}, sd[2][2] = {{0}}, sum = 0;
+        for (int j = 0; j < K; j++) {
+            for (int i = 0; i < K; i++)
+                if (class_of[i] == class_of[j])
+                    CHECK_NEAR(a->p[j], a->p[i], 1e-15, "a class's share split equally");
+            CHECK(a->ci_lo[j] <= a->p[j] && a->p[j] <= a->ci_hi[j]);
+            sum += a->p[j];
+            const pd_sim_result *r[2] = {a, poses_chain};
+            for (int e = 0; e < 2; e++) {
+                pc[e][class_of[j]] += r[e]->p[j];
+                /* Each pose's error taken as fully correlated within its
+                 * class: the larger, conservative, standard error. */
+                sd[e][class_of[j]] += (r[e]->ci_hi[j] - r[e]->ci_lo[j]) / (2 * 1.959963984540054);
+            }
+        }
+        CHECK_NEAR(sum, 1.0, 1e-12, "a distribution, round-off");
+        CHECK(pc[0][0] > 0.05 && pc[0][1] > 0.05); /* a chain that moves */
+        /* The first class's difference over its standard error within the
+         * 99.9% normal bound (the second is its complement). */
+        double z = (pc[0][0] - pc[1][0]) / sqrt(sd[0][0] * sd[0][0] + sd[1][0] * sd[1][0]);
+        CHECK(fabs(z) < 3.29);
+        pd_note("class chain: %.3f %.3f (900 drops); pose chain: %.3f %.3f (2010): z %.2f\n",
+                pc[0][0], pc[0][1], pc[1][0], pc[1][1], z);
+    }
+    pd_sim_result_free(a);
+    pd_sim_result_free(b);
+    pd_sim_result *g = NULL;
+    if (poses_chain)
+        CHECK_STATUS(pd_sim_result_grouped(poses_chain, class_of, nc, &g, &d), PD_OK);
+    pd_sim_result_free(g);
+    pd_sim_result_free(poses_chain);
+    /* The minimum is per class: (2 + 1) 10 drops. */
+    o.ndrops = 3 * PD_STATIONARY_MIN_POSE_DROPS - 1;
+    pd_sim_result *r = NULL;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+    CHECK(r == NULL && strstr(d.message, " 30 ") != NULL && strstr(d.message, "classes"));
+    /* Not for shards, nor a sum of them. */
+    o.ndrops = 900;
+    o.nshards = 2;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+    o.nshards = 0;
+    CHECK_STATUS(pd_sim_result_new(poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+    o.stationary_by_class = 2;
+    CHECK_STATUS(pd_sim_run(part, poses, &sc, &o, &r, &d), PD_ERR_USAGE);
+    CHECK(r == NULL);
+    pd_static_result_free(poses);
+    pd_part_free(part);
+}
+
 void suite_markov(void)
 {
     test_closed_forms();
@@ -416,4 +521,5 @@ void suite_markov(void)
     test_estimate();
     test_coverage();
     test_cube();
+    test_by_class();
 }
