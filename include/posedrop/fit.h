@@ -4,9 +4,10 @@
  * finds the scene values, shared by all the parts (one feeder), that
  * maximise the multinomial likelihood of all the counts together, the
  * model's pose probabilities coming from simulated drops. Every evaluation
- * runs the same drops (the same seed: common random numbers), so that the
- * simulated likelihood moves with the parameters and not with the noise of
- * fresh draws. The search is GSL's Nelder-Mead simplex on the parameters
+ * of the search runs the same drops (the same seed: common random numbers),
+ * so that the simulated likelihood moves with the parameters and not with
+ * the noise of fresh draws; its best points are compared, and everything
+ * after computed, on drops of another seed. The search is GSL's Nelder-Mead simplex on the parameters
  * mapped onto the real line; the intervals and the averaged predictions
  * weigh points around the optimum by their likelihood (docs/calibration.md
  * gives the method and its sources). */
@@ -93,9 +94,10 @@ typedef void (*pd_fit_progress_fn)(const pd_fit_progress *progress, void *user);
 typedef struct pd_fit_options {
     long ndrops;        /* simulated drops per part and evaluation, >= 10; 1000
                            (raised to what --initial stationary needs). The
-                           search's design runs a quarter of them and its simplex
-                           half (docs/calibration.md, "The optimiser") */
-    uint64_t seed;      /* 1: every evaluation's drops use it (common random numbers) */
+                           search and the weighting's points run a quarter of
+                           them (docs/calibration.md, "The optimiser") */
+    uint64_t seed;      /* 1: the search's drops use it (common random numbers), the
+                           later stages seeds derived from it */
     int threads;        /* 0: all cores */
     pd_engine_kind engine; /* PD_ENGINE_IMPULSE */
     int fit_initial;    /* 1: the initial mode is fitted too, as a discrete choice:
@@ -104,7 +106,7 @@ typedef struct pd_fit_options {
     int max_evals;      /* Nelder-Mead evaluations per search, >= 1; 150. The simplex
                            stops once it has spent them, finishing its step (up to
                            max_evals + d + 1); each search's design (4 d + 1) and
-                           final d + 1, the weighting, the predicted parts and the
+                           final 2, the weighting, the predicted parts and the
                            fresh drops come on top (pd_fit_progress's
                            max_evaluations adds them up) */
     int npoints;        /* likelihood-weighted points per round (3 to 6 rounds),
@@ -171,7 +173,7 @@ typedef struct pd_fit_result {
                              counts, which cannot test it */
     double loglik;      /* at the maximum, all fitted parts: sum_k count_k log p_k */
     double chi2;        /* the parts' X^2 summed: in-sample, a diagnostic (these
-                           drops chose the best values among the search's last d + 1) */
+                           drops chose the best values between the search's two best) */
     int df;             /* sum of (nclasses - 1) over the fitted parts, minus nparams;
                            <= 0: the data cannot test the fit */
     double pvalue;      /* 1 when df <= 0 */
