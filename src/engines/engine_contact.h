@@ -150,11 +150,11 @@ static inline double pd_engine_contact_restitution(double zeta)
  *             = 2 acosh(zeta) / sqrt(zeta^2 - 1)          (zeta > 1), 2 at 1,
  * whatever the approach speed. zeta is found from e by bisection (e falls
  * from 1 at zeta = 0 toward 0), then omega from T. e is taken within
- * [PD_ENGINE_E_MIN, 1]. docs/engines-crosscheck.md derives it. Until
- * 2026-12-07 every contact of ODE and Bullet was this law (a face landed
- * stiffer and more damped than one contact: pd_engine_hc_law says why);
- * its omega still sets their drilling patch, the sink under the weight
- * g / omega^2 (drilling_arm in engine_ode.c says why). */
+ * [PD_ENGINE_E_MIN, 1]. docs/engines-crosscheck.md derives it. Not the
+ * engines' contact law (points sharing one contact under it land stiffer
+ * and more damped than one contact: pd_engine_hc_law says why); its omega
+ * sets their drilling patch, the sink under the weight g / omega^2
+ * (drilling_arm in engine_ode.c says why). */
 static inline void pd_engine_contact_law(double T, double e, double *omega, double *zeta)
 {
     double target = fmin(1.0, fmax(e, PD_ENGINE_E_MIN));
@@ -173,17 +173,17 @@ static inline void pd_engine_contact_law(double T, double e, double *omega, doub
 }
 
 /* The impulse simulator's contact law, which the stepping engines realise
- * since 2026-12-07 (compliant.c; docs/contact.md): each vertex below the
- * floor pushes with the Hunt-Crossley force F = k d (1 + lambda d'), d its
- * depth and d' the rate, k = m_eff omega^2 for its own effective mass along
+ * (compliant.c; docs/contact.md): each vertex below the floor pushes with
+ * the Hunt-Crossley force F = k d (1 + lambda d'), d its depth and d' the
+ * rate, k = m_eff omega^2 for its own effective mass along
  * the normal and lambda = chi / v0, v0 its approach speed when it touched.
  * Scaled (time by 1 / omega, depth by v0 / omega) the contact is
  * s'' = -s (1 + chi s'), started at s = 0, s' = 1, whatever the mass and the
  * speed; so its rebound and its duration do not depend on the stiffness:
  * vertices that land together (a face, an edge) rebound together with e,
  * however many there are, where a linear dashpot fitted to each vertex's
- * own mass made their sum stiffer and more damped than the law (a face of 8
- * kept vertices rebounded 0.24 for e = 0.3). The rebound has a closed form:
+ * own mass made their sum stiffer and more damped than the law
+ * (docs/engines-crosscheck.md). The rebound has a closed form:
  * along the contact s'/chi - ln(1 + chi s')/chi^2 + s^2/2 is constant, so
  * at its end (s = 0, s' = -e)
  *     ln((1 + chi) / (1 - chi e)) = chi (1 + e),

@@ -407,8 +407,8 @@ static double pow2_near(double x)
  * stand for, whose omega for the same T is higher (3.59 / T against
  * 2.42 / T at e = 0.3), its sink 2.2 times less and its couple 1.48 times
  * weaker: with that one, Bullet's tops on the flat pyramid of
- * test_hard_parts.c (h/r 1e-3) spun past the time limit in 3 of 200 drops.
- * The impulse simulator's patch is the weaker one (sim_model.c). */
+ * test_hard_parts.c spun past the time limit (docs/engines.md). The impulse
+ * simulator's patch is the weaker one (sim_model.c). */
 static void drilling_arm(pd_engine_world *w)
 {
     double d = w->compliant ? w->gscale / (w->patch_omega * w->patch_omega)
