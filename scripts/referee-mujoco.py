@@ -32,9 +32,11 @@ orientation in --trials, lowest point at the scene's height, the belt's
 velocity, no spin):
   - the part's mesh in metres with MuJoCo's exact volume inertia; MuJoCo
     collides its convex hull, as posedrop does;
-  - each contact a push-only spring-dashpot with the scene's contact time T
-    (the part's automatic one) and restitution e, in acceleration units, as
-    the stepping engines' law (docs/engines-crosscheck.md): zeta from
+  - each contact a push-only linear spring-dashpot with the scene's contact
+    time T (the part's automatic one) and restitution e, in acceleration
+    units (MuJoCo has no Hunt-Crossley law, which posedrop's three engines
+    use; per contact in acceleration units a face of any number of points
+    rebounds with e, as with that law; docs/engines-crosscheck.md): zeta from
     e = exp(-zeta g(zeta)), omega = g(zeta) / T, given to MuJoCo as solref
     (timeconst 1 / (zeta omega), dampratio zeta) with an impedance of 0.9999
     throughout (solimp), so that the contact's acceleration is the spring's;

@@ -29,6 +29,7 @@
  *   count. */
 #include <cfloat>
 #include <cmath>
+#include <algorithm>
 #include <new>
 
 #include <btBulletDynamicsCommon.h>
@@ -40,6 +41,7 @@ extern "C" {
 #include "engines/engines_tol.h"
 #include "base/base_tol.h"
 #include "posedrop/version.h"
+#include "posedrop/tolerances.h"
 }
 
 /* The hull against the floor: every hull vertex within the manifold's
@@ -54,10 +56,19 @@ extern "C" {
  * drops). The vertices' heights depend only on where they are, so this
  * contact set is the same whichever way the part's frame is turned. */
 /* The scene's contact law (contact_time > 0, resolved by the step;
- * engine.h): every contact a spring-dashpot for its own effective mass. */
+ * engine.h): every contact the impulse simulator's Hunt-Crossley law for its
+ * own effective mass (pd_engine_hc_law). */
 struct contact_law {
     bool on;
-    double omega, zeta;
+    double omega, chi;
+    /* The speed of resting contact's fall (the impulse simulator's,
+     * settle.c), m/s: the least approach speed the damping is divided by. */
+    double v_rest;
+    /* Per hull vertex, the approach speed of its impact under way (at
+     * least v_rest; negative once it recedes), 0 while it is above the
+     * floor (touch below). */
+    double *touch = nullptr;
+    size_t ntouch = 0;
     double reach; /* the manifold's contact breaking threshold, m */
     /* A contact slipping faster than this (m/s) slides through the step
      * (slide_speed); the solver info whose friction directions
@@ -72,8 +83,11 @@ class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
 
     /* Bullet's own spring form, the same as ODE's: with the flag set, its
      * solver takes erp = h k / (h k + c) and cfm = 1 / (h k + c) from the
-     * point's stiffness k and damping c. The effective mass along the
-     * normal is Bullet's impulse denominator's inverse. */
+     * point's stiffness k and damping c: k = m_eff omega^2, the effective
+     * mass along the normal Bullet's impulse denominator's inverse, and the
+     * Hunt-Crossley damping c = k chi d / v0 at the point's depth d (at the
+     * step's start), v0 its vertex's approach speed at touch (the point's
+     * m_index0: the manifold's first body is the hull). */
     void set_springs(const btRigidBody *body, const btVector3 &n)
     {
         for (int j = 0; j < manifold->getNumContacts(); j++) {
@@ -81,8 +95,13 @@ class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
             btVector3 pa = manifold->getBody0() == body ? p.getPositionWorldOnA()
                                                         : p.getPositionWorldOnB();
             double m = 1.0 / double(body->computeImpulseDenominator(pa, n));
-            p.m_combinedContactStiffness1 = btScalar(m * law->omega * law->omega);
-            p.m_combinedContactDamping1 = btScalar(2.0 * law->zeta * m * law->omega);
+            double k = m * law->omega * law->omega, depth = -double(p.getDistance()), c = 0.0;
+            int v = p.m_index0;
+            double v0 = v >= 0 && size_t(v) < law->ntouch ? fabs(law->touch[v]) : 0.0;
+            if (depth > 0.0)
+                c = k * law->chi * depth / (v0 > 0.0 ? v0 : law->v_rest);
+            p.m_combinedContactStiffness1 = btScalar(k);
+            p.m_combinedContactDamping1 = btScalar(c);
             p.m_contactPointFlags |= BT_CONTACT_FLAG_CONTACT_STIFFNESS_DAMPING;
         }
     }
@@ -112,6 +131,28 @@ class hull_floor_algorithm : public btActivatingCollisionAlgorithm {
             law->info->m_solverMode |= SOLVER_USE_2_FRICTION_DIRECTIONS;
         else
             law->info->m_solverMode &= ~SOLVER_USE_2_FRICTION_DIRECTIONS;
+    }
+
+    /* Vertex i at p, d from the floor along n: the approach speed of its
+     * impact (at least v_rest; negative once it recedes), 0 above the
+     * floor. An impact starts when the vertex goes below the floor, and
+     * again when it approaches after it receded while still below, as
+     * ODE's adapter has it (touch_speeds in engine_ode.c says why). */
+    void touch(const btRigidBody *body, int i, const btVector3 &p, const btVector3 &n, double d)
+    {
+        if (!law->on || !body || size_t(i) >= law->ntouch)
+            return;
+        double &v0 = law->touch[size_t(i)];
+        if (d >= 0.0) {
+            v0 = 0.0;
+            return;
+        }
+        btVector3 v = body->getVelocityInLocalPoint(p - body->getCenterOfMassPosition());
+        double in = -double(n.dot(v));
+        if (v0 == 0.0 || (v0 < 0.0 && in > 0.0))
+            v0 = fmax(in, law->v_rest);
+        else if (in < 0.0)
+            v0 = -fabs(v0);
     }
 
 public:
@@ -152,14 +193,21 @@ public:
          * its inflated sphere's lowest point. */
         btScalar margin = hull->getMargin();
         btScalar reach = manifold->getContactBreakingThreshold();
+        const btRigidBody *body = btRigidBody::upcast(hw->getCollisionObject());
         for (int i = 0; i < hull->getNumPoints(); i++) {
             btVector3 p = th(hull->getScaledPoint(i)) - margin * n;
             btScalar d = n.dot(p) - c;
-            if (d < reach)
+            touch(body, i, p, n, double(d));
+            if (d < reach) {
+                /* The vertex, for its touch speed (set_springs). */
+                if (swapped)
+                    out->setShapeIdentifiersB(-1, i);
+                else
+                    out->setShapeIdentifiersA(-1, i);
                 out->addContactPoint(n, p - d * n, d);
+            }
         }
         out->refreshContactPoints();
-        const btRigidBody *body = btRigidBody::upcast(hw->getCollisionObject());
         if (law->on && body)
             set_springs(body, n);
         if (body)
@@ -286,10 +334,13 @@ static double contact_reach(const btConvexHullShape &hull)
 static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
 {
     contact_law &law = w->hull_floor.law;
-    law.omega = law.zeta = 0.0;
+    law.omega = law.chi = 0.0;
     law.on = false;
+    double gv = scene->gravity != 0.0 ? fabs(scene->gravity) : 9.81;
+    law.v_rest = 2.0 * sqrt(2.0 * gv * PD_TOL_REST_FALL_REL * w->size_m);
+    std::fill(law.touch, law.touch + law.ntouch, 0.0);
     if (scene->contact_time > 0.0) {
-        pd_engine_contact_law(scene->contact_time, scene->restitution, &law.omega, &law.zeta);
+        pd_engine_hc_law(scene->contact_time, scene->restitution, &law.omega, &law.chi);
         law.on = pd_engine_contact_resolved(w->step_s, scene->contact_time, law.omega,
                                             pd_engine_fall_speed(scene, w->size_m),
                                             w->width_m);
@@ -323,8 +374,12 @@ static pd_status bullet_material(pd_engine_world *w, const pd_scene *scene)
      * face's drilling acts at one of its corners only. A rigid scene
      * (contact time 0) has no patch, as in the impulse engine. */
     double arm = 0.0;
-    if (scene->contact_time > 0.0)
-        arm = 2.0 / 3.0 * scene->mu * sqrt(PD_CORNER_RADIUS_REL * w->size_m * g) / law.omega;
+    if (scene->contact_time > 0.0) {
+        /* The patch's omega as ODE's adapter takes it (drilling_arm). */
+        double patch_omega, zeta;
+        pd_engine_contact_law(scene->contact_time, scene->restitution, &patch_omega, &zeta);
+        arm = 2.0 / 3.0 * scene->mu * sqrt(PD_CORNER_RADIUS_REL * w->size_m * g) / patch_omega;
+    }
     w->body.setSpinningFriction(btScalar(arm));
     w->body.setRollingFriction(btScalar(arm > 0.0 ? 1e-30 * arm : 0.0));
     return PD_OK;
@@ -381,6 +436,12 @@ static pd_engine_world *bullet_world_alloc(const pd_body *b, const pd_hull *hull
     w->hull.setMargin(btScalar(margin));
 
     w->hull_floor.law.reach = contact_reach(w->hull);
+    w->hull_floor.law.touch = new (std::nothrow) double[size_t(b->nverts)]();
+    w->hull_floor.law.ntouch = w->hull_floor.law.touch ? size_t(b->nverts) : 0;
+    if (!w->hull_floor.law.touch) {
+        delete w;
+        return nullptr;
+    }
     w->dispatcher.registerCollisionCreateFunc(CONVEX_HULL_SHAPE_PROXYTYPE, STATIC_PLANE_PROXYTYPE,
                                               &w->hull_floor);
     w->dispatcher.registerCollisionCreateFunc(STATIC_PLANE_PROXYTYPE, CONVEX_HULL_SHAPE_PROXYTYPE,
@@ -431,6 +492,7 @@ static void bullet_world_free(pd_engine_world *w)
         return;
     w->world.removeRigidBody(&w->body);
     w->world.removeRigidBody(&w->floor_body);
+    delete[] w->hull_floor.law.touch;
     delete w;
 }
 
@@ -460,6 +522,7 @@ static pd_status bullet_reset(pd_engine_world *w, const pd_state *s)
         b.getBroadphaseHandle(), &w->dispatcher);
     w->world.updateSingleAabb(&b);
     w->solver.reset();
+    std::fill(w->hull_floor.law.touch, w->hull_floor.law.touch + w->hull_floor.law.ntouch, 0.0);
     w->q_last = q;
     return PD_OK;
 }

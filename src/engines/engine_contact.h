@@ -139,7 +139,7 @@ static inline double pd_engine_contact_restitution(double zeta)
     return exp(-zeta * pd_engine_contact_duration(zeta));
 }
 
-/* The spring-dashpot standing for one contact of the scene (contact_time
+/* The linear spring-dashpot fitted to one contact of the scene (contact_time
  * T > 0, restitution e), as natural frequency *omega (rad/s) and damping
  * ratio *zeta, for a contact of effective mass m: stiffness k = m omega^2,
  * damping c = 2 zeta m omega. The contact pushes only (the engines' contact
@@ -150,7 +150,11 @@ static inline double pd_engine_contact_restitution(double zeta)
  *             = 2 acosh(zeta) / sqrt(zeta^2 - 1)          (zeta > 1), 2 at 1,
  * whatever the approach speed. zeta is found from e by bisection (e falls
  * from 1 at zeta = 0 toward 0), then omega from T. e is taken within
- * [PD_ENGINE_E_MIN, 1]. docs/engines-crosscheck.md derives it. */
+ * [PD_ENGINE_E_MIN, 1]. docs/engines-crosscheck.md derives it. Not the
+ * engines' contact law (points sharing one contact under it land stiffer
+ * and more damped than one contact: pd_engine_hc_law says why); its omega
+ * sets their drilling patch, the sink under the weight g / omega^2
+ * (drilling_arm in engine_ode.c says why). */
 static inline void pd_engine_contact_law(double T, double e, double *omega, double *zeta)
 {
     double target = fmin(1.0, fmax(e, PD_ENGINE_E_MIN));
@@ -166,6 +170,83 @@ static inline void pd_engine_contact_law(double T, double e, double *omega, doub
     }
     *zeta = target >= 1.0 ? 0.0 : 0.5 * (lo + hi);
     *omega = pd_engine_contact_duration(*zeta) / T;
+}
+
+/* The impulse simulator's contact law, which the stepping engines realise
+ * (compliant.c; docs/contact.md): each vertex below the floor pushes with
+ * the Hunt-Crossley force F = k d (1 + lambda d'), d its depth and d' the
+ * rate, k = m_eff omega^2 for its own effective mass along
+ * the normal and lambda = chi / v0, v0 its approach speed when it touched.
+ * Scaled (time by 1 / omega, depth by v0 / omega) the contact is
+ * s'' = -s (1 + chi s'), started at s = 0, s' = 1, whatever the mass and the
+ * speed; so its rebound and its duration do not depend on the stiffness:
+ * vertices that land together (a face, an edge) rebound together with e,
+ * however many there are, where a linear dashpot fitted to each vertex's
+ * own mass made their sum stiffer and more damped than the law
+ * (docs/engines-crosscheck.md). The rebound has a closed form:
+ * along the contact s'/chi - ln(1 + chi s')/chi^2 + s^2/2 is constant, so
+ * at its end (s = 0, s' = -e)
+ *     ln((1 + chi) / (1 - chi e)) = chi (1 + e),
+ * whose root in (0, 1/e) is chi (bisection: the left side less the right
+ * is negative from 0 to the root, positive after it); chi = 0 at e = 1. Its
+ * duration tau (scaled time) is integrated by classical RK4 over
+ * PD_ENGINE_HC_STEPS steps of the undamped half period, the end located
+ * between two steps by the crossing of s = 0 (RK4's error, of order
+ * (pi / PD_ENGINE_HC_STEPS)^4, and the crossing's, of the square of the
+ * step: both below 1e-7 of tau); omega = tau / T. */
+enum { PD_ENGINE_HC_STEPS = 20000 };
+
+static inline double pd_engine_hc_gap(double chi, double e)
+{
+    return log((1.0 + chi) / (1.0 - chi * e)) - chi * (1.0 + e);
+}
+
+static inline void pd_engine_hc_accel(double chi, double s, double v, double *a)
+{
+    double f = s * (1.0 + chi * v);
+    *a = f > 0.0 ? -f : 0.0;
+}
+
+static inline void pd_engine_hc_law(double T, double e, double *omega, double *chi)
+{
+    const double pi = 3.14159265358979323846;
+    double target = fmin(1.0, fmax(e, PD_ENGINE_E_MIN));
+    double c = 0.0;
+    if (target < 1.0) {
+        double lo = 0.0, hi = 1.0 / target;
+        for (int i = 0; i < PD_ENGINE_CONTACT_HALVINGS; i++) {
+            double mid = 0.5 * (lo + hi);
+            if (mid <= lo || mid >= hi)
+                break;
+            if (pd_engine_hc_gap(mid, target) < 0.0)
+                lo = mid;
+            else
+                hi = mid;
+        }
+        c = 0.5 * (lo + hi);
+    }
+    double h = pi / PD_ENGINE_HC_STEPS, t = 0.0, s = 0.0, v = 1.0, tau = 0.0;
+    /* The contact lasts 4.6 undamped half periods at PD_ENGINE_E_MIN; the
+     * bound only stops a loop that would not end. */
+    for (long k = 0; k < 64L * PD_ENGINE_HC_STEPS; k++) {
+        double a1, a2, a3, a4;
+        pd_engine_hc_accel(c, s, v, &a1);
+        pd_engine_hc_accel(c, s + 0.5 * h * v, v + 0.5 * h * a1, &a2);
+        pd_engine_hc_accel(c, s + 0.5 * h * (v + 0.5 * h * a1), v + 0.5 * h * a2, &a3);
+        pd_engine_hc_accel(c, s + h * (v + 0.5 * h * a2), v + h * a3, &a4);
+        double s1 = s + h * (v + h * (a1 + a2 + a3) / 6.0);
+        double v1 = v + h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0;
+        if (s1 <= 0.0 && v1 < 0.0) {
+            tau = t + h * s / (s - s1);
+            break;
+        }
+        t += h;
+        s = s1;
+        v = v1;
+        tau = t;
+    }
+    *chi = c;
+    *omega = tau / T;
 }
 
 #endif

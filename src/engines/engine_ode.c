@@ -56,6 +56,7 @@
 #include "base/base_tol.h"
 #include "engines/engines_tol.h"
 #include "base/vec3.h"
+#include "posedrop/tolerances.h"
 
 /* Under the address sanitizer's leak checker: see step_memory_untracked. */
 #if defined(__SANITIZE_ADDRESS__)
@@ -86,6 +87,11 @@ struct pd_engine_world {
     int npoints;
     dContactGeom *cand;
     double *mind;
+    /* Per hull vertex: the approach speed of its impact under way (at least
+     * v_rest; negative once it recedes), 0 while it is above the floor; the
+     * contact law's damping is chi over it (pd_engine_hc_law,
+     * touch_speeds). */
+    double *touch;
     /* What a rebuild needs, in ODE's units (see the top): mass and
      * principal moments, gravity along -z. */
     double mass, moment[3], gravity;
@@ -98,10 +104,14 @@ struct pd_engine_world {
     double slide_speed;
     double erp, cfm;
     /* contact_time > 0 and resolved by the step: each contact is the
-     * scene's spring-dashpot (pd_engine_contact_law) for its effective mass,
-     * in ODE's units. */
+     * scene's law (pd_engine_hc_law) for its effective mass, in ODE's units;
+     * v_rest, the speed of resting contact's fall (the impulse simulator's,
+     * settle.c), bounds the approach speed the damping is divided by. */
     int compliant;
-    double omega, zeta;
+    double omega, chi, v_rest;
+    /* The linear spring-dashpot's omega for T and e (pd_engine_contact_law),
+     * which sets the drilling patch (drilling_arm). */
+    double patch_omega;
     /* The part's thickness and size, m, for pd_engine_contact_resolved. */
     double width_m, size_m;
     /* ODE's units: gravity's magnitude for the scales, the part's size;
@@ -166,7 +176,8 @@ static int build_points(pd_engine_world *w, const pd_body *body)
     w->points = malloc(sizeof *w->points * nv);
     w->cand = malloc(sizeof *w->cand * nv);
     w->mind = malloc(sizeof *w->mind * nv);
-    if (!w->points || !w->cand || !w->mind)
+    w->touch = calloc(nv, sizeof *w->touch);
+    if (!w->points || !w->cand || !w->mind || !w->touch)
         return 0;
     for (size_t i = 0; i < nv; i++)
         w->points[i] = v3_scale(body->verts[i], 1.0 / w->len);
@@ -369,6 +380,7 @@ static void world_free(pd_engine_world *w)
     free(w->points);
     free(w->cand);
     free(w->mind);
+    free(w->touch);
     free(w);
 }
 
@@ -389,10 +401,18 @@ static double pow2_near(double x)
  * deep as the contact sinks under the part's weight makes, a = sqrt(R d):
  * d = g / omega^2 with the scene's law, PD_ODE_SINK_REL L with ODE's own;
  * R = PD_CORNER_RADIUS_REL L. ODE's spinning friction (rhoN, with
- * dContactApprox1 a multiple of the normal force) is that couple's arm. */
+ * dContactApprox1 a multiple of the normal force) is that couple's arm.
+ * omega is the linear spring-dashpot's for T and e (pd_engine_contact_law),
+ * the engines' law until 2026-12-07, not the Hunt-Crossley law's they now
+ * stand for, whose omega for the same T is higher (3.59 / T against
+ * 2.42 / T at e = 0.3), its sink 2.2 times less and its couple 1.48 times
+ * weaker: with that one, Bullet's tops on the flat pyramid of
+ * test_hard_parts.c spun past the time limit (docs/engines.md). The impulse
+ * simulator's patch is the weaker one (sim_model.c). */
 static void drilling_arm(pd_engine_world *w)
 {
-    double d = w->compliant ? w->gscale / (w->omega * w->omega) : PD_ODE_SINK_REL * w->size;
+    double d = w->compliant ? w->gscale / (w->patch_omega * w->patch_omega)
+                            : PD_ODE_SINK_REL * w->size;
     w->drill = 2.0 / 3.0 * w->mu * sqrt(PD_CORNER_RADIUS_REL * w->size * d);
 }
 
@@ -403,11 +423,14 @@ static pd_status material(pd_engine_world *w, const pd_scene *scene)
     w->mu = scene->mu;
     w->restitution = scene->restitution;
     double dt = w->dt * w->time;
-    w->omega = w->zeta = 0.0;
+    w->omega = w->chi = 0.0;
     w->compliant = 0;
+    w->v_rest = 2.0 * sqrt(2.0 * w->gscale * PD_TOL_REST_FALL_REL * w->size);
     if (scene->contact_time > 0.0) {
-        pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->omega,
-                              &w->zeta);
+        pd_engine_hc_law(scene->contact_time / w->time, scene->restitution, &w->omega, &w->chi);
+        double zeta;
+        pd_engine_contact_law(scene->contact_time / w->time, scene->restitution, &w->patch_omega,
+                              &zeta);
         w->compliant = pd_engine_contact_resolved(dt, scene->contact_time, w->omega / w->time,
                                                   pd_engine_fall_speed(scene, w->size_m),
                                                   w->width_m);
@@ -484,6 +507,7 @@ static int ode_reset_body(pd_engine_world *w, const pd_state *s)
     dBodySetForce(w->body, 0.0, 0.0, 0.0);
     dBodySetTorque(w->body, 0.0, 0.0, 0.0);
     dBodyEnable(w->body);
+    memset(w->touch, 0, sizeof *w->touch * (size_t)w->npoints);
     return 1;
 }
 
@@ -566,19 +590,24 @@ static int floor_contacts(const pd_engine_world *w, dContactGeom *c)
         c[n].pos[2] = pz;
         c[n].normal[2] = 1.0;
         c[n].depth = -pz;
+        c[n].side1 = i; /* the vertex, for its touch speed */
         n++;
     }
     return n;
 }
 
-/* The scene's spring-dashpot at a contact at p (world, ODE's units) as ODE's
- * erp and cfm: stiffness k = m_eff omega^2 and damping c = 2 zeta m_eff omega
- * for the contact's effective mass along the floor's normal z,
- * 1 / m_eff = 1/m + (r x z) . I^-1 (r x z), r from the centre of mass; ODE's
- * spring form for a step h: erp = h k / (h k + c), cfm = 1 / (h k + c). No
- * bounce on top: the dashpot's loss is the restitution. */
-static void compliant_softness(const pd_engine_world *w, const dReal *p, dReal *erp, dReal *cfm)
+/* The scene's law at contact g (world, ODE's units) as ODE's erp and cfm:
+ * stiffness k = m_eff omega^2 for the contact's effective mass along the
+ * floor's normal z, 1 / m_eff = 1/m + (r x z) . I^-1 (r x z), r from the
+ * centre of mass, and the Hunt-Crossley damping c = k chi d / v0 at its
+ * depth d, v0 its approach speed at touch (pd_engine_hc_law); ODE's spring
+ * form for a step h: erp = h k / (h k + c), cfm = 1 / (h k + c), with c
+ * taken at the step's start. No bounce on top: the damping's loss is the
+ * restitution. */
+static void compliant_softness(const pd_engine_world *w, const dContactGeom *g, dReal *erp,
+                               dReal *cfm)
 {
+    const dReal *p = g->pos;
     const dReal *x = dBodyGetPosition(w->body);
     const dReal *R = dBodyGetRotation(w->body); /* 3 x 4, row-major: body -> world */
     double ux = p[1] - x[1], uy = -(p[0] - x[0]); /* r x z, world; its z is 0 */
@@ -588,15 +617,43 @@ static void compliant_softness(const pd_engine_world *w, const dReal *p, dReal *
         inv += ub * ub / w->moment[i];
     }
     double m = 1.0 / inv, h = w->dt;
-    double k = m * w->omega * w->omega, c = 2.0 * w->zeta * m * w->omega;
+    double k = m * w->omega * w->omega, c = k * w->chi * g->depth / fabs(w->touch[g->side1]);
     *erp = h * k / (h * k + c);
     *cfm = 1.0 / (h * k + c);
+}
+
+/* Each vertex's approach speed at the start of its impact (at least
+ * v_rest), negative once it recedes, 0 above the floor; c[0..n) are the
+ * vertices below the floor. An impact starts when a vertex goes below the
+ * floor, and again when one still below approaches after it receded (a
+ * resting part rocking on it): each compression is an impact of its own
+ * speed, as in the impulse simulator, whose impacts end when the part
+ * separates or rests, so that a vertex landing fast and then resting is
+ * not left with the little damping of its landing. */
+static void touch_speeds(pd_engine_world *w, const dContactGeom *c, int n)
+{
+    for (int i = 0; i < n; i++)
+        w->mind[c[i].side1] = w->touch[c[i].side1];
+    memset(w->touch, 0, sizeof *w->touch * (size_t)w->npoints);
+    for (int i = 0; i < n; i++) {
+        int v = c[i].side1;
+        dVector3 pv;
+        dBodyGetPointVel(w->body, c[i].pos[0], c[i].pos[1], c[i].pos[2], pv);
+        double was = w->mind[v], in = -pv[2];
+        if (was == 0.0 || (was < 0.0 && in > 0.0))
+            w->touch[v] = fmax(in, w->v_rest);
+        else
+            w->touch[v] = in < 0.0 ? -fabs(was) : was;
+    }
 }
 
 static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
 {
     dContactGeom *cg = w->cand;
-    int n = select_contacts(cg, w->mind, floor_contacts(w, cg));
+    int below = floor_contacts(w, cg);
+    if (w->compliant)
+        touch_speeds(w, cg, below);
+    int n = select_contacts(cg, w->mind, below);
     for (int i = 0; i < n; i++) {
         dContact c;
         memset(&c, 0, sizeof c);
@@ -625,7 +682,7 @@ static pd_status ode_step_body(pd_engine_world *w, pd_state *s)
             c.surface.rhoN = w->drill;
         }
         if (w->compliant) {
-            compliant_softness(w, cg[i].pos, &c.surface.soft_erp, &c.surface.soft_cfm);
+            compliant_softness(w, &cg[i], &c.surface.soft_erp, &c.surface.soft_cfm);
         } else {
             c.surface.mode |= dContactBounce;
             c.surface.bounce = w->restitution;
