@@ -63,8 +63,9 @@ velocity, no spin):
 
 -r reuses what DIR keeps: MuJoCo's drops from the same releases (they
 depend on posedrop only through the release), and posedrop's runs made at
-the same commit (no changes) with the same command; so after the engines
-change, -r reruns posedrop's engines and only the MuJoCo drops not yet made,
+a commit whose src/, include/ and Makefile are this one's (neither with
+changes) with the same command; so after the engines change, -r reruns
+posedrop's engines and only the MuJoCo drops not yet made,
 and a stopped run resumes. The posedrop runs' commands and commits go in the
 table's heading.
 
@@ -82,6 +83,7 @@ import json
 import math
 import os
 import resource
+import subprocess
 import sys
 import time
 
@@ -274,10 +276,22 @@ def sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
+def same_code(commit):
+    """Whether posedrop's code (src/, include/, the Makefile) is now what it
+    was at commit, both without changes."""
+    if COMMIT[1] or commit.endswith(", with changes"):
+        return False
+    p = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", commit, "HEAD", "--", "src",
+                        "include", "Makefile"], stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+    return p.returncode == 0
+
+
 def posedrop_engine(part, name, engine, n, seed, initial, outdir, reuse):
     """Drops on one engine: the trials (release, outcome), CPU ms per drop and
-    the run's record (command, commit). With reuse, a run kept in outdir from
-    the same commit (no changes), part file, drops and seed is read back."""
+    the run's record (command, commit). With reuse, a run kept in outdir with
+    the same command, from a commit whose code is this one's (no changes),
+    is read back."""
     trials = os.path.join(outdir, "trials.%s.%s.csv" % (name, engine))
     meta = trials[:-len(".csv")] + ".json"
     cmd = [part.exe, "-n", str(n), "--seed", str(seed), "--engine", engine, "--units",
@@ -286,7 +300,7 @@ def posedrop_engine(part, name, engine, n, seed, initial, outdir, reuse):
         os.path.relpath(w, ROOT) if w.startswith(ROOT + "/") else w for w in cmd[1:])
     if reuse and os.path.exists(meta) and os.path.exists(trials):
         m = json.load(open(meta))
-        if m["command"] == shown and m["commit"] == COMMIT[0] and not COMMIT[1]:
+        if m["command"] == shown and same_code(m["commit"]):
             sys.stderr.write("referee-mujoco: %s on %s: the kept run (%s)\n"
                              % (name, engine, m["commit"]))
             return rows(open(trials).read()), m["cpu_ms_per_drop"], m
@@ -506,7 +520,7 @@ def main():
     ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
     ap.add_argument("-r", action="store_true",
                     help="reuse the runs kept in -o: MuJoCo's drops from the same releases, "
-                    "posedrop's runs made at this commit with the same command")
+                    "posedrop's runs made with this code and the same command")
     ap.add_argument("--doc", help="Markdown file to put the table in, between the markers")
     ap.add_argument("--doc-tag", default="referee-mujoco",
                     help="the markers' name (referee-mujoco): several runs, several tables")
