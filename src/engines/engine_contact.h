@@ -20,8 +20,9 @@
  * (its bounce with restitution e), the law's own limit as T -> 0. Why 10:
  * the engines step the law as semi-implicit Euler (PD_ENGINE_SPRING_IMPLICIT
  * in engines_tol.h), whose rebound wavers with where in its step a vertex
- * touches: within 0.004 of e at 10 steps a contact, 0.01 at 5 and 0.2 at
- * 2.5 (the scaled law stepped so, e 0.05 to 1); and the several vertices
+ * touches: within 0.007 of e at 10 steps a contact, 0.03 at 5 and 0.24 at
+ * 2.5 (the scaled law stepped so, e 0.05 to 1,
+ * scripts/engine-step-rebound.py); and the several vertices
  * of a face press at a higher rate than one, which the step must still
  * resolve. A contact that short is rigid as far as such a step can tell. */
 #define PD_ENGINE_CONTACT_STEPS 10.0
