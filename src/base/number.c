@@ -20,8 +20,8 @@
  * left to strtod. 1 with *out set, 0 when strtod must decide (other forms,
  * more digits, a larger exponent, or a near-midpoint). Text that strtod
  * reads differently (hexadecimal, inf, nan, blanks, a bare point) never
- * takes this path. The parse of the large meshes' 17-digit coordinates was
- * as long as a whole convex hull of them. */
+ * takes this path. A large mesh file holds millions of such coordinates,
+ * most of them printed with 17 digits. */
 static int parse_fast(const char *s, size_t n, double *out)
 {
 #if LDBL_MANT_DIG == 64 && (defined(__x86_64__) || defined(__i386__))

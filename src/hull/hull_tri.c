@@ -123,8 +123,7 @@ static void free_tri(qhull *q, int id)
  * new capacity is at least the initial one (the point count), so
  * compaction, which walks every triangle, happens only O(log n) times over
  * a run. The two pools take turns: a fresh one each time cost a page fault
- * per 4 kB written, a third of the faults of the static pipeline on a
- * 2-million-triangle mesh. */
+ * per 4 kB written. */
 static int pool_reserve(qhull *q, size_t need, size_t mincap)
 {
     if (q->npool + need <= q->cappool)

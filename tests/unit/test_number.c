@@ -101,14 +101,14 @@ static void random_decimal(char *buf)
 /* The fast reading of coordinates (number.c's parse_fast) against strtod,
  * bit for bit, on text drawn to reach its edges: 200,000 random decimals;
  * 100,000 doubles printed with 17 significant digits as the mesh files
- * hold them; 100,000 texts of 17 to 19 digits at and next to a midpoint
+ * hold them, in both notations; 100,000 texts of 17 to 19 digits at and next to a midpoint
  * between two doubles, where a reading that rounds twice goes wrong (the
- * midpoint printed to 19 digits, its last digit moved by -2 to 2); every
- * odd multiple of a double's half step that is an integer below 10^19 in
- * one of 2,000 binades draws; and 100,000 random strings of digits, points,
- * signs and letters, whose outcome (not a number, or its value) must be
- * strtod's too. No difference allowed: the reading is exact or it is a
- * defect. */
+ * midpoint printed to 17 to 19 digits, its last digit moved by -2 to 2);
+ * up to 2,000 midpoints between doubles that are integers below 10^19
+ * (2^53 + 2k + 1 times a power of two), each as an integer and with
+ * ".0e0"; and 100,000 random strings of digits, points, signs, letters and
+ * blanks, whose outcome (not a number, or its value) must be strtod's
+ * too. No difference allowed: the reading is exact or it is a defect. */
 static void test_parse_vs_strtod(void)
 {
     char buf[96];
