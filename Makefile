@@ -239,21 +239,25 @@ check-readme: deps
 # scripts/doc_tables.py, the table of docs/uncertainty.md and the big-mesh
 # table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart
 # from its kept CSV instead of rerunning it; CHEAP=1 makes only the cap's
-# pictures, paper.txt and doc_tables.py's tables (seconds).
+# pictures, paper.txt and doc_tables.py's cheap tables (seconds); the others
+# time make bench's sections, python/bench.py (PYTHON names a Python with
+# the module) and make fuzz.
 figures: deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory all $(TEST_BIN) $(if $(CHEAP),,$(BENCH_BIN))
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))
-	python3 scripts/doc_tables.py -b $(CLI)
+	python3 scripts/doc_tables.py -b $(CLI) $(if $(CHEAP),--cheap)
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 
 # The cheap measured files behind docs/ rerun, after the check's own
-# controls: fails when a number moved beyond its drops' noise (make
-# check-full runs it; about 1 CPU minute, docs/figures.md).
+# controls: fails when a number moved beyond its drops' noise, or when a
+# table of doc_tables.py's was edited by hand (make check-full runs it;
+# about 1 CPU minute, docs/figures.md).
 check-figures:
-	@$(MAKE) --no-print-directory $(CLI)
+	@$(MAKE) --no-print-directory $(CLI) $(TEST_BIN)
 	python3 scripts/check_figures.py -b $(CLI) --self-test docs/figures/cap.csv \
 	    docs/figures/paper/*.csv docs/figures/uncertainty/*-ranged.csv
+	python3 scripts/doc_tables.py -b $(CLI) --check --self-test
 
 # The paper's Tables 1-4 with posedrop's columns beside them (results/).
 paper: deps
