@@ -528,8 +528,13 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
                     a[j] = mj * sj;
                     bb[j] = (1.0 - mj) * sj;
                 }
-                out->plo[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.025);
-                out->phi[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.975);
+                /* A class of mean below 0.025 can have its 97.5% quantile
+                 * fall as the scatter grows (the Beta tends to a coin of 0
+                 * and 1): the interval keeps the drops' at least. */
+                double lo = fit_beta_mixture_quantile(n, wi, a, bb, 0.025);
+                double hi = fit_beta_mixture_quantile(n, wi, a, bb, 0.975);
+                out->plo[i][cl] = lo < out->plo[i][cl] ? lo : out->plo[i][cl];
+                out->phi[i][cl] = hi > out->phi[i][cl] ? hi : out->phi[i][cl];
             }
             off += (size_t)k;
         }
