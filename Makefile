@@ -236,7 +236,8 @@ check-readme: deps
 # with their cost): the insulator cap's gallery, chart and gauss-sphere map
 # and make paper's tables on the impulse engine (docs/figures/paper.txt),
 # the cost-accuracy chart, the design demonstrations, the small tables of
-# scripts/doc_tables.py, the table of docs/uncertainty.md and the big-mesh
+# scripts/doc_tables.py, the leave-one-out table of docs/validation.md (from
+# its kept runs), the table of docs/uncertainty.md and the big-mesh
 # table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart
 # from its kept CSV instead of rerunning it; CHEAP=1 makes only the cap's
 # pictures, paper.txt and doc_tables.py's cheap tables (seconds); the others
@@ -246,6 +247,12 @@ figures: deps
 	@$(MAKE) --no-print-directory all $(TEST_BIN) $(if $(CHEAP),,$(BENCH_BIN))
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))
 	python3 scripts/doc_tables.py -b $(CLI) $(if $(CHEAP),--cheap)
+	python3 scripts/loo-table.py --now docs/figures/loo/s1.summary.txt \
+	    docs/figures/loo/s2.summary.txt --before docs/figures/loo/before-s1.summary.txt \
+	    docs/figures/loo/before-s2.summary.txt --doc docs/validation.md --tag loo-table
+	python3 scripts/loo-table.py --now docs/figures/loo/variant-s1.summary.txt \
+	    docs/figures/loo/variant-s2.summary.txt --before docs/figures/loo/before-s1.summary.txt \
+	    docs/figures/loo/before-s2.summary.txt --doc docs/validation.md --tag loo-table-variant
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 

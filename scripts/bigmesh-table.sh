@@ -9,6 +9,9 @@
 # that grows faster than n log n shows. qconvex is not run on the rod: on
 # its 20,000-sided rings it ran over 20 minutes and was stopped.
 # make figures writes its output to docs/figures/bigmesh.txt.
+# A second table: CPU seconds of each stage of the static pipeline on the
+# 2-million-triangle meshes (tests/bench/stages.c, built against the
+# libposedrop.a beside BIN).
 set -e
 cd "$(dirname "$0")/.."
 bin=${1:-build/opt/posedrop}
@@ -47,4 +50,14 @@ for m in $meshes; do
         r=$(echo "$p $q" | awk '{printf "%.1fx", $1 / $5}')
     fi
     echo "| $m | $nt | $p | $q | $r |"
+done
+echo
+echo "CPU seconds per stage (tests/bench/stages.c against $(dirname "$bin")/libposedrop.a):"
+echo
+echo "| mesh | reading | weld | hull | orientation | mass | check | whole |"
+echo "|---|---|---|---|---|---|---|---|"
+cc -std=c11 -O2 -Iinclude tests/bench/stages.c "$(dirname "$bin")/libposedrop.a" -lgsl -lgslcblas \
+   -lm -pthread -lstdc++ -o "$dir/stages"
+for m in latlong ico rod; do
+    "$dir/stages" "$dir/$m.off" 2> /dev/null
 done

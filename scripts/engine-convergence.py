@@ -96,7 +96,9 @@ def resting_run(n, extra, part_args, outdir):
     kept. {1: share ending on the pose it started on, 2: elsewhere}, the
     unsettled among them and the CPU seconds per drop run."""
     k1 = len(list(csv.DictReader(io.StringIO(run(part_args)[0])))) + 1
-    ndrops = max((n * k1 + k1 - 2) // (k1 - 1), 10 * k1)
+    # A whole number of rounds: drops past the last whole round of k + 1
+    # start uniform (pd_stationary_start), not resting.
+    ndrops = k1 * max(-(-n // (k1 - 1)), 10)
     trials = os.path.join(outdir, "trials.tmp.csv")
     _, _, cpu = run(["-n", str(ndrops), "--trials", trials] + extra + part_args)
     rows = list(csv.DictReader(open(trials)))

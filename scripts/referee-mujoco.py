@@ -8,7 +8,7 @@ same rule and grouped into the same pose classes as posedrop's --group.
 
   .venv/bin/python scripts/referee-mujoco.py [-n DROPS] [--seed S]
       [--parts a,b,...] [--engines impulse,...] [--steps K,...] [--mj-n M]
-      [--check-n M] [--jobs J] [-o DIR] [--doc FILE]
+      [--check-n M] [--jobs J] [-o DIR] [-r] [--doc FILE]
 
 The corpus (--parts picks some):
   bushing   flanged bushing: a stepped solid of revolution, 32-gon, mm:
@@ -46,18 +46,28 @@ velocity, no spin):
     sunk d = g / omega^2);
   - the first --mj-n releases (all by default; MuJoCo costs 10 to 100 times
     posedrop's engines per drop), in --jobs processes (1), each drop's
-    outcome written to DIR/mujoco.PART.T<K>.csv as it ends, so a run
-    stopped early leaves what it did;
-  - the step T / K for the first K of --steps (default 20,40): the table's;
-    each further (finer) step runs the first --check-n releases (200) again,
-    and the total variation between successive steps on those, against
-    its sampling noise, shows whether the table's step is converged;
+    outcome, release and CPU time written to DIR/mujoco.PART.T<K>.csv as it
+    ends, so a run stopped early leaves what it did;
+  - the step T / K for the first K of --steps (default 20,40, and 40,80 for
+    the cube: "20,40;cube=40,80"): the table's; each further (finer) step
+    runs the first --check-n releases (200) again, and the total variation
+    between successive steps on those, against its noise, shows whether the
+    table's step is converged (the resting cube's flat landings were not at
+    T/20: docs/engines-crosscheck.md);
   - the drop is decided as posedrop's stepping engines decide it: the part
     lies on a stable pose's facet, tilted less than 1 degree, and its energy
     above that rest is below the least height it must rise to tip over one
     of the facet's edges (a lower bound of the basin's barrier, so a decided
     drop cannot leave); or it runs to posedrop's automatic time limit,
     100 (sqrt(L/g) + sqrt(2h/g)), unsettled.
+
+-r reuses what DIR keeps: MuJoCo's drops from the same releases (they
+depend on posedrop only through the release), and posedrop's runs made at
+a commit whose src/, include/ and Makefile are this one's (neither with
+changes) with the same command; so after the engines change, -r reruns
+posedrop's engines and only the MuJoCo drops not yet made,
+and a stopped run resumes. The posedrop runs' commands and commits go in the
+table's heading.
 
 Writes DIR/referee.csv (part,engine,class,n,count,p,ci_lo,ci_hi,unsettled,
 cpu_ms_per_drop), prints the corpus table in Markdown and, with --doc FILE,
@@ -68,10 +78,12 @@ Needs the mujoco package (not a posedrop dependency; outside make check):
   python3 -m venv .venv && .venv/bin/pip install mujoco numpy
 """
 import argparse
+import csv
 import json
 import math
 import os
 import resource
+import subprocess
 import sys
 import time
 
@@ -99,6 +111,7 @@ ORDER = ["cube", "box", "bushing", "hexnut", "button", "cap"]
 ENGINES = ["impulse", "ode", "bullet"]
 PARTS_SEEN = {}
 COMMIT = ["?", ""]
+RUNS = []   # (part, engine, command, commit) of the posedrop runs in the table
 
 
 # --- the part ----------------------------------------------------------------
@@ -263,15 +276,43 @@ def sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-def posedrop_engine(part, engine, n, seed, initial, tmp):
-    """Drops on one engine: the trials (release, outcome) and CPU ms per drop."""
-    trials = os.path.join(tmp, "trials.%s.csv" % engine)
+def same_code(commit):
+    """Whether posedrop's code (src/, include/, the Makefile) is now what it
+    was at commit, both without changes."""
+    if COMMIT[1] or commit.endswith(", with changes"):
+        return False
+    p = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", commit, "HEAD", "--", "src",
+                        "include", "Makefile"], stdout=subprocess.DEVNULL,
+                       stderr=subprocess.DEVNULL)
+    return p.returncode == 0
+
+
+def posedrop_engine(part, name, engine, n, seed, initial, outdir, reuse):
+    """Drops on one engine: the trials (release, outcome), CPU ms per drop and
+    the run's record (command, commit). With reuse, a run kept in outdir with
+    the same command, from a commit whose code is this one's (no changes),
+    is read back."""
+    trials = os.path.join(outdir, "trials.%s.%s.csv" % (name, engine))
+    meta = trials[:-len(".csv")] + ".json"
     cmd = [part.exe, "-n", str(n), "--seed", str(seed), "--engine", engine, "--units",
            part.units, "--initial", initial, "--trials", trials, part.path]
+    shown = "posedrop " + " ".join(
+        os.path.relpath(w, ROOT) if w.startswith(ROOT + "/") else w for w in cmd[1:])
+    if reuse and os.path.exists(meta) and os.path.exists(trials):
+        m = json.load(open(meta))
+        if m["command"] == shown and same_code(m["commit"]):
+            sys.stderr.write("referee-mujoco: %s on %s: the kept run (%s)\n"
+                             % (name, engine, m["commit"]))
+            return rows(open(trials).read()), m["cpu_ms_per_drop"], m
+    sys.stderr.write("referee-mujoco: %s on %s, %d drops\n" % (name, engine, n))
     c0 = child_cpu()
     run(cmd)
     cpu = child_cpu() - c0
-    return rows(open(trials).read()), 1000.0 * cpu / n
+    m = {"command": shown, "commit": COMMIT[0] + COMMIT[1],
+         "cpu_ms_per_drop": 1000.0 * cpu / n}
+    with open(meta, "w") as f:
+        json.dump(m, f)
+    return rows(open(trials).read()), m["cpu_ms_per_drop"], m
 
 
 # --- MuJoCo ------------------------------------------------------------------
@@ -338,9 +379,9 @@ class Referee:
         self.stable = [(i, f) for i, f in enumerate(part.facets) if f[2] > f[1]]
         self.cos_tilt = math.cos(REST_TILT)
 
-    def drop(self, q):
-        """Pose number (1-based) the release q (file frame to world, w x y z)
-        rests in, or 0 at the time limit; and the simulated time."""
+    def release(self, q):
+        """The data at the release q (file frame to world, w x y z): lowest
+        point at the drop height, the belt's velocity, no spin."""
         mj, np, d = self.mj, self.np, self.data
         mj.mj_resetData(self.model, d)
         mat = np.zeros(9)
@@ -350,6 +391,12 @@ class Referee:
         d.qpos[3:7] = q
         d.qvel[:] = 0.0
         d.qvel[0] = self.v
+        return d
+
+    def drop(self, q):
+        """Pose number (1-based) the release q rests in, or 0 at the time
+        limit; and the simulated time."""
+        mj, d = self.mj, self.release(q)
         mg = self.mass * self.g
         while d.time < self.limit:
             mj.mj_step(self.model, d, self.every)
@@ -427,6 +474,24 @@ def tvn(a, na, b, nb):
     return 0.5 * sum(abs(a.get(k, 0) / na - b.get(k, 0) / nb) for k in keys)
 
 
+def noise_tv(a, na, b, nb, redraws=1000, seed=1):
+    """The 95th percentile of the TV between two samples of na and nb drops
+    drawn from the two count tables' pooled shares: what sampling alone
+    gives were the two to agree."""
+    import random
+    rng = random.Random(seed)
+    keys = sorted(set(a) | set(b))
+    w = [a.get(k, 0) + b.get(k, 0) for k in keys]
+    if sum(w) == 0:
+        return 0.0
+    out = []
+    for _ in range(redraws):
+        x, y = rng.choices(keys, w, k=na), rng.choices(keys, w, k=nb)
+        out.append(0.5 * sum(abs(x.count(k) / na - y.count(k) / nb) for k in keys))
+    out.sort()
+    return out[int(0.95 * len(out))]
+
+
 def tv(a, b, n):
     keys = set(a) | set(b)
     return 0.5 * sum(abs(a.get(k, 0) - b.get(k, 0)) for k in keys) / n
@@ -443,15 +508,19 @@ def main():
                     "impulse is always run, first)")
     ap.add_argument("--jobs", type=int, default=1,
                     help="processes for MuJoCo's drops (1)")
-    ap.add_argument("--steps", default="20,40",
+    ap.add_argument("--steps", default="20,40;cube=40,80",
                     help="MuJoCo's steps per contact time: the table's, then finer ones "
-                    "for the convergence check (20,40)")
+                    "(K,K,... for every part, then ;PART=K,K,... for one part) "
+                    "for the convergence check (20,40;cube=40,80)")
     ap.add_argument("--mj-n", type=int,
                     help="MuJoCo drops per part at the table's step: the first of the "
                     "releases (default: all -n)")
     ap.add_argument("--check-n", type=int, default=200,
                     help="releases the finer steps run again (200)")
     ap.add_argument("-o", default="referee-out", help="output directory (referee-out)")
+    ap.add_argument("-r", action="store_true",
+                    help="reuse the runs kept in -o: MuJoCo's drops from the same releases, "
+                    "posedrop's runs made with this code and the same command")
     ap.add_argument("--doc", help="Markdown file to put the table in, between the markers")
     ap.add_argument("--doc-tag", default="referee-mujoco",
                     help="the markers' name (referee-mujoco): several runs, several tables")
@@ -484,7 +553,7 @@ def main():
         if a.doc:
             script_util.put_between(a.doc, "referee-law", "\n" + text + "\n", "referee-mujoco")
         return 0
-    steps = [int(k) for k in a.steps.split(",")]
+    steps = parse_steps(a.steps, names)
     # The code that ran: the commit at the start, and whether the tree
     # differed from it.
     COMMIT[:] = script_util.commit_here()
@@ -502,34 +571,33 @@ def main():
         part = Part(a.posedrop, path, units, [])
         PARTS_SEEN[name] = part
         # A stationary run's drop i (from 0) is uniform when i mod (k + 1) is
-        # 0 and starts resting on pose i mod (k + 1) otherwise (sim.h); the
-        # resting ones are kept, n of them.
+        # 0 and starts resting on pose i mod (k + 1) otherwise (sim.h), in
+        # whole rounds of k + 1 (the drops past the last whole round start
+        # uniform); the resting ones are kept, n of them (at least 10 resting
+        # on each pose, as posedrop asks).
         k1 = len(part.poses) + 1
-        # (at least 10 resting on each pose, as posedrop asks).
-        ndrops = max((a.n * k1 + k1 - 2) // (k1 - 1), 10 * k1) if resting else a.n
+        ndrops = k1 * max(-(-a.n // (k1 - 1)), 10) if resting else a.n
         keep = [i for i in range(ndrops) if not resting or i % k1 != 0][:a.n]
         starts = [i % k1 for i in range(ndrops)]
         results = {}
         releases = None
         for engine in ENGINES:
-            sys.stderr.write("referee-mujoco: %s on %s, %d drops\n" % (name, engine, ndrops))
-            tr, ms = posedrop_engine(part, engine, ndrops, a.seed, init, a.o)
+            tr, ms, m = posedrop_engine(part, name, engine, ndrops, a.seed, init, a.o, a.r)
+            RUNS.append((name, engine, m["command"], m["commit"]))
             if releases is None:
                 releases = [tuple(float(t[c]) for c in ("qw", "qx", "qy", "qz")) for t in tr]
             outcomes = [int(tr[i]["pose"]) for i in keep]
             results[engine] = (outcomes, ms)
-        for s, K in enumerate(steps):
+        for s, K in enumerate(steps[name]):
             dt = part.scene["contact_time_s"] / K
             ref = Referee(mujoco, part, dt)
             these = keep[:a.mj_n or len(keep)] if s == 0 else keep[:a.check_n]
             sys.stderr.write("referee-mujoco: %s on MuJoCo, dt = T/%d = %.3g s, %d drops\n"
                              % (name, K, dt, len(these)))
-            t0 = time.process_time()
-            c0 = child_cpu()
             log = os.path.join(a.o, "mujoco.%s.T%d.csv" % (name, K))
-            outcomes = mujoco_drops(ref, [releases[i] for i in these], these, a.jobs, log)
-            ms = 1000.0 * (time.process_time() - t0 + child_cpu() - c0) / len(these)
-            results["mujoco T/%d" % K] = (outcomes, ms)
+            outcomes, ms = mujoco_drops(ref, [releases[i] for i in these], these, a.jobs, log,
+                                        a.r)
+            results["mujoco" if s == 0 else "mujoco %d" % s] = (outcomes, ms)
         st = [starts[i] for i in keep]
         n = len(keep)
         counts = {e: outcome_table(part, o, resting, st) for e, (o, _) in results.items()}
@@ -541,7 +609,7 @@ def main():
                 cnt = counts[e].get(c, 0)
                 lo, hi = wilson(cnt, n_of[e])
                 out_rows.append([name, e, c, n_of[e], cnt, cnt / n_of[e], lo, hi, unsettled, ms])
-        table.append((name, resting, classes, counts, results, n, st))
+        table.append((name, resting, classes, counts, results, n, st, steps[name]))
         # After each part, so that a run stopped half way leaves what it did.
         write_csv(os.path.join(a.o, "referee.csv"), out_rows)
         text = markdown(table, steps, a)
@@ -560,30 +628,57 @@ def _worker_init(part, dt):
 
 
 def _worker_drop(q):
-    return _WORKER["ref"].drop(q)[0]
+    c0 = time.process_time()
+    pose = _WORKER["ref"].drop(q)[0]
+    return pose, 1000.0 * (time.process_time() - c0)
 
 
-def mujoco_drops(ref, qs, index, jobs, log):
+def mujoco_drops(ref, qs, index, jobs, log, reuse):
     """The outcome of each release in qs (drops index), in order, in jobs
-    processes; each written to log (drop,pose) as it ends."""
+    processes, and the CPU ms per drop; each written to log
+    (drop,pose,qw,qx,qy,qz,cpu_ms) as it ends. With reuse, the drops the log
+    already holds from the same release (MuJoCo's drops depend on posedrop
+    only through it) are read back and only the others run."""
+    kept = {}
+    if reuse and os.path.exists(log):
+        with open(log) as f:
+            for r in csv.DictReader(f):
+                if "qw" in r and r["cpu_ms"]:
+                    kept[int(r["drop"])] = (tuple(float(r[c]) for c in ("qw", "qx", "qy", "qz")),
+                                            int(r["pose"]), float(r["cpu_ms"]))
+    old = {i: kept[i] for i, q in zip(index, qs)
+           if i in kept and max(abs(x - y) for x, y in zip(kept[i][0], q)) < 1e-15}
+    todo = [(i, q) for i, q in zip(index, qs) if i not in old]
+    if old:
+        sys.stderr.write("referee-mujoco: %d drops kept in %s, %d to run\n"
+                         % (len(old), log, len(todo)))
+    got = {}
     with open(log, "w") as f:
-        f.write("drop,pose\n")
+        f.write("drop,pose,qw,qx,qy,qz,cpu_ms\n")
+
+        def put(i, q, pose, ms):
+            got[i] = (pose, ms)
+            f.write("%d,%d,%s,%.6g\n" % (i, pose, ",".join("%.17g" % x for x in q), ms))
+            f.flush()
+        # Every drop kept stays in the log (those not asked for this time too).
+        for i, (q, pose, ms) in sorted(kept.items()):
+            if i in old or i not in index:
+                put(i, q, pose, ms)
         if jobs <= 1:
-            out = []
-            for i, q in zip(index, qs):
-                out.append(ref.drop(q)[0])
-                f.write("%d,%d\n" % (i, out[-1]))
-                f.flush()
-            return out
-        import multiprocessing
-        ctx = multiprocessing.get_context("fork")
-        with ctx.Pool(jobs, _worker_init, (ref.part, ref.dt)) as pool:
-            out = []
-            for i, pose in zip(index, pool.imap(_worker_drop, qs, chunksize=4)):
-                out.append(pose)
-                f.write("%d,%d\n" % (i, pose))
-                f.flush()
-            return out
+            for i, q in todo:
+                c0 = time.process_time()
+                pose = ref.drop(q)[0]
+                put(i, q, pose, 1000.0 * (time.process_time() - c0))
+        elif todo:
+            import multiprocessing
+            ctx = multiprocessing.get_context("fork")
+            with ctx.Pool(jobs, _worker_init, (ref.part, ref.dt)) as pool:
+                for (i, q), (pose, ms) in zip(todo, pool.imap(_worker_drop,
+                                                              [q for _, q in todo],
+                                                              chunksize=4)):
+                    put(i, q, pose, ms)
+    out = [got[i][0] for i in index]
+    return out, sum(got[i][1] for i in index) / len(index)
 
 
 def write_csv(path, out_rows):
@@ -593,8 +688,47 @@ def write_csv(path, out_rows):
             f.write("%s,%s,%d,%d,%d,%.6g,%.6g,%.6g,%d,%.4g\n" % tuple(r))
 
 
+def parse_steps(text, names):
+    """{part: [K, ...]} from 'K,K,...' for every part, then ';PART=K,K' for
+    one part."""
+    words = text.split(";")
+    try:
+        default = [int(k) for k in words[0].split(",")]
+        out = {x: default for x in names}
+        for w in words[1:]:
+            name, ks = w.split("=")
+            if name not in PARTS:
+                raise ValueError(name)
+            out[name] = [int(k) for k in ks.split(",")]
+    except ValueError:
+        sys.exit("referee-mujoco: --steps %r: expected K,K,...[;PART=K,K,...]" % text)
+    return out
+
+
+def swap_noise(a, b, part, resting, st, redraws=2000, seed=1):
+    """95th percentile of the TV between paired outcomes a and b when each
+    pair that differs is put in random order: the TV a step that only
+    reshuffled chaotic outcomes within one distribution would show."""
+    import random
+    rng = random.Random(seed)
+    diff = [(x, y, s) for x, y, s in zip(a, b, st) if x != y]
+    out = []
+    for _ in range(redraws):
+        ca, cb = {}, {}
+        for x, y, s in diff:
+            if rng.random() < 0.5:
+                x, y = y, x
+            for pose, c in ((x, ca), (y, cb)):
+                if pose:
+                    k = (1 if pose == s else 2) if resting else part.class_of[pose]
+                    c[k] = c.get(k, 0) + 1
+        out.append(tv(ca, cb, len(a)))
+    out.sort()
+    return out[int(0.95 * len(out))] if out else 0.0
+
+
 def markdown(table, steps, a):
-    fine = "mujoco T/%d" % steps[0]
+    fine = "mujoco"
     cols = ENGINES + [fine]
     label = {"impulse": "impulse", "ode": "ODE", "bullet": "Bullet", fine: "MuJoCo"}
     lines = []
@@ -604,15 +738,22 @@ def markdown(table, steps, a):
                  % (cmd.strip(), time.strftime("%Y-%m-%d", time.gmtime()), COMMIT[0],
                     COMMIT[1], time.strftime("%H:%M", time.gmtime()),
                     __import__("mujoco").__version__))
+    if RUNS:
+        lines.append("posedrop's runs: %s.\n\n" % "; ".join(
+            "%s on %s: `%s` (commit %s)" % r for r in RUNS))
     lines.append("Share of each pose class (posedrop's `--group` numbering) over %d drops "
                  "per engine (MuJoCo: the first %d of them) from the same releases (seed %d), "
                  "with the 95%% Wilson "
                  "interval's half-width; the cube: the share that ends on the face it "
-                 "started resting on. TV: total variation from MuJoCo at T/%d. Unsettled "
-                 "drops are in no class.\n\n" % (a.n, a.mj_n or a.n, a.seed, steps[0]))
+                 "started resting on. MuJoCo at the step of its row 'MuJoCo step' (T the "
+                 "part's automatic contact time). TV: total variation from MuJoCo; noise: the "
+                 "95th percentile of the TV that sampling alone gives at these counts were "
+                 "the engine and MuJoCo to agree (redraws from their pooled shares), a TV "
+                 "above it marked *. Unsettled drops are in no class.\n\n"
+                 % (a.n, a.mj_n or a.n, a.seed))
     lines.append("| part | class | " + " | ".join(label[c] for c in cols) + " |\n")
     lines.append("|---|---|" + "---|" * len(cols) + "\n")
-    for name, resting, classes, counts, results, n, st in table:
+    for name, resting, classes, counts, results, n, st, ks in table:
         for c in classes:
             cells = []
             for e in cols:
@@ -622,36 +763,41 @@ def markdown(table, steps, a):
             lines.append("| %s | %s | %s |\n" % (name, "same face" if resting else c,
                                                   " | ".join(cells)))
         nf = len(results[fine][0])
-        tvs = ["%.3f" % tvn(counts[e], n, counts[fine], nf) for e in ENGINES] + ["-"]
+        tvs = []
+        for e in ENGINES:
+            t = tvn(counts[e], n, counts[fine], nf)
+            z = noise_tv(counts[e], n, counts[fine], nf)
+            tvs.append("%.3f%s (noise %.3f)" % (t, "*" if t > z else "", z))
+        tvs.append("-")
         uns = [str(sum(1 for x in results[e][0] if x == 0)) for e in cols]
         ms = ["%.3g" % results[e][1] for e in cols]
         lines.append("| %s | TV to MuJoCo | %s |\n" % (name, " | ".join(tvs)))
         lines.append("| %s | unsettled | %s |\n" % (name, " | ".join(uns)))
         lines.append("| %s | CPU ms per drop | %s |\n" % (name, " | ".join(ms)))
-    if len(steps) < 2:
+        lines.append("| %s | MuJoCo step | %s | T/%d |\n"
+                     % (name, " | ".join("" for _ in ENGINES), ks[0]))
+    if all(len(r[7]) < 2 for r in table):
         return "".join(lines)
-    m = a.check_n
-    lines.append("\nMuJoCo's step against the contact time T (each part's automatic one), "
-                 "on the first %d releases: the total variation between successive steps, "
-                 "and the share of drops whose outcome did not change. Two independent "
-                 "samples of %d from one distribution would differ by a TV of about "
-                 "sqrt((k - 1) / (pi %d)) for k classes of equal weight (%.3f for k = 2), "
-                 "and paired releases by less.\n\n" % (m, m, m, math.sqrt(1 / (math.pi * m))))
-    lines.append("| part | " + " | ".join("T/%d to T/%d" % (steps[i], steps[i + 1])
-                                          for i in range(len(steps) - 1)) + " |\n")
-    lines.append("|---|" + "---|" * (len(steps) - 1) + "\n")
-    for name, resting, classes, counts, results, n, st in table:
-        cells = []
-        for i in range(len(steps) - 1):
-            ea, eb = "mujoco T/%d" % steps[i], "mujoco T/%d" % steps[i + 1]
-            oa, ob = results[ea][0], results[eb][0]
+    lines.append("\nMuJoCo's step against the contact time T, on the first %d releases: "
+                 "the total variation between successive steps, the drops whose outcome "
+                 "changed, and the TV's noise bound: its 95th percentile when each pair of "
+                 "outcomes that differs is put in random order (what a step that only "
+                 "reshuffled chaotic outcomes would show); a TV above it marked *.\n\n"
+                 % a.check_n)
+    lines.append("| part | steps | TV | noise | outcomes changed |\n|---|---|---|---|---|\n")
+    for name, resting, classes, counts, results, n, st, ks in table:
+        part = PARTS_SEEN[name]
+        for i in range(len(ks) - 1):
+            ea = "mujoco" if i == 0 else "mujoco %d" % i
+            oa, ob = results[ea][0], results["mujoco %d" % (i + 1)][0]
             k = min(len(oa), len(ob))
-            part = PARTS_SEEN[name]
             ca = outcome_table(part, oa[:k], resting, st[:k])
             cb = outcome_table(part, ob[:k], resting, st[:k])
-            same = sum(1 for x, y in zip(oa, ob) if x == y) / k
-            cells.append("TV %.3f, %.1f%% unchanged" % (tv(ca, cb, k), 100 * same))
-        lines.append("| %s | %s |\n" % (name, " | ".join(cells)))
+            t = tv(ca, cb, k)
+            z = swap_noise(oa[:k], ob[:k], part, resting, st[:k])
+            changed = sum(1 for x, y in zip(oa, ob) if x != y)
+            lines.append("| %s | T/%d to T/%d | %.3f%s | %.3f | %d of %d |\n"
+                         % (name, ks[i], ks[i + 1], t, "*" if t > z else "", z, changed, k))
     return "".join(lines)
 
 

@@ -53,6 +53,9 @@ def run(cmd):
     return script_util.run(cmd, "trust.py")
 
 
+RUN_COMMITS = set()   # --runs: the commits of the stepping engines' runs (paper.sh's)
+
+
 def engines_from(runs, name, n, seed):
     """--crosscheck's rows rebuilt from make paper's three runs of the part
     (RUNS/NAME.ENGINE.csv, the same drops: --group, the belt, the seed it
@@ -63,7 +66,11 @@ def engines_from(runs, name, n, seed):
         path = os.path.join(runs, "%s.%s.csv" % (name, e))
         if not os.path.exists(path):
             sys.exit("trust.py: %s missing (run scripts/paper.sh -o %s)" % (path, runs))
-        got[e] = {r["pose"]: r for r in rows(open(path).read())}
+        text = open(path).read()
+        got[e] = {r["pose"]: r for r in rows(text)}
+        if e != "impulse":
+            RUN_COMMITS.update(l.split()[2].rstrip(",") for l in text.splitlines()
+                               if l.startswith("# commit "))
         if any(int(r["n"]) != n for r in got[e].values()):
             sys.exit("trust.py: %s is not of %d drops (give -n as paper.sh had it)" % (path, n))
     if seed != 1:
@@ -126,7 +133,10 @@ def main():
             res.append(measure(a.posedrop, name, a.n, a.seed, tmp, a.runs))
     cmd = "scripts/trust.py " + " ".join(sys.argv[1:])
     when = time.strftime("%Y-%m-%d", time.gmtime())
-    made = "Made by `%s` on %s (commit %s%s)." % (cmd.strip(), when, commit, dirty)
+    made = "Made by `%s` on %s (commit %s%s%s)." % (
+        cmd.strip(), when, commit, dirty,
+        "; ODE's and Bullet's runs made by `scripts/paper.sh` at commit %s"
+        % ", ".join(sorted(RUN_COMMITS)) if RUN_COMMITS else "")
     lines = [made + " Points are percentage points of a class's probability; %d drops "
              "per run, the paper's belt (`--initial stationary`), seed %d.\n\n" % (a.n, a.seed),
              "| part | classes | sampling: widest 95% interval, +- | scene: largest move "
@@ -147,13 +157,15 @@ def main():
     apart = sum(r["apart"] for r in res)
     classes = sum(r["classes"] for r in res)
     para = ("**How far to trust p.** On the paper's four parts (`scripts/trust.py`, %s, "
-            "commit %s%s; %d drops, its belt): the 95%% intervals reach %s points either "
+            "commit %s%s%s; %d drops, its belt): the 95%% intervals reach %s points either "
             "side (more drops narrow them); the scene's plausible ranges move a class by up "
             "to %s points (`--sensitivity`); the three engines differ by up to %s points, "
             "beyond their intervals on %d of %d classes (`--crosscheck`); the physical tests "
             "are %s%% away in total variation ([docs/validation.md](docs/validation.md)). "
             "Differences below these are not findings.\n"
-            % (when, commit, dirty, a.n, span("half"), span("shift"), span("spread"), apart,
+            % (when, commit, dirty,
+               "; ODE and Bullet from `paper.sh` at %s" % ", ".join(sorted(RUN_COMMITS))
+               if RUN_COMMITS else "", a.n, span("half"), span("shift"), span("spread"), apart,
                classes, span("tv")))
     para = "\n".join(textwrap.wrap(para, 78, break_long_words=False, break_on_hyphens=False)) + "\n"
     sys.stdout.write("\n" + para)

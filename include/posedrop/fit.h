@@ -146,7 +146,12 @@ typedef struct pd_fit_part_result {
     double *p_best;     /* the smoothed simulated probabilities at the best fit */
     double *p, *lo, *hi; /* averaged over the likelihood-weighted points, and the
                            95% interval of the probability, which carries the
-                           parameters' spread and the simulation's own error */
+                           parameters' spread and the simulation's own error,
+                           and for a predicted part the model's discrepancy
+                           (pd_fit_result's) */
+    double *lo_fit, *hi_fit; /* the 95% interval without the discrepancy: what
+                           the parameters and the drops leave open if the model
+                           were right (lo, hi for a fitted part) */
     double loglik;      /* sum_k count_k log p_best_k (0 for a predicted part) */
     double chi2;        /* Pearson's X^2 of the counts against n p_best */
     int df;             /* cells of counts (nclasses without cell_of) - 1 */
@@ -178,10 +183,16 @@ typedef struct pd_fit_result {
                            <= 0: the data cannot test the fit */
     double pvalue;      /* 1 when df <= 0 */
     pd_fit_quality fresh_best, fresh_mean; /* all fitted parts, against fresh drops */
-    double dispersion;  /* >= 1: the parts' X^2 at the best fit over what the data's
+    double dispersion;  /* >= 1: the parts' X^2 at the best fit (the 2 x K tables of
+                           counts and simulated drops) over what the data's
                            and the simulation's noise explain; the weights' log-
                            likelihood is divided by it, widening the intervals by
                            its square root when no value reproduces the counts */
+    double discrepancy; /* tau^2 in [0, 0.9]: the fitted parts' X^2 beyond their
+                           noise read as each part's true probabilities scattering
+                           about the model's with variance tau^2 p (1 - p) (0 when
+                           the model fits within the noise); a predicted part's
+                           interval carries that scatter */
     int npoints;        /* weighted points */
     double ess;         /* their effective sample size (sum w)^2 / sum w^2 */
     int evaluations;    /* likelihood evaluations, all searches and points */

@@ -9,8 +9,93 @@
 #include <string.h>
 #include "base/number.h"
 
+/* The common case of pd_parse_double without strtod: [+-]digits[.digits]
+ * [(e|E)[+-]digits] with at most 19 significant digits w and a power of
+ * ten 10^e, |e| <= 27, both exact in x87's 64-bit extended mantissa (5^27 <
+ * 2^64). One extended product or quotient is then w * 10^e rounded once,
+ * within half a unit of its 64th bit; rounding that to a double gives the
+ * correctly rounded double unless the true value and the extended one may
+ * lie on two sides of a midpoint between doubles, which the 11 bits
+ * rounded off show: within one unit of 10000000000 (binary) the answer is
+ * left to strtod. 1 with *out set, 0 when strtod must decide (other forms,
+ * more digits, a larger exponent, or a near-midpoint). Text that strtod
+ * reads differently (hexadecimal, inf, nan, blanks, a bare point) never
+ * takes this path. A large mesh file holds millions of such coordinates,
+ * most of them printed with 17 digits. */
+static int parse_fast(const char *s, size_t n, double *out)
+{
+#if LDBL_MANT_DIG == 64 && (defined(__x86_64__) || defined(__i386__))
+    size_t i = 0;
+    int neg = 0, digits = 0, sig = 0, scale = 0;
+    uint64_t w = 0;
+    if (i < n && (s[i] == '+' || s[i] == '-'))
+        neg = s[i++] == '-';
+    for (; i < n && s[i] >= '0' && s[i] <= '9'; i++, digits++) {
+        if (w == 0 && s[i] == '0')
+            continue; /* a leading zero: not significant */
+        if (++sig > 19)
+            return 0;
+        w = 10 * w + (uint64_t)(s[i] - '0');
+    }
+    if (i < n && s[i] == '.')
+        for (i++; i < n && s[i] >= '0' && s[i] <= '9'; i++, digits++) {
+            scale--;
+            if (w == 0 && s[i] == '0')
+                continue;
+            if (++sig > 19)
+                return 0;
+            w = 10 * w + (uint64_t)(s[i] - '0');
+        }
+    if (digits == 0)
+        return 0;
+    if (i < n && (s[i] == 'e' || s[i] == 'E')) {
+        int eneg = 0, ex = 0, edigits = 0;
+        i++;
+        if (i < n && (s[i] == '+' || s[i] == '-'))
+            eneg = s[i++] == '-';
+        for (; i < n && s[i] >= '0' && s[i] <= '9'; i++)
+            if (++edigits > 4)
+                return 0;
+            else
+                ex = 10 * ex + (s[i] - '0');
+        if (edigits == 0)
+            return 0;
+        scale += eneg ? -ex : ex;
+    }
+    if (i != n)
+        return 0;
+    if (w == 0) {
+        *out = neg ? -0.0 : 0.0;
+        return 1;
+    }
+    if (scale < -27 || scale > 27)
+        return 0;
+    /* Exact: 10^27 = 5^27 2^27, and 5^27 < 2^63. */
+    static const long double ten[28] = {1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,
+                                        1e7L,  1e8L,  1e9L,  1e10L, 1e11L, 1e12L, 1e13L,
+                                        1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L, 1e20L,
+                                        1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L};
+    long double x = scale < 0 ? (long double)w / ten[-scale] : (long double)w * ten[scale];
+    uint64_t mant;
+    memcpy(&mant, &x, sizeof mant); /* the explicit 64-bit significand */
+    unsigned low = (unsigned)(mant & 0x7ff);
+    if (low >= 0x3ff && low <= 0x401)
+        return 0;
+    double v = (double)x;
+    *out = neg ? -v : v;
+    return 1;
+#else
+    (void)s;
+    (void)n;
+    (void)out;
+    return 0;
+#endif
+}
+
 int pd_parse_double(const char *s, size_t n, double *out)
 {
+    if (parse_fast(s, n, out))
+        return PD_NUM_OK;
     /* strtod needs a terminated string; no genuine number is this long. */
     char buf[128];
     if (n == 0 || n >= sizeof buf)

@@ -14,6 +14,19 @@ static inline pd_vec3 v3_sub(pd_vec3 a, pd_vec3 b) { return v3(a.x - b.x, a.y - 
 static inline pd_vec3 v3_scale(pd_vec3 a, double s) { return v3(a.x * s, a.y * s, a.z * s); }
 static inline pd_vec3 v3_neg(pd_vec3 a) { return v3(-a.x, -a.y, -a.z); }
 static inline double v3_dot(pd_vec3 a, pd_vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+/* fmin and fmax per component, inline (libm's are calls through the PLT,
+ * which bounding-box loops over millions of corners paid for): the same
+ * results, a NaN on either side giving the other. */
+static inline double v3_fmin1(double a, double b) { return b < a || a != a ? b : a; }
+static inline double v3_fmax1(double a, double b) { return b > a || a != a ? b : a; }
+static inline pd_vec3 v3_min(pd_vec3 a, pd_vec3 b)
+{
+    return v3(v3_fmin1(a.x, b.x), v3_fmin1(a.y, b.y), v3_fmin1(a.z, b.z));
+}
+static inline pd_vec3 v3_max(pd_vec3 a, pd_vec3 b)
+{
+    return v3(v3_fmax1(a.x, b.x), v3_fmax1(a.y, b.y), v3_fmax1(a.z, b.z));
+}
 static inline pd_vec3 v3_cross(pd_vec3 a, pd_vec3 b)
 {
     return v3(a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x);

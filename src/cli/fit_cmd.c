@@ -40,7 +40,8 @@ static void fit_usage(FILE *out)
         "simulated probability at the best fit (smoothed: each class given alpha = 1/2\n"
         "more drops, so that a pose seen but never simulated is not impossible); p:\n"
         "averaged over the likelihood-weighted values, ci_lo, ci_hi: its 95%% interval,\n"
-        "which carries both the parameters' spread and the simulation's own error.\n"
+        "which carries both the parameters' spread and the simulation's own error\n"
+        "(a predicted part's also the fitted parts' scatter about the model).\n"
         "stderr: before the first evaluation, the most the fit can cost (evaluations,\n"
         "drops); after it, an estimate in seconds; then a progress line every 10 s\n"
         "(evaluation, stage and round, best log-likelihood so far, time left at most);\n"
@@ -424,7 +425,15 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
                 "not go on) and are in no count\n", prog, r->failed, r->drops);
     if (r->dispersion > 1.0)
         fprintf(stderr, "%s: fit: X^2 is %.3g times what the noise explains: the intervals are "
-                "widened by its square root for the model's misfit\n", prog, r->dispersion);
+                "widened for the model's misfit\n", prog, r->dispersion);
+    int predicted = 0;
+    for (int i = 0; i < r->nparts; i++)
+        predicted += r->parts[i].n == 0;
+    if (r->discrepancy > 0 && predicted)
+        fprintf(stderr, "%s: fit: the fitted parts' probabilities scatter about the model's by "
+                "%.3g sqrt(p (1 - p)) beyond their noise: the predicted parts' intervals carry "
+                "that scatter; a prediction is no better than the model's fit to the parts it "
+                "was fitted to\n", prog, sqrt(r->discrepancy));
     fprintf(stderr, "%s: fit: %d evaluations, %ld drops simulated, %d weighted values (effective "
             "%.1f); %.1f s wall, %.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints,
             r->ess, wall, cpu);

@@ -8,6 +8,7 @@
 #include <math.h>
 #include "posedrop/hull.h"
 #include "posedrop/sim.h"
+#include "engines/engines_tol.h"
 
 /* Restitution below this is taken as this by the contact law below, as by
  * the impulse simulator's compliant law (PD_COMPLIANT_E_MIN, in a layer this
@@ -17,11 +18,13 @@
 /* Steps a contact must span for an engine to stand for it by that law: with
  * a step h > T / PD_ENGINE_CONTACT_STEPS the engine keeps its own contact
  * (its bounce with restitution e), the law's own limit as T -> 0. Why 10:
- * both engines step the spring-dashpot implicitly, which loses about
- * e g^2 / 2 h / T of the rebound (g = omega T <= pi): at 10 steps a
- * corner's rebound of 0.3 comes out 0.25 (ODE) and 0.23 (Bullet), at 2
- * steps 0.18 and 0.10, at Bullet's default 1/960 s for T = 5e-4 s 0.02. A
- * contact that short is rigid as far as such a step can tell. */
+ * the engines step the law as semi-implicit Euler (PD_ENGINE_SPRING_IMPLICIT
+ * in engines_tol.h), whose rebound wavers with where in its step a vertex
+ * touches: within 0.007 of e at 10 steps a contact, 0.03 at 5 and 0.24 at
+ * 2.5 (the scaled law stepped so, e 0.05 to 1,
+ * scripts/engine-step-rebound.py); and the several vertices
+ * of a face press at a higher rate than one, which the step must still
+ * resolve. A contact that short is rigid as far as such a step can tell. */
 #define PD_ENGINE_CONTACT_STEPS 10.0
 
 /* Depth a contact may reach at the fall speed, times the part's thickness,
@@ -84,13 +87,13 @@ static inline int pd_engine_contact_resolved(double dt, double contact_time, dou
 
 /* Steps per contact of the automatic step (dt auto): the lowest contact
  * time the scene can draw, T, is cut into this many steps, so that every
- * contact is the scene's spring-dashpot (at least PD_ENGINE_CONTACT_STEPS
- * steps) and the engines' first-order loss of rebound, about
- * e g^2 / 2 h / T (above), stays a few hundredths of e. Why 20: the
- * coarsest of 10, 20 and 40 at which halving the step moved no pose class
- * of the cross-check corpus's parts measured beyond sampling noise, on
- * either engine; at 10 Bullet was far off (docs/engines-crosscheck.md,
- * "Converged by default", scripts/engine-convergence.py). */
+ * contact is the scene's law (at least PD_ENGINE_CONTACT_STEPS steps) and
+ * its rebound is within 0.0016 of e wherever the vertex touches in its step
+ * (engines_tol.h, PD_ENGINE_SPRING_IMPLICIT). Why 20: the coarsest of 10,
+ * 20 and 40 at which halving the step moved no pose class of the
+ * cross-check corpus's parts measured beyond sampling noise, on either
+ * engine (docs/engines-crosscheck.md, "Converged by default",
+ * scripts/engine-convergence.py). */
 #define PD_ENGINE_AUTO_STEPS 20.0
 
 /* The most a corner may travel in one automatic step at the fall speed,
@@ -189,13 +192,10 @@ static inline void pd_engine_contact_law(double T, double e, double *omega, doub
  *     ln((1 + chi) / (1 - chi e)) = chi (1 + e),
  * whose root in (0, 1/e) is chi (bisection: the left side less the right
  * is negative from 0 to the root, positive after it); chi = 0 at e = 1. Its
- * duration tau (scaled time) is integrated by classical RK4 over
- * PD_ENGINE_HC_STEPS steps of the undamped half period, the end located
- * between two steps by the crossing of s = 0 (RK4's error, of order
- * (pi / PD_ENGINE_HC_STEPS)^4, and the crossing's, of the square of the
- * step: both below 1e-7 of tau); omega = tau / T. */
-enum { PD_ENGINE_HC_STEPS = 20000 };
-
+ * duration tau (scaled time) is integrated by classical RK4 in steps of
+ * pi / PD_ENGINE_HC_STEPS, the end located within the last step on the
+ * cubic through both ends' s and s' (PD_ENGINE_HC_STEPS says why that is
+ * within 1e-8 of tau); omega = tau / T. */
 static inline double pd_engine_hc_gap(double chi, double e)
 {
     return log((1.0 + chi) / (1.0 - chi * e)) - chi * (1.0 + e);
@@ -205,6 +205,26 @@ static inline void pd_engine_hc_accel(double chi, double s, double v, double *a)
 {
     double f = s * (1.0 + chi * v);
     *a = f > 0.0 ? -f : 0.0;
+}
+
+/* The root in (0, 1] of the cubic Hermite interpolant through (0, s0, v0 h)
+ * and (1, s1, v1 h), s0 > 0 >= s1: where a step of h ends the contact. */
+static inline double pd_engine_hc_crossing(double s0, double v0, double s1, double v1, double h)
+{
+    double lo = 0.0, hi = 1.0;
+    for (int i = 0; i < PD_ENGINE_CONTACT_HALVINGS; i++) {
+        double x = 0.5 * (lo + hi);
+        if (x <= lo || x >= hi)
+            break;
+        double x2 = x * x, x3 = x2 * x;
+        double p = (2.0 * x3 - 3.0 * x2 + 1.0) * s0 + (x3 - 2.0 * x2 + x) * h * v0 +
+                   (3.0 * x2 - 2.0 * x3) * s1 + (x3 - x2) * h * v1;
+        if (p > 0.0)
+            lo = x;
+        else
+            hi = x;
+    }
+    return 0.5 * (lo + hi);
 }
 
 static inline void pd_engine_hc_law(double T, double e, double *omega, double *chi)
@@ -226,9 +246,7 @@ static inline void pd_engine_hc_law(double T, double e, double *omega, double *c
         c = 0.5 * (lo + hi);
     }
     double h = pi / PD_ENGINE_HC_STEPS, t = 0.0, s = 0.0, v = 1.0, tau = 0.0;
-    /* The contact lasts 4.6 undamped half periods at PD_ENGINE_E_MIN; the
-     * bound only stops a loop that would not end. */
-    for (long k = 0; k < 64L * PD_ENGINE_HC_STEPS; k++) {
+    for (long k = 0; k < (long)PD_ENGINE_HC_HALF_PERIODS * PD_ENGINE_HC_STEPS; k++) {
         double a1, a2, a3, a4;
         pd_engine_hc_accel(c, s, v, &a1);
         pd_engine_hc_accel(c, s + 0.5 * h * v, v + 0.5 * h * a1, &a2);
@@ -237,7 +255,7 @@ static inline void pd_engine_hc_law(double T, double e, double *omega, double *c
         double s1 = s + h * (v + h * (a1 + a2 + a3) / 6.0);
         double v1 = v + h * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0;
         if (s1 <= 0.0 && v1 < 0.0) {
-            tau = t + h * s / (s - s1);
+            tau = t + h * pd_engine_hc_crossing(s, v, s1, v1, h);
             break;
         }
         t += h;

@@ -600,10 +600,15 @@ static int floor_contacts(const pd_engine_world *w, dContactGeom *c)
  * stiffness k = m_eff omega^2 for the contact's effective mass along the
  * floor's normal z, 1 / m_eff = 1/m + (r x z) . I^-1 (r x z), r from the
  * centre of mass, and the Hunt-Crossley damping c = k chi d / v0 at its
- * depth d, v0 its approach speed at touch (pd_engine_hc_law); ODE's spring
- * form for a step h: erp = h k / (h k + c), cfm = 1 / (h k + c), with c
- * taken at the step's start. No bounce on top: the damping's loss is the
- * restitution. */
+ * depth d, v0 its approach speed at touch (pd_engine_hc_law), both taken
+ * at the step's start. ODE's row with erp and cfm pushes with
+ * (erp d / h - u) / cfm, u the separation speed at the step's end; with
+ * erp = h k / b and cfm = 1 / b that is k d + b d', the spring at the
+ * step's start and the damper at its end, for b = c (plus
+ * PD_ENGINE_SPRING_IMPLICIT h k, which keeps cfm finite), where ODE's own
+ * form, b = h k + c, steps the spring implicitly and loses a share of the
+ * rebound of order omega h (engines_tol.h). No bounce on top: the
+ * damping's loss is the restitution. */
 static void compliant_softness(const pd_engine_world *w, const dContactGeom *g, dReal *erp,
                                dReal *cfm)
 {
@@ -618,8 +623,9 @@ static void compliant_softness(const pd_engine_world *w, const dContactGeom *g, 
     }
     double m = 1.0 / inv, h = w->dt;
     double k = m * w->omega * w->omega, c = k * w->chi * g->depth / fabs(w->touch[g->side1]);
-    *erp = h * k / (h * k + c);
-    *cfm = 1.0 / (h * k + c);
+    double b = c + PD_ENGINE_SPRING_IMPLICIT * h * k;
+    *erp = h * k / b;
+    *cfm = 1.0 / b;
 }
 
 /* Each vertex's approach speed at the start of its impact (at least

@@ -108,4 +108,41 @@
  * smaller: resting contacts chatter. */
 #define PD_BULLET_BOUNCE_STEPS 2.0
 
+/* RK4 steps per undamped half period (pi in scaled time) with which
+ * pd_engine_hc_law integrates the scaled Hunt-Crossley contact for its
+ * duration tau, the end found on the cubic through the last step's ends.
+ * Why 256: RK4's error goes as the fourth power of the step and so does
+ * the cubic's; at 256 tau is within 1e-8 of a 200000-step integration at
+ * every restitution from PD_ENGINE_E_MIN to 1 (2e-5 at 64, 5e-7 at 128),
+ * a hundredth of the 1e-6 to which test_law holds it against the impulse
+ * simulator's rk8pd integration; the law then costs some thousand RK4
+ * steps, where 20000 steps a half period and a linear crossing (its error
+ * the square of the step) cost 90,000 each time an engine's material
+ * changed, once per drop in runs whose drops draw their restitution. */
+#define PD_ENGINE_HC_STEPS 256
+
+/* The most undamped half periods pd_engine_hc_law integrates: the contact
+ * lasts 4.6 of them at PD_ENGINE_E_MIN (tau = 14.31) and fewer at any
+ * higher restitution, so the bound only stops a loop that would not end. */
+#define PD_ENGINE_HC_HALF_PERIODS 64
+
+/* Share of the backward-Euler spring the stepping engines' contact rows
+ * keep. ODE and Bullet take a contact row's spring and damper as erp and
+ * cfm, which give the force k d + b d' at the step's end rate d', with
+ * b = h k + c for a spring stepped implicitly (their documented form) and
+ * b = c for one taken at the step's start. The implicit spring loses a
+ * share of the rebound of order omega h, first order in the step (at 20
+ * steps a contact, 0.043 of the approach speed for e = 0.3, 0.19 for
+ * e = 0.9); the spring at the step's start with the damper at its end
+ * (semi-implicit Euler, as the impulse simulator's compliant step)
+ * rebounds within 0.0016 of e at 20 steps and 0.0004 at 40, wherever in
+ * the step the vertex touches (the scaled law stepped as the engines step
+ * it, e 0.05 to 1: scripts/engine-step-rebound.py, docs/engines-crosscheck.md). b = c alone would leave a row without damping
+ * (c = 0 at e = 1 or at zero depth) an infinite cfm, so b keeps this share
+ * of h k. Why 1e-3: its loss is that share of the implicit spring's, at
+ * most 2e-4 of the approach speed at 20 steps, below the step's own error,
+ * while cfm stays within 1e3 / (h k) and the rows of the solvers well
+ * scaled. */
+#define PD_ENGINE_SPRING_IMPLICIT 1e-3
+
 #endif

@@ -377,6 +377,8 @@ void pd_fit_result_free(pd_fit_result *r)
         free(r->parts[i].p);
         free(r->parts[i].lo);
         free(r->parts[i].hi);
+        free(r->parts[i].lo_fit);
+        free(r->parts[i].hi_fit);
     }
     free(r->parts);
     free(r);
@@ -403,7 +405,9 @@ static pd_fit_result *result_alloc(int d, const pd_fit_part *parts, int nparts)
         q->p = calloc(k, sizeof *q->p);
         q->lo = calloc(k, sizeof *q->lo);
         q->hi = calloc(k, sizeof *q->hi);
-        ok = q->p_best && q->p && q->lo && q->hi;
+        q->lo_fit = calloc(k, sizeof *q->lo_fit);
+        q->hi_fit = calloc(k, sizeof *q->hi_fit);
+        ok = q->p_best && q->p && q->lo && q->hi && q->lo_fit && q->hi_fit;
     }
     if (!ok) {
         pd_fit_result_free(r);
@@ -418,24 +422,13 @@ static pd_fit_result *result_alloc(int d, const pd_fit_part *parts, int nparts)
 static pd_fit_quality quality(int k, const int *cell_of, int ncells, const long *count,
                               const double *p, double nsim)
 {
-    pd_fit_quality q = {0.0, -1, 1.0, 0.0};
+    pd_fit_quality q = {0.0, 0, 1.0, 0.0};
     long n = 0;
     for (int c = 0; c < ncells; c++)
         n += count[c];
-    if (!(nsim > 0) || n <= 0) {
-        q.df = 0;
-        return q;
-    }
-    double tot = (double)n + nsim;
-    for (int c = 0; c < ncells; c++) {
-        double pc = fit_cell_p(k, cell_of, c, p), s = nsim * pc, both = (double)count[c] + s;
-        q.tv += 0.5 * fabs((double)count[c] / (double)n - pc);
-        if (!(both > 0))
-            continue;
-        q.df++;
-        double em = (double)n * both / tot, es = nsim * both / tot;
-        q.chi2 += ((double)count[c] - em) * ((double)count[c] - em) / em + (s - es) * (s - es) / es;
-    }
+    q.chi2 = fit_chi2_two_sample(k, cell_of, ncells, count, p, nsim, &q.df);
+    for (int c = 0; n > 0 && c < ncells; c++)
+        q.tv += 0.5 * fabs((double)count[c] / (double)n - fit_cell_p(k, cell_of, c, p));
     q.pvalue = q.df > 0 ? pd_gsl_chisq_q(q.chi2, q.df) : 1.0;
     return q;
 }
@@ -549,6 +542,8 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     double **pb_best = malloc(sizeof *pb_best * (size_t)nparts);
     double **pp = malloc(sizeof *pp * (size_t)nparts), **plo = malloc(sizeof *plo * (size_t)nparts);
     double **phi = malloc(sizeof *phi * (size_t)nparts), *nsim = malloc(sizeof *nsim * (size_t)nparts);
+    double **plo_fit = malloc(sizeof *plo_fit * (size_t)nparts);
+    double **phi_fit = malloc(sizeof *phi_fit * (size_t)nparts);
     /* The model's output outside the result: the held-out predictions and
      * the fresh drops. */
     double **ps = malloc(sizeof *ps * (size_t)nparts), *ns = malloc(sizeof *ns * (size_t)nparts);
@@ -560,7 +555,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     for (int i = 0; memo_ok && i < nparts; i++)
         memo_ok = m.memo_p[i] != NULL;
     if (!memo_ok || !m.ndrops || !m.need || !m.nsym || !sym_of || !m.pose_p || !kk || !count || !one || !cell_of || !ncells || !r || !pb_best || !pp || !plo || !phi ||
-        !nsim || !ps || !ns || !pbuf) {
+        !plo_fit || !phi_fit || !nsim || !ps || !ns || !pbuf) {
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit");
         goto done;
     }
@@ -582,6 +577,8 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         pp[i] = r->parts[i].p;
         plo[i] = r->parts[i].lo;
         phi[i] = r->parts[i].hi;
+        plo_fit[i] = r->parts[i].lo_fit;
+        phi_fit[i] = r->parts[i].hi_fit;
         ps[i] = i ? ps[i - 1] + kk[i - 1] : pbuf;
     }
     fit_problem pb = {d,      lo,      hi,        nparts,    kk,   count, cell_of,
@@ -680,7 +677,9 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
     }
     if (st != PD_OK)
         goto done;
-    fit_weighed w = {r->lo, r->hi, r->mean, pb_best, nsim, pp, plo, phi, 1.0, 0.0, 0};
+    fit_weighed w = {r->lo,  r->hi, r->mean, pb_best, nsim,    pp,
+                     plo,    phi,   1.0,     0.0,     0,       0.0,
+                     plo_fit, phi_fit};
     st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
     if (st == PD_OK) {
         r->loglik = 0.0;
@@ -709,6 +708,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         r->pvalue = r->df > 0 ? pd_gsl_chisq_q(r->chi2, r->df) : 1.0;
         r->initial = chosen;
         r->dispersion = w.dispersion;
+        r->discrepancy = w.discrepancy;
         r->ess = w.ess;
         r->npoints = w.npoints;
         /* The fit's quality from drops it was not tuned to, at the best
@@ -736,6 +736,8 @@ done:
     free(pp);
     free(plo);
     free(phi);
+    free(plo_fit);
+    free(phi_fit);
     free(nsim);
     free(ps);
     free(ns);

@@ -30,6 +30,11 @@ static const double SIMPLEX_STEP = 1.0;
  * shrinking at most 4-fold a round so that a round whose points all but
  * one weigh nothing still leaves the next one room. */
 static const double BOX_SDS = 3.5, BOX_SHRINK = 4.0;
+/* The relative discrepancy tau^2 is a variance over m (1 - m), which a
+ * Beta of mean m stays below (tau^2 = 1 / (A + 1) for a Dirichlet of
+ * concentration A): at 0.9 a class's interval is nearly [0, 1], and a
+ * misfit so large says no more. */
+static const double MAX_DISCREPANCY = 0.9;
 /* u beyond this is z within 1e-9 of a bound: the box's edge. */
 static const double U_MAX = 20.0;
 
@@ -44,6 +49,10 @@ typedef struct {
     const char *stage; /* for fit_problem's note */
     int round;
     fit_level level;
+    /* The model's relative discrepancy (the weighting's, once estimated; 0
+     * in the search): each part's log-likelihood is divided by the variance
+     * it adds to that of the data's and the drops' noise. */
+    double tau2;
     /* The simplex's best points so far, best first. */
     int ntop;
     double top_z[FIT_FINALISTS][PD_FIT_MAX_PARAMS], top_l[FIT_FINALISTS];
@@ -79,7 +88,15 @@ static pd_status evaluate(ctx *c, const double *z, int all, double *loglik)
         if (pb->count[i]) {
             int nc;
             const int *of = cells(pb, i, &nc);
-            l += fit_loglik_cells(pb->k[i], of, nc, pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+            double li =
+                fit_loglik_cells(pb->k[i], of, nc, pb->count[i], c->p[i], c->nsim[i], pb->alpha);
+            if (c->tau2 > 0) {
+                long n = 0;
+                for (int j = 0; j < nc; j++)
+                    n += pb->count[i][j];
+                li /= 1.0 + c->tau2 * (double)n * c->nsim[i] / ((double)n + c->nsim[i]);
+            }
+            l += li;
         }
     *loglik = l;
     if (pb->note)
@@ -325,25 +342,46 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             out->nsim_best[i] = nsim[i];
         }
         /* Overdispersion: X^2 beyond what the data's and the simulation's
-         * noise explain is the model's own misfit, and widens the
-         * weights' spread by its square root (quasi-likelihood). */
-        double x2 = 0.0, expect = 0.0;
+         * noise explain is the model's own misfit. X^2 of the 2 x K table
+         * of counts and simulated drops, whose terms stay of order 1 where
+         * the drops reached a class rarely: against the smoothed
+         * probabilities, a class of many counts and no drop gave terms of
+         * hundreds (expected counts near alpha n / nsim). The excess is
+         * read as a scatter of every part's true probabilities about the
+         * model's, of variance tau^2 p (1 - p), added to the noise's p (1 -
+         * p)(1 / n + 1 / nsim): the fitted parameters take their share
+         * df / (df + d) of both. */
+        double x2 = 0.0, expect = 0.0, spread = 0.0;
         int df = -d;
         for (int i = 0; i < np; i++) {
             if (!pb->count[i])
                 continue;
             long n = 0;
-            int nc;
+            int nc, dfi;
             const int *of = cells(pb, i, &nc);
             for (int j = 0; j < nc; j++)
                 n += pb->count[i][j];
-            x2 += fit_chi2_cells(pb->k[i], of, nc, pb->count[i], out->p_best[i]);
-            expect += (double)(nc - 1) * (1.0 + (double)n / nsim[i]);
-            df += nc - 1;
+            x2 += fit_chi2_two_sample(pb->k[i], of, nc, pb->count[i], p[i], nsim[i], &dfi);
+            expect += dfi;
+            /* What a relative discrepancy tau^2 adds to the part's
+             * expected X^2: tau^2 dfi n nsim / (n + nsim). */
+            spread += dfi * (double)n * nsim[i] / ((double)n + nsim[i]);
+            df += dfi;
         }
         /* Without a degree of freedom left, X^2 says nothing of the fit. */
-        expect *= df > 0 ? (double)df / (double)(df + d) : 0.0;
+        double share = df > 0 ? (double)df / (double)(df + d) : 0.0;
+        expect *= share;
+        spread *= share;
         out->dispersion = df > 0 && x2 > expect ? x2 / expect : 1.0;
+        out->discrepancy = df > 0 && x2 > expect && spread > 0 ? (x2 - expect) / spread : 0.0;
+        if (out->discrepancy > MAX_DISCREPANCY)
+            out->discrepancy = MAX_DISCREPANCY;
+        /* The weights' likelihood counts the discrepancy beside the noise
+         * of the points' own drops (quasi-likelihood, the variance scaled
+         * part by part): at the drops X^2 was measured on, the division
+         * by the dispersion; at the weighting's fewer drops, whose own
+         * noise the Dirichlet-multinomial already counts, less. */
+        c.tau2 = out->discrepancy;
     }
     box b[MAX_ROUNDS];
     double half[PD_FIT_MAX_PARAMS];
@@ -382,7 +420,6 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
             for (int i = 0; i < d; i++)
                 zj[i] = b[r].lo[i] + (b[r].hi[i] - b[r].lo[i]) * fit_halton(index, i);
             st = evaluate(&c, zj, 0, &lt[n]);
-            lt[n] /= out->dispersion;
             double *sj = store + (size_t)n * ksum;
             for (int i = 0; st == PD_OK && i < np; i++) {
                 memcpy(sj, p[i], sizeof *sj * (size_t)pb->k[i]);
@@ -470,6 +507,34 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
                 out->p[i][cl] = mean;
                 out->plo[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.025);
                 out->phi[i][cl] = fit_beta_mixture_quantile(n, wi, a, bb, 0.975);
+                if (out->plo_fit) {
+                    out->plo_fit[i][cl] = out->plo[i][cl];
+                    out->phi_fit[i][cl] = out->phi[i][cl];
+                }
+                if (pb->count[i] || !(out->discrepancy > 0))
+                    continue;
+                /* A predicted part's true probability scatters about the
+                 * model's as the fitted parts' do: at each point, the Beta
+                 * of the same mean whose variance adds tau^2 m (1 - m)
+                 * to what the drops leave open (their compound's variance,
+                 * matched). */
+                for (int j = 0; j < n; j++) {
+                    if (!(wi[j] > 0))
+                        continue;
+                    double sj = a[j] + bb[j], mj = a[j] / sj;
+                    double v = mj * (1.0 - mj) / (sj + 1.0);
+                    v = v * (1.0 - out->discrepancy) + out->discrepancy * mj * (1.0 - mj);
+                    sj = mj * (1.0 - mj) / v - 1.0;
+                    a[j] = mj * sj;
+                    bb[j] = (1.0 - mj) * sj;
+                }
+                /* A class of mean below 0.025 can have its 97.5% quantile
+                 * fall as the scatter grows (the Beta tends to a coin of 0
+                 * and 1): the interval keeps the drops' at least. */
+                double lo = fit_beta_mixture_quantile(n, wi, a, bb, 0.025);
+                double hi = fit_beta_mixture_quantile(n, wi, a, bb, 0.975);
+                out->plo[i][cl] = lo < out->plo[i][cl] ? lo : out->plo[i][cl];
+                out->phi[i][cl] = hi > out->phi[i][cl] ? hi : out->phi[i][cl];
             }
             off += (size_t)k;
         }

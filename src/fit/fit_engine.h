@@ -75,11 +75,18 @@ typedef struct fit_weighed {
     double *nsim_best;        /* per part */
     double *const *p;         /* per part, k[i]: averaged */
     double *const *plo, *const *phi; /* per part, k[i]: 95% interval */
-    double dispersion;        /* X^2 at theta over what the noise explains
-                                 (sum (k_i - 1)(1 + n_i / nsim_i) - d), at least 1:
-                                 the log-likelihood the weights use is divided by it */
+    double dispersion;        /* X^2 of the 2 x K tables of counts and drops at theta
+                                 over what the noise explains (their degrees of freedom,
+                                 less d in proportion), at least 1: the log-likelihood
+                                 the weights use is divided by it */
     double ess;
     int npoints;
+    double discrepancy;       /* tau^2, in [0, 0.9]: the fitted parts' X^2 beyond the noise
+                                 read as a scatter of each part's true probabilities
+                                 about the model's of variance tau^2 p (1 - p); the
+                                 predicted parts' intervals carry it */
+    double *const *plo_fit, *const *phi_fit; /* per part, k[i], or NULL: the 95%
+                                 interval without the discrepancy */
 } fit_weighed;
 
 /* At FIT_LEVEL_FULL, evaluates theta (the search's maximum) with every part (and its
@@ -113,6 +120,14 @@ double fit_loglik_cells(int k, const int *cell_of, int ncells, const long *count
                         const double *p_sim, double nsim, double alpha);
 double fit_chi2_cells(int k, const int *cell_of, int ncells, const long *count, const double *p);
 double fit_cell_p(int k, const int *cell_of, int j, const double *p);
+
+/* Pearson's X^2 of the 2 x K table of the counts (ncells cells) and nsim
+ * simulated drops of frequencies p (per class), the test that both rows come
+ * from one distribution, which counts the simulation's error as well as the
+ * data's; the cells neither row reached are left out, and *df receives the
+ * cells kept less one (0 when there are no counts or drops). */
+double fit_chi2_two_sample(int k, const int *cell_of, int ncells, const long *count,
+                           const double *p, double nsim, int *df);
 
 /* The q-quantile of a mixture of Beta(a_j, b_j) with weights w_j (n terms,
  * summing to 1), by bisection to 1e-9. */

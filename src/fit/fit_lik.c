@@ -96,6 +96,31 @@ double fit_chi2_cells(int k, const int *cell_of, int ncells, const long *count, 
     return x2;
 }
 
+double fit_chi2_two_sample(int k, const int *cell_of, int ncells, const long *count,
+                           const double *p, double nsim, int *df)
+{
+    long n = 0;
+    for (int j = 0; j < ncells; j++)
+        n += count[j];
+    *df = 0;
+    if (!(nsim > 0) || n <= 0)
+        return 0.0;
+    *df = -1;
+    double tot = (double)n + nsim, x2 = 0.0;
+    for (int j = 0; j < ncells; j++) {
+        int m;
+        double s = nsim * cell_p(k, cell_of, j, p, &m), both = (double)count[j] + s;
+        if (!(both > 0))
+            continue;
+        (*df)++;
+        double em = (double)n * both / tot, es = nsim * both / tot;
+        x2 += ((double)count[j] - em) * ((double)count[j] - em) / em + (s - es) * (s - es) / es;
+    }
+    if (*df < 0)
+        *df = 0;
+    return x2;
+}
+
 double fit_chi2(int k, const long *count, const double *p)
 {
     return fit_chi2_cells(k, NULL, k, count, p);

@@ -46,6 +46,8 @@ typedef struct {
     int nt, capt, freelist;
     opt *pool;
     size_t npool, cappool, live; /* live: records in the sets of live triangles */
+    opt *spare;                  /* the pool before the last compaction, reused */
+    size_t capspare;
     opt *tmp;
     size_t captmp;
     int *asg;
@@ -117,9 +119,11 @@ static void free_tri(qhull *q, int id)
 }
 
 /* Makes room for need more records at the end of the pool, compacting the
- * sets of live triangles into a fresh pool when it is full. The new capacity
- * is at least the initial one (the point count), so compaction, which walks
- * every triangle, happens only O(log n) times over a run. */
+ * sets of live triangles into the other of two pools when it is full. The
+ * new capacity is at least the initial one (the point count), so
+ * compaction, which walks every triangle, happens only O(log n) times over
+ * a run. The two pools take turns: a fresh one each time cost a page fault
+ * per 4 kB written. */
 static int pool_reserve(qhull *q, size_t need, size_t mincap)
 {
     if (q->npool + need <= q->cappool)
@@ -127,9 +131,17 @@ static int pool_reserve(qhull *q, size_t need, size_t mincap)
     size_t cap = 2 * (q->live + need);
     if (cap < mincap)
         cap = mincap;
-    opt *np = malloc(sizeof *np * cap);
-    if (!np)
-        return -1;
+    opt *np = q->spare;
+    if (q->capspare >= cap) {
+        cap = q->capspare;
+    } else {
+        free(q->spare);
+        q->spare = NULL;
+        q->capspare = 0;
+        np = malloc(sizeof *np * cap);
+        if (!np)
+            return -1;
+    }
     size_t k = 0;
     for (int i = 0; i < q->nt; i++) {
         qtri *t = &q->t[i];
@@ -139,7 +151,8 @@ static int pool_reserve(qhull *q, size_t need, size_t mincap)
         t->os = k;
         k += (size_t)t->oc;
     }
-    free(q->pool);
+    q->spare = q->pool;
+    q->capspare = q->cappool;
     q->pool = np;
     q->npool = k;
     q->cappool = cap;
@@ -416,6 +429,7 @@ pd_status pd_trihull_build(const pd_vec3 *pts, int npts, const int seed[4], pd_c
 done:
     free(q.t);
     free(q.pool);
+    free(q.spare);
     free(q.tmp);
     free(q.asg);
     free(q.dist);

@@ -76,8 +76,8 @@ static int part_box(const pd_mesh *m, pd_vec3 *lo, pd_vec3 *hi)
                 *lo = *hi = v;
                 any = 1;
             }
-            *lo = v3(fmin(lo->x, v.x), fmin(lo->y, v.y), fmin(lo->z, v.z));
-            *hi = v3(fmax(hi->x, v.x), fmax(hi->y, v.y), fmax(hi->z, v.z));
+            *lo = v3_min(*lo, v);
+            *hi = v3_max(*hi, v);
         }
     }
     return any;

@@ -374,8 +374,8 @@ double pd_mesh_size(const pd_mesh *mesh)
     pd_vec3 lo = mesh->verts[0], hi = lo;
     for (int i = 1; i < mesh->nverts; i++) {
         pd_vec3 v = mesh->verts[i];
-        lo = v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
-        hi = v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
+        lo = v3_min(lo, v);
+        hi = v3_max(hi, v);
     }
     return v3_dist(lo, hi);
 }

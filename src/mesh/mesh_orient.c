@@ -353,8 +353,8 @@ pd_status pd_mesh_orient_cancel(pd_mesh *mesh, int *nflipped, pd_cancel_flag *ca
         comps[c].vol6 += v3_dot(a, v3_cross(b, d));
         for (int k = 0; k < 3; k++) {
             pd_vec3 v = mesh->verts[mesh->tris[t][k]];
-            comps[c].lo = v3(fmin(comps[c].lo.x, v.x), fmin(comps[c].lo.y, v.y), fmin(comps[c].lo.z, v.z));
-            comps[c].hi = v3(fmax(comps[c].hi.x, v.x), fmax(comps[c].hi.y, v.y), fmax(comps[c].hi.z, v.z));
+            comps[c].lo = v3_min(comps[c].lo, v);
+            comps[c].hi = v3_max(comps[c].hi, v);
         }
     }
     for (int c = 0; c < ncomps; c++) {

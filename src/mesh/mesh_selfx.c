@@ -414,11 +414,28 @@ static void arc_box(const pd_mesh *m, int t, int v, arc *b)
     }
 }
 
+enum { SWEEP_MIN = 12 };
+
 /* Sort and sweep of n boxes along the axis where they are shortest against
  * their spread; each pair whose boxes meet and that shares no edge goes to
  * the exact test. 1 when a crossing is found. */
 static int sweep(search *s, arc *bx, int n)
 {
+    /* The usual star of five to eight: every pair, those that share an edge
+     * set aside before their boxes; the sort pays only for large fans. */
+    if (n <= SWEEP_MIN) {
+        for (int a = 0; a < n; a++)
+            for (int b = a + 1; b < n; b++) {
+                if (shared(s->m->tris[bx[a].t], s->m->tris[bx[b].t]) >= 2 ||
+                    bx[b].lo[0] > bx[a].hi[0] || bx[b].hi[0] < bx[a].lo[0] ||
+                    bx[b].lo[1] > bx[a].hi[1] || bx[b].hi[1] < bx[a].lo[1] ||
+                    bx[b].lo[2] > bx[a].hi[2] || bx[b].hi[2] < bx[a].lo[2])
+                    continue;
+                if (test_pair(s, bx[a].t, bx[b].t))
+                    return 1;
+            }
+        return 0;
+    }
     int ax = 0;
     double best = HUGE_VAL;
     for (int k = 0; k < 3; k++) {
@@ -482,25 +499,20 @@ static int star_pairs(search *s)
     return found;
 }
 
-/* Pairs that share no vertex: a tree of boxes over the triangles in the
- * order of their centroids along a Morton curve, each box oriented along
- * the longest edge of its triangles and the normal of that edge's triangle
- * (a spike of a noisy scan, a sliver of a rod turned off the axes: its box
- * is as thin as it is, where a box along the coordinate axes would span the
- * part). Two boxes are apart when their projections on one of their six
- * axes are apart, a triangle projecting its corners and a box its centre
- * and half-widths; every projection is widened by pad, far above the
- * round-off of the frames and dot products, so a pair that may cross is
- * never dropped: the exact test decides. A node's corners common to all its
- * triangles, and its flat patch, skip a pair of nodes whose triangles all
- * share a vertex (taken by the stars) or a plane.
- *
- * The order is one sort of 63-bit keys (a radix sort, linear), the tree
- * splits it into halves of whole leaves (balanced, built in linear time),
- * and a node's box is fitted to its children's boxes, not to its corners:
- * the whole build is linear in the triangles, and the traversal, which
- * visits the pairs of nodes whose boxes meet, about n log n on surfaces
- * whose triangles' neighbours are few, whatever their shapes. */
+/* Pairs that share no vertex: a tree of boxes whose leaves are groups of
+ * up to LEAF_TRIS neighbouring triangles of the surface (grow_groups) and
+ * whose upper levels split the groups by the surface-area heuristic, each
+ * box oriented along the longest edge of its triangles and the normal of
+ * that edge's triangle (a spike of a noisy scan, a sliver of a rod turned
+ * off the axes: its box is as thin as it is, where a box along the
+ * coordinate axes would span the part). Two boxes are apart when their
+ * projections on one of their six axes are apart, a triangle projecting its
+ * corners and a box its centre and half-widths; every projection is widened
+ * by pad, far above the round-off of the frames and dot products, so a pair
+ * that may cross is never dropped: the exact test decides. A node's corners
+ * common to all its triangles, and its flat patch, skip a pair of nodes
+ * whose triangles all share a vertex (taken by the stars) or a plane. The
+ * traversal visits the pairs of nodes whose boxes meet. */
 enum { LEAF_TRIS = 8, REFIT_TRIS = 64 };
 
 typedef struct bnode {
@@ -527,7 +539,9 @@ typedef struct item {
 typedef struct bvh {
     bnode *nodes;
     int nn, cap, *order;
-    item *items;
+    item *items;                /* one per patch */
+    int *members, *patch_start; /* patch i: members[patch_start[i] .. patch_start[i + 1]) */
+    int filled;                 /* triangles laid out in order so far */
 } bvh;
 
 /* An orthonormal frame (to round-off) with ax[0] along d, ax[1] in the
@@ -778,9 +792,9 @@ static void fit_leaf(search *s, const bvh *tr, bnode *nd)
             nd->patch = -1;
 }
 
-/* Builds node id over order[first .. first + count): a leaf of at most
- * LEAF_TRIS triangles, or two children that split them between whole
- * leaves, half of the leaves each. */
+/* Builds node id over the patches items[first .. first + count): a leaf
+ * of one patch, its triangles appended to order, or two children that
+ * split the patches by the surface-area heuristic. */
 static int build(search *s, bvh *tr, int id, int first, int count)
 {
     /* A cancelled build stops as one out of memory does; the caller tells
@@ -788,12 +802,13 @@ static int build(search *s, bvh *tr, int id, int first, int count)
     if (stop(s))
         return -1;
     bnode *nd = &tr->nodes[id];
-    nd->first = first;
-    nd->count = count;
-    if (count <= LEAF_TRIS) {
+    nd->first = tr->filled;
+    if (count == 1) {
+        const int *pt = tr->members + tr->patch_start[tr->items[first].t];
+        nd->count = tr->patch_start[tr->items[first].t + 1] - tr->patch_start[tr->items[first].t];
         nd->left = -1;
-        for (int i = 0; i < count; i++)
-            tr->order[first + i] = tr->items[first + i].t;
+        for (int i = 0; i < nd->count; i++)
+            tr->order[tr->filled++] = pt[i];
         fit_leaf(s, tr, nd);
         return 0;
     }
@@ -811,6 +826,7 @@ static int build(search *s, bvh *tr, int id, int first, int count)
     if (build(s, tr, l, first, nl) != 0 || build(s, tr, l + 1, first + nl, count - nl) != 0)
         return -1;
     nd = &tr->nodes[id];
+    nd->count = tr->filled - nd->first;
     const bnode *c[2] = {&tr->nodes[l], &tr->nodes[l + 1]};
     /* The frame of either child, or the coordinate axes, whichever holds
      * both children's boxes in the least surface: a frame kept from the
@@ -1008,43 +1024,140 @@ static int node_self(search *s, const bvh *tr, int id)
            node_pair(s, tr, nd->left, nd->left + 1);
 }
 
+/* The leaves' groups. First the fans: the triangles about a vertex of
+ * more than FAN_TRIS, LEAF_TRIS at a time in the star's order (a polygon
+ * fanned from one corner: runs of neighbouring wedges, all about that
+ * corner, whose pairs the corner tests skip; long wedges spread over the
+ * leaves of their other corners would meet one another's boxes at the
+ * fan's corner, every leaf with every other). Then groups of up to
+ * LEAF_TRIS grown from a seed over shared corners, breadth first (the
+ * triangles about each corner of the seed, then about theirs), seeds in
+ * the order of the triangles. A leaf of triangles whose centres or boxes
+ * lie close together gathers, on a noisy scan whose spikes span the shell,
+ * spikes from a patch of the surface many spikes wide at different depths,
+ * and its box meets those of every leaf stacked over that patch; a group
+ * grown over the surface is a patch a few triangles wide. Any grouping is
+ * sound: every pair of triangles is still under one node, in one leaf or
+ * across two children. 0, or -1 when out of memory or cancelled. */
+enum { FAN_TRIS = 32 };
+
+static int grow_groups(search *s, bvh *tr, int *ngroups)
+{
+    const pd_mesh *m = s->m;
+    int n = m->ntris, ng = 0, filled = 0;
+    char *taken = calloc((size_t)n, 1);
+    tr->members = malloc(sizeof *tr->members * (size_t)n);
+    tr->patch_start = malloc(sizeof *tr->patch_start * ((size_t)n + 1));
+    if (!taken || !tr->members || !tr->patch_start) {
+        free(taken);
+        return -1;
+    }
+    int *mb = tr->members;
+    for (int v = 0; v < m->nverts; v++) {
+        if (s->start[v + 1] - s->start[v] <= FAN_TRIS)
+            continue;
+        int in = LEAF_TRIS;
+        for (int i = s->start[v]; i < s->start[v + 1]; i++) {
+            int t = s->list[i];
+            if (taken[t])
+                continue;
+            if (in == LEAF_TRIS) {
+                tr->patch_start[ng++] = filled;
+                in = 0;
+            }
+            taken[t] = 1;
+            mb[filled++] = t;
+            in++;
+        }
+    }
+    for (int seed = 0; seed < n; seed++) {
+        if (taken[seed])
+            continue;
+        if (stop(s)) {
+            free(taken);
+            return -1;
+        }
+        int first = filled;
+        tr->patch_start[ng++] = first;
+        taken[seed] = 1;
+        mb[filled++] = seed;
+        for (int q = first; q < filled && filled - first < LEAF_TRIS; q++) {
+            const int *T = m->tris[mb[q]];
+            for (int k = 0; k < 3 && filled - first < LEAF_TRIS; k++)
+                for (int i = s->start[T[k]]; i < s->start[T[k] + 1] && filled - first < LEAF_TRIS;
+                     i++) {
+                    int u = s->list[i];
+                    if (!taken[u]) {
+                        taken[u] = 1;
+                        mb[filled++] = u;
+                    }
+                }
+        }
+    }
+    tr->patch_start[ng] = filled;
+    free(taken);
+    *ngroups = ng;
+    return 0;
+}
+
 /* 1 when a crossing is found (or the search is cancelled), -1 when out of
- * memory. */
+ * memory. Frees the stars once the leaves' groups are grown. */
 static int apart_pairs(search *s)
 {
     const pd_mesh *m = s->m;
     size_t n = (size_t)m->ntris;
-    bvh tr = {NULL, 1, (int)(n / 2 + 1), malloc(sizeof *tr.order * n), malloc(sizeof *tr.items * n)};
-    tr.nodes = malloc(sizeof *tr.nodes * (size_t)tr.cap);
-    int found = -1;
-    if (tr.order && tr.items && tr.nodes) {
-        for (size_t t = 0; t < n; t++) {
-            const int *T = m->tris[t];
-            const pd_vec3 *v = m->verts;
-            item *x = &tr.items[t];
-            double lo[3] = {dmin(dmin(v[T[0]].x, v[T[1]].x), v[T[2]].x),
-                            dmin(dmin(v[T[0]].y, v[T[1]].y), v[T[2]].y),
-                            dmin(dmin(v[T[0]].z, v[T[1]].z), v[T[2]].z)};
-            double hi[3] = {dmax(dmax(v[T[0]].x, v[T[1]].x), v[T[2]].x),
-                            dmax(dmax(v[T[0]].y, v[T[1]].y), v[T[2]].y),
-                            dmax(dmax(v[T[0]].z, v[T[1]].z), v[T[2]].z)};
+    bvh tr = {0};
+    int ng = 0, found = -1;
+    int grown = grow_groups(s, &tr, &ng);
+    free(s->start);
+    free(s->list);
+    s->start = s->list = NULL;
+    if (grown == 0) {
+        tr.nn = 1;
+        tr.cap = 2 * ng;
+        tr.order = malloc(sizeof *tr.order * n);
+        tr.items = malloc(sizeof *tr.items * (size_t)ng);
+        tr.nodes = malloc(sizeof *tr.nodes * (size_t)tr.cap);
+    }
+    if (grown != 0 && s->cancelled)
+        found = 1;
+    else if (tr.order && tr.items && tr.nodes) {
+        const pd_vec3 *v = m->verts;
+        for (int g = 0; g < ng; g++) {
+            double lo[3] = {HUGE_VAL, HUGE_VAL, HUGE_VAL}, hi[3] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL};
+            for (int i = tr.patch_start[g]; i < tr.patch_start[g + 1]; i++) {
+                const int *T = m->tris[tr.members[i]];
+                for (int k = 0; k < 3; k++) {
+                    double c[3] = {v[T[k]].x, v[T[k]].y, v[T[k]].z};
+                    for (int j = 0; j < 3; j++) {
+                        lo[j] = dmin(lo[j], c[j]);
+                        hi[j] = dmax(hi[j], c[j]);
+                    }
+                }
+            }
+            item *x = &tr.items[g];
             for (int k = 0; k < 3; k++) {
                 x->lo[k] = (float)lo[k];
                 x->hi[k] = (float)hi[k];
             }
-            x->t = (int)t;
+            x->t = g;
         }
         if (stop(s))
             found = 1;
-        else if (build(s, &tr, 0, 0, (int)n) == 0) {
+        else if (build(s, &tr, 0, 0, ng) == 0) {
             free(tr.items);
+            free(tr.members);
+            free(tr.patch_start);
             tr.items = NULL;
+            tr.members = tr.patch_start = NULL;
             found = node_self(s, &tr, 0);
         }
     }
     free(tr.nodes);
     free(tr.order);
     free(tr.items);
+    free(tr.members);
+    free(tr.patch_start);
     return found;
 }
 
@@ -1066,10 +1179,6 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
     int found = -1;
     if (s.patch && build_stars(&s) == 0 && flat_patches(&s) == 0) {
         found = s.cancelled ? 1 : star_pairs(&s);
-        /* The stars are not needed by the tree: their memory goes first. */
-        free(s.start);
-        free(s.list);
-        s.start = s.list = NULL;
         if (found == 0)
             found = apart_pairs(&s);
     }

@@ -226,8 +226,8 @@ static pd_status build(pd_part *p, const pd_part_options *opt, pd_diag *diag)
     pd_vec3 lo = v3(0.0, 0.0, 0.0), hi = lo;
     for (int i = 0; i < m->nverts; i++) {
         pd_vec3 v = m->verts[i];
-        lo = i == 0 ? v : v3(fmin(lo.x, v.x), fmin(lo.y, v.y), fmin(lo.z, v.z));
-        hi = i == 0 ? v : v3(fmax(hi.x, v.x), fmax(hi.y, v.y), fmax(hi.z, v.z));
+        lo = i == 0 ? v : v3_min(lo, v);
+        hi = i == 0 ? v : v3_max(hi, v);
     }
     pd_status st = pd_size_check(lo, hi, "", diag);
     if (st != PD_OK)
