@@ -63,10 +63,10 @@ velocity, no spin):
 
 -r reuses what DIR keeps: MuJoCo's drops from the same releases (they
 depend on posedrop only through the release), and posedrop's runs made at
-a commit whose src/ and include/ are this one's (neither with changes) with the same command; so after the engines change, -r reruns
-posedrop's engines and only the MuJoCo drops not yet made,
-and a stopped run resumes. The posedrop runs' commands and commits go in the
-table's heading.
+a commit whose src/ and include/ are this one's (neither with changes)
+with the same command; so after the engines change, -r reruns posedrop's
+engines and only the MuJoCo drops not yet made, and a stopped run resumes.
+The posedrop runs' commands and commits go in the table's heading.
 
 Writes DIR/referee.csv (part,engine,class,n,count,p,ci_lo,ci_hi,unsettled,
 cpu_ms_per_drop), prints the corpus table in Markdown and, with --doc FILE,
