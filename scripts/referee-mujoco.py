@@ -63,11 +63,10 @@ velocity, no spin):
 
 -r reuses what DIR keeps: MuJoCo's drops from the same releases (they
 depend on posedrop only through the release), and posedrop's runs made at
-a commit whose src/, include/ and Makefile are this one's (neither with
-changes) with the same command; so after the engines change, -r reruns
-posedrop's engines and only the MuJoCo drops not yet made,
-and a stopped run resumes. The posedrop runs' commands and commits go in the
-table's heading.
+a commit whose src/ and include/ are this one's (neither with changes)
+with the same command; so after the engines change, -r reruns posedrop's
+engines and only the MuJoCo drops not yet made, and a stopped run resumes.
+The posedrop runs' commands and commits go in the table's heading.
 
 Writes DIR/referee.csv (part,engine,class,n,count,p,ci_lo,ci_hi,unsettled,
 cpu_ms_per_drop), prints the corpus table in Markdown and, with --doc FILE,
@@ -277,12 +276,14 @@ def sub(a, b):
 
 
 def same_code(commit):
-    """Whether posedrop's code (src/, include/, the Makefile) is now what it
-    was at commit, both without changes."""
+    """Whether posedrop's code (src/, include/) is now what it was at
+    commit, both without changes. The Makefile's flags change no result
+    (no -ffast-math; -ffp-contract=off), and a recipe's edit should not
+    redo the runs."""
     if COMMIT[1] or commit.endswith(", with changes"):
         return False
     p = subprocess.run(["git", "-C", ROOT, "diff", "--quiet", commit, "HEAD", "--", "src",
-                        "include", "Makefile"], stdout=subprocess.DEVNULL,
+                        "include"], stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL)
     return p.returncode == 0
 
