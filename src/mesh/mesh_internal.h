@@ -24,7 +24,7 @@ pd_status pd_mesh_orient_cancel(pd_mesh *mesh, int *nflipped, pd_cancel_flag *ca
  * without crossing, is not crossing; coplanar pairs are not examined).
  * *ta < *tb are their indices and *at a point of the crossing (rounded), or
  * *ta = *tb = -1 when there is none; *tested (when not NULL) the number of
- * pairs that reached the exact test. PD_OK, PD_ERR_NOMEM, or
+ * pairs that passed the broad phase (to the plane filter and exact test). PD_OK, PD_ERR_NOMEM, or
  * PD_ERR_CANCELLED when *cancel (may be NULL) is found non-zero (read
  * before the search and every few thousand steps of it). Pairs sharing a
  * vertex are found from the directions about it, the others by a tree of
@@ -32,5 +32,12 @@ pd_status pd_mesh_orient_cancel(pd_mesh *mesh, int *nflipped, pd_cancel_flag *ca
  * across the axes and fans of them about one corner included. */
 pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *ta, int *tb,
                                 pd_vec3 *at, size_t *tested);
+
+/* The floating-point filter in front of pd_mesh_self_crossing's exact test:
+ * 1 when it proves that one of triangles a and b (corners indexed into v)
+ * has no corner strictly on each side of the other's plane, so that they do
+ * not cross; 0 when it cannot tell. R at least the largest coordinate
+ * magnitude of v. */
+int pd_selfx_plane_filter(const pd_vec3 *v, const int a[3], const int b[3], double R);
 
 #endif

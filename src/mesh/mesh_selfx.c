@@ -9,6 +9,7 @@
  * segment of their boundaries, are never reported: touching is not
  * crossing. Coplanar pairs are not examined (they touch, or overlap within
  * one plane, which the moment checks see as area, not as volume). */
+#include <float.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -178,7 +179,8 @@ typedef struct search {
     int *patch;            /* the flat patch of each triangle */
     int *start, *list;     /* the triangles about vertex v: list[start[v] .. start[v + 1]) */
     double pad;            /* widening of every projection (PD_SELFX_PAD_REL) */
-    size_t tested;         /* pairs given to the exact test */
+    float *plane;          /* per triangle: normal and rejection bound (plane_of) */
+    size_t tested;         /* pairs past the broad phase (the plane filter's input) */
     int ta, tb;
     pd_vec3 at;
     pd_cancel_flag *cancel; /* may be NULL */
@@ -343,6 +345,92 @@ static int shared(const int a[3], const int b[3])
     return n;
 }
 
+/* A filter in front of the exact test: triangle t's plane stored once as
+ * pl = {nx, ny, nz, B}, floats, so that a triangle lying strictly on one side
+ * of another's plane is set aside with three dot products.
+ *
+ * Why it is rigorous. Let T = (a, b, c) be t's corners, N = (b - a) x (c - a)
+ * exact, nd the same computed in doubles and n = (float)nd; for a point p
+ * the exact sign tested by side() is that of N . w, w = p - a. The filter
+ * computes f = n . wd in doubles, wd = fl(p - a). With u = 2^-53 and R the
+ * largest coordinate magnitude of the mesh (so |w_i|, |wd_i| <= 2R):
+ *  - |nd_i - N_i| <= 5u P_i (two rounded differences in each product, the
+ *    product and the subtraction: 4 roundings and second-order terms), P_i
+ *    the permanent |u_y v_z| + |u_z v_y| (...) of the rounded edges;
+ *  - |n_i - nd_i| <= 2^-24 |nd_i| <= 2^-24 (1 + 2^-23) |n_i| when nd_i is
+ *    zero or within the range of normal floats;
+ *  - |n . (wd - w)| <= u |n|_1 2R (one rounding per difference);
+ *  - the computed dot product differs from n . wd by at most 3u |n|_1 2R
+ *    (floats times doubles are exact in doubles only up to the rounding of
+ *    each product and of the two sums).
+ * So |f - N . w| <= 2R [2^-24 (1 + 2^-23) |n|_1 + 5u |P|_1 + 4u |n|_1]
+ *                <= 2R 2^-23 (|n|_1 + |P|_1) = B,
+ * each of the small u terms being far below the slack 2^-24 (|n|_1 + |P|_1)
+ * that the factor 2^-23 leaves; B is evaluated in doubles (a relative error
+ * of a few u, again inside that slack) and rounded up to a float. f > B then
+ * means N . w > 0, exactly, and f < -B that N . w < 0. Products that could
+ * underflow (a normal float component below FLT_MIN, or an nd too large for a
+ * float) or edges below 2^-500 (whose products could fall below DBL_MIN and
+ * lose their relative accuracy) make B infinite: that triangle is never set
+ * aside. The remaining round-off, products of the dot below DBL_MIN, is
+ * covered by PD_ORIENT3D_FILTER_ABS added at the comparison. */
+static void plane_of(const pd_vec3 *v, const int T[3], double R, float pl[4])
+{
+    pd_vec3 a = v[T[0]], b = v[T[1]], c = v[T[2]];
+    double ux = b.x - a.x, uy = b.y - a.y, uz = b.z - a.z;
+    double vx = c.x - a.x, vy = c.y - a.y, vz = c.z - a.z;
+    double nd[3] = {uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx};
+    double P = fabs(uy * vz) + fabs(uz * vy) + fabs(uz * vx) + fabs(ux * vz) + fabs(ux * vy) +
+               fabs(uy * vx);
+    double n1 = 0.0, e[6] = {ux, uy, uz, vx, vy, vz};
+    int ok = isfinite(P);
+    for (int i = 0; i < 6; i++)
+        ok = ok && (e[i] == 0.0 || fabs(e[i]) >= 0x1p-500);
+    for (int i = 0; i < 3; i++) {
+        double x = fabs(nd[i]);
+        ok = ok && (x == 0.0 || (x >= (double)FLT_MIN && x <= (double)FLT_MAX / 2));
+        pl[i] = ok ? (float)nd[i] : 0.0f;
+        n1 += fabs((double)pl[i]);
+    }
+    double B = 2.0 * R * 0x1p-23 * (n1 + P);
+    float Bf = (float)B;
+    if ((double)Bf < B)
+        Bf = nextafterf(Bf, HUGE_VALF);
+    pl[3] = ok && B < (double)FLT_MAX / 2 ? Bf : HUGE_VALF;
+}
+
+/* 1 when the filter proves that triangle p (corners P) does not straddle the
+ * plane of triangle q (corners Q, plane pl) strictly: no corner certainly on
+ * one side, each either a corner of q (sign 0, exactly, as side() has it) or
+ * certainly on the other. side() then returns 0 and so does cross(). */
+static int one_side(const pd_vec3 *v, const int P[3], const int Q[3], const float pl[4])
+{
+    double nx = pl[0], ny = pl[1], nz = pl[2], B = (double)pl[3] + PD_ORIENT3D_FILTER_ABS;
+    const pd_vec3 *a = &v[Q[0]];
+    int pos = 0, neg = 0;
+    for (int i = 0; i < 3; i++) {
+        if (P[i] == Q[0] || P[i] == Q[1] || P[i] == Q[2])
+            continue;
+        const pd_vec3 *p = &v[P[i]];
+        double f = nx * (p->x - a->x) + ny * (p->y - a->y) + nz * (p->z - a->z);
+        if (f > B)
+            pos = 1;
+        else if (f < -B)
+            neg = 1;
+        else
+            return 0;
+    }
+    return !(pos && neg);
+}
+
+int pd_selfx_plane_filter(const pd_vec3 *v, const int a[3], const int b[3], double R)
+{
+    float pa[4], pb[4];
+    plane_of(v, a, R, pa);
+    plane_of(v, b, R, pb);
+    return one_side(v, a, b, pb) || one_side(v, b, a, pa);
+}
+
 /* The exact test of triangles a and b (not of one flat patch); records them
  * when they cross. */
 static int test_pair(search *s, int a, int b)
@@ -351,9 +439,11 @@ static int test_pair(search *s, int a, int b)
         return 0;
     const int *A = s->m->tris[a], *B = s->m->tris[b];
     const pd_vec3 *v = s->m->verts;
+    s->tested++;
+    if (one_side(v, A, B, s->plane + 4 * (size_t)b) || one_side(v, B, A, s->plane + 4 * (size_t)a))
+        return 0;
     const pd_vec3 *p[3] = {&v[A[0]], &v[A[1]], &v[A[2]]};
     const pd_vec3 *q[3] = {&v[B[0]], &v[B[1]], &v[B[2]]};
-    s->tested++;
     if (!cross(p, q, &s->at))
         return 0;
     s->ta = a < b ? a : b;
@@ -1175,14 +1265,18 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
     for (int i = 0; i < m->nverts; i++)
         R = dmax(R, dmax(fabs(m->verts[i].x), dmax(fabs(m->verts[i].y), fabs(m->verts[i].z))));
     search s = {m, malloc(sizeof *s.patch * (size_t)m->ntris), NULL, NULL, PD_SELFX_PAD_REL * R,
-                0, -1, -1, {0, 0, 0}, cancel, 0, 0};
+                malloc(sizeof *s.plane * 4 * (size_t)m->ntris), 0, -1, -1, {0, 0, 0}, cancel, 0, 0};
     int found = -1;
-    if (s.patch && build_stars(&s) == 0 && flat_patches(&s) == 0) {
+    if (s.plane)
+        for (int t = 0; t < m->ntris; t++)
+            plane_of(m->verts, m->tris[t], R, s.plane + 4 * (size_t)t);
+    if (s.patch && s.plane && build_stars(&s) == 0 && flat_patches(&s) == 0) {
         found = s.cancelled ? 1 : star_pairs(&s);
         if (found == 0)
             found = apart_pairs(&s);
     }
     free(s.patch);
+    free(s.plane);
     free(s.start);
     free(s.list);
     if (tested)

@@ -12,6 +12,7 @@
 #include <string.h>
 #include <unistd.h>
 #include "check.h"
+#include "base/predicates.h"
 #include "base/vec3.h"
 #include "mesh/mesh_internal.h"
 #include "posedrop/mesh.h"
@@ -1098,6 +1099,76 @@ static void test_self_crossing_rod(void)
     CHECK(per[1] < 2.0 * per[0]);
 }
 
+/* Exact signs of triangle p's corners against the plane of q: 1 when one is
+ * strictly positive and one strictly negative (a shared corner counts 0). */
+static int exact_straddle(const pd_vec3 *v, const int p[3], const int q[3])
+{
+    int pos = 0, neg = 0;
+    for (int i = 0; i < 3; i++) {
+        if (p[i] == q[0] || p[i] == q[1] || p[i] == q[2])
+            continue;
+        int s = pd_orient3d_exact(&v[q[0]], &v[q[1]], &v[q[2]], &v[p[i]]);
+        pos += s > 0;
+        neg += s < 0;
+    }
+    return pos && neg;
+}
+
+/* The plane filter in front of the exact test never sets aside a pair in
+ * which each triangle straddles the other's plane (exact signs), on random
+ * pairs whose second triangle's corners lie on the first's plane to
+ * rounding, then moved off it by 0 to 1e-1 of the triangle's size, with
+ * corners shared, at offsets from the origin up to 1e4 times the size and
+ * sizes from 1e-6 to 1e6. It does set aside every pair moved clearly to one
+ * side (by 1e-2 of the size, near the origin), or it would save nothing. */
+static void test_self_crossing_filter(void)
+{
+    test_rng rng = {20261207};
+    int wrong = 0, straddling = 0, clear = 0, clear_kept = 0, trials = 200000;
+    for (int it = 0; it < trials; it++) {
+        double L = pow(10.0, -6.0 + 12.0 * rng_uniform(&rng));
+        double off = rng_uniform(&rng) < 0.5 ? 0.0 : L * pow(10.0, 4.0 * rng_uniform(&rng));
+        pd_vec3 v[6];
+        for (int i = 0; i < 3; i++)
+            v[i] = v3(off + L * (rng_uniform(&rng) - 0.5), off * 0.3 + L * (rng_uniform(&rng) - 0.5),
+                      -off + L * (rng_uniform(&rng) - 0.5));
+        pd_vec3 n = v3_unit(v3_cross(v3_sub(v[1], v[0]), v3_sub(v[2], v[0])));
+        int one_way = rng_uniform(&rng) < 0.5;
+        double h = rng_uniform(&rng) < 0.3 ? 0.0 : L * pow(10.0, -16.0 + 15.0 * rng_uniform(&rng));
+        for (int i = 3; i < 6; i++) {
+            double a = 2.0 * rng_uniform(&rng) - 0.5, b = 2.0 * rng_uniform(&rng) - 0.5;
+            pd_vec3 on = v3_add(v[0], v3_add(v3_scale(v3_sub(v[1], v[0]), a),
+                                            v3_scale(v3_sub(v[2], v[0]), b)));
+            double side = one_way ? 1.0 : (rng_uniform(&rng) < 0.5 ? -1.0 : 1.0);
+            v[i] = v3_add(on, v3_scale(n, side * h * (0.5 + rng_uniform(&rng))));
+        }
+        int p[3] = {0, 1, 2}, q[3] = {3, 4, 5};
+        double u = rng_uniform(&rng);
+        if (u < 0.2)
+            q[0] = 0;
+        if (u < 0.05)
+            q[1] = 1;
+        double R = 0.0;
+        for (int i = 0; i < 6; i++)
+            R = fmax(R, fmax(fabs(v[i].x), fmax(fabs(v[i].y), fabs(v[i].z))));
+        int set_aside = pd_selfx_plane_filter(v, p, q, R);
+        int both = exact_straddle(v, p, q) && exact_straddle(v, q, p);
+        straddling += both;
+        wrong += set_aside && both;
+        if (one_way && off == 0.0 && h >= 1e-2 * L && q[0] != 0) {
+            clear++;
+            clear_kept += !set_aside;
+        }
+    }
+    pd_note("self-crossing filter, %d pairs: %d straddle each other exactly, %d clearly apart\n",
+            trials, straddling, clear);
+    CHECK_INT(wrong, 0);
+    /* The near-degenerate cases the filter must not decide occur. */
+    CHECK(straddling > trials / 100);
+    CHECK(clear > 100);
+    CHECK_INT(clear_kept, 0);
+}
+
 void suite_mesh(void)
 {
     test_off();
@@ -1115,4 +1186,5 @@ void suite_mesh(void)
     test_self_crossing();
     test_self_crossing_many();
     test_self_crossing_rod();
+    test_self_crossing_filter();
 }
