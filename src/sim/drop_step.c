@@ -23,16 +23,17 @@
  * And one hold: the energy test reads the part's motion and height, not
  * what its contacts' springs hold, so at the bottom of a bounce (the part
  * still, its contacts compressed) a part landing on a facet passes it with
- * the energy of the fall stored in the floor, to be given back: a 1 cm cube
- * dropped resting on a face from 12 cm ended there in 479 of 996 ODE drops
- * (484 Bullet), before rebounding with e^2 of the fall's energy, five times
- * what it needs to tip. A decision stands only when it has held on every
- * step for one contact time of the drop, longer than a bounce's turning
- * point lasts; at rest it holds throughout. Only where the step resolves
- * the contact (PD_ENGINE_CONTACT_STEPS): at a coarser step the engine keeps
- * its own rigid contact, which stores nothing, and its resting state may
- * flicker from step to step (a 0.1 mm cube on ODE at 1 ms: 17 of 200 drops
- * never held two steps running). */
+ * the energy of the fall stored in the floor, to be given back (a cube
+ * dropped resting on a face ended there in about half its drops, before a
+ * rebound with several times the energy it needs to tip: measured in
+ * docs/engines-crosscheck.md, "The resting cube: which engine is right").
+ * A decision stands only when it has held on every step for one contact
+ * time of the drop, longer than a bounce's turning point lasts; at rest it
+ * holds throughout. Only where the step resolves the contact
+ * (PD_ENGINE_CONTACT_STEPS): at a coarser step the engine keeps its own
+ * rigid contact, which stores nothing, and its resting state may flicker
+ * from step to step, never holding a contact time (a tiny cube on ODE at
+ * 1 ms, test_hard_parts.c). */
 #include <math.h>
 #include "base/fail.h"
 #include "base/vec3.h"
