@@ -137,8 +137,9 @@
  * (semi-implicit Euler, as the impulse simulator's compliant step)
  * rebounds within 0.0016 of e at 20 steps and 0.0004 at 40, wherever in
  * the step the vertex touches (the scaled law stepped as the engines step
- * it, e 0.05 to 1: scripts/engine-step-rebound.py, docs/engines-crosscheck.md). b = c alone would leave a row without damping
- * (c = 0 at e = 1 or at zero depth) an infinite cfm, so b keeps this share
+ * it, e 0.05 to 1: scripts/engine-step-rebound.py,
+ * docs/engines-crosscheck.md). b = c alone would leave a row without
+ * damping (c = 0 at e = 1 or at zero depth) an infinite cfm, so b keeps this share
  * of h k. Why 1e-3: its loss is that share of the implicit spring's, at
  * most 2e-4 of the approach speed at 20 steps, below the step's own error,
  * while cfm stays within 1e3 / (h k) and the rows of the solvers well
