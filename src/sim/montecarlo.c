@@ -510,25 +510,16 @@ static pd_status drive_stationary(const pd_sim_model *model, const pd_scene *sce
 
 /* p and its intervals become pi of the estimated chain and its resampled
  * intervals, when the counts define the chain; otherwise they stay count / n
- * and Wilson's (closed_classes 0 says which). */
+ * and Wilson's (closed_classes 0 says which). The chain's states are the
+ * poses, or their classes (chain_class_of), each class's share then split
+ * equally among its poses, which the part's symmetry makes equally likely. */
 static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
 {
-    if (!r->chain_class_of) {
-        pd_markov_counts c = {r->nposes, r->first_count, r->transitions};
-        pd_markov_summary s = {r->p, r->ci_lo, r->ci_hi, 0, 0.0};
-        pd_status st = pd_markov_estimate(&c, NULL, r->nposes, r->seed, &s);
-        if (st != PD_OK)
-            return pd_fail(diag, st, "the long-run distribution of the pose chain: %s",
-                           pd_status_str(st));
-        r->closed_classes = s.nclosed;
-        r->stationary_shift = s.shift;
-        return PD_OK;
-    }
-    /* The chain of classes; each class's share split equally among its
-     * poses, which the part's symmetry makes equally likely. */
-    int K = r->chain_states;
-    double *buf = malloc(sizeof *buf * 3 * (size_t)K);
-    int *size = calloc((size_t)K, sizeof *size);
+    const int *class_of = r->chain_class_of;
+    int K = class_of ? r->chain_states : r->nposes;
+    /* One more than needed: a run of no pose asks for no bytes. */
+    double *buf = malloc(sizeof *buf * (3 * (size_t)K + 1));
+    int *size = calloc((size_t)K + 1, sizeof *size);
     if (!buf || !size) {
         free(buf);
         free(size);
@@ -539,9 +530,9 @@ static pd_status finish_stationary(pd_sim_result *r, pd_diag *diag)
     pd_status st = pd_markov_estimate(&c, NULL, K, r->seed, &s);
     if (st == PD_OK && s.nclosed > 0) {
         for (int j = 0; j < r->nposes; j++)
-            size[r->chain_class_of[j]]++;
+            size[class_of ? class_of[j] : j]++;
         for (int j = 0; j < r->nposes; j++) {
-            int cl = r->chain_class_of[j];
+            int cl = class_of ? class_of[j] : j;
             r->p[j] = s.p[cl] / size[cl];
             r->ci_lo[j] = s.lo[cl] / size[cl];
             r->ci_hi[j] = s.hi[cl] / size[cl];
