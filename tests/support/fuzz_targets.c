@@ -120,7 +120,15 @@ int pd_fuzz_part(const uint8_t *data, size_t size)
  * message and its outputs untouched; PD_ERR_USAGE for a NULL it needs; on
  * success a result that holds together. */
 
-enum { FZ_SLOTS = 4, FZ_MAX_CALLS = 48 };
+/* A program's drops are its cost: a drop that never settles (a tilt of half
+ * a turn, a pose table from another part) runs to its time or collision
+ * limit, a hundredth of a second in the optimised build and about a hundred
+ * times that under the sanitizers and the fuzzer's coverage, so a program
+ * may drop FZ_DROPS times in all, each for at most FZ_DROP_TIME simulated
+ * seconds (a fall of a metre) and FZ_COLLISIONS collisions. Beyond them a
+ * program is a slow run, not a finding (an input may take 10 s). */
+enum { FZ_SLOTS = 4, FZ_MAX_CALLS = 48, FZ_DROPS = 8, FZ_COLLISIONS = 300 };
+#define FZ_DROP_TIME 0.5
 
 typedef struct {
     const uint8_t *p;
@@ -211,6 +219,7 @@ typedef struct {
     pd_sim_result *sim[FZ_SLOTS];
     int ok;
     long calls;
+    long drops; /* run so far, against FZ_DROPS */
 } fz_state;
 
 /* A failed call's answer: a status of the set, a message, outputs as they
@@ -262,14 +271,16 @@ static void fz_scene(fz_in *in, pd_scene *s)
 static void fz_sim_options(fz_in *in, pd_sim_options *o)
 {
     static const double dts[] = {0.0, 1e-3, 5e-3, 0.01, -1e-3, NAN, 0.02};
-    static const double limits[] = {2.0, 1.0, 0.5, 2.0, 1.0, 0.0, -1.0, NAN};
+    static const double limits[] = {FZ_DROP_TIME, 0.25, 0.1, FZ_DROP_TIME, 0.25, 0.0, -1.0, NAN};
     pd_sim_options_default(o);
     /* Counts stay small (a huge one would be a slow run, not a finding). */
     o->ndrops = fz_pick(in, 16) ? fz_pick(in, 4) : -1;
     o->threads = 1 + fz_pick(in, 2);
     o->seed = fz_byte(in);
     o->time_limit = limits[fz_pick(in, 8)];
-    o->max_collisions = fz_small(in, 0, 300);
+    o->max_collisions = fz_small(in, 0, FZ_COLLISIONS);
+    if (o->max_collisions > FZ_COLLISIONS)
+        o->max_collisions = FZ_COLLISIONS;
     if (fz_pick(in, 4) == 0) {
         o->engine = (pd_engine_kind)fz_enum(in, 3);
         o->dt = dts[fz_pick(in, 7)];
@@ -513,6 +524,26 @@ static void fz_call_sim(fz_state *s, fz_in *in)
     fz_scene(in, &sc);
     pd_sim_options o;
     fz_sim_options(in, &o);
+    /* A stepping engine's automatic step follows the contact time, which
+     * scales with the part: a drop of a built-in shape read in millimetres
+     * (10-40 um across) takes 10^5-10^7 steps, a quarter of a second in the
+     * optimised build. Parts under a centimetre take their automatic step
+     * on the impulse engine, whose cost does not depend on a step. */
+    if ((o.engine == PD_ENGINE_ODE || o.engine == PD_ENGINE_BULLET) && o.dt == 0.0 && p &&
+        !(p->size >= 1e-2))
+        o.engine = PD_ENGINE_IMPULSE;
+    /* The automatic time limit, a hundred falls, only where it is within the
+     * program's for the scene drawn and for the default one (a NULL scene
+     * below); and the drops the program has left. */
+    if (o.time_limit == 0.0 && p &&
+        !(fmax(pd_time_limit_auto(p->size, &sc), pd_time_limit_auto(p->size, NULL)) <=
+          FZ_DROP_TIME))
+        o.time_limit = FZ_DROP_TIME;
+    long left = FZ_DROPS - s->drops;
+    if (o.ndrops > left)
+        o.ndrops = left;
+    if (o.max_drops > left)
+        o.max_drops = left;
     int null_out = fz_null(in), null_scene = fz_null(in), null_opt = fz_pick(in, 64) == 0;
     pd_sim_result *r = NULL;
     pd_diag d;
@@ -530,6 +561,8 @@ static void fz_call_sim(fz_state *s, fz_in *in)
         s->ok &= fz_answer(st, &d, r == NULL, !p || !poses || null_out);
         s->ok &= st != PD_OK || (r && fz_sim_sound(r) && r->n <= o.ndrops + o.max_drops + 2000);
     }
+    if (r)
+        s->drops += r->n;
     if (st == PD_OK && r)
         fz_keep_sim(s, k, r);
 }
