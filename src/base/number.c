@@ -17,8 +17,11 @@
  * correctly rounded double unless the true value and the extended one may
  * lie on two sides of a midpoint between doubles, which the 11 bits
  * rounded off show: within one unit of 10000000000 (binary) the answer is
- * left to strtod. 1 with *out set, 0 when strtod must decide (other forms,
- * more digits, a larger exponent, or a near-midpoint). Text that strtod
+ * left to strtod. That is round-to-nearest; under a directed rounding mode
+ * that a caller may have set (strtod follows it too) the two roundings go
+ * the same way and compose exactly, doubles being extended values. 1 with
+ * *out set, 0 when strtod must decide (other forms, more digits, a larger
+ * exponent, or a near-midpoint). Text that strtod
  * reads differently (hexadecimal, inf, nan, blanks, a bare point) never
  * takes this path. A large mesh file holds millions of such coordinates,
  * most of them printed with 17 digits. */
@@ -75,14 +78,16 @@ static int parse_fast(const char *s, size_t n, double *out)
                                         1e7L,  1e8L,  1e9L,  1e10L, 1e11L, 1e12L, 1e13L,
                                         1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L, 1e20L,
                                         1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L};
-    long double x = scale < 0 ? (long double)w / ten[-scale] : (long double)w * ten[scale];
+    /* Signed before it is rounded, so that a directed rounding goes the
+     * way the mode says for a negative number too. */
+    long double sw = neg ? -(long double)w : (long double)w;
+    long double x = scale < 0 ? sw / ten[-scale] : sw * ten[scale];
     uint64_t mant;
     memcpy(&mant, &x, sizeof mant); /* the explicit 64-bit significand */
     unsigned low = (unsigned)(mant & 0x7ff);
     if (low >= 0x3ff && low <= 0x401)
         return 0;
-    double v = (double)x;
-    *out = neg ? -v : v;
+    *out = (double)x;
     return 1;
 #else
     (void)s;

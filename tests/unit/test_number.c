@@ -4,6 +4,7 @@
 #include <errno.h>
 #include <float.h>
 #include <limits.h>
+#include <fenv.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -173,6 +174,30 @@ static void test_parse_vs_strtod(void)
         CHECK(!differs(edges[i]));
 }
 
+/* Under each directed rounding mode a caller may set, strtod rounds that
+ * way, and so must the fast reading (number.c: its two roundings then
+ * compose exactly): 20,000 random decimals and 20,000 doubles printed with
+ * 17 digits per mode, bit for bit. */
+static void test_parse_directed(void)
+{
+    static const int modes[] = {FE_UPWARD, FE_DOWNWARD, FE_TOWARDZERO};
+    char buf[96];
+    for (size_t m = 0; m < sizeof modes / sizeof *modes; m++) {
+        int bad = 0;
+        if (fesetround(modes[m]) != 0)
+            continue; /* a machine without the mode: nothing to compare */
+        for (int i = 0; i < 20000; i++) {
+            random_decimal(buf);
+            bad += differs(buf);
+            double x = ldexp((double)(next64() >> 11) * 0x1p-53 + 0.5, below(160) - 80);
+            sprintf(buf, "%.17g", below(2) ? x : -x);
+            bad += differs(buf);
+        }
+        fesetround(FE_TONEAREST);
+        CHECK_INT(bad, 0);
+    }
+}
+
 static int real(const pd_num_rule *r, const char *text, double *v)
 {
     return pd_num_read(r, text, v, NULL);
@@ -182,6 +207,7 @@ void suite_number(void)
 {
     test_format();
     test_parse_vs_strtod();
+    test_parse_directed();
     const pd_num_rule angle = {"an angle", 0, 0.0, 90.0, 0, 0, 0, 0};
     const pd_num_rule open = {"a half-width", 0, 0.0, 0.5, 1, 1, 0, 0};
     const pd_num_rule seed = {"a seed", 1, 0, 0, 0, 0, 0, LLONG_MAX};
