@@ -428,22 +428,22 @@ static int kernel_point(search *s, pd_vec3 *o)
         }
         if (st == 0 || !(y[3] > 1e-12 * diag))
             break;
-        /* The planes this centre is not y[3] inside of, all or a stride of
-         * them. */
+        /* The planes this centre is not y[3] inside of: all of them when
+         * they are few (one pass), else a stride of them (a second). */
         int bad = 0, added = 0;
         pd_lp_halfspace h;
         for (int pass = 0; pass < 2 && ok; pass++) {
             int every = pass == 0 ? 1 : bad / KERNEL_ADD + 1, seen = 0;
+            added = 0;
             for (int t = 0; t < n && ok; t++) {
                 ok = kernel_row(m, t, sg, c0, &h);
                 if (ok && h.a[0] * y[0] + h.a[1] * y[1] + h.a[2] * y[2] + (1.0 - 1e-9) * y[3] > h.b) {
-                    if (pass == 0)
-                        bad++;
-                    else if (seen++ % every == 0 && added < KERNEL_ADD)
+                    bad += pass == 0;
+                    if (seen++ % every == 0 && added < KERNEL_ADD)
                         w[k + added++] = h;
                 }
             }
-            if (bad == 0)
+            if (bad <= KERNEL_ADD)
                 break;
         }
         k += added;
