@@ -3,7 +3,7 @@
 # scripts/make-big-meshes.py against qconvex on the same vertices, CPU
 # seconds (user + sys) and peak RSS of each whole process (/usr/bin/time),
 # as the rows of the table in docs/performance.md. Writes the meshes into
-# DIR (default /tmp/bigmesh; about 400 MB, 1.2 GB with BIG=1) unless they are
+# DIR (default /tmp/bigmesh; about 500 MB, 1.2 GB with BIG=1) unless they are
 # there. BIN: the posedrop to measure (default build/opt/posedrop).
 # BIG=1 adds the 4-million-triangle sphere and icosphere, where a term
 # that grows faster than n log n shows. qconvex is not run on the rod: on
@@ -21,10 +21,11 @@ gen() {
     [ -s "$dir/$1.off" ] || scripts/make-big-meshes.py $2 "$dir/$1.off"
     [ -s "$dir/$1.pts" ] || scripts/make-big-meshes.py points "$dir/$1.off" "$dir/$1.pts"
 }
-meshes="hull latlong400k latlong ico rod"
+meshes="hull latlong400k latlong pair ico rod"
 gen hull "hull 10000"
 gen latlong400k "latlong 447"
 gen latlong "latlong 1000"
+gen pair "pair 707"
 gen ico "icosphere 316"
 gen rod "rod 20000 50"
 if [ "${BIG:-0}" = 1 ]; then
@@ -58,6 +59,6 @@ echo "| mesh | reading | weld | hull | orientation | mass | check | whole |"
 echo "|---|---|---|---|---|---|---|---|"
 cc -std=c11 -O2 -Iinclude tests/bench/stages.c "$(dirname "$bin")/libposedrop.a" -lgsl -lgslcblas \
    -lm -pthread -lstdc++ -o "$dir/stages"
-for m in latlong ico rod; do
+for m in latlong pair ico rod; do
     "$dir/stages" "$dir/$m.off" 2> /dev/null
 done

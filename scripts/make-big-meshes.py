@@ -11,6 +11,11 @@ writes the same bytes.
             the origin (a radial graph over the sphere, so it cannot cross
             itself), most vertices inside the hull, many long thin
             triangles, as in a noisy scan. 2 m^2 triangles.
+  pair      two latlong spheres of m, the second after the first in the
+            random stream and moved 2.5 along x: they do not meet, and
+            no point is faced by every triangle (the part is not
+            star-shaped), so the self-crossing check cannot settle it
+            before its search. 4 m^2 triangles.
   icosphere an icosahedron with each face cut into k x k triangles, the
             vertices pushed onto the unit sphere and then to a radius
             1 + 0.01 u, u uniform in [-1, 1] (1% radial noise). 20 k^2
@@ -25,13 +30,14 @@ writes the same bytes.
 
 Usage:
   scripts/make-big-meshes.py latlong M OUT.off [--seed S]
+  scripts/make-big-meshes.py pair M OUT.off [--seed S]
   scripts/make-big-meshes.py icosphere K OUT.off [--seed S]
   scripts/make-big-meshes.py rod N K OUT.off [--seed S]
   scripts/make-big-meshes.py hull P OUT.off [--seed S]
   scripts/make-big-meshes.py points IN.off OUT.txt   qconvex input of a mesh's vertices
 
 Sizes used in docs/performance.md: latlong 1000 (2,000,000 triangles),
-icosphere 316 (1,997,120), rod 20000 50 (2,039,996), hull 10000 (~20,000).
+pair 707 (1,999,396), icosphere 316 (1,997,120), rod 20000 50 (2,039,996), hull 10000 (~20,000).
 Python 3 standard library only.
 """
 
@@ -48,8 +54,8 @@ def write_off(path, verts, tris):
         f.write("".join("3 %d %d %d\n" % t for t in tris))
 
 
-def latlong(m, seed):
-    rng = random.Random(seed)
+def latlong(m, seed, rng=None):
+    rng = rng or random.Random(seed)
     verts = []
     for i in range(m):
         th = math.pi * (i + 1) / (m + 1)
@@ -76,6 +82,15 @@ def latlong(m, seed):
         jn = (j + 1) % m
         tris.append((south, a + jn, a + j))
     return verts, tris
+
+
+def pair(m, seed):
+    rng = random.Random(seed)
+    v1, t1 = latlong(m, seed, rng)
+    v2, t2 = latlong(m, seed, rng)
+    n = len(v1)
+    return (v1 + [(x + 2.5, y, z) for (x, y, z) in v2],
+            t1 + [(a + n, b + n, c + n) for (a, b, c) in t2])
 
 
 ICO_V = None
@@ -209,6 +224,8 @@ def main(argv):
     kind = argv[1]
     if kind == "latlong" and len(argv) == 4:
         write_off(argv[3], *latlong(int(argv[2]), seed))
+    elif kind == "pair" and len(argv) == 4:
+        write_off(argv[3], *pair(int(argv[2]), seed))
     elif kind == "icosphere" and len(argv) == 4:
         write_off(argv[3], *icosphere(int(argv[2]), seed))
     elif kind == "rod" and len(argv) == 5:

@@ -40,22 +40,19 @@
  * touch along a few faces, and bounds the cost for pathological input. */
 #define ORIENT_MAX_PROBES 16
 
-/* One directed edge a -> b of triangle tri, starting at its corner k, keyed by
- * the unordered pair (lo, hi). */
+/* One directed edge of triangle tri, starting at its corner k (code 3 tri +
+ * k), keyed by the unordered pair (lo, hi) of its ends; lo is the run it is
+ * stored in (pair_edges), so it is not stored. */
 typedef struct half_edge {
-    int lo, hi, tri, k;
+    int hi, code;
 } half_edge;
 
 static int cmp_half_edge(const void *pa, const void *pb)
 {
     const half_edge *a = pa, *b = pb;
-    if (a->lo != b->lo)
-        return a->lo < b->lo ? -1 : 1;
     if (a->hi != b->hi)
         return a->hi < b->hi ? -1 : 1;
-    if (a->tri != b->tri)
-        return a->tri < b->tri ? -1 : 1;
-    return (a->k > b->k) - (a->k < b->k);
+    return (a->code > b->code) - (a->code < b->code);
 }
 
 static int tri_degenerate(const int t[3])
@@ -181,7 +178,6 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
     int *at = calloc((size_t)m->nverts + 1, sizeof *at);
     if (!at)
         return pd_fail(diag, PD_ERR_NOMEM, "orient: out of memory for %d vertices", m->nverts);
-    int nh = 0;
     for (int t = 0; t < m->ntris; t++) {
         for (int k = 0; k < 3; k++)
             nbr[3 * t + k] = -1;
@@ -190,7 +186,6 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
         for (int k = 0; k < 3; k++) {
             int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
             at[(a < b ? a : b)]++;
-            nh++;
         }
     }
     for (int v = 0, sum = 0; v <= m->nverts; v++) {
@@ -208,10 +203,8 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
         for (int k = 0; k < 3; k++) {
             int a = m->tris[t][k], b = m->tris[t][(k + 1) % 3];
             half_edge *h = &he[at[a < b ? a : b]++];
-            h->lo = a < b ? a : b;
             h->hi = a < b ? b : a;
-            h->tri = t;
-            h->k = k;
+            h->code = 3 * t + k;
         }
     }
     /* at[v] is now the end of v's run. */
@@ -235,27 +228,32 @@ static pd_status pair_edges(const pd_mesh *m, half_edge *he, int *nbr, unsigned 
         }
         first = at[v];
     }
+    pd_status st = PD_OK;
+    for (int v = 0, first = 0; v < m->nverts && st == PD_OK; first = at[v], v++)
+        for (int i = first; i < at[v];) {
+            int j = i + 1;
+            while (j < at[v] && he[j].hi == he[i].hi)
+                j++;
+            int pt = he[i].code / 3, pk = he[i].code % 3;
+            if (j - i != 2) {
+                st = pd_fail(diag, PD_ERR_NOT_CLOSED,
+                             "orient: edge (%d, %d) is used by %d face%s (triangle %d%s): %s", v,
+                             he[i].hi, j - i, j - i == 1 ? "" : "s", pt,
+                             j - i == 1 ? "" : " and others",
+                             j - i == 1 ? "boundary edge, the mesh has a hole"
+                                        : "non-manifold edge, more than two faces meet there");
+                break;
+            }
+            int qt = he[i + 1].code / 3, qk = he[i + 1].code % 3;
+            /* The edge's direction in each triangle: does it run lo -> hi? */
+            int pfwd = m->tris[pt][pk] == v, qfwd = m->tris[qt][qk] == v;
+            nbr[3 * pt + pk] = qt;
+            nbr[3 * qt + qk] = pt;
+            same[3 * pt + pk] = same[3 * qt + qk] = (unsigned char)(pfwd == qfwd);
+            i = j;
+        }
     free(at);
-    for (int i = 0; i < nh;) {
-        int j = i + 1;
-        while (j < nh && he[j].lo == he[i].lo && he[j].hi == he[i].hi)
-            j++;
-        if (j - i != 2)
-            return pd_fail(diag, PD_ERR_NOT_CLOSED,
-                           "orient: edge (%d, %d) is used by %d face%s (triangle %d%s): %s", he[i].lo,
-                           he[i].hi, j - i, j - i == 1 ? "" : "s", he[i].tri,
-                           j - i == 1 ? "" : " and others",
-                           j - i == 1 ? "boundary edge, the mesh has a hole"
-                                      : "non-manifold edge, more than two faces meet there");
-        const half_edge *p = &he[i], *q = &he[i + 1];
-        /* The edge's direction in each triangle: does it run lo -> hi? */
-        int pfwd = m->tris[p->tri][p->k] == p->lo, qfwd = m->tris[q->tri][q->k] == q->lo;
-        nbr[3 * p->tri + p->k] = q->tri;
-        nbr[3 * q->tri + q->k] = p->tri;
-        same[3 * p->tri + p->k] = same[3 * q->tri + q->k] = (unsigned char)(pfwd == qfwd);
-        i = j;
-    }
-    return PD_OK;
+    return st;
 }
 
 pd_status pd_mesh_orient(pd_mesh *mesh, int *nflipped, pd_diag *diag)

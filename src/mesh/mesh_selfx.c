@@ -14,6 +14,7 @@
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
+#include "base/lp.h"
 #include "base/predicates.h"
 #include "base/vec3.h"
 #include "mesh/mesh_internal.h"
@@ -228,6 +229,262 @@ static int build_stars(search *s)
             s->list[--s->start[m->tris[t][k] + 1]] = t;
     memmove(s->start, s->start + 1, sizeof *s->start * (size_t)nv);
     s->start[nv] = (int)n3;
+    return 0;
+}
+
+/* A sufficient condition for no crossing, checked in linear time before the
+ * search: the surface is closed and consistently oriented (every directed
+ * edge once, its reverse once), every triangle faces one point o strictly
+ * from the same side (orient3d(a, b, c, o) all of one sign, none zero), and
+ * a line through o pierces exactly two triangles, through their interiors.
+ *
+ * Why it suffices. Project the surface from o onto the sphere about o. Each
+ * triangle maps one to one onto a spherical triangle (o is off its plane),
+ * all with the same orientation; the surface being a closed cycle (each
+ * edge's two triangles run it in opposite directions), the number of
+ * triangles a ray from o meets through their interiors is the same for
+ * every ray that misses all edges: the degree of the projection. The line's
+ * two rays, which miss every edge (no zero sign below), meet two triangles
+ * in all, so that degree is 1. If two triangles crossed, a point x of both
+ * relative interiors would have a neighbourhood of rays from o, all meeting
+ * both triangles near x (each projects its interior onto an open set); one
+ * of them misses every edge and meets two triangles, against a degree of 1.
+ * A star-shaped part (a ball, a noisy scan of one, a rod, a die) passes;
+ * any other fails one of the signs or the count, usually early, and the
+ * search below decides. The point o comes from kernel_point. */
+static int faces_point(const pd_mesh *m, search *s, pd_vec3 o)
+{
+    const pd_vec3 *v = m->verts;
+    int sign = 0;
+    for (int t = 0; t < m->ntris; t++) {
+        const int *T = m->tris[t];
+        int g = pd_orient3d(&v[T[0]], &v[T[1]], &v[T[2]], &o);
+        if (g == 0 || (sign != 0 && g != sign) || stop(s))
+            return 0;
+        sign = g;
+    }
+    return 1;
+}
+
+/* The triangles the line through o and p pierces through their interiors,
+ * or -1 when it passes through an edge or a corner of one (or lies in a
+ * triangle's plane). */
+static long line_hits(const pd_mesh *m, pd_vec3 o, pd_vec3 p)
+{
+    const pd_vec3 *v = m->verts;
+    long hits = 0;
+    for (int t = 0; t < m->ntris; t++) {
+        const int *T = m->tris[t];
+        int g0 = pd_orient3d(&o, &p, &v[T[0]], &v[T[1]]);
+        int g1 = pd_orient3d(&o, &p, &v[T[1]], &v[T[2]]);
+        if (g0 * g1 < 0)
+            continue;
+        int g2 = pd_orient3d(&o, &p, &v[T[2]], &v[T[0]]);
+        if (g0 * g2 < 0 || g1 * g2 < 0)
+            continue;
+        if (g0 == 0 || g1 == 0 || g2 == 0)
+            return -1;
+        hits++;
+    }
+    return hits;
+}
+
+static int int_cmp(const void *a, const void *b)
+{
+    int x = *(const int *)a, y = *(const int *)b;
+    return (x > y) - (x < y);
+}
+
+/* Sorts a vertex's few neighbours by insertion, a fan's many by qsort. */
+static void sort_ints(int *x, int n)
+{
+    if (n > 24) {
+        qsort(x, (size_t)n, sizeof *x, int_cmp);
+        return;
+    }
+    for (int i = 1; i < n; i++) {
+        int y = x[i], j = i;
+        for (; j > 0 && x[j - 1] > y; j--)
+            x[j] = x[j - 1];
+        x[j] = y;
+    }
+}
+
+/* Every directed edge once and its reverse once: at each vertex, the
+ * corners that follow it in its triangles are distinct and are those that
+ * precede it. 1 when so, 0 when not, -1 when out of memory. */
+static int closed_oriented(search *s)
+{
+    const pd_mesh *m = s->m;
+    int maxdeg = 0, ok = 1;
+    for (int v = 0; v < m->nverts; v++)
+        maxdeg = s->start[v + 1] - s->start[v] > maxdeg ? s->start[v + 1] - s->start[v] : maxdeg;
+    int *out = malloc(sizeof *out * (2 * (size_t)maxdeg + 1)), *in = out + maxdeg;
+    if (!out)
+        return -1;
+    for (int a = 0; a < m->nverts && ok && !stop(s); a++) {
+        int n = s->start[a + 1] - s->start[a];
+        for (int i = 0; i < n; i++) {
+            const int *T = m->tris[s->list[s->start[a] + i]];
+            int k = T[0] == a ? 0 : T[1] == a ? 1 : 2;
+            out[i] = T[(k + 1) % 3];
+            in[i] = T[(k + 2) % 3];
+        }
+        sort_ints(out, n);
+        sort_ints(in, n);
+        for (int i = 0; i < n && ok; i++)
+            ok = out[i] == in[i] && (i == 0 || out[i] != out[i - 1]);
+    }
+    free(out);
+    return ok && !s->cancelled;
+}
+
+/* Triangle t's plane as a constraint of the kernel's program: u . x + r
+ * <= u . (a - c0), u its unit normal turned by sg towards the outside, a a
+ * corner, x the point measured from c0 and r its distance inside the
+ * plane. 0 for a triangle of no area. */
+static int kernel_row(const pd_mesh *m, int t, int sg, pd_vec3 c0, pd_lp_halfspace *h)
+{
+    const pd_vec3 *v = m->verts;
+    const int *T = m->tris[t];
+    pd_vec3 a = v3_sub(v[T[0]], c0);
+    pd_vec3 n = v3_cross(v3_sub(v[T[1]], v[T[0]]), v3_sub(v[T[2]], v[T[0]]));
+    double len = v3_norm(n);
+    if (!(len > 0.0) || !isfinite(len))
+        return 0;
+    pd_vec3 u = v3_scale(n, sg / len);
+    h->a[0] = u.x;
+    h->a[1] = u.y;
+    h->a[2] = u.z;
+    h->a[3] = 1.0;
+    h->b = v3_dot(u, a);
+    return 1;
+}
+
+/* A candidate for o: the centre of the largest ball inside every
+ * triangle's plane (the part's kernel, where it has one), by a linear
+ * program over a sample of the planes, then again with the planes the last
+ * answer violated, until it violates none (Clarkson's scheme: the working
+ * set stays small). Floating point: faces_point then decides exactly. 1
+ * with the point, 0 when the kernel looks empty, -1 when out of memory. */
+enum { KERNEL_SAMPLE = 1024, KERNEL_ADD = 4096, KERNEL_ROUNDS = 12 };
+
+static int kernel_point(search *s, pd_vec3 *o)
+{
+    const pd_mesh *m = s->m;
+    const pd_vec3 *v = m->verts;
+    int n = m->ntris;
+    double lo[4] = {HUGE_VAL, HUGE_VAL, HUGE_VAL, 0}, hi[4] = {-HUGE_VAL, -HUGE_VAL, -HUGE_VAL, 0};
+    for (int i = 0; i < m->nverts; i++) {
+        double c[3] = {v[i].x, v[i].y, v[i].z};
+        for (int k = 0; k < 3; k++) {
+            lo[k] = dmin(lo[k], c[k]);
+            hi[k] = dmax(hi[k], c[k]);
+        }
+    }
+    pd_vec3 c0 = v3(0.5 * (lo[0] + hi[0]), 0.5 * (lo[1] + hi[1]), 0.5 * (lo[2] + hi[2]));
+    double diag = 0.0, vol = 0.0;
+    for (int k = 0; k < 3; k++) {
+        double e = hi[k] - lo[k];
+        diag += e * e;
+        lo[k] -= k == 0 ? c0.x : k == 1 ? c0.y : c0.z;
+        hi[k] -= k == 0 ? c0.x : k == 1 ? c0.y : c0.z;
+    }
+    diag = sqrt(diag);
+    lo[3] = -diag;
+    hi[3] = diag;
+    /* Outwards by the sign of the enclosed volume. */
+    for (int t = 0; t < n; t++) {
+        const int *T = m->tris[t];
+        vol += v3_dot(v3_sub(v[T[0]], c0),
+                      v3_cross(v3_sub(v[T[1]], c0), v3_sub(v[T[2]], c0)));
+    }
+    int sg = vol >= 0.0 ? 1 : -1, cap = 2 * KERNEL_SAMPLE + KERNEL_ROUNDS * KERNEL_ADD, k = 0;
+    if (!(diag > 0.0) || !isfinite(diag))
+        return 0;
+    pd_lp_halfspace *w = malloc(sizeof *w * (size_t)cap);
+    if (!w)
+        return -1;
+    int step = n > KERNEL_SAMPLE ? n / KERNEL_SAMPLE : 1, ok = 1;
+    for (int t = 0; t < n && ok; t += step)
+        ok = kernel_row(m, t, sg, c0, &w[k++]);
+    uint64_t seed = 0x9e3779b97f4a7c15u;
+    double y[4] = {0, 0, 0, 0}, c[4] = {0, 0, 0, 1};
+    int found = 0;
+    for (int round = 0; ok && round < KERNEL_ROUNDS && !stop(s); round++) {
+        /* A fixed shuffle (Seidel's expected time needs an order unrelated
+         * to the planes'). */
+        for (int i = k - 1; i > 0; i--) {
+            seed = seed * 6364136223846793005u + 1442695040888963407u;
+            int r = (int)((seed >> 33) % (uint64_t)(i + 1));
+            pd_lp_halfspace x = w[i];
+            w[i] = w[r];
+            w[r] = x;
+        }
+        int st = pd_lp_solve(4, w, k, c, lo, hi, 1e-15 * diag, y);
+        if (st < 0) {
+            free(w);
+            return -1;
+        }
+        if (st == 0 || !(y[3] > 1e-12 * diag))
+            break;
+        /* The planes this centre is not y[3] inside of: all of them when
+         * they are few (one pass), else a stride of them (a second). */
+        int bad = 0, added = 0;
+        pd_lp_halfspace h;
+        for (int pass = 0; pass < 2 && ok; pass++) {
+            int every = pass == 0 ? 1 : bad / KERNEL_ADD + 1, seen = 0;
+            added = 0;
+            for (int t = 0; t < n && ok; t++) {
+                ok = kernel_row(m, t, sg, c0, &h);
+                if (ok && h.a[0] * y[0] + h.a[1] * y[1] + h.a[2] * y[2] + (1.0 - 1e-9) * y[3] > h.b) {
+                    bad += pass == 0;
+                    if (seen++ % every == 0 && added < KERNEL_ADD)
+                        w[k + added++] = h;
+                }
+            }
+            if (bad <= KERNEL_ADD)
+                break;
+        }
+        k += added;
+        if (bad == 0) {
+            found = 1;
+            break;
+        }
+        if (k + KERNEL_ADD > cap)
+            break;
+    }
+    free(w);
+    if (!ok || !found)
+        return 0;
+    *o = v3(c0.x + y[0], c0.y + y[1], c0.z + y[2]);
+    return 1;
+}
+
+/* 1 when the condition above holds (no crossing), 0 when not or not shown,
+ * -1 when out of memory. */
+static int star_shaped(search *s)
+{
+    const pd_mesh *m = s->m;
+    const pd_vec3 *v = m->verts;
+    int closed = closed_oriented(s);
+    if (closed != 1)
+        return closed;
+    pd_vec3 o;
+    int kp = kernel_point(s, &o);
+    if (kp != 1)
+        return kp;
+    if (!faces_point(m, s, o))
+        return 0;
+    /* Lines through the centres of the first few triangles: one that
+     * grazes an edge is tried again through the next. */
+    for (int t = 0; t < m->ntris && t < 8; t++) {
+        const int *T = m->tris[t];
+        pd_vec3 p = v3_scale(v3_add(v3_add(v[T[0]], v[T[1]]), v[T[2]]), 1.0 / 3.0);
+        long h = line_hits(m, o, p);
+        if (h >= 0)
+            return h == 2;
+    }
     return 0;
 }
 
@@ -1266,14 +1523,19 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
         R = dmax(R, dmax(fabs(m->verts[i].x), dmax(fabs(m->verts[i].y), fabs(m->verts[i].z))));
     search s = {m, malloc(sizeof *s.patch * (size_t)m->ntris), NULL, NULL, PD_SELFX_PAD_REL * R,
                 malloc(sizeof *s.plane * 4 * (size_t)m->ntris), 0, -1, -1, {0, 0, 0}, cancel, 0, 0};
-    int found = -1;
-    if (s.plane)
+    int found = -1, star = -1;
+    if (s.patch && s.plane && build_stars(&s) == 0)
+        star = star_shaped(&s);
+    if (star == 1)
+        found = 0;
+    else if (star == 0) {
         for (int t = 0; t < m->ntris; t++)
             plane_of(m->verts, m->tris[t], R, s.plane + 4 * (size_t)t);
-    if (s.patch && s.plane && build_stars(&s) == 0 && flat_patches(&s) == 0) {
-        found = s.cancelled ? 1 : star_pairs(&s);
-        if (found == 0)
-            found = apart_pairs(&s);
+        if (flat_patches(&s) == 0) {
+            found = s.cancelled ? 1 : star_pairs(&s);
+            if (found == 0)
+                found = apart_pairs(&s);
+        }
     }
     free(s.patch);
     free(s.plane);
