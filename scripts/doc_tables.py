@@ -628,7 +628,8 @@ def bench_mujoco(binary):
     compared."""
     py = venv_python()
     run = subprocess.run([py, os.path.join(ROOT, "scripts/bench-mujoco.py"), "--posedrop",
-                          binary], cwd=ROOT, capture_output=True, text=True)
+                          os.path.relpath(binary, ROOT)], cwd=ROOT, capture_output=True,
+                         text=True)
     if run.returncode != 0:
         sys.exit(f"doc_tables.py: {py} scripts/bench-mujoco.py failed (is mujoco installed in "
                  f"it? set PYTHON): {run.stderr.strip()[-1500:]}")
@@ -765,6 +766,10 @@ RECORDS = {
     "limits-crossing": (
         "docs/limits.md", "an experimental harness against the sort and sweep of axis-aligned "
         "boxes it replaced (no script kept)", "on 2026-11-27 (first recorded in commit 732c595)"),
+    "limits-stepping": (
+        "docs/limits.md", "tests/unit/test_hard_parts.c's failing cases on ODE and Bullet, "
+        "drops stepped and printed one by one (PD_TEST_VERBOSE=1)",
+        "on 2026-11-27 (first recorded in commit 6077063)"),
     "contact-strikes": (
         "docs/contact.md", "an experimental build's strike sampler (no script kept; "
         "tests/unit/test_compliant.c's test_rigid_limit_strikes is its small form)",
