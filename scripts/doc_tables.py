@@ -31,6 +31,10 @@ CPU in all):
                  on a regular 4000-gon prism, the symmetry search's worst
                  case within its limit: rows (compared) and CPU seconds (not).
                  Under 1 s of CPU.
+  rigid-limit    docs/contact.md: the compliant law at T = 1e-7 s against
+                 its limit law and Poisson's, from make check's own test
+                 (tests/unit/test_compliant.c's notes); compared exactly.
+                 About 8 s of CPU.
 
 Not cheap (make figures without CHEAP=1):
 
@@ -52,6 +56,21 @@ Not cheap (make figures without CHEAP=1):
                  else python3). About 15 s of CPU.
   test-cost      docs/development.md: make check's suites, checks and CPU
                  seconds. About 90 s of CPU.
+  bench-engines  docs/performance.md: make bench's engines section (the
+                 three engines' cost per drop, the stepping engines against
+                 their step). Several CPU minutes.
+  bench-mujoco   docs/performance.md: scripts/bench-mujoco.py and whether
+                 the goal of 40 times MuJoCo's speed is met; needs mujoco in
+                 PYTHON (as python-bench). About 11 s of CPU.
+  trimesh        docs/python.md: scripts/trimesh-table.py, posedrop's
+                 stable poses against trimesh's; needs posedrop, trimesh and
+                 pytest in PYTHON. About 2 s of CPU.
+  fit-mirror     docs/calibration.md: scripts/fit-mirror.sh on ten seeds
+                 (the fit's in-sample TV against fresh drops); its means
+                 are compared only by hand. About 5 CPU minutes.
+  extreme-scenes docs/engines-crosscheck.md: test_engine_extreme.c's rod,
+                 flake and cube under its four scenes on the three engines,
+                 10 drops each: unsettled drops. About 2 CPU minutes.
   fuzz           docs/cli-input.md: make fuzz, 60 s per target (builds the
                  fuzzers with clang first): executions per target. Eight
                  minutes of wall time whatever the load (libFuzzer's limit
@@ -68,6 +87,15 @@ timing) is not compared. --self-test checks first that the check fails on
 a moved number and on a hand edit, on a table of its own.
 
     scripts/doc_tables.py [-b POSEDROP] --check [--self-test] [NAME...]
+
+Records: blocks between '<!-- record NAME begin -->' and '<!-- record NAME
+end -->' whose numbers were measured once and are not remade (hours of
+CPU, or code that has changed since); each opens with a line giving the
+command and the commit and date it was measured on (RECORDS below), and its
+side file the hash of its text: --check (with no NAME) fails on a hand
+edit. After a new measurement, edit the block and its RECORDS entry, then
+
+    scripts/doc_tables.py --record NAME...
 
 Python 3 standard library only; posedrop must be built (make all).
 """
@@ -332,10 +360,12 @@ def drops_run(binary, path, n, extra=()):
 def cube_sizes(binary):
     """Cubes from 0.1 mm to 1000 km, 30 impulse drops each in the default
     scene: how many settle, the slowest in the part's natural time units
-    (sqrt(L/g) + sqrt(2h/g), of which the automatic time limit is 100),
-    and the CPU per drop (not compared)."""
-    out = ["| cube edge | h / L | unsettled of 30 | slowest settled drop, natural units | "
-           "CPU per drop |", "|---|---:|---:|---:|---:|"]
+    (sqrt(L/g) + sqrt(2h/g), of which the automatic time limit is 100)
+    and the most collisions in a drop (maxima: not compared), and the CPU
+    per drop (not compared)."""
+    out = ["| cube edge | h / L | unsettled of 30 | slowest settled drop, natural units (s) | "
+           "the time limit, 100 units | most collisions in a drop | CPU per drop |",
+           "|---|---:|---:|---:|---:|---:|---:|"]
     numbers = []
     with tempfile.TemporaryDirectory() as tmp:
         for edge in ("1e-4", "1e-3", "1e-2", "1e-1", "1", "10", "100", "1e3", "1e6"):
@@ -346,8 +376,9 @@ def cube_sizes(binary):
             unit = math.sqrt(size / 9.81) + math.sqrt(2 * 0.12 / 9.81)
             settled = [float(r["time"]) for r in rows if r["end"] == "settled"]
             unsettled = len(rows) - len(settled)
-            slow = f"{max(settled) / unit:.1f}" if settled else "-"
+            slow = f"{max(settled) / unit:.1f} ({max(settled):.3g} s)" if settled else "-"
             out.append(f"| {edge} m | {0.12 / L:.3g} | {unsettled} | {slow} | "
+                       f"{100 * unit:.4g} s | {max(int(r['collisions']) for r in rows)} | "
                        f"{1e3 * cpu / len(rows):.3g} ms |")
             numbers.append((f"unsettled {edge}", unsettled / len(rows),
                             binomial_se(unsettled / len(rows), len(rows))))
@@ -386,9 +417,10 @@ def settle_times(binary):
 
 def tops(binary):
     """Small cubes that end spinning on a corner (tops): unsettled drops
-    (compared) and CPU per drop (not)."""
-    out = ["| part | drops | unsettled | slowest drop, simulated s | CPU per drop |",
-           "|---|---:|---:|---:|---:|"]
+    (compared), the slowest drop and the most collisions (maxima: not
+    compared) and CPU per drop (not)."""
+    out = ["| part | drops | unsettled | slowest drop, simulated s | most collisions in a drop "
+           "| CPU per drop |", "|---|---:|---:|---:|---:|---:|"]
     numbers = []
     with tempfile.TemporaryDirectory() as tmp:
         for label, edge, n, extra in (("cube 0.1 mm", 1e-4, 200, []),
@@ -399,7 +431,7 @@ def tops(binary):
             rows, _, cpu = drops_run(binary, path, n, extra)
             unsettled = sum(r["end"] != "settled" for r in rows)
             out.append(f"| {label} | {n} | {unsettled} | {max(float(r['time']) for r in rows):.0f} | "
-                       f"{1e3 * cpu / n:.3g} ms |")
+                       f"{max(int(r['collisions']) for r in rows)} | {1e3 * cpu / n:.3g} ms |")
             numbers.append((f"unsettled {label}", unsettled / n, binomial_se(unsettled / n, n)))
     return ("posedrop -n N -j 1 --seed 1 [--tumble 3000] --trials FILE cube.off (cubes written "
             "by the script)", "\n".join(out), numbers)
@@ -410,8 +442,7 @@ def python_bench(binary):
     module installed in the Python that $PYTHON names (default the
     git-ignored .venv's when there, as make bench-mujoco, else python3;
     docs/python.md says how to install it). Timings: not compared."""
-    venv = os.path.join(ROOT, ".venv/bin/python")
-    py = os.environ.get("PYTHON") or (venv if os.access(venv, os.X_OK) else "python3")
+    py = venv_python()
     load = os.getloadavg()[0]
     run = subprocess.run([py, os.path.join(ROOT, "python/bench.py"), "--repeat", "7"], cwd=ROOT,
                          capture_output=True, text=True)
@@ -476,6 +507,203 @@ def test_cost(binary):
     return "build/opt/test_posedrop -j2 (make test)", text, []
 
 
+def test_notes(binary, suite):
+    """make check's suite SUITE run alone with its notes (PD_TEST_VERBOSE=1):
+    the lines it prints."""
+    test_bin = os.path.join(os.path.dirname(binary), "test_posedrop")
+    if not os.access(test_bin, os.X_OK):
+        sys.exit(f"doc_tables.py: {test_bin} not built (make {os.path.relpath(test_bin, ROOT)})")
+    run = subprocess.run([test_bin, suite], cwd=ROOT, capture_output=True, text=True,
+                         env=dict(os.environ, PD_TEST_VERBOSE="1"))
+    if run.returncode != 0:
+        sys.exit(f"doc_tables.py: test_posedrop {suite} failed:\n{run.stdout[-1500:]}"
+                 f"{run.stderr[-1500:]}")
+    return (run.stdout + run.stderr).splitlines()
+
+
+def note_numbers(lines, start, pattern):
+    """The numbers PATTERN (a regular expression) finds in the one note
+    that starts with START."""
+    import re
+    hits = [l for l in lines if l.startswith(start)]
+    m = re.search(pattern, hits[0]) if len(hits) == 1 else None
+    if not m:
+        sys.exit(f"doc_tables.py: no note '{start}' matching '{pattern}' in the test's output")
+    return [float(g) for g in m.groups()]
+
+
+def rigid_limit(binary):
+    """docs/contact.md's rigid limit: the compliant law at T = 1e-7 s against
+    its limit law and Poisson's, as tests/unit/test_compliant.c measures it
+    in every make check (its notes). Deterministic: compared exactly (as
+    printed, two digits)."""
+    notes = test_notes(binary, "compliant")
+    num = r"([-0-9.e+]+)"
+    (f8, _, s8, _, _, _, s32, s64, f64, lawp_f, lawp_s, _) = note_numbers(
+        notes, "compliant: rigid limit at T = 1e-7 s vs Poisson",
+        rf"frictionless {num} over {num}, sliding {num} over {num} .*step {num} and {num}; "
+        rf".*sliding: {num} and {num} \(frictionless {num} at a 64th\); the limit law vs "
+        rf"Poisson, frictionless {num}, sliding {num}; .*within {num} of")
+    stop_n, st8, st32, lp_lo, lp_hi, _ = note_numbers(
+        notes, "compliant: limit law where the slip stops",
+        rf"{num} cases, compliant within {num} \(an 8th.*, {num} \(a 32nd\); the limit law vs "
+        rf"Poisson {num} to {num}; .*impact.c {num}")
+    strikes = []
+    for l in notes:
+        if l.startswith("compliant: rigid limit vs Poisson on "):
+            n, part = l.split(" on ", 1)[1].split(" lone-corner strikes of ")
+            part, rest = part.split(":", 1)
+            worst, mean = note_numbers([l], l[:30], rf"up to {num} .*, centre's velocity {num}")
+            strikes.append((os.path.basename(part), int(n), worst, mean))
+    if not strikes:
+        sys.exit("doc_tables.py: no lone-corner strike notes in test_posedrop compliant")
+    real = "; ".join(f"{p} ({n}): up to {w:.2g}, {100 * m:.2g}% of the corner's approach "
+                     f"speed on average" for p, n, w, m in strikes)
+    out = ["| compared | frictionless | sliding fast in 3-D (random bodies) | slip stopping "
+           f"(closed form, {stop_n:.0f} cases) | real strikes (lone corners) |",
+           "|---|---|---|---|---|",
+           f"| compliant, a 64th of its step, against its limit law | {f64:.2g} | {s64:.2g} "
+           f"({s32:.2g} at a 32nd) | {st32:.2g} at a 32nd, {st8:.2g} at an 8th | |",
+           f"| its limit law against Poisson's (impact.c) | {lawp_f:.2g} | up to {lawp_s:.2g} | "
+           f"{lp_lo:.2g} to {lp_hi:.2g} | |",
+           f"| compliant, an eighth of its step, against Poisson's | {f8:.2g} | {s8:.2g} | | "
+           f"{real} |"]
+    numbers = [("frictionless 64th vs limit", f64), ("sliding 64th vs limit", s64),
+               ("sliding 32nd vs limit", s32), ("stops 32nd", st32), ("stops 8th", st8),
+               ("limit vs Poisson frictionless", lawp_f), ("limit vs Poisson sliding", lawp_s),
+               ("stops limit vs Poisson lo", lp_lo), ("stops limit vs Poisson hi", lp_hi),
+               ("frictionless 8th vs Poisson", f8), ("sliding 8th vs Poisson", s8)]
+    numbers += [(f"strikes {p} worst", w) for p, _, w, _ in strikes]
+    # The test's random bodies and strikes come from fixed seeds: exact, but
+    # for the frictionless limit law against Poisson's, round-off (not
+    # compared).
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop compliant (tests/unit/test_compliant.c: "
+            "test_rigid_limit, test_rigid_limit_stops, test_rigid_limit_strikes)",
+            "\n".join(out),
+            [(k, v, None if k == "limit vs Poisson frictionless" else 0.0) for k, v in numbers])
+
+
+def extreme_scenes(binary):
+    """tests/unit/test_engine_extreme.c's parts and scenes from the command,
+    10 drops each at the default limits: drops left unsettled, and failed
+    (an unsettled count of 10 drops has a binomial error; compared)."""
+    parts = (("1 m x 1 cm x 1 cm rod", (1.0, 0.01, 0.01)),
+             ("1 x 1 x 0.01 mm flake", (1e-3, 1e-3, 1e-5)),
+             ("1 mm cube", (1e-3, 1e-3, 1e-3)))
+    scenes = (("mu 10", ["--mu", "10"]), ("e 0", ["--restitution", "0"]),
+              ("e 1", ["--restitution", "1"]), ("e 1, mu 0", ["--restitution", "1", "--mu", "0"]))
+    out = ["| part, scene | impulse | ode | bullet |", "|---|---|---|---|"]
+    numbers, failed = [], 0
+    with tempfile.TemporaryDirectory() as tmp:
+        for label, dims in parts:
+            path = os.path.join(tmp, "part.off")
+            box_off(path, *dims)
+            for scene, opts in scenes:
+                cells = []
+                for engine in ("impulse", "ode", "bullet"):
+                    rows, _, _ = drops_run(binary, path, 10, ["--engine", engine] + opts)
+                    unsettled = sum(r["end"] != "settled" for r in rows)
+                    failed += sum(r["end"] == "failed" for r in rows)
+                    cells.append(str(unsettled))
+                    numbers.append((f"{label}, {scene}, {engine}", unsettled / 10,
+                                    binomial_se(unsettled / 10, 10)))
+                out.append(f"| {label}, {scene} | " + " | ".join(cells) + " |")
+    out += ["", f"Failed drops in all: {failed}."]
+    return ("posedrop -n 10 -j 1 --seed 1 --engine E [--mu 10 | --restitution 0 | --restitution 1 "
+            "[--mu 0]] --trials FILE PART (boxes written by the script)", "\n".join(out), numbers)
+
+
+def venv_python():
+    """The Python that $PYTHON names, else the git-ignored .venv's when
+    there (as make bench-mujoco), else python3."""
+    venv = os.path.join(ROOT, ".venv/bin/python")
+    return os.environ.get("PYTHON") or (venv if os.access(venv, os.X_OK) else "python3")
+
+
+def bench_mujoco(binary):
+    """scripts/bench-mujoco.py's table as it prints it, and whether the
+    goal of 40 times MuJoCo's speed per drop is met on each part (by the
+    ratio over all MuJoCo's drops and over its settled ones). Needs the
+    mujoco package in $PYTHON (make bench-mujoco's .venv). Timings: not
+    compared."""
+    py = venv_python()
+    run = subprocess.run([py, os.path.join(ROOT, "scripts/bench-mujoco.py"), "--posedrop",
+                          os.path.relpath(binary, ROOT)], cwd=ROOT, capture_output=True,
+                         text=True)
+    if run.returncode != 0:
+        sys.exit(f"doc_tables.py: {py} scripts/bench-mujoco.py failed (is mujoco installed in "
+                 f"it? set PYTHON): {run.stderr.strip()[-1500:]}")
+    lines = run.stdout.strip().splitlines()
+    met, unmet = [], []
+    for l in lines:
+        f = l.split()
+        if len(f) == 9 and f[-1].endswith("x") and f[-2].endswith("x"):
+            ratios = (float(f[-2][:-1]), float(f[-1][:-1]))
+            (met if min(ratios) >= 40 else unmet).append(f"{f[0]} ({f[-2]}, {f[-1]} settled)")
+    if not met and not unmet:
+        sys.exit("doc_tables.py: scripts/bench-mujoco.py printed no ratios")
+    text = ("```text\n" + "\n".join(lines) + "\n```\n\n"
+            f"The goal of 40 times MuJoCo's speed per drop, by both ratios: met on "
+            f"{', '.join(met) or 'no part'}; not met on {', '.join(unmet) or 'no part'}.")
+    return "python scripts/bench-mujoco.py (make bench-mujoco)", text, []
+
+
+def trimesh_table(binary):
+    """scripts/trimesh-table.py: posedrop.compute_stable_poses against
+    trimesh's. Needs the posedrop module, trimesh and pytest in $PYTHON.
+    Deterministic but for its timings (not compared)."""
+    py = venv_python()
+    run = subprocess.run([py, os.path.join(ROOT, "scripts/trimesh-table.py")], cwd=ROOT,
+                         capture_output=True, text=True)
+    if run.returncode != 0 or "#numbers" not in run.stdout:
+        sys.exit(f"doc_tables.py: {py} scripts/trimesh-table.py failed (are posedrop, trimesh "
+                 f"and pytest installed in it? set PYTHON): {run.stderr.strip()[-1500:]}")
+    text, nums = run.stdout.split("#numbers\n", 1)
+    numbers = [(k, float(v), float(se)) for k, v, se in
+               (l.rsplit(",", 2) for l in nums.strip().splitlines())]
+    return "python scripts/trimesh-table.py", text.strip(), numbers
+
+
+def fit_mirror(binary):
+    """scripts/fit-mirror.sh on ten seeds: the fit's in-sample TV against its
+    own fresh check and 20,000 fresh drops, on the box's mirror pairs.
+    Deterministic for a binary (the fit's drops come from its seed); a
+    mean's standard error is the seeds' spread, so the means are compared
+    with it."""
+    with tempfile.TemporaryDirectory() as tmp:
+        run = subprocess.run([os.path.join(ROOT, "scripts/fit-mirror.sh"), "-s",
+                              "1 2 3 4 5 6 7 8 9 10", "-o", tmp], cwd=ROOT, capture_output=True,
+                             text=True, env=dict(os.environ, POSEDROP=binary))
+    if run.returncode != 0:
+        sys.exit(f"doc_tables.py: scripts/fit-mirror.sh failed: {run.stderr.strip()[-1500:]}")
+    out = ["| seed | in-sample TV | its own fresh check (300 drops) | fresh TV, 20,000 drops |",
+           "|---|---|---|---|"]
+    numbers, insample = [], []
+    for l in run.stdout.splitlines():
+        f = [c.strip() for c in l.split("|")]
+        if len(f) == 4 and f[0].isdigit():
+            out.append(f"| {' | '.join(f)} |")
+            insample.append(float(f[1]))
+        elif l.startswith("mean of "):
+            out.append(f"| mean | {' | '.join(f[1:])} |")
+            for name, cell in zip(("in-sample", "own fresh check", "fresh 20000"), f[1:]):
+                v, se = (float(x) for x in cell.split("+-"))
+                numbers.append((f"mean {name}", v, se))
+        elif l.startswith("in-sample minus fresh"):
+            diff = l.split(": ", 1)[1]
+            v, se = (float(x) for x in diff.split("(")[0].split("+-"))
+            numbers.append(("in-sample minus own check", v, se))
+    if len(out) != 13 or len(numbers) != 4:
+        sys.exit(f"doc_tables.py: scripts/fit-mirror.sh printed an unexpected table:\n"
+                 f"{run.stdout[-1500:]}")
+    v, se = numbers[-1][1:]
+    out += ["", f"In-sample minus the fit's own fresh check: {v:.3f} +- {se:.3f} "
+            f"({'within' if abs(v) <= 2 * se else 'beyond'} two standard errors of zero). "
+            f"The lowest in-sample TV {min(insample):.3f}; {sum(x < 0.070 for x in insample)} "
+            f"of the 10 seeds below the 0.070 that no scene of the model can beat."]
+    return ('scripts/fit-mirror.sh -s "1 2 3 4 5 6 7 8 9 10"', "\n".join(out), numbers)
+
+
 # name: (doc, function, cheap). A cheap table (seconds of CPU, or read from
 # kept files) is made again by --check and its numbers compared.
 TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
@@ -495,19 +723,141 @@ TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
           "bench-batch": ("docs/batch.md", bench(["batch"], (
               "Whole processes: the command with -j 2, and posedrop-mpi on two ranks when "
               "built, against -j 1, each output compared with -j 1's.")), False),
+          "bench-engines": ("docs/performance.md", bench(["engines"], (
+              "Each engine's cost per drop on the same parts and scene, and the stepping "
+              "engines against their step.")), False),
+          "bench-mujoco": ("docs/performance.md", bench_mujoco, False),
+          "rigid-limit": ("docs/contact.md", rigid_limit, True),
+          "extreme-scenes": ("docs/engines-crosscheck.md", extreme_scenes, False),
+          "trimesh": ("docs/python.md", trimesh_table, False),
+          "fit-mirror": ("docs/calibration.md", fit_mirror, False),
           "fuzz": ("docs/cli-input.md", fuzz, False),
           "test-cost": ("docs/development.md", test_cost, False),
           "python-bench": ("docs/python.md", python_bench, False)}
 SIDECARS = "docs/figures/tables"
 
+# Records: blocks of a doc, between '<!-- record NAME begin -->' and
+# '<!-- record NAME end -->', whose numbers were measured once and are not
+# remade by make figures (hours of CPU, or code that has changed since).
+# Each opens with a line naming the command, the commit and the date of the
+# measurement; its side file docs/figures/tables/NAME.csv holds them with a
+# hash of the block, so that --check fails on a hand edit. After measuring
+# again: edit the block's text, set its entry here, and run
+# `scripts/doc_tables.py --record NAME`. name: (doc, command, when: the
+# commit and the date).
+RECORDS = {
+    "limits-height": (
+        "docs/limits.md", "posedrop -n 2 -j 1 cube.off, cubes of 1 mm, 0.1 mm and 10 um "
+        "written by hand, the CPU seconds of each whole run",
+        "on 2026-12-07 under a load of about 10 (first recorded in commit 7507e8b)"),
+    "limits-corpus": (
+        "docs/limits.md", "tests/unit/test_hard_parts.c's corpus with its trial records "
+        "printed (an experimental build; no script kept)",
+        "on 2026-11-27 (first recorded in commit 91aa1c1)"),
+    "limits-tops": (
+        "docs/limits.md", "posedrop -n 200 (100) -j 1 --seed 1 --trials FILE on cubes of "
+        "0.1 mm and 0.03 mm, drops traced one by one, and callgrind on the phases' "
+        "integrators (experimental builds; no script kept)",
+        "on 2026-11-27 (first recorded in commit 175182f)"),
+    "limits-spike": (
+        "docs/limits.md", "posedrop on parts/square_black_button.off with the corner moved "
+        "(the file tests/unit/test_part.c mutates), before and after the refit",
+        "on 2026-11-27 (first recorded in commit 03f0188)"),
+    "limits-crossing": (
+        "docs/limits.md", "an experimental harness against the sort and sweep of axis-aligned "
+        "boxes it replaced (no script kept)", "on 2026-11-27 (first recorded in commit 732c595)"),
+    "limits-stepping": (
+        "docs/limits.md", "tests/unit/test_hard_parts.c's failing cases on ODE and Bullet, "
+        "drops stepped and printed one by one (PD_TEST_VERBOSE=1)",
+        "on 2026-11-27 (first recorded in commit 6077063)"),
+    "contact-strikes": (
+        "docs/contact.md", "an experimental build's strike sampler (no script kept; "
+        "tests/unit/test_compliant.c's test_rigid_limit_strikes is its small form)",
+        "on 2026-11-28 (first recorded in commit 1035b5d)"),
+    "engines-model": (
+        "docs/engines.md", "tests/unit/test_engine_contact.c, test_engine_ode.c, "
+        "test_engine_bullet.c and test_hard_parts.c (PD_TEST_VERBOSE=1), and the runs of "
+        "engines-crosscheck.md that each row names",
+        "from 2026-11-27 to 2026-12-07, each row on the engines of its day (the table as of "
+        "commit d17ddd1)"),
+    "fit-mirror-before": (
+        "docs/calibration.md", 'scripts/fit-mirror.sh -s "1 2 3 4 5 6 7 8 9 10" with the '
+        "binary of commit e8d8523 (the search on its own drops)", "at commit e8d8523 on 2026-12-07"),
+    "xc-contact-steps": (
+        "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
+        "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
+        "on 2026-11-26 (first recorded in commit ab5ee7b)"),
+    "xc-white-button": (
+        "docs/engines-crosscheck.md", "posedrop -n 600 --seed 5 (6, 7) [--engine ode|bullet] "
+        "[--dt 1e-5] parts/white_button.off, on main ebdd1fe and on the two fixes' builds",
+        "on 2026-11-28 (first recorded in commit 1035b5d)"),
+    "xc-strikes": (
+        "docs/engines-crosscheck.md", "an experimental strike harness on the stepping engines "
+        "(no script kept)", "on 2026-11-28 (first recorded in commit 1035b5d)"),
+    "xc-lone-vertex": (
+        "docs/engines-crosscheck.md", "posedrop -n 6000 --seed 5 parts/white_button.off on "
+        "experimental builds (not committed)", "on 2026-11-28 (first recorded in commit d704941)"),
+    "xc-convergence": (
+        "docs/engines-crosscheck.md", "scripts/engine-convergence.py -o DIR -n 300 --engines "
+        "impulse,ode --k 10,20,40,80 (and --engines bullet)", "at commit 9f2cb89 on 2026-12-07"),
+    "xc-disc": (
+        "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
+        "(test_face_and_edge)", "at commit e6e11fa on 2026-12-07, before the Hunt-Crossley law"),
+    "xc-flange-down": (
+        "docs/engines-crosscheck.md", "the runs each row names: posedrop --group --units mm "
+        "parts/flanged_bushing.off on each engine, scripts/referee-mujoco.py, "
+        "scripts/engine-convergence.py", "on 2026-12-07 (first recorded in commit 96ad014)"),
+}
 
-def markers(name):
-    return f"<!-- table {name} begin -->", f"<!-- table {name} end -->"
+
+def record_header(name):
+    doc, cmd, when = RECORDS[name]
+    return (f"Measured {when}: `{cmd}`. A record of that code, not remade by `make figures` "
+            f"(`scripts/doc_tables.py --check` fails on an edit of it).")
 
 
-def block(text, name, doc):
-    """The text between a table's markers in a doc's TEXT."""
-    begin, end = markers(name)
+def record(name):
+    """Puts the record's header line over its block's text (replacing the
+    one there) and writes its side file."""
+    doc = RECORDS[name][0]
+    with open(os.path.join(ROOT, doc)) as f:
+        body = block(f.read(), name, doc, "record").strip("\n")
+    if body.startswith("Measured on "):
+        body = body.split("\n\n", 1)[1] if "\n\n" in body else ""
+    inner = put(ROOT, doc, name, record_header(name) + "\n\n" + body, "record")
+    write_sidecar(os.path.join(ROOT, SIDECARS, name + ".csv"), name, doc, RECORDS[name][1],
+                  inner, [])
+    print(f"doc_tables.py: {doc}: record {name}", file=sys.stderr)
+
+
+def check_records(root, names):
+    """A record whose block is not the text its side file hashed, or whose
+    header is not its entry's, was edited by hand."""
+    failures = []
+    for name in names:
+        doc = RECORDS[name][0]
+        side = os.path.join(root, SIDECARS, name + ".csv")
+        if not os.path.exists(side):
+            failures.append(f"{doc}: record {name}: no {SIDECARS}/{name}.csv "
+                            f"(run scripts/doc_tables.py --record {name})")
+            continue
+        want, _ = read_sidecar(side)
+        with open(os.path.join(root, doc)) as f:
+            inner = block(f.read(), name, doc, "record")
+        if digest(inner) != want or not inner.startswith("\n" + record_header(name)):
+            failures.append(f"{doc}: record {name} is not the text its side file hashed "
+                            f"(edited by hand?): a record changes with a new measurement, "
+                            f"then scripts/doc_tables.py --record {name}")
+    return failures
+
+
+def markers(name, kind="table"):
+    return f"<!-- {kind} {name} begin -->", f"<!-- {kind} {name} end -->"
+
+
+def block(text, name, doc, kind="table"):
+    """The text between a table's (or a record's) markers in a doc's TEXT."""
+    begin, end = markers(name, kind)
     if text.count(begin) != 1 or text.count(end) != 1 or text.index(begin) > text.index(end):
         sys.exit(f"doc_tables.py: {doc}: expected one '{begin}' before one '{end}'")
     return text[text.index(begin) + len(begin):text.index(end)]
@@ -517,13 +867,13 @@ def digest(text):
     return hashlib.sha256(text.encode()).hexdigest()[:16]
 
 
-def put(root, doc, name, text):
+def put(root, doc, name, text, kind="table"):
     """Puts TEXT between NAME's markers in DOC; returns the block as written."""
     path = os.path.join(root, doc)
     with open(path) as f:
         s = f.read()
-    block(s, name, doc)
-    begin, end = markers(name)
+    block(s, name, doc, kind)
+    begin, end = markers(name, kind)
     inner = "\n" + text + "\n"
     s = s[:s.index(begin) + len(begin)] + inner + s[s.index(end):]
     with open(path + ".tmp", "w") as f:
@@ -658,9 +1008,35 @@ def self_test(binary):
                 if got != want:
                     sys.exit(f"doc_tables.py: self-test: the control '{label}' gave {got} "
                              f"failures, not {want}")
+        # A record: as written passes, a number in it edited by hand fails.
+        RECORDS["control-record"] = ("docs/control.md", "posedrop parts/hexnut.obj",
+                                     "at commit 0000000 on 2026-01-01")
+        for edit, want in ((None, 0), (("0.", "0.9"), 1)):
+            with tempfile.TemporaryDirectory() as tmp:
+                doc = "docs/control.md"
+                begin, end = markers("control-record", "record")
+                os.makedirs(os.path.join(tmp, "docs"))
+                with open(os.path.join(tmp, doc), "w") as f:
+                    f.write(f"text\n{begin}\n{end}\nmore\n")
+                inner = put(tmp, doc, "control-record",
+                            record_header("control-record") + "\n\np 0.25, 0.75", "record")
+                write_sidecar(os.path.join(tmp, SIDECARS, "control-record.csv"),
+                              "control-record", doc, "", inner, [])
+                if edit:
+                    with open(os.path.join(tmp, doc)) as f:
+                        text = f.read()
+                    with open(os.path.join(tmp, doc), "w") as f:
+                        f.write(text.replace(edit[0], edit[1]))
+                got = len(check_records(tmp, ["control-record"]))
+                if got != want:
+                    sys.exit(f"doc_tables.py: self-test: the record control "
+                             f"'{'edited' if edit else 'as written'}' gave {got} failures, "
+                             f"not {want}")
+            cases.append(edit)
     finally:
         TABLES.clear()
         TABLES.update(saved)
+        RECORDS.pop("control-record", None)
     print(f"doc_tables.py: self-test: {len(cases)} controls as expected", file=sys.stderr)
 
 
@@ -682,6 +1058,13 @@ def main():
     cheap_only = args[:1] == ["--cheap"]
     if cheap_only:
         args = args[1:]
+    if args[:1] == ["--record"]:
+        for name in args[1:]:
+            if name not in RECORDS:
+                usage(f"no record '{name}' (records: {', '.join(RECORDS)})")
+        for name in args[1:] or RECORDS:
+            record(name)
+        return
     checking = args[:1] == ["--check"]
     if checking:
         args = args[1:]
@@ -694,6 +1077,9 @@ def main():
     names = args or [n for n in TABLES if TABLES[n][2] or not cheap_only]
     if checking:
         failures = check(ROOT, binary, names)
+        if not args:
+            failures += check_records(ROOT, list(RECORDS))
+            print(f"doc_tables.py: --check: {len(RECORDS)} records", file=sys.stderr)
         for f in failures:
             print(f"doc_tables.py: {f}", file=sys.stderr)
         sys.exit(1 if failures else 0)

@@ -509,7 +509,7 @@ static void bench_drop_cost(dyn_part *parts, int nparts)
            DYN_DROPS, DROP_REPEATS);
     printf("mean: pd_sim_run, threads = 1, the same %d drops, total / n (model build included),\n"
            "best of %d; drops/s = 1 / mean\n", DYN_DROPS, DYN_BEST_OF);
-    printf("reference: the issue's target of %.0f us per drop\n", DROP_TARGET_US);
+    printf("reference: the early goal of %.0f us per drop\n", DROP_TARGET_US);
     printf("%-16s %5s %9s %9s %9s %9s %8s %9s %6s  %s\n", "part", "poses", "median us", "p90 us",
            "max us", "mean us", "drops/s", "coll/drop", "unset", "vs target (median; mean)");
     for (int k = 0; k < nparts; k++) {
