@@ -153,8 +153,10 @@ typedef struct pd_fit_part_result {
                            the parameters and the drops leave open if the model
                            were right (lo, hi for a fitted part) */
     double loglik;      /* sum_k count_k log p_best_k (0 for a predicted part) */
-    double chi2;        /* Pearson's X^2 of the counts against n p_best */
-    int df;             /* cells of counts (nclasses without cell_of) - 1 */
+    double chi2;        /* Pearson's X^2 of the 2 x K table of the counts and the
+                           best point's drops (the cells neither reached left out) */
+    int df;             /* its cells less one (a predicted part: its cells of
+                           counts - 1) */
     double pvalue;      /* P(chi2_df > chi2) */
     double tv;          /* total variation between the counts and p_best: in-sample */
     pd_fit_quality fresh_best, fresh_mean; /* against fresh drops at the best
@@ -201,6 +203,11 @@ typedef struct pd_fit_result {
     pd_fit_part_result *parts; /* in the order given */
     long failed;        /* of the drops simulated, those that failed (a solver
                            could not go on): in no count, as in pd_sim_run */
+    double weigh_noise_sd;  /* the weighting's log-likelihood at the maximum: its
+                               standard deviation over sets of drops (the simulation's
+                               noise the weights are smoothed against) */
+    double weigh_misfit_sd; /* the weighting's points' scatter about their fitted
+                               quadratic beyond that noise; -1: no quadratic fitted */
 } pd_fit_result;
 
 /* Fits params (nparams in 1..PD_FIT_MAX_PARAMS, distinct keys) to the parts

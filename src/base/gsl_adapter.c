@@ -2,6 +2,7 @@
 #include <gsl/gsl_cdf.h>
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_integration.h>
+#include <gsl/gsl_multifit.h>
 #include <gsl/gsl_multimin.h>
 #include <gsl/gsl_odeiv2.h>
 #include <gsl/gsl_poly.h>
@@ -84,6 +85,39 @@ static double min_trampoline(const gsl_vector *v, void *p)
         return GSL_POSINF;
     }
     return f;
+}
+
+pd_status pd_gsl_least_squares(int n, int p, const double *X, const double *y, double *c,
+                               double *rss)
+{
+    gsl_set_error_handler_off();
+    gsl_matrix *A = gsl_matrix_alloc((size_t)n, (size_t)p);
+    gsl_matrix *cov = gsl_matrix_alloc((size_t)p, (size_t)p);
+    gsl_vector *b = gsl_vector_alloc((size_t)n), *x = gsl_vector_alloc((size_t)p);
+    gsl_multifit_linear_workspace *w = gsl_multifit_linear_alloc((size_t)n, (size_t)p);
+    pd_status st = A && cov && b && x && w ? PD_OK : PD_ERR_NOMEM;
+    if (st == PD_OK) {
+        for (int i = 0; i < n; i++) {
+            gsl_vector_set(b, (size_t)i, y[i]);
+            for (int j = 0; j < p; j++)
+                gsl_matrix_set(A, (size_t)i, (size_t)j, X[(size_t)i * (size_t)p + (size_t)j]);
+        }
+        if (gsl_multifit_linear(A, b, x, cov, rss, w) != GSL_SUCCESS)
+            st = PD_ERR_NO_CONVERGENCE;
+        for (int j = 0; st == PD_OK && j < p; j++)
+            c[j] = gsl_vector_get(x, (size_t)j);
+    }
+    if (w)
+        gsl_multifit_linear_free(w);
+    if (x)
+        gsl_vector_free(x);
+    if (b)
+        gsl_vector_free(b);
+    if (cov)
+        gsl_matrix_free(cov);
+    if (A)
+        gsl_matrix_free(A);
+    return st;
 }
 
 pd_status pd_gsl_nelder_mead(pd_min_fn fn, void *user, int n, double *x, const double *step,

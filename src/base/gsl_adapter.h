@@ -48,6 +48,14 @@ typedef double (*pd_min_fn)(const double *x, void *user);
 pd_status pd_gsl_nelder_mead(pd_min_fn fn, void *user, int n, double *x, const double *step,
                              double size_tol, int max_evals, int *evals, double *fmin);
 
+/* Ordinary least squares: the p coefficients c minimising |y - X c|^2 for
+ * the n x p matrix X (row-major, n > p) and y (n values), by GSL's
+ * multifit_linear (SVD, so a rank-deficient X gives the minimum-norm
+ * solution rather than failing); *rss receives the residual sum of squares.
+ * PD_ERR_NOMEM, or PD_ERR_NO_CONVERGENCE if GSL fails. */
+pd_status pd_gsl_least_squares(int n, int p, const double *X, const double *y, double *c,
+                               double *rss);
+
 /* ==== Elliptic functions (flight: torque-free rotation) ===============
  * Thin wrappers on GSL's special functions, error handler off, GSL status
  * turned into PD_ERR_NONFINITE (a domain error can only come from a bad

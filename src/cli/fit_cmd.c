@@ -437,6 +437,11 @@ static void print_summary(const pd_fit_result *r, const pd_fit_param *params, co
     fprintf(stderr, "%s: fit: %d evaluations, %ld drops simulated, %d weighted values (effective "
             "%.1f); %.1f s wall, %.1f s CPU\n", prog, r->evaluations, r->drops, r->npoints,
             r->ess, wall, cpu);
+    if (r->weigh_misfit_sd >= 0)
+        fprintf(stderr, "%s: fit: the weighting's log-likelihood varies by %.3g (standard "
+                "deviation) from one set of drops to another at the best values; its points "
+                "were smoothed toward a quadratic about which they scatter by %.3g beyond that "
+                "noise\n", prog, r->weigh_noise_sd, r->weigh_misfit_sd);
     if (r->ess < FEW_EFFECTIVE)
         fprintf(stderr, "%s: fit: warning: the weighting rests on %.1f effective values: the "
                 "intervals and the averaged predictions are coarse (raise --points)\n", prog,

@@ -108,13 +108,19 @@ static void set_ndrops(model *m, long ndrops, pd_initial mode)
  * quarter of the full drops (at least what the mode needs). */
 static long level_drops(const model *m, int i, fit_level level)
 {
-    long n = level == FIT_LEVEL_SEARCH || level == FIT_LEVEL_WEIGH ? m->ndrops[i] / 4
-                                                                   : m->ndrops[i];
+    long n = level == FIT_LEVEL_SEARCH || level == FIT_LEVEL_WEIGH || level >= FIT_LEVEL_REPEAT
+                 ? m->ndrops[i] / 4
+                 : m->ndrops[i];
     return n > m->need[i] ? n : m->need[i];
 }
 
 static uint64_t level_seed(const model *m, fit_level level)
 {
+    /* The repeats' seeds: the full level's, moved by a multiple of an odd
+     * constant (the golden ratio's) that no other level's equals. */
+    if (level >= FIT_LEVEL_REPEAT)
+        return m->sim.seed ^ FULL_SEED ^
+               (0x9e3779b97f4a7c15u * (uint64_t)(level - FIT_LEVEL_REPEAT + 2));
     return level == FIT_LEVEL_FRESH                                  ? m->sim.seed ^ FRESH_SEED
            : level == FIT_LEVEL_FULL || level == FIT_LEVEL_WEIGH ? m->sim.seed ^ FULL_SEED
                                                                  : m->sim.seed;
@@ -679,7 +685,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         goto done;
     fit_weighed w = {r->lo,  r->hi, r->mean, pb_best, nsim,    pp,
                      plo,    phi,   1.0,     0.0,     0,       0.0,
-                     plo_fit, phi_fit};
+                     plo_fit, phi_fit, 0.0, 0.0};
     st = fit_weigh(&pb, &set, best_theta, &w, &r->evaluations, diag);
     if (st == PD_OK) {
         r->loglik = 0.0;
@@ -699,7 +705,19 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
                     q->loglik += (double)parts[i].count[c] * log(pc);
                 q->tv += 0.5 * fabs((double)parts[i].count[c] / (double)q->n - pc);
             }
-            q->chi2 = fit_chi2_cells(kk[i], cell_of[i], ncells[i], parts[i].count, q->p_best);
+            /* X^2 of the 2 x K table of the counts and the best point's drops
+             * (their frequencies, the smoothing undone), the statistic the
+             * dispersion and the fresh-drop check use: against the smoothed
+             * probabilities, a class of many counts that no drop reached
+             * gives a term of hundreds. */
+            for (int c = 0; c < kk[i]; c++) {
+                double f = nsim[i] > 0 ? (q->p_best[c] * (nsim[i] + kk[i] * o.alpha) - o.alpha) /
+                                             nsim[i]
+                                       : 0.0;
+                ps[i][c] = f > 0 ? f : 0.0;
+            }
+            q->chi2 = fit_chi2_two_sample(kk[i], cell_of[i], ncells[i], parts[i].count, ps[i],
+                                          nsim[i], &q->df);
             q->pvalue = q->df > 0 ? pd_gsl_chisq_q(q->chi2, q->df) : 1.0;
             r->loglik += q->loglik;
             r->chi2 += q->chi2;
@@ -710,6 +728,8 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
         r->dispersion = w.dispersion;
         r->discrepancy = w.discrepancy;
         r->ess = w.ess;
+        r->weigh_noise_sd = w.noise_sd;
+        r->weigh_misfit_sd = w.misfit_sd;
         r->npoints = w.npoints;
         /* The fit's quality from drops it was not tuned to, at the best
          * values and at the weighted means. */

@@ -22,8 +22,18 @@ typedef enum fit_level {
     FIT_LEVEL_WEIGH,      /* a quarter of the drops, FIT_LEVEL_FULL's seed: the
                              weighting's points, whose likelihood (the Dirichlet-
                              multinomial) counts their larger simulation error */
-    FIT_LEVEL_FRESH       /* all the drops, a seed no other level uses (fit.c's check) */
+    FIT_LEVEL_FRESH,      /* all the drops, a seed no other level uses (fit.c's check) */
+    FIT_LEVEL_REPEAT      /* FIT_LEVEL_REPEAT + r, r in 0..FIT_REPEATS): FIT_LEVEL_WEIGH's
+                             drops of the r-th seed of their own, to measure the
+                             simulation's noise in the weighting's likelihood */
 } fit_level;
+
+/* The weighting's likelihood is evaluated this many times at the maximum,
+ * each on drops of its own, for the variance of its simulation noise (the
+ * centre points of a response-surface design, whose spread is the pure
+ * error: Box and Draper 1987, Empirical Model-Building and Response
+ * Surfaces, ch. 6). */
+#define FIT_REPEATS 6
 
 /* Fills p[i][0..k[i]) (summing to 1) and nsim[i] (the simulated drops behind
  * them) for every part i with counts when all is 0, for every part when all
@@ -87,15 +97,21 @@ typedef struct fit_weighed {
                                  predicted parts' intervals carry it */
     double *const *plo_fit, *const *phi_fit; /* per part, k[i], or NULL: the 95%
                                  interval without the discrepancy */
+    double noise_sd;          /* the weighting's log-likelihood's simulation noise at the
+                                 maximum (standard deviation over FIT_REPEATS seeds) */
+    double misfit_sd;         /* its points' scatter about the fitted quadratic beyond
+                                 that noise (-1 when the quadratic was not fitted) */
 } fit_weighed;
 
 /* At FIT_LEVEL_FULL, evaluates theta (the search's maximum) with every part (and its
- * dispersion from there), then rounds of s->npoints quasi-random points
- * with the fitted parts: the whole box, then boxes around theta shrunk to
- * the weighted spread (at least 3 rounds, at most 6, stopping once the
- * effective sample size reaches s->npoints), all weighed by their
- * Dirichlet-multinomial likelihood over the density they were drawn from
- * (the balance heuristic). The parts without counts are then simulated at
+ * dispersion from there), then theta FIT_REPEATS times on the weighting's
+ * drops of other seeds (the simulation's noise in its likelihood), then
+ * rounds of s->npoints quasi-random points with the fitted parts: the whole
+ * box, then boxes about the weighted mean shrunk to the weighted spread (at
+ * least 3 rounds, at most 6, stopping once the effective sample size
+ * reaches s->npoints), all weighed by their Dirichlet-multinomial
+ * likelihood, smoothed against that noise by a quadratic, over the density
+ * they were drawn from (the balance heuristic). The parts without counts are then simulated at
  * s->npoints of those points drawn by their weights (systematic
  * resampling), and averaged over them. The interval of every parameter
  * holds theta. */

@@ -143,7 +143,7 @@ static void test_search_closed_form(void)
         phi0[2], phi1[2], nsb[2];
     double *pb_best[] = {pbest0, pbest1}, *pp[] = {p0, p1}, *plo[] = {plo0, plo1},
            *phi[] = {phi0, phi1};
-    fit_weighed w = {wlo, whi, wmean, pb_best, nsb, pp, plo, phi, 1, 0, 0, 0, NULL, NULL};
+    fit_weighed w = {wlo, whi, wmean, pb_best, nsb, pp, plo, phi, 1, 0, 0, 0, NULL, NULL, 0, 0};
     fit_settings s2 = {200, 64};
     CHECK_STATUS(fit_weigh(&pb, &s2, theta, &w, &evals, &diag), PD_OK);
     const double one[] = {1.0}, a[] = {41.0}, b[] = {61.0};
@@ -155,6 +155,36 @@ static void test_search_closed_form(void)
     CHECK_NEAR(wmean[0], 41.0 / 102.0, 0.005, "the posterior mean; quasi-random integration");
     pd_note("closed-form weighting: [%.4f, %.4f] against Beta's [%.4f, %.4f], ESS %.1f of %d\n",
             wlo[0], whi[0], qlo, qhi, w.ess, w.npoints);
+    /* A closed form has no simulation noise: the repeats agree exactly and
+     * the points' own likelihoods are used, unsmoothed. */
+    CHECK(w.noise_sd == 0.0);
+    CHECK(w.misfit_sd == -1.0);
+}
+
+/* The least squares behind the weighting's smoothing, against hand
+ * values: a line through (0, 0), (1, 1), (2, 0) is 1/3 flat, residuals
+ * -1/3, 2/3, -1/3 (sum of squares 2/3); an exact quadratic is recovered. */
+static void test_least_squares(void)
+{
+    const double X1[] = {1, 0, 1, 1, 1, 2}, y1[] = {0, 1, 0};
+    double c[3], rss;
+    CHECK_STATUS(pd_gsl_least_squares(3, 2, X1, y1, c, &rss), PD_OK);
+    CHECK_NEAR(c[0], 1.0 / 3.0, 1e-12, "round-off of an SVD of a 3 x 2 matrix");
+    CHECK_NEAR(c[1], 0.0, 1e-12, "round-off");
+    CHECK_NEAR(rss, 2.0 / 3.0, 1e-12, "round-off");
+    double X2[3 * 6], y2[6];
+    for (int i = 0; i < 6; i++) {
+        double x = -1.0 + 0.4 * i;
+        X2[3 * i] = 1.0;
+        X2[3 * i + 1] = x;
+        X2[3 * i + 2] = x * x;
+        y2[i] = 1.0 + 2.0 * x - 3.0 * x * x;
+    }
+    CHECK_STATUS(pd_gsl_least_squares(6, 3, X2, y2, c, &rss), PD_OK);
+    CHECK_NEAR(c[0], 1.0, 1e-12, "round-off");
+    CHECK_NEAR(c[1], 2.0, 1e-12, "round-off");
+    CHECK_NEAR(c[2], -3.0, 1e-12, "round-off");
+    CHECK_NEAR(rss, 0.0, 1e-20, "round-off squared");
 }
 
 /* A model that cannot fit: p = (theta, (1 - theta) / 2, (1 - theta) / 2)
@@ -182,7 +212,7 @@ static void test_dispersion(void)
     fit_settings s = {200, 32};
     double theta[1], l, wlo[1], whi[1], wmean[1], pb0[3], p0[3], l0[3], h0[3], nsb[1];
     double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
-    fit_weighed w = {wlo, whi, wmean, pbb, nsb, pp, pl, ph, 1, 0, 0, 0, NULL, NULL};
+    fit_weighed w = {wlo, whi, wmean, pbb, nsb, pp, pl, ph, 1, 0, 0, 0, NULL, NULL, 0, 0};
     int evals = 0;
     pd_diag diag;
     pd_diag_init(&diag);
@@ -205,7 +235,8 @@ static void test_dispersion(void)
  * below theta. Its p is a step function of theta, as posedrop's counts are.
  * As fit.c's drops: 2 S uniforms fixed for the whole fit, the first S the
  * search's seed (a quarter of them for the design and the simplex), the
- * other S the full level's (a quarter of them for the weighting's points). */
+ * other S the full level's (a quarter of them for the weighting's points),
+ * then a quarter of S for each of the weighting's repeats at the maximum. */
 typedef struct {
     int S;
     double *u;
@@ -217,8 +248,13 @@ static pd_status crn_sim(void *user, const double *theta, int all, fit_level lev
     const crn_model *m = user;
     (void)all;
     (void)diag;
-    int n = level == FIT_LEVEL_SEARCH || level == FIT_LEVEL_WEIGH ? m->S / 4 : m->S;
-    const double *u = level >= FIT_LEVEL_FULL ? m->u + m->S : m->u;
+    int n = level == FIT_LEVEL_SEARCH || level == FIT_LEVEL_WEIGH || level >= FIT_LEVEL_REPEAT
+                ? m->S / 4
+                : m->S;
+    const double *u = level >= FIT_LEVEL_REPEAT
+                          ? m->u + 2 * m->S + (level - FIT_LEVEL_REPEAT) * (m->S / 4)
+                      : level >= FIT_LEVEL_FULL ? m->u + m->S
+                                                : m->u;
     int below = 0;
     for (int i = 0; i < n; i++)
         below += u[i] < theta[0];
@@ -233,8 +269,9 @@ static pd_status crn_sim(void *user, const double *theta, int all, fit_level lev
 static void crn_fit(test_rng *rng, double truth, long n, int S, double *lo, double *hi,
                     double *best)
 {
-    crn_model m = {S, malloc(sizeof(double) * 2 * (size_t)S)};
-    for (int i = 0; i < 2 * S; i++)
+    int nu = 2 * S + FIT_REPEATS * (S / 4);
+    crn_model m = {S, malloc(sizeof(double) * (size_t)nu)};
+    for (int i = 0; i < nu; i++)
         m.u[i] = rng_uniform(rng);
     long c[2] = {0, 0};
     for (long i = 0; i < n; i++)
@@ -246,7 +283,7 @@ static void crn_fit(test_rng *rng, double truth, long n, int S, double *lo, doub
     fit_settings s = {150, 16};
     double theta[1], l, wmean[1], pb0[2], p0[2], l0[2], h0[2], nsb[1];
     double *pbb[] = {pb0}, *pp[] = {p0}, *pl[] = {l0}, *ph[] = {h0};
-    fit_weighed w = {lo, hi, wmean, pbb, nsb, pp, pl, ph, 1, 0, 0, 0, NULL, NULL};
+    fit_weighed w = {lo, hi, wmean, pbb, nsb, pp, pl, ph, 1, 0, 0, 0, NULL, NULL, 0, 0};
     int evals = 0;
     pd_diag diag;
     pd_diag_init(&diag);
@@ -1030,6 +1067,7 @@ void suite_fit(void)
     test_likelihood_hand();
     test_beta_mixture();
     test_search_closed_form();
+    test_least_squares();
     test_dispersion();
     test_coverage_crn();
     test_recovery();
