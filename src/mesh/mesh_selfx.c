@@ -531,7 +531,9 @@ static int star_shaped(search *s, int *closed)
  * the cells below.
  * A part that is nearly star-shaped (a scan with a few overhangs) leaves
  * few triangles to the search; on a pair of spheres apart, o in one, the
- * other and the first's triangles that lie in its directions. */
+ * other and the first's triangles that lie in its directions, and with o
+ * in the other too (narrow), only the triangles of each that the other
+ * hides. */
 #define CAP_PAD 1e-9
 
 typedef struct dircap {
@@ -660,11 +662,11 @@ static int cap_meets(const capgrid *g, const dircap *caps, const dircap *q)
     return 0;
 }
 
-/* The largest connected part's triangles (in[t] = 1), connected through
- * shared corners. 0, or -1 when out of memory. */
-static int largest_part(const pd_mesh *m, unsigned char *in)
+/* The largest connected part of the triangles of mask (in[t] = 1),
+ * connected through shared corners. 0, or -1 when out of memory. */
+static int largest_part(const pd_mesh *m, const unsigned char *mask, unsigned char *in)
 {
-    int n = m->ntris, nv = m->nverts, best = 0;
+    int n = m->ntris, nv = m->nverts, best = -1;
     int *up = malloc(sizeof *up * (size_t)nv), *size = calloc((size_t)nv, sizeof *size);
     if (!up || !size) {
         free(up);
@@ -674,37 +676,35 @@ static int largest_part(const pd_mesh *m, unsigned char *in)
     for (int i = 0; i < nv; i++)
         up[i] = i;
     for (int t = 0; t < n; t++)
-        for (int k = 1; k < 3; k++) {
+        for (int k = 1; k < 3 && mask[t]; k++) {
             int a = root(up, m->tris[t][0]), b = root(up, m->tris[t][k]);
             if (a != b)
                 up[a > b ? a : b] = a > b ? b : a;
         }
-    for (int t = 0; t < n; t++) {
-        int r = root(up, m->tris[t][0]);
-        if (++size[r] > size[best])
-            best = r;
-    }
     for (int t = 0; t < n; t++)
-        in[t] = root(up, m->tris[t][0]) == best;
+        if (mask[t]) {
+            int r = root(up, m->tris[t][0]);
+            if (++size[r] > (best < 0 ? 0 : size[best]))
+                best = r;
+        }
+    for (int t = 0; t < n; t++)
+        in[t] = mask[t] && root(up, m->tris[t][0]) == best;
     free(up);
     free(size);
     return 0;
 }
 
-/* The triangles the search needs (keep[t] = 1), by the argument above,
- * for a closed and consistently oriented surface. 1 when fewer than nine
- * in ten, 0 when the argument does not apply or keeps more (search them
- * all), -1 when out of memory. */
-static int shadow_subset(search *s, unsigned char *keep, int *nkeep)
+/* The triangles the search needs (keep[t] = 1) by the argument above,
+ * for a closed and consistently oriented surface, o drawn from the planes
+ * of the triangles of cand. 1 when the argument applies, 0 when not, -1
+ * when out of memory. */
+static int shadow_subset(search *s, const unsigned char *cand, unsigned char *keep)
 {
     const pd_mesh *m = s->m;
     const pd_vec3 *v = m->verts;
     int n = m->ntris, ret = 0;
     pd_vec3 o;
-    int exact = 0;
-    if (largest_part(m, keep) != 0)
-        return -1;
-    int kp = kernel_point(s, keep, &o, &exact);
+    int exact = 0, kp = kernel_point(s, cand, &o, &exact);
     if (kp != 1)
         return kp;
     signed char *side = malloc((size_t)n);
@@ -778,16 +778,12 @@ static int shadow_subset(search *s, unsigned char *keep, int *nkeep)
         for (int i = 0; i < k && ok; i++)
             ok = cap_insert(&g, &caps[i], i) == 0;
     }
-    int nk = 0;
     for (int t = 0; t < n && ok && !stop(s); t++) {
         dircap q;
         keep[t] = side[t] != front || !cap_of(m, t, o, &q) || cap_meets(&g, caps, &q);
-        nk += keep[t];
     }
-    if (ok && !s->cancelled && nk < n - n / 10) {
-        *nkeep = nk;
+    if (ok && !s->cancelled)
         ret = 1;
-    }
     free(side);
     free(caps);
     free(rs);
@@ -1815,6 +1811,47 @@ static int apart_pairs(search *s)
     return found;
 }
 
+/* The triangles a crossing can involve: those every point o tried keeps
+ * (each point's set holds every crossing pair, so their intersection
+ * does), o drawn first from the largest connected part, then from the
+ * largest connected part of what is still kept (on a part of several
+ * shells, the next shell), while a round takes away a tenth of what is
+ * left. *nk < ntris when narrowed. 0, or -1 when out of memory. */
+enum { NARROW_ROUNDS = 3 };
+
+static int narrow(search *s, unsigned char *keep, int *nk)
+{
+    const pd_mesh *m = s->m;
+    int n = m->ntris;
+    unsigned char *cand = malloc((size_t)n), *cur = malloc((size_t)n);
+    int st = cand && cur ? 0 : -1;
+    memset(keep, 1, (size_t)n);
+    *nk = n;
+    for (int round = 0; round < NARROW_ROUNDS && st == 0 && *nk >= 2; round++) {
+        if (largest_part(m, keep, cand) != 0) {
+            st = -1;
+            break;
+        }
+        int r = shadow_subset(s, cand, cur);
+        if (r <= 0) {
+            st = r;
+            break;
+        }
+        int left = 0;
+        for (int t = 0; t < n; t++) {
+            keep[t] &= cur[t];
+            left += keep[t];
+        }
+        int enough = left > *nk - *nk / 10;
+        *nk = left;
+        if (enough)
+            break;
+    }
+    free(cand);
+    free(cur);
+    return st;
+}
+
 /* The search over all of s's mesh (its stars built): 1 when a crossing
  * is found (or the search is cancelled), 0 when none, -1 when out of
  * memory. */
@@ -1894,11 +1931,13 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
     if (star == 1)
         found = 0;
     else if (star == 0) {
-        int nk = 0, sh = 0;
+        int nk = m->ntris, sh = 0;
         unsigned char *keep = closed == 1 ? malloc((size_t)m->ntris) : NULL;
         if (closed == 1)
-            sh = keep ? shadow_subset(&s, keep, &nk) : -1;
-        if (sh == 1)
+            sh = keep ? narrow(&s, keep, &nk) : -1;
+        if (sh == 0 && nk < 2)
+            found = 0; /* a crossing takes two triangles */
+        else if (sh == 0 && nk < m->ntris - m->ntris / 10)
             found = search_part(&s, keep, nk, R);
         else if (sh == 0)
             found = search_pairs(&s, R);
