@@ -1,8 +1,9 @@
 #!/bin/sh
 # selfx-compare.sh [N [COMMIT]]: the self-crossing search of this tree against
 # that of COMMIT (default 9f2cb89, the oriented-box tree before the
-# surface-area tree) on N (default 20000) seeded random meshes and on every
-# mesh under parts/ (tests/selfx/compare.c). Exit 0 when every answer agrees.
+# surface-area tree) on N (default 20000) seeded random meshes, N/10 pairs of
+# noisy spheres apart, and every mesh under parts/ (tests/selfx/compare.c).
+# Exit 0 when every answer agrees.
 set -e
 n=${1:-20000}
 commit=${2:-9f2cb89}

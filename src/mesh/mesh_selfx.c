@@ -10,6 +10,7 @@
  * crossing. Coplanar pairs are not examined (they touch, or overlap within
  * one plane, which the moment checks see as area, not as volume). */
 #include <float.h>
+#include <limits.h>
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -266,27 +267,29 @@ static int faces_point(const pd_mesh *m, search *s, pd_vec3 o)
     return 1;
 }
 
-/* The triangles the line through o and p pierces through their interiors,
- * or -1 when it passes through an edge or a corner of one (or lies in a
- * triangle's plane). */
-static long line_hits(const pd_mesh *m, pd_vec3 o, pd_vec3 p)
+/* Twice the degree of the projection from o: the triangles the line
+ * through o and p pierces through their interiors (both rays), the
+ * front-facing ones less the back-facing ones (every one counts 1 when
+ * side is NULL); LONG_MIN when the line touches an edge or a corner of
+ * one, or a grazing triangle. */
+static long line_degree(const pd_mesh *m, pd_vec3 o, pd_vec3 p, const signed char *side, int front)
 {
     const pd_vec3 *v = m->verts;
-    long hits = 0;
-    for (int t = 0; t < m->ntris; t++) {
-        const int *T = m->tris[t];
-        int g0 = pd_orient3d(&o, &p, &v[T[0]], &v[T[1]]);
-        int g1 = pd_orient3d(&o, &p, &v[T[1]], &v[T[2]]);
+    long sum = 0;
+    for (int u = 0; u < m->ntris; u++) {
+        const int *U = m->tris[u];
+        int g0 = pd_orient3d(&o, &p, &v[U[0]], &v[U[1]]);
+        int g1 = pd_orient3d(&o, &p, &v[U[1]], &v[U[2]]);
         if (g0 * g1 < 0)
             continue;
-        int g2 = pd_orient3d(&o, &p, &v[T[2]], &v[T[0]]);
+        int g2 = pd_orient3d(&o, &p, &v[U[2]], &v[U[0]]);
         if (g0 * g2 < 0 || g1 * g2 < 0)
             continue;
-        if (g0 == 0 || g1 == 0 || g2 == 0)
-            return -1;
-        hits++;
+        if (g0 == 0 || g1 == 0 || g2 == 0 || (side && side[u] == 0))
+            return LONG_MIN;
+        sum += !side || side[u] == front ? 1 : -1;
     }
-    return hits;
+    return sum;
 }
 
 static int int_cmp(const void *a, const void *b)
@@ -365,11 +368,14 @@ static int kernel_row(const pd_mesh *m, int t, int sg, pd_vec3 c0, pd_lp_halfspa
  * triangle's plane (the part's kernel, where it has one), by a linear
  * program over a sample of the planes, then again with the planes the last
  * answer violated, until it violates none (Clarkson's scheme: the working
- * set stays small). Floating point: faces_point then decides exactly. 1
- * with the point, 0 when the kernel looks empty, -1 when out of memory. */
+ * set stays small). Floating point: faces_point then decides exactly.
+ * Only the triangles t with in[t] count (all when in is NULL). 1 with the
+ * point, *exact set when no plane is violated (the kernel's centre), else
+ * clear (the last round's answer: the point least outside its sample's
+ * planes); 0 when there is none, -1 when out of memory. */
 enum { KERNEL_SAMPLE = 1024, KERNEL_ADD = 4096, KERNEL_ROUNDS = 12 };
 
-static int kernel_point(search *s, pd_vec3 *o)
+static int kernel_point(search *s, const unsigned char *in, pd_vec3 *o, int *exact)
 {
     const pd_mesh *m = s->m;
     const pd_vec3 *v = m->verts;
@@ -394,8 +400,12 @@ static int kernel_point(search *s, pd_vec3 *o)
     lo[3] = -diag;
     hi[3] = diag;
     /* Outwards by the sign of the enclosed volume. */
+    int nin = 0;
     for (int t = 0; t < n; t++) {
         const int *T = m->tris[t];
+        if (in && !in[t])
+            continue;
+        nin++;
         vol += v3_dot(v3_sub(v[T[0]], c0),
                       v3_cross(v3_sub(v[T[1]], c0), v3_sub(v[T[2]], c0)));
     }
@@ -405,12 +415,13 @@ static int kernel_point(search *s, pd_vec3 *o)
     pd_lp_halfspace *w = malloc(sizeof *w * (size_t)cap);
     if (!w)
         return -1;
-    int step = n > KERNEL_SAMPLE ? n / KERNEL_SAMPLE : 1, ok = 1;
-    for (int t = 0; t < n && ok; t += step)
-        ok = kernel_row(m, t, sg, c0, &w[k++]);
+    int step = nin > KERNEL_SAMPLE ? nin / KERNEL_SAMPLE : 1, ok = 1;
+    for (int t = 0, i = 0; t < n && ok; t++)
+        if ((!in || in[t]) && i++ % step == 0)
+            ok = kernel_row(m, t, sg, c0, &w[k++]);
     uint64_t seed = 0x9e3779b97f4a7c15u;
     double y[4] = {0, 0, 0, 0}, c[4] = {0, 0, 0, 1};
-    int found = 0;
+    int found = 0, solved = 0;
     for (int round = 0; ok && round < KERNEL_ROUNDS && !stop(s); round++) {
         /* A fixed shuffle (Seidel's expected time needs an order unrelated
          * to the planes'). */
@@ -426,7 +437,10 @@ static int kernel_point(search *s, pd_vec3 *o)
             free(w);
             return -1;
         }
-        if (st == 0 || !(y[3] > 1e-12 * diag))
+        if (st == 0)
+            break;
+        solved = 1;
+        if (!(y[3] > 1e-12 * diag))
             break;
         /* The planes this centre is not y[3] inside of: all of them when
          * they are few (one pass), else a stride of them (a second). */
@@ -436,6 +450,8 @@ static int kernel_point(search *s, pd_vec3 *o)
             int every = pass == 0 ? 1 : bad / KERNEL_ADD + 1, seen = 0;
             added = 0;
             for (int t = 0; t < n && ok; t++) {
+                if (in && !in[t])
+                    continue;
                 ok = kernel_row(m, t, sg, c0, &h);
                 if (ok && h.a[0] * y[0] + h.a[1] * y[1] + h.a[2] * y[2] + (1.0 - 1e-9) * y[3] > h.b) {
                     bad += pass == 0;
@@ -455,25 +471,26 @@ static int kernel_point(search *s, pd_vec3 *o)
             break;
     }
     free(w);
-    if (!ok || !found)
+    if (!ok || !solved)
         return 0;
     *o = v3(c0.x + y[0], c0.y + y[1], c0.z + y[2]);
+    *exact = found;
     return 1;
 }
 
 /* 1 when the condition above holds (no crossing), 0 when not or not shown,
  * -1 when out of memory. */
-static int star_shaped(search *s)
+static int star_shaped(search *s, int *closed)
 {
     const pd_mesh *m = s->m;
     const pd_vec3 *v = m->verts;
-    int closed = closed_oriented(s);
-    if (closed != 1)
-        return closed;
+    *closed = closed_oriented(s);
+    if (*closed != 1)
+        return *closed;
     pd_vec3 o;
-    int kp = kernel_point(s, &o);
-    if (kp != 1)
-        return kp;
+    int exact = 0, kp = kernel_point(s, NULL, &o, &exact);
+    if (kp != 1 || !exact)
+        return kp < 0 ? -1 : 0;
     if (!faces_point(m, s, o))
         return 0;
     /* Lines through the centres of the first few triangles: one that
@@ -481,11 +498,297 @@ static int star_shaped(search *s)
     for (int t = 0; t < m->ntris && t < 8; t++) {
         const int *T = m->tris[t];
         pd_vec3 p = v3_scale(v3_add(v3_add(v[T[0]], v[T[1]]), v[T[2]]), 1.0 / 3.0);
-        long h = line_hits(m, o, p);
-        if (h >= 0)
+        long h = line_degree(m, o, p, NULL, 1);
+        if (h != LONG_MIN)
             return h == 2;
     }
     return 0;
+}
+
+/* Parts that are not star-shaped. Take o from kernel_point over the
+ * planes of the largest connected part (inside it, or least outside its
+ * planes; inside one shell of a part of several) and call a triangle
+ * front-facing when o is on the side of its plane that most triangles put
+ * it on, back-facing on the other side, grazing in its plane. The count of
+ * front-facing triangles a ray from o meets, less the back-facing ones, is
+ * the degree of the projection from o (for rays that miss the edges); when
+ * a line through o gives 2 for its two rays, that degree is 1, and every
+ * ray that meets two front-facing triangles also meets a back-facing one.
+ * Two front-facing triangles that cross therefore do so in a direction
+ * from o that some back-facing or grazing triangle covers (the rays near a
+ * crossing meet both, so each of them meets one of finitely many closed
+ * sets of directions, and one of those holds the crossing's direction; a
+ * grazing triangle's directions are those of its edges), and a crossing
+ * that involves a back-facing or grazing triangle is in a direction it
+ * covers too. So the search needs only the back-facing and grazing
+ * triangles and the front-facing ones whose directions from o meet
+ * theirs: each triangle's directions lie in the cap about the mean of its
+ * corners' unit directions that holds them (a cap of chord radius under 1
+ * holds the spherical triangle of its corners; a grazing triangle with o
+ * inside it or on its boundary gives a radius of at least the square root
+ * of 2 or a corner at o, and is kept), caps met by a chord test, widened
+ * by CAP_PAD far above their round-off, which also covers the rounding of
+ * the cells below.
+ * A part that is nearly star-shaped (a scan with a few overhangs) leaves
+ * few triangles to the search; on a pair of spheres apart, o in one, the
+ * other and the first's triangles that lie in its directions, and with o
+ * in the other too (narrow), only the triangles of each that the other
+ * hides. */
+#define CAP_PAD 1e-9
+
+typedef struct dircap {
+    double c[3], r; /* unit centre and chord radius */
+} dircap;
+
+/* Triangle t's cap seen from o; 0 when it reaches beyond 60 degrees (or a
+ * corner is o). */
+static int cap_of(const pd_mesh *m, int t, pd_vec3 o, dircap *x)
+{
+    const int *T = m->tris[t];
+    pd_vec3 u[3], c = v3(0, 0, 0);
+    for (int k = 0; k < 3; k++) {
+        pd_vec3 d = v3_sub(m->verts[T[k]], o);
+        double len = v3_norm(d);
+        if (!(len > 0.0) || !isfinite(len))
+            return 0;
+        u[k] = v3_scale(d, 1.0 / len);
+        c = v3_add(c, u[k]);
+    }
+    double len = v3_norm(c);
+    if (!(len > 1e-3))
+        return 0;
+    c = v3_scale(c, 1.0 / len);
+    double r = 0.0;
+    for (int k = 0; k < 3; k++)
+        r = dmax(r, v3_norm(v3_sub(u[k], c)));
+    r = r * (1.0 + 1e-12) + CAP_PAD;
+    if (!(r < 1.0))
+        return 0;
+    x->c[0] = c.x;
+    x->c[1] = c.y;
+    x->c[2] = c.z;
+    x->r = r;
+    return 1;
+}
+
+static int caps_meet(const dircap *a, const dircap *b)
+{
+    double dx = a->c[0] - b->c[0], dy = a->c[1] - b->c[1], dz = a->c[2] - b->c[2];
+    double rr = a->r + b->r + CAP_PAD;
+    return dx * dx + dy * dy + dz * dz <= rr * rr;
+}
+
+/* The cells of width h that the boxes of the back-facing and grazing caps
+ * meet, as a hash set; a cap over more than CAP_INSERT_CELLS cells is kept
+ * in a short list of its own, tested against every front-facing cap. A
+ * front-facing cap whose box meets none of the cells, and that meets none
+ * of the listed caps, meets no back-facing or grazing cap; one whose box
+ * spans more than CAP_CELLS cells is kept without looking. */
+enum { CAP_CELLS = 64, CAP_INSERT_CELLS = 512, CAP_BIG = 16 };
+
+typedef struct capgrid {
+    double h;
+    size_t mask, used;
+    uint64_t *key; /* cell key + 1, 0 for an empty slot */
+    int big[CAP_BIG], nbig;
+} capgrid;
+
+static size_t slot_of(const capgrid *g, uint64_t key)
+{
+    uint64_t h = key * 0x9e3779b97f4a7c15ULL;
+    size_t i = (size_t)(h >> 20) & g->mask;
+    while (g->key[i] && g->key[i] != key + 1)
+        i = (i + 1) & g->mask;
+    return i;
+}
+
+/* The cells of x's box (lo and hi indices); their count. */
+static double cell_range(const capgrid *g, const dircap *x, int64_t lo[3], int64_t hi[3])
+{
+    double count = 1.0;
+    for (int i = 0; i < 3; i++) {
+        lo[i] = (int64_t)floor((x->c[i] - x->r + 2.5) / g->h);
+        hi[i] = (int64_t)floor((x->c[i] + x->r + 2.5) / g->h);
+        count *= (double)(hi[i] - lo[i] + 1);
+    }
+    return count;
+}
+
+static uint64_t cell_id(int64_t a, int64_t b, int64_t c)
+{
+    return ((uint64_t)a << 42) | ((uint64_t)b << 21) | (uint64_t)c;
+}
+
+/* Cap i's cells into the set: 0, or -1 when the set or the list is full. */
+static int cap_insert(capgrid *g, const dircap *x, int i)
+{
+    int64_t lo[3], hi[3];
+    if (cell_range(g, x, lo, hi) > CAP_INSERT_CELLS) {
+        if (g->nbig == CAP_BIG)
+            return -1;
+        g->big[g->nbig++] = i;
+        return 0;
+    }
+    for (int64_t a = lo[0]; a <= hi[0]; a++)
+        for (int64_t b = lo[1]; b <= hi[1]; b++)
+            for (int64_t c = lo[2]; c <= hi[2]; c++) {
+                uint64_t k = cell_id(a, b, c);
+                size_t s = slot_of(g, k);
+                if (!g->key[s]) {
+                    if (2 * (g->used + 1) > g->mask)
+                        return -1;
+                    g->key[s] = k + 1;
+                    g->used++;
+                }
+            }
+    return 0;
+}
+
+/* May cap q meet one of the set's? 1 also when its box spans too many
+ * cells to look (the answer that keeps the triangle). */
+static int cap_meets(const capgrid *g, const dircap *caps, const dircap *q)
+{
+    for (int i = 0; i < g->nbig; i++)
+        if (caps_meet(q, &caps[g->big[i]]))
+            return 1;
+    int64_t lo[3], hi[3];
+    if (cell_range(g, q, lo, hi) > CAP_CELLS)
+        return 1;
+    for (int64_t a = lo[0]; a <= hi[0]; a++)
+        for (int64_t b = lo[1]; b <= hi[1]; b++)
+            for (int64_t c = lo[2]; c <= hi[2]; c++)
+                if (g->key[slot_of(g, cell_id(a, b, c))])
+                    return 1;
+    return 0;
+}
+
+/* The largest connected part of the triangles of mask (in[t] = 1),
+ * connected through shared corners. 0, or -1 when out of memory. */
+static int largest_part(const pd_mesh *m, const unsigned char *mask, unsigned char *in)
+{
+    int n = m->ntris, nv = m->nverts, best = -1;
+    int *up = malloc(sizeof *up * (size_t)nv), *size = calloc((size_t)nv, sizeof *size);
+    if (!up || !size) {
+        free(up);
+        free(size);
+        return -1;
+    }
+    for (int i = 0; i < nv; i++)
+        up[i] = i;
+    for (int t = 0; t < n; t++)
+        for (int k = 1; k < 3 && mask[t]; k++) {
+            int a = root(up, m->tris[t][0]), b = root(up, m->tris[t][k]);
+            if (a != b)
+                up[a > b ? a : b] = a > b ? b : a;
+        }
+    for (int t = 0; t < n; t++)
+        if (mask[t]) {
+            int r = root(up, m->tris[t][0]);
+            if (++size[r] > (best < 0 ? 0 : size[best]))
+                best = r;
+        }
+    for (int t = 0; t < n; t++)
+        in[t] = mask[t] && root(up, m->tris[t][0]) == best;
+    free(up);
+    free(size);
+    return 0;
+}
+
+/* The triangles the search needs (keep[t] = 1) by the argument above,
+ * for a closed and consistently oriented surface, o drawn from the planes
+ * of the triangles of cand. 1 when the argument applies, 0 when not, -1
+ * when out of memory. */
+static int shadow_subset(search *s, const unsigned char *cand, unsigned char *keep)
+{
+    const pd_mesh *m = s->m;
+    const pd_vec3 *v = m->verts;
+    int n = m->ntris, ret = 0;
+    pd_vec3 o;
+    int exact = 0, kp = kernel_point(s, cand, &o, &exact);
+    if (kp != 1)
+        return kp;
+    signed char *side = malloc((size_t)n);
+    if (!side)
+        return -1;
+    int npos = 0, nneg = 0;
+    for (int t = 0; t < n && !stop(s); t++) {
+        const int *T = m->tris[t];
+        side[t] = (signed char)pd_orient3d(&v[T[0]], &v[T[1]], &v[T[2]], &o);
+        npos += side[t] > 0;
+        nneg += side[t] < 0;
+    }
+    int front = npos >= nneg ? 1 : -1, nb = n - (front > 0 ? npos : nneg);
+    long deg2 = LONG_MIN;
+    for (int t = 0; t < n && t < 8 && deg2 == LONG_MIN && !s->cancelled && nb <= n / 3; t++) {
+        const int *T = m->tris[t];
+        pd_vec3 p = v3_scale(v3_add(v3_add(v[T[0]], v[T[1]]), v[T[2]]), 1.0 / 3.0);
+        deg2 = line_degree(m, o, p, side, front);
+    }
+    dircap *caps = NULL;
+    double *rs = NULL;
+    capgrid g = {0};
+    int ok = deg2 == 2 && nb > 0;
+    if (ok) {
+        caps = malloc(sizeof *caps * (size_t)nb);
+        rs = malloc(sizeof *rs * (size_t)nb);
+        ok = caps && rs;
+        if (!ok)
+            ret = -1;
+    }
+    int k = 0;
+    for (int t = 0; t < n && ok; t++)
+        if (side[t] != front) {
+            ok = cap_of(m, t, o, &caps[k]);
+            rs[k] = caps[k].r;
+            k++;
+        }
+    if (ok) {
+        /* Cells twice the median radius wide (a selection of it). */
+        int mid = k / 2;
+        for (int lo = 0, hi = k - 1; lo < hi;) {
+            double piv = rs[lo + (hi - lo) / 2];
+            int i = lo, j = hi;
+            while (i <= j) {
+                while (rs[i] < piv)
+                    i++;
+                while (rs[j] > piv)
+                    j--;
+                if (i <= j) {
+                    double x = rs[i];
+                    rs[i++] = rs[j];
+                    rs[j--] = x;
+                }
+            }
+            if (mid <= j)
+                hi = j;
+            else if (mid >= i)
+                lo = i;
+            else
+                break;
+        }
+        g.h = dmax(2.0 * rs[mid], 1e-5);
+        size_t slots = 1024;
+        while (slots < 4 * (size_t)k && slots < ((size_t)1 << 22))
+            slots *= 2;
+        g.mask = slots - 1;
+        g.key = calloc(slots, sizeof *g.key);
+        ok = g.key != NULL;
+        if (!ok)
+            ret = -1;
+        for (int i = 0; i < k && ok; i++)
+            ok = cap_insert(&g, &caps[i], i) == 0;
+    }
+    for (int t = 0; t < n && ok && !stop(s); t++) {
+        dircap q;
+        keep[t] = side[t] != front || !cap_of(m, t, o, &q) || cap_meets(&g, caps, &q);
+    }
+    if (ok && !s->cancelled)
+        ret = 1;
+    free(side);
+    free(caps);
+    free(rs);
+    free(g.key);
+    return ret;
 }
 
 typedef struct edge {
@@ -1508,6 +1811,105 @@ static int apart_pairs(search *s)
     return found;
 }
 
+/* The triangles a crossing can involve: those every point o tried keeps
+ * (each point's set holds every crossing pair, so their intersection
+ * does), o drawn first from the largest connected part, then from the
+ * largest connected part of what is still kept (on a part of several
+ * shells, the next shell), while a round takes away a tenth of what is
+ * left. *nk < ntris when narrowed. 0, or -1 when out of memory. */
+enum { NARROW_ROUNDS = 3 };
+
+static int narrow(search *s, unsigned char *keep, int *nk)
+{
+    const pd_mesh *m = s->m;
+    int n = m->ntris;
+    unsigned char *cand = malloc((size_t)n), *cur = malloc((size_t)n);
+    int st = cand && cur ? 0 : -1;
+    memset(keep, 1, (size_t)n);
+    *nk = n;
+    for (int round = 0; round < NARROW_ROUNDS && st == 0 && *nk >= 2; round++) {
+        if (largest_part(m, keep, cand) != 0) {
+            st = -1;
+            break;
+        }
+        int r = shadow_subset(s, cand, cur);
+        if (r <= 0) {
+            st = r;
+            break;
+        }
+        int left = 0;
+        for (int t = 0; t < n; t++) {
+            keep[t] &= cur[t];
+            left += keep[t];
+        }
+        int enough = left > *nk - *nk / 10;
+        *nk = left;
+        if (enough)
+            break;
+    }
+    free(cand);
+    free(cur);
+    return st;
+}
+
+/* The search over all of s's mesh (its stars built): 1 when a crossing
+ * is found (or the search is cancelled), 0 when none, -1 when out of
+ * memory. */
+static int search_pairs(search *s, double R)
+{
+    const pd_mesh *m = s->m;
+    for (int t = 0; t < m->ntris; t++)
+        plane_of(m->verts, m->tris[t], R, s->plane + 4 * (size_t)t);
+    if (flat_patches(s) != 0)
+        return -1;
+    int found = s->cancelled ? 1 : star_pairs(s);
+    return found == 0 ? apart_pairs(s) : found;
+}
+
+/* The search over the nk triangles of keep (shadow_subset), as a mesh of
+ * its own on the same vertices; the pair found named by the triangles of
+ * s's mesh. */
+static int search_part(search *s, const unsigned char *keep, int nk, double R)
+{
+    const pd_mesh *m = s->m;
+    int *idx = malloc(sizeof *idx * (size_t)nk), found = -1;
+    int(*tris)[3] = malloc(sizeof *tris * (size_t)nk);
+    free(s->start);
+    free(s->list);
+    s->start = s->list = NULL;
+    pd_mesh part = {m->nverts, m->verts, nk, tris};
+    search p = *s;
+    p.m = &part;
+    p.patch = p.start = p.list = NULL;
+    p.plane = NULL;
+    if (idx && tris) {
+        for (int t = 0, k = 0; t < m->ntris; t++)
+            if (keep[t]) {
+                idx[k] = t;
+                memcpy(tris[k++], m->tris[t], sizeof *tris);
+            }
+        p.patch = malloc(sizeof *p.patch * (size_t)nk);
+        p.plane = malloc(sizeof *p.plane * 4 * (size_t)nk);
+        if (p.patch && p.plane && build_stars(&p) == 0)
+            found = search_pairs(&p, R);
+    }
+    s->tested = p.tested;
+    s->cancelled = p.cancelled;
+    s->polls = p.polls;
+    if (found == 1 && !p.cancelled) {
+        s->ta = idx[p.ta] < idx[p.tb] ? idx[p.ta] : idx[p.tb];
+        s->tb = idx[p.ta] < idx[p.tb] ? idx[p.tb] : idx[p.ta];
+        s->at = p.at;
+    }
+    free(p.patch);
+    free(p.plane);
+    free(p.start);
+    free(p.list);
+    free(idx);
+    free(tris);
+    return found;
+}
+
 pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *ta, int *tb,
                                 pd_vec3 *at, size_t *tested)
 {
@@ -1523,19 +1925,23 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
         R = dmax(R, dmax(fabs(m->verts[i].x), dmax(fabs(m->verts[i].y), fabs(m->verts[i].z))));
     search s = {m, malloc(sizeof *s.patch * (size_t)m->ntris), NULL, NULL, PD_SELFX_PAD_REL * R,
                 malloc(sizeof *s.plane * 4 * (size_t)m->ntris), 0, -1, -1, {0, 0, 0}, cancel, 0, 0};
-    int found = -1, star = -1;
+    int found = -1, star = -1, closed = 0;
     if (s.patch && s.plane && build_stars(&s) == 0)
-        star = star_shaped(&s);
+        star = star_shaped(&s, &closed);
     if (star == 1)
         found = 0;
     else if (star == 0) {
-        for (int t = 0; t < m->ntris; t++)
-            plane_of(m->verts, m->tris[t], R, s.plane + 4 * (size_t)t);
-        if (flat_patches(&s) == 0) {
-            found = s.cancelled ? 1 : star_pairs(&s);
-            if (found == 0)
-                found = apart_pairs(&s);
-        }
+        int nk = m->ntris, sh = 0;
+        unsigned char *keep = closed == 1 ? malloc((size_t)m->ntris) : NULL;
+        if (closed == 1)
+            sh = keep ? narrow(&s, keep, &nk) : -1;
+        if (sh == 0 && nk < 2)
+            found = 0; /* a crossing takes two triangles */
+        else if (sh == 0 && nk < m->ntris - m->ntris / 10)
+            found = search_part(&s, keep, nk, R);
+        else if (sh == 0)
+            found = search_pairs(&s, R);
+        free(keep);
     }
     free(s.patch);
     free(s.plane);

@@ -9,7 +9,8 @@
  * triangles on a random walk of integer points (corners and edges shared
  * often); closed UV spheres and fanned rods of 3 to 22 sides, turned at
  * random, one vertex pushed in by up to 2.5 radii; each of the last two
- * scaled by 1e-3 to 1e3 and moved up to 1e3 sizes off the origin. */
+ * scaled by 1e-3 to 1e3 and moved up to 1e3 sizes off the origin. Then a
+ * tenth as many pairs of noisy UV spheres apart, placed the same way. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -98,9 +99,29 @@ static void place(pd_vec3 *v, int nv, double radius)
     }
 }
 
+/* The triangles of a UV sphere of nu x (nw - 1) corners and two poles
+ * (the last two), its corners numbered from o, written from tri[t] on;
+ * the next free triangle. */
+static int sphere_faces(int (*tri)[3], int t, int o, int nu, int nw)
+{
+    int nv = nu * (nw - 1) + 2;
+    for (int j = 0; j < nu; j++) {
+        int jn = (j + 1) % nu;
+        tri[t][0] = o + nv - 2, tri[t][1] = o + j, tri[t][2] = o + jn, t++;
+        int a = (nw - 2) * nu;
+        tri[t][0] = o + nv - 1, tri[t][1] = o + a + jn, tri[t][2] = o + a + j, t++;
+        for (int r = 0; r + 1 < nw - 1; r++) {
+            int p = o + r * nu, q = o + (r + 1) * nu;
+            tri[t][0] = p + j, tri[t][1] = q + j, tri[t][2] = q + jn, t++;
+            tri[t][0] = p + j, tri[t][1] = q + jn, tri[t][2] = p + jn, t++;
+        }
+    }
+    return t;
+}
+
 static void uv_sphere(int i, int nu, int nw)
 {
-    int nv = nu * (nw - 1) + 2, nt = 2 * nu * (nw - 1), t = 0;
+    int nv = nu * (nw - 1) + 2, nt = 2 * nu * (nw - 1);
     pd_vec3 *v = malloc(sizeof *v * (size_t)nv);
     int(*tri)[3] = malloc(sizeof *tri * (size_t)nt);
     for (int r = 1; r < nw; r++)
@@ -110,17 +131,7 @@ static void uv_sphere(int i, int nu, int nw)
         }
     v[nv - 2] = (pd_vec3){0, 0, 1};
     v[nv - 1] = (pd_vec3){0, 0, -1};
-    for (int j = 0; j < nu; j++) {
-        int jn = (j + 1) % nu;
-        tri[t][0] = nv - 2, tri[t][1] = j, tri[t][2] = jn, t++;
-        int a = (nw - 2) * nu;
-        tri[t][0] = nv - 1, tri[t][1] = a + jn, tri[t][2] = a + j, t++;
-        for (int r = 0; r + 1 < nw - 1; r++) {
-            int p = r * nu, q = (r + 1) * nu;
-            tri[t][0] = p + j, tri[t][1] = q + j, tri[t][2] = q + jn, t++;
-            tri[t][0] = p + j, tri[t][1] = q + jn, tri[t][2] = p + jn, t++;
-        }
-    }
+    int t = sphere_faces(tri, 0, 0, nu, nw);
     place(v, nv, 1.0);
     pd_mesh m = {nv, v, t, tri};
     compare(&m, "sphere", i);
@@ -155,6 +166,35 @@ static void rod(int i, int n)
     free(tri);
 }
 
+/* Two noisy UV spheres 3 radii apart (each corner at a radius drawn in
+ * [0.6, 1]), then placed as above, which pushes one corner of either
+ * towards the first one's centre: a part that is not star-shaped, whose
+ * check searches only the triangles of one sphere that the other hides
+ * from a point inside it, and the other's. */
+static void sphere_pair(int i, int nu, int nw)
+{
+    int nv1 = nu * (nw - 1) + 2, nt1 = 2 * nu * (nw - 1), nv = 2 * nv1, t = 0;
+    pd_vec3 *v = malloc(sizeof *v * (size_t)nv);
+    int(*tri)[3] = malloc(sizeof *tri * 2 * (size_t)nt1);
+    for (int h = 0; h < 2; h++) {
+        int o = h * nv1;
+        for (int r = 1; r < nw; r++)
+            for (int j = 0; j < nu; j++) {
+                double th = M_PI * r / nw, ph = 2 * M_PI * j / nu, rr = 0.6 + 0.4 * uni();
+                v[o + (r - 1) * nu + j] = (pd_vec3){rr * sin(th) * cos(ph) + 3.0 * h,
+                                                    rr * sin(th) * sin(ph), rr * cos(th)};
+            }
+        v[o + nv1 - 2] = (pd_vec3){3.0 * h, 0, 0.6 + 0.4 * uni()};
+        v[o + nv1 - 1] = (pd_vec3){3.0 * h, 0, -0.6 - 0.4 * uni()};
+        t = sphere_faces(tri, t, o, nu, nw);
+    }
+    place(v, nv, 1.0);
+    pd_mesh m = {nv, v, t, tri};
+    compare(&m, "pair", i);
+    free(v);
+    free(tri);
+}
+
 int main(int argc, char **argv)
 {
     int n = argc > 1 ? atoi(argv[1]) : 20000;
@@ -172,6 +212,13 @@ int main(int argc, char **argv)
         }
     }
     printf("random set: %d meshes, %d cross (old), %d mismatches\n", total, crossing, mismatches);
+    /* Pairs of spheres, a tenth as many, after the set above (which they
+     * leave as it was). */
+    int t0 = total, c0 = crossing, m0 = mismatches;
+    for (int i = 0; i < n / 10; i++)
+        sphere_pair(i, 6 + (int)(uni() * 40), 4 + (int)(uni() * 40));
+    printf("pairs of spheres: %d meshes, %d cross (old), %d mismatches\n", total - t0,
+           crossing - c0, mismatches - m0);
     for (int a = 2; a < argc; a++) {
         pd_mesh *m = NULL;
         if (pd_mesh_read(argv[a], NULL, &m, NULL) != PD_OK)

@@ -1150,7 +1150,10 @@ static void uv_sphere(int m, pd_vec3 c, double r, double noise, test_rng *g, pd_
  * through it pierce four: no crossing), two overlapping spheres (the same,
  * and they cross), a sphere with one triangle turned over (closed, not
  * consistently oriented), a sphere with one vertex pushed through the far
- * side (it crosses), two spheres apart (no point faces all). */
+ * side (it crosses), two spheres apart (no point faces all: the search
+ * then takes only the second sphere and the triangles of the first that
+ * it hides from the first's centre), the same with a vertex of the first
+ * pushed through its far side (found). */
 static void test_self_crossing_star(void)
 {
     enum { M = 24, NT = 2 * M * M, NV = M * M + 2 };
@@ -1173,6 +1176,8 @@ static void test_self_crossing_star(void)
         {"one triangle turned over", {0, 0, 0}, 0, 0.01, 0, 1, 0, 0, 0},
         {"a vertex pushed through", {0, 0, 0}, 0, 0.01, 0, 0, 1, 1, 0},
         {"spheres apart", {3, 0, 0}, 1.0, 0.01, 0, 0, 0, 0, 0},
+        {"spheres apart, a vertex pushed through", {3, 0, 0}, 1.0, 0.01, 0, 0, 1, 1, 0},
+        {"noisy spheres apart, a vertex pushed through", {3, 0, 0}, 1.0, 0.333, 0, 0, 1, 1, 0},
     };
     for (size_t c = 0; c < sizeof cases / sizeof cases[0]; c++) {
         /* noise 0.333: radii in [0.667, 1.333], twice the smallest. */
