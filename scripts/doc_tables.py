@@ -35,6 +35,12 @@ CPU in all):
                  its limit law and Poisson's, from make check's own test
                  (tests/unit/test_compliant.c's notes); compared exactly.
                  About 8 s of CPU.
+  lasting-depth  docs/contact.md: the deepest lasting contact and energy
+                 rise over make check's drops of four parts, from the same
+                 test run as rigid-limit; compared exactly.
+  crn-coverage   docs/calibration.md: the fit's coverage test of make
+                 check (tests/unit/test_fit.c's note); compared exactly.
+                 About 2 s of CPU.
 
 Not cheap (make figures without CHEAP=1):
 
@@ -100,6 +106,7 @@ edit. After a new measurement, edit the block and its RECORDS entry, then
 Python 3 standard library only; posedrop must be built (make all).
 """
 import csv
+import functools
 import hashlib
 import io
 import math
@@ -507,6 +514,7 @@ def test_cost(binary):
     return "build/opt/test_posedrop -j2 (make test)", text, []
 
 
+@functools.lru_cache(maxsize=None)
 def test_notes(binary, suite):
     """make check's suite SUITE run alone with its notes (PD_TEST_VERBOSE=1):
     the lines it prints."""
@@ -518,7 +526,7 @@ def test_notes(binary, suite):
     if run.returncode != 0:
         sys.exit(f"doc_tables.py: test_posedrop {suite} failed:\n{run.stdout[-1500:]}"
                  f"{run.stderr[-1500:]}")
-    return (run.stdout + run.stderr).splitlines()
+    return tuple((run.stdout + run.stderr).splitlines())
 
 
 def note_numbers(lines, start, pattern):
@@ -611,6 +619,45 @@ def extreme_scenes(binary):
     out += ["", f"Failed drops in all: {failed}."]
     return ("posedrop -n 10 -j 1 --seed 1 --engine E [--mu 10 | --restitution 0 | --restitution 1 "
             "[--mu 0]] --trials FILE PART (boxes written by the script)", "\n".join(out), numbers)
+
+
+def lasting_depth(binary):
+    """docs/contact.md: the deepest lasting contact and the largest energy
+    rise over make check's drops of tests/unit/test_compliant.c's
+    test_convergence (its notes; the same run as rigid-limit's).
+    Deterministic: compared exactly."""
+    import re
+    out = ["| part | drops | deepest lasting contact | energy rise at most | unsettled |",
+           "|---|---:|---:|---:|---:|"]
+    numbers = []
+    for l in test_notes(binary, "compliant"):
+        m = re.match(r"compliant: (\S+), (\d+) drops at tolerance scale 1 and 0.5: .*unsettled "
+                     r"(\d+), (\d+); lasting contact depth at most ([-0-9.e+]+) L; energy rise "
+                     r"at most ([-0-9.e+]+) L", l)
+        if m:
+            part, n, u1, u2, depth, rise = m.groups()
+            out.append(f"| `{part[len('parts/'):]}` | {n} | {depth} L | {rise} L | {u1}, {u2} |")
+            numbers += [(f"{part} depth", float(depth), 0.0), (f"{part} rise", float(rise), 0.0)]
+    if not numbers:
+        sys.exit("doc_tables.py: no lasting-contact notes in test_posedrop compliant")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop compliant (tests/unit/test_compliant.c, "
+            "test_convergence: the automatic contact time, tolerance scales 1 and 0.5)",
+            "\n".join(out), numbers)
+
+
+def crn_coverage(binary):
+    """docs/calibration.md: the fit's coverage test as make check runs it
+    (tests/unit/test_fit.c, its note): intervals covering the truth, of
+    200, and their mean width. Deterministic: compared exactly."""
+    num = r"([-0-9.e+]+)"
+    covered, n, bound, width = note_numbers(
+        test_notes(binary, "fit"), "CRN coverage:",
+        rf"{num} of {num} \(bound {num}\), mean width {num}")
+    text = (f"| intervals covering the truth | bound (3 standard deviations below 95%) | "
+            f"mean width |\n|---:|---:|---:|\n| {covered:.0f} of {n:.0f} | {bound:g} | "
+            f"{width:.3f} |")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (tests/unit/test_fit.c, the "
+            "coverage test)", text, [("covered", covered, 0.0), ("width", width, 0.0)])
 
 
 def venv_python():
@@ -728,6 +775,8 @@ TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
               "engines against their step.")), False),
           "bench-mujoco": ("docs/performance.md", bench_mujoco, False),
           "rigid-limit": ("docs/contact.md", rigid_limit, True),
+          "crn-coverage": ("docs/calibration.md", crn_coverage, True),
+          "lasting-depth": ("docs/contact.md", lasting_depth, True),
           "extreme-scenes": ("docs/engines-crosscheck.md", extreme_scenes, False),
           "trimesh": ("docs/python.md", trimesh_table, False),
           "fit-mirror": ("docs/calibration.md", fit_mirror, False),
@@ -783,6 +832,14 @@ RECORDS = {
     "fit-mirror-before": (
         "docs/calibration.md", 'scripts/fit-mirror.sh -s "1 2 3 4 5 6 7 8 9 10" with the '
         "binary of commit e8d8523 (the search on its own drops)", "at commit e8d8523 on 2026-12-07"),
+    "fit-coverage": (
+        "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop --full fit (340 s "
+        "of CPU)", "on 2026-12-07, with the discrepancy's change (first recorded in commit "
+        "119e480)"),
+    "fit-tempering": (
+        "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (the coverage "
+        "test) with the tempering, the Dirichlet-multinomial and the weighting on S/4 drops",
+        "on 2026-12-07 (first recorded in commit 5cff1f7)"),
     "xc-contact-steps": (
         "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
         "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
