@@ -38,6 +38,8 @@ CPU in all):
   lasting-depth  docs/contact.md: the deepest lasting contact and energy
                  rise over make check's drops of four parts, from the same
                  test run as rigid-limit; compared exactly.
+  topple-rules   docs/readings.md: --topple edge against the default on
+                 every shipped part (static estimates); exact. Under 1 s.
   crn-coverage   docs/calibration.md: the fit's coverage test of make
                  check (tests/unit/test_fit.c's note); compared exactly.
                  About 2 s of CPU.
@@ -645,6 +647,31 @@ def lasting_depth(binary):
             "\n".join(out), numbers)
 
 
+def topple_rules(binary):
+    """docs/readings.md: the static estimate under --topple edge against the
+    default (descent) on every shipped part: the same CSV byte for byte, or
+    the largest difference of a pose's QS probability. Exact."""
+    out = ["| part | poses | `--topple edge` and the default | largest QS difference |",
+           "|---|---:|---|---:|"]
+    numbers = []
+    for name in sorted(os.listdir(os.path.join(ROOT, "parts"))):
+        if not name.endswith((".off", ".obj", ".stl")):
+            continue
+        path = "parts/" + name
+        units = ["--units", "mm"] if name.endswith((".obj", ".stl")) else []
+        a = posedrop(binary, units + [path])
+        b = posedrop(binary, units + ["--topple", "edge", path])
+        ra, rb = list(csv.DictReader(a.splitlines())), list(csv.DictReader(b.splitlines()))
+        diff = (max(abs(float(x["p_qs"]) - float(y["p_qs"])) for x, y in zip(ra, rb))
+                if len(ra) == len(rb) else float("nan"))
+        same = "the same CSV" if a == b else (
+            "the same poses" if len(ra) == len(rb) else "different poses")
+        out.append(f"| `{name}` | {len(ra)} | {same} | {diff:.3g} |")
+        numbers.append((f"{name} same", float(a == b), 0.0))
+    return ("posedrop [--units mm] [--topple edge] PART, each shipped part (the .obj and .stl "
+            "in mm)", "\n".join(out), numbers)
+
+
 def crn_coverage(binary):
     """docs/calibration.md: the fit's coverage test as make check runs it
     (tests/unit/test_fit.c, its note): intervals covering the truth, of
@@ -776,6 +803,7 @@ TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
           "bench-mujoco": ("docs/performance.md", bench_mujoco, False),
           "rigid-limit": ("docs/contact.md", rigid_limit, True),
           "crn-coverage": ("docs/calibration.md", crn_coverage, True),
+          "topple-rules": ("docs/readings.md", topple_rules, True),
           "lasting-depth": ("docs/contact.md", lasting_depth, True),
           "extreme-scenes": ("docs/engines-crosscheck.md", extreme_scenes, False),
           "trimesh": ("docs/python.md", trimesh_table, False),
@@ -840,6 +868,10 @@ RECORDS = {
         "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (the coverage "
         "test) with the tempering, the Dirichlet-multinomial and the weighting on S/4 drops",
         "on 2026-12-07 (first recorded in commit 5cff1f7)"),
+    "readings-eq2": (
+        "docs/readings.md", "the paper's route of eq. (1)-(3) implemented in double precision "
+        "against the closed form, on right isosceles triangles (no script kept)",
+        "on 2026-11-26 (first recorded in commit 8f24208)"),
     "xc-contact-steps": (
         "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
         "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
