@@ -872,6 +872,9 @@ RECORDS = {
         "docs/readings.md", "the paper's route of eq. (1)-(3) implemented in double precision "
         "against the closed form, on right isosceles triangles (no script kept)",
         "on 2026-11-26 (first recorded in commit 8f24208)"),
+    "design-demos": (
+        "docs/design.md", "scripts/design-demos.sh (docs/figures/design/summary.md; tens of "
+        "CPU minutes)", "at commits bba359c and 61b4a6f (the bushing) on 2026-12-07"),
     "xc-contact-steps": (
         "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
         "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
