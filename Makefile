@@ -241,8 +241,10 @@ check-readme: deps
 # table of docs/performance.md. CHART_ONLY=1 redraws the cost-accuracy chart
 # from its kept CSV instead of rerunning it; CHEAP=1 makes only the cap's
 # pictures, paper.txt and doc_tables.py's cheap tables (seconds); the others
-# time make bench's sections, python/bench.py (PYTHON names a Python with
-# the module) and make fuzz.
+# time make bench's sections, python/bench.py, the trimesh comparison and
+# scripts/bench-mujoco.py (PYTHON names a Python with the module, trimesh,
+# pytest and mujoco; default .venv's) and make fuzz. Records (doc_tables.py
+# --record) are not remade: check-figures guards their text.
 figures: deps
 	@$(MAKE) --no-print-directory all $(TEST_BIN) $(if $(CHEAP),,$(BENCH_BIN))
 	POSEDROP=$(CLI) scripts/figures.sh $(if $(CHEAP),--cheap,$(if $(CHART_ONLY),--chart-only))

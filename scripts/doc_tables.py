@@ -35,6 +35,14 @@ CPU in all):
                  its limit law and Poisson's, from make check's own test
                  (tests/unit/test_compliant.c's notes); compared exactly.
                  About 8 s of CPU.
+  lasting-depth  docs/contact.md: the deepest lasting contact and energy
+                 rise over make check's drops of four parts, from the same
+                 test run as rigid-limit; compared exactly.
+  topple-rules   docs/readings.md: --topple edge against the default on
+                 every shipped part (static estimates); exact. Under 1 s.
+  crn-coverage   docs/calibration.md: the fit's coverage test of make
+                 check (tests/unit/test_fit.c's note); compared exactly.
+                 About 2 s of CPU.
 
 Not cheap (make figures without CHEAP=1):
 
@@ -100,6 +108,7 @@ edit. After a new measurement, edit the block and its RECORDS entry, then
 Python 3 standard library only; posedrop must be built (make all).
 """
 import csv
+import functools
 import hashlib
 import io
 import math
@@ -507,6 +516,7 @@ def test_cost(binary):
     return "build/opt/test_posedrop -j2 (make test)", text, []
 
 
+@functools.lru_cache(maxsize=None)
 def test_notes(binary, suite):
     """make check's suite SUITE run alone with its notes (PD_TEST_VERBOSE=1):
     the lines it prints."""
@@ -518,7 +528,7 @@ def test_notes(binary, suite):
     if run.returncode != 0:
         sys.exit(f"doc_tables.py: test_posedrop {suite} failed:\n{run.stdout[-1500:]}"
                  f"{run.stderr[-1500:]}")
-    return (run.stdout + run.stderr).splitlines()
+    return tuple((run.stdout + run.stderr).splitlines())
 
 
 def note_numbers(lines, start, pattern):
@@ -611,6 +621,70 @@ def extreme_scenes(binary):
     out += ["", f"Failed drops in all: {failed}."]
     return ("posedrop -n 10 -j 1 --seed 1 --engine E [--mu 10 | --restitution 0 | --restitution 1 "
             "[--mu 0]] --trials FILE PART (boxes written by the script)", "\n".join(out), numbers)
+
+
+def lasting_depth(binary):
+    """docs/contact.md: the deepest lasting contact and the largest energy
+    rise over make check's drops of tests/unit/test_compliant.c's
+    test_convergence (its notes; the same run as rigid-limit's).
+    Deterministic: compared exactly."""
+    import re
+    out = ["| part | drops | deepest lasting contact | energy rise at most | unsettled |",
+           "|---|---:|---:|---:|---:|"]
+    numbers = []
+    for l in test_notes(binary, "compliant"):
+        m = re.match(r"compliant: (\S+), (\d+) drops at tolerance scale 1 and 0.5: .*unsettled "
+                     r"(\d+), (\d+); lasting contact depth at most ([-0-9.e+]+) L; energy rise "
+                     r"at most ([-0-9.e+]+) L", l)
+        if m:
+            part, n, u1, u2, depth, rise = m.groups()
+            out.append(f"| `{part[len('parts/'):]}` | {n} | {depth} L | {rise} L | {u1}, {u2} |")
+            numbers += [(f"{part} depth", float(depth), 0.0), (f"{part} rise", float(rise), 0.0)]
+    if not numbers:
+        sys.exit("doc_tables.py: no lasting-contact notes in test_posedrop compliant")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop compliant (tests/unit/test_compliant.c, "
+            "test_convergence: the automatic contact time, tolerance scales 1 and 0.5)",
+            "\n".join(out), numbers)
+
+
+def topple_rules(binary):
+    """docs/readings.md: the static estimate under --topple edge against the
+    default (descent) on every shipped part: the same CSV byte for byte, or
+    the largest difference of a pose's QS probability. Exact."""
+    out = ["| part | poses | `--topple edge` and the default | largest QS difference |",
+           "|---|---:|---|---:|"]
+    numbers = []
+    for name in sorted(os.listdir(os.path.join(ROOT, "parts"))):
+        if not name.endswith((".off", ".obj", ".stl")):
+            continue
+        path = "parts/" + name
+        units = ["--units", "mm"] if name.endswith((".obj", ".stl")) else []
+        a = posedrop(binary, units + [path])
+        b = posedrop(binary, units + ["--topple", "edge", path])
+        ra, rb = list(csv.DictReader(a.splitlines())), list(csv.DictReader(b.splitlines()))
+        diff = (max(abs(float(x["p_qs"]) - float(y["p_qs"])) for x, y in zip(ra, rb))
+                if len(ra) == len(rb) else float("nan"))
+        same = "the same CSV" if a == b else (
+            "the same poses" if len(ra) == len(rb) else "different poses")
+        out.append(f"| `{name}` | {len(ra)} | {same} | {diff:.3g} |")
+        numbers.append((f"{name} same", float(a == b), 0.0))
+    return ("posedrop [--units mm] [--topple edge] PART, each shipped part (the .obj and .stl "
+            "in mm)", "\n".join(out), numbers)
+
+
+def crn_coverage(binary):
+    """docs/calibration.md: the fit's coverage test as make check runs it
+    (tests/unit/test_fit.c, its note): intervals covering the truth, of
+    200, and their mean width. Deterministic: compared exactly."""
+    num = r"([-0-9.e+]+)"
+    covered, n, bound, width = note_numbers(
+        test_notes(binary, "fit"), "CRN coverage:",
+        rf"{num} of {num} \(bound {num}\), mean width {num}")
+    text = (f"| intervals covering the truth | bound (3 standard deviations below 95%) | "
+            f"mean width |\n|---:|---:|---:|\n| {covered:.0f} of {n:.0f} | {bound:g} | "
+            f"{width:.3f} |")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (tests/unit/test_fit.c, the "
+            "coverage test)", text, [("covered", covered, 0.0), ("width", width, 0.0)])
 
 
 def venv_python():
@@ -728,6 +802,9 @@ TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
               "engines against their step.")), False),
           "bench-mujoco": ("docs/performance.md", bench_mujoco, False),
           "rigid-limit": ("docs/contact.md", rigid_limit, True),
+          "crn-coverage": ("docs/calibration.md", crn_coverage, True),
+          "topple-rules": ("docs/readings.md", topple_rules, True),
+          "lasting-depth": ("docs/contact.md", lasting_depth, True),
           "extreme-scenes": ("docs/engines-crosscheck.md", extreme_scenes, False),
           "trimesh": ("docs/python.md", trimesh_table, False),
           "fit-mirror": ("docs/calibration.md", fit_mirror, False),
@@ -783,6 +860,21 @@ RECORDS = {
     "fit-mirror-before": (
         "docs/calibration.md", 'scripts/fit-mirror.sh -s "1 2 3 4 5 6 7 8 9 10" with the '
         "binary of commit e8d8523 (the search on its own drops)", "at commit e8d8523 on 2026-12-07"),
+    "fit-coverage": (
+        "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop --full fit (340 s "
+        "of CPU)", "on 2026-12-07, with the discrepancy's change (first recorded in commit "
+        "119e480)"),
+    "fit-tempering": (
+        "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (the coverage "
+        "test) with the tempering, the Dirichlet-multinomial and the weighting on S/4 drops",
+        "on 2026-12-07 (first recorded in commit 5cff1f7)"),
+    "readings-eq2": (
+        "docs/readings.md", "the paper's route of eq. (1)-(3) implemented in double precision "
+        "against the closed form, on right isosceles triangles (no script kept)",
+        "on 2026-11-26 (first recorded in commit 8f24208)"),
+    "design-demos": (
+        "docs/design.md", "scripts/design-demos.sh (docs/figures/design/summary.md; tens of "
+        "CPU minutes)", "at commits bba359c and 61b4a6f (the bushing) on 2026-12-07"),
     "xc-contact-steps": (
         "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
         "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
@@ -1078,8 +1170,10 @@ def main():
     if checking:
         failures = check(ROOT, binary, names)
         if not args:
-            failures += check_records(ROOT, list(RECORDS))
-            print(f"doc_tables.py: --check: {len(RECORDS)} records", file=sys.stderr)
+            edited = check_records(ROOT, list(RECORDS))
+            failures += edited
+            print(f"doc_tables.py: --check: {len(RECORDS)} records, {len(edited)} edited by hand",
+                  file=sys.stderr)
         for f in failures:
             print(f"doc_tables.py: {f}", file=sys.stderr)
         sys.exit(1 if failures else 0)
