@@ -255,6 +255,12 @@ figures: deps
 	python3 scripts/loo-table.py --now docs/figures/loo/variant-s1.summary.txt \
 	    docs/figures/loo/variant-s2.summary.txt --before docs/figures/loo/before-s1.summary.txt \
 	    docs/figures/loo/before-s2.summary.txt --doc docs/validation.md --tag loo-table-variant
+	python3 scripts/loo-table.py --now docs/figures/loo/noise-s1.summary.txt \
+	    docs/figures/loo/noise-s2.summary.txt --before docs/figures/loo/s1.summary.txt \
+	    docs/figures/loo/s2.summary.txt --doc docs/validation.md --tag loo-table-noise
+	python3 scripts/loo-table.py --now docs/figures/loo/smooth-s1.summary.txt \
+	    docs/figures/loo/smooth-s2.summary.txt --before docs/figures/loo/s1.summary.txt \
+	    docs/figures/loo/s2.summary.txt --doc docs/validation.md --tag loo-table-smooth
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 

@@ -616,7 +616,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
             else if (l == FIT_LEVEL_FULL)
                 pred += level_drops(&m, i, FIT_LEVEL_FULL);
         }
-    int weigh_points = fit_weigh_max_evals(&set) - 1 - set.npoints;
+    int weigh_points = fit_weigh_max_evals(&set) - 1 - FIT_PREDICT_ROUNDS * set.npoints;
     m.prog = (pd_fit_progress){"start", mode_name(modes[0]), 0, 0, 0, 0, 0, 0, -HUGE_VAL};
     m.prog.max_evaluations = searches * search_max_evals(d, o.max_evals) +
                              (holdout ? nmodes * nfit : 0) + fit_weigh_max_evals(&set) + 2;
@@ -624,7 +624,7 @@ pd_status pd_fit_run(const pd_fit_part *parts, int nparts, const pd_fit_param *p
                                    FIT_FINALISTS * per[FIT_LEVEL_FULL]) +
                        (holdout ? nmodes * nfit : 0) * per[FIT_LEVEL_FULL] +
                        per[FIT_LEVEL_FULL] + pred + weigh_points * per[FIT_LEVEL_WEIGH] +
-                       set.npoints * pred + 2 * per[FIT_LEVEL_FRESH];
+                       FIT_PREDICT_ROUNDS * set.npoints * pred + 2 * per[FIT_LEVEL_FRESH];
     if (m.progress)
         m.progress(&m.prog, m.progress_user);
     pd_initial chosen = modes[0];

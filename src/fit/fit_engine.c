@@ -292,7 +292,42 @@ static void weights(int d, int n, const double *z, const double *lt, const box *
 
 int fit_weigh_max_evals(const fit_settings *s)
 {
-    return 1 + FIT_REPEATS + (MAX_ROUNDS + 1) * s->npoints;
+    return 1 + FIT_REPEATS + (MAX_ROUNDS + FIT_PREDICT_ROUNDS) * s->npoints;
+}
+
+/* The resampled points the predicted parts need, given their values at the
+ * m points of pick: the averaged probability of a class is a mean over the
+ * picks, whose Monte Carlo error (the picks' variance over m) is held to
+ * the error one point's own drops leave, p (1 - p) / S: m at least the
+ * picks' variance over p (1 - p) / S for every class, at most
+ * FIT_PREDICT_ROUNDS s->npoints (what the plan allows). */
+static int predict_points(const fit_problem *pb, const fit_settings *s, int m, const int *pick,
+                          const double *store, size_t ksum, const double *sims)
+{
+    double need = 0.0;
+    size_t off = 0;
+    if (m < 2)
+        return m;
+    for (int i = 0; i < pb->nparts; off += (size_t)pb->k[i], i++) {
+        if (pb->count[i])
+            continue;
+        for (int cl = 0; cl < pb->k[i]; cl++) {
+            double mean = 0.0, var = 0.0, ns = 0.0;
+            for (int t = 0; t < m; t++) {
+                mean += store[(size_t)pick[t] * ksum + off + (size_t)cl] / m;
+                ns += sims[(size_t)pick[t] * (size_t)pb->nparts + (size_t)i] / m;
+            }
+            for (int t = 0; t < m; t++) {
+                double e = store[(size_t)pick[t] * ksum + off + (size_t)cl] - mean;
+                var += e * e / (m - 1);
+            }
+            double own = ns > 0 ? mean * (1.0 - mean) / ns : 0.0;
+            if (own > 0 && var / own > need)
+                need = var / own;
+        }
+    }
+    int most = FIT_PREDICT_ROUNDS * s->npoints;
+    return need >= most ? most : need > m ? (int)ceil(need) : m;
 }
 
 /* The weighting's log-likelihoods lt of n points z (d each) with their
@@ -378,12 +413,14 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
     double *x = malloc(sizeof *x * (size_t)total), *a = malloc(sizeof *a * (size_t)total);
     double *bb = malloc(sizeof *bb * (size_t)total), *wp = malloc(sizeof *wp * (size_t)total);
     int *order = malloc(sizeof *order * (size_t)total);
-    int *pick = malloc(sizeof *pick * (size_t)(s->npoints > 0 ? s->npoints : 1));
+    int *pick =
+        malloc(sizeof *pick * (size_t)(s->npoints > 0 ? FIT_PREDICT_ROUNDS * s->npoints : 1));
+    int *have = calloc((size_t)total, sizeof *have);
     ctx c = {.pb = pb, .p = p, .nsim = nsim, .st = PD_OK, .diag = diag, .stage = "weighting",
              .level = FIT_LEVEL_FULL};
     pd_status st = PD_OK;
     if (!p || !nsim || !z || !lt || !ls || !X || !w || !store || !sims || !x || !a || !bb || !wp ||
-        !order || !pick)
+        !order || !pick || !have)
         st = pd_fail(diag, PD_ERR_NOMEM, "out of memory for the fit's weighting");
     double zhat[PD_FIT_MAX_PARAMS], l;
     for (int i = 0; i < d; i++)
@@ -523,20 +560,26 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
         }
     }
     /* The parts without counts do not move the weights: they are simulated
-     * only at s->npoints of the points, drawn by weight, each standing for
-     * its share (an unbiased estimate of their weighted mixture). */
+     * only at some of the points, drawn by weight, each standing for its
+     * share (an unbiased estimate of their weighted mixture): s->npoints
+     * first, then as many as their Monte Carlo error asks, up to
+     * FIT_PREDICT_ROUNDS times that (predict_points). */
     for (int j = 0; j < n; j++)
         wp[j] = 0.0;
-    if (st == PD_OK && npred > 0) {
-        resample(n, w, s->npoints, pick);
+    int mpred = s->npoints;
+    for (int pass = 0; st == PD_OK && npred > 0 && pass < 2; pass++) {
+        resample(n, w, mpred, pick);
         c.stage = "prediction";
         c.round = 0;
         c.level = FIT_LEVEL_FULL;
-        for (int t = 0; st == PD_OK && t < s->npoints; t++) {
+        for (int j = 0; j < n; j++)
+            wp[j] = 0.0;
+        for (int t = 0; st == PD_OK && t < mpred; t++) {
             int j = pick[t];
-            wp[j] += 1.0 / (double)s->npoints;
-            if (t > 0 && pick[t - 1] == j)
+            wp[j] += 1.0 / (double)mpred;
+            if (have[j])
                 continue;
+            have[j] = 1;
             st = evaluate(&c, z + (size_t)j * (size_t)d, 2, &l);
             size_t off = 0;
             for (int i = 0; st == PD_OK && i < np; off += (size_t)pb->k[i], i++) {
@@ -546,6 +589,10 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
                 sims[(size_t)j * (size_t)np + (size_t)i] = nsim[i];
             }
         }
+        if (st == PD_OK && pass == 0)
+            mpred = predict_points(pb, s, mpred, pick, store, ksum, sims);
+        if (mpred <= s->npoints)
+            break;
     }
     if (st == PD_OK) {
         out->ess = ess;
@@ -644,5 +691,6 @@ pd_status fit_weigh(const fit_problem *pb, const fit_settings *s, const double *
     free(wp);
     free(order);
     free(pick);
+    free(have);
     return st;
 }

@@ -35,6 +35,10 @@ typedef enum fit_level {
  * Surfaces, ch. 6). */
 #define FIT_REPEATS 6
 
+/* The predicted parts are simulated at up to this many times the
+ * weighting's points per round, drawn by weight (fit_weigh). */
+#define FIT_PREDICT_ROUNDS 4
+
 /* Fills p[i][0..k[i]) (summing to 1) and nsim[i] (the simulated drops behind
  * them) for every part i with counts when all is 0, for every part when all
  * is 1, and for the parts without counts alone when all is 2 (a model may
