@@ -261,6 +261,9 @@ figures: deps
 	python3 scripts/loo-table.py --now docs/figures/loo/smooth-s1.summary.txt \
 	    docs/figures/loo/smooth-s2.summary.txt --before docs/figures/loo/s1.summary.txt \
 	    docs/figures/loo/s2.summary.txt --doc docs/validation.md --tag loo-table-smooth
+	python3 scripts/loo-table.py --now docs/figures/loo/noise-p16-s1.summary.txt \
+	    docs/figures/loo/noise-p16-s2.summary.txt --before docs/figures/loo/noise-s1.summary.txt \
+	    docs/figures/loo/noise-s2.summary.txt --doc docs/validation.md --tag loo-table-noise-p16
 	$(if $(CHEAP),,POSEDROP=$(CLI) scripts/uncertainty.sh)
 	$(if $(CHEAP),,scripts/bigmesh-table.sh $(CLI) > docs/figures/bigmesh.txt)
 

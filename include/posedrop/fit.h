@@ -76,8 +76,10 @@ typedef struct pd_fit_part {
  * evaluation 0): for a progress line, never needed for the result. */
 typedef struct pd_fit_progress {
     const char *stage;     /* "design", "search", "final" (the search's best points on
-                              the full drops), "weighting", "prediction", "fresh",
-                              and "start" before the first evaluation */
+                              the full drops), "repeat" (the best point on other
+                              drops, for the simulation's noise), "weighting",
+                              "prediction", "fresh", and "start" before the first
+                              evaluation */
     const char *initial;   /* the initial mode being searched */
     int held_out;          /* choosing the initial mode: the part left out (1..), else 0 */
     int round;             /* the weighting's round (1..6), else 0 */
@@ -86,7 +88,8 @@ typedef struct pd_fit_progress {
     long drops;            /* drops simulated */
     long max_drops;        /* the most the fit can simulate */
     double best_loglik;    /* the best log-likelihood of the current search or
-                              weighting so far (-HUGE_VAL before one) */
+                              weighting so far (-HUGE_VAL before one; the
+                              Dirichlet-multinomial's, not the weights' tempered one) */
 } pd_fit_progress;
 
 typedef void (*pd_fit_progress_fn)(const pd_fit_progress *progress, void *user);
