@@ -847,11 +847,9 @@ static int flat_patches(search *s)
         free(flat);
         return -1;
     }
-    for (int t = 0; t < m->ntris; t++) {
+    for (int t = 0; t < m->ntris && !stop(s); t++) {
         up[t] = t;
         flat[t] = !degenerate(m, t);
-        if (stop(s))
-            break;
     }
     for (int a = 0; a < m->nverts && !stop(s); a++) {
         int n = 0;
@@ -891,8 +889,9 @@ static int flat_patches(search *s)
     }
     free(e);
     free(flat);
-    /* Each triangle's root, once: the tests below compare patches directly. */
-    for (int t = 0; t < m->ntris; t++)
+    /* Each triangle's root, once: the tests below compare patches directly.
+     * Cancelled, the patches may be half made, and no test follows. */
+    for (int t = 0; t < m->ntris && !s->cancelled; t++)
         up[t] = root(up, t);
     return 0;
 }
@@ -1935,7 +1934,9 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
         unsigned char *keep = closed == 1 ? malloc((size_t)m->ntris) : NULL;
         if (closed == 1)
             sh = keep ? narrow(&s, keep, &nk) : -1;
-        if (sh == 0 && nk < 2)
+        if (s.cancelled)
+            found = 1; /* the search's answer when cancelled */
+        else if (sh == 0 && nk < 2)
             found = 0; /* a crossing takes two triangles */
         else if (sh == 0 && nk < m->ntris - m->ntris / 10)
             found = search_part(&s, keep, nk, R);
