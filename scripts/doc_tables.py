@@ -1014,6 +1014,26 @@ RECORDS = {
         "the compliant impact's steps counted in an instrumented build",
         "on 2026-11-26 (commits f21fb18 and 36195ce) and 2026-11-27 (the steps, commit "
         "e86ff11)"),
+    "contact-slip-onset": (
+        "docs/contact.md", "posedrop -n 200 -j 1 --seed 1 --trials FILE on a 0.1 mm cube, drops "
+        "traced one by one (experimental builds), and paired runs of the cube, box, coin and "
+        "cap before and after the slip onset", "on 2026-11-27 (first recorded in commits "
+        "d1177b3 and 175182f)"),
+    "contact-auto-before": (
+        "docs/contact.md", "posedrop -n 200 on a 1 m x 1 mm needle, and 2000 (600) uniform drops "
+        "of the cube, box, coin and the paper's parts, before and after the volume entered the "
+        "automatic contact time", "on 2026-11-27 (first recorded in commit 19f10f0)"),
+    "contact-resting-before": (
+        "docs/contact.md", "the contact-time table's resting cube (600 drops) on the rigid model "
+        "before the compliant one, on ODE at 1 ms, Bullet and MuJoCo (scripts/referee-mujoco.py "
+        "of that day)", "on 2026-11-26 (first recorded in commit f21fb18)"),
+    "limits-outside-range": (
+        "docs/limits.md", "posedrop on cubes of 1e-89 m to 1e308 m written by hand, before the "
+        "size range was enforced", "on 2026-11-26 (first recorded in commit fa7f553)"),
+    "limits-stepping-golden": (
+        "docs/limits.md", "the golden test's four parts, 3000 drops each on ODE and Bullet "
+        "before and after the drilling friction, the margin and Bullet's mass unit",
+        "on 2026-11-27 (first recorded in commit 04daf37)"),
     "limits-roundoff": (
         "docs/limits.md", "flat pyramids turned and moved off the origin through the part build, "
         "their second moments' most negative over the largest (an experimental build; no "
