@@ -1048,6 +1048,10 @@ RECORDS = {
         "folds' CPU seconds, evaluations and drops (validation.md's leave-one-out), on each "
         "version of the fit the text names", "on 2026-12-07 (the first figures at commit "
         "0cdda07; the earlier at 119e480 and 5cff1f7)"),
+    "readings-topple-before": (
+        "docs/readings.md", "posedrop [--topple edge] on parts/square_black_button.off as "
+        "shipped before its refit", "on 2026-11-27 (first recorded in commit 446b3d9; first "
+        "seen on 2026-11-26)"),
     "readings-eq2": (
         "docs/readings.md", "the paper's route of eq. (1)-(3) implemented in double precision "
         "against the closed form, on right isosceles triangles (no script kept)",
@@ -1093,6 +1097,25 @@ RECORDS = {
     "xc-disc": (
         "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
         "(test_face_and_edge)", "at commit e6e11fa on 2026-12-07, before the Hunt-Crossley law"),
+    "xc-referee-reading": (
+        "docs/engines-crosscheck.md", "scripts/referee-mujoco.py -n 400 --mj-n 400 --check-n "
+        "100 --parts cube,box,hexnut,bushing (the table above, read); MuJoCo's CPU per drop "
+        "from its runs", "at commit 76c56d0 on 2026-12-07 (first recorded in commit 3afe403)"),
+    "xc-bushing-traces": (
+        "docs/engines-crosscheck.md", "scripts/referee-mujoco.py on the bushing (600 MuJoCo "
+        "drops at T/20, 200 at T/40); scripts/engine-convergence.py -n 4000 --seed S --engines "
+        "impulse --parts flanged_bushing; posedrop -n 3 --seed 3 --units mm --trace FILE "
+        "--trace-drop 2 and scripts/trace-compare.py", "on 2026-12-07 at commits e6e11fa and "
+        "ba38651 (first recorded in commits 96ad014 and 291121b)"),
+    "xc-law-fix": (
+        "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
+        "(test_face_and_edge); scripts/engine-convergence.py -n 1000 (400) --engines impulse,ode "
+        "--k auto (80) --parts flanged_bushing; the trace of drop 2 at T/200",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit 534feac)"),
+    "xc-corpus-new-law": (
+        "docs/engines-crosscheck.md", "scripts/engine-convergence.py -o DIR -n 1000 --engines "
+        "impulse,ode,bullet --k auto --parts hexnut,box_1x2x3cm",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit 3cc882a)"),
     "xc-flange-down": (
         "docs/engines-crosscheck.md", "the runs each row names: posedrop --group --units mm "
         "parts/flanged_bushing.off on each engine, scripts/referee-mujoco.py, "
