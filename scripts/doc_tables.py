@@ -1116,6 +1116,32 @@ RECORDS = {
         "docs/engines-crosscheck.md", "scripts/engine-convergence.py -o DIR -n 1000 --engines "
         "impulse,ode,bullet --k auto --parts hexnut,box_1x2x3cm",
         "at commit ba38651 on 2026-12-07 (first recorded in commit 3cc882a)"),
+    "xc-step-rebound-before": (
+        "docs/engines-crosscheck.md", "the first contact of the bushing's drop 2 on ODE at T/20 "
+        "and T/200 and on the impulse engine (the record of the law's fix)",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit b96ba9f)"),
+    "xc-step-rebound-after": (
+        "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
+        "with the spring at the step's start and with the implicit spring; the laws' omega T "
+        "under load; test_hard_parts.c's drops", "on 2026-12-07 (first recorded in commit "
+        "b96ba9f)"),
+    "xc-resting-cube": (
+        "docs/engines-crosscheck.md", "posedrop -n 1169 --seed 3 --initial stationary on "
+        "parts/canonical/cube.off on each engine, scripts/referee-mujoco.py at T/20 to T/160, "
+        "and --trace of drop 11 on every engine", "on 2026-12-07 (first recorded in commit "
+        "91fa0ec; the hold at b331935)"),
+    "xc-resting-cube-reading": (
+        "docs/engines-crosscheck.md", "the runs of the record above and the corpus table's "
+        "(the resting cube's rows)", "on 2026-12-07 (first recorded in commit 91fa0ec)"),
+    "xc-tolerance-reading": (
+        "docs/engines-crosscheck.md", "scripts/tolerance-study.py -n 4000 (the table above, "
+        "read)", "on 2026-12-07 (first recorded in commit 91fa0ec)"),
+    "xc-cap-belt": (
+        "docs/engines-crosscheck.md", "posedrop --initial stationary parts/insulator_cap.off on "
+        "ODE (shard 2 of 99, seed 1, d17ddd1's engines), --trace and scripts/trace-compare.py "
+        "on its first landing, and two experimental ODE builds (every vertex kept; the force "
+        "moved to the nearest kept point) at T/20 to T/200", "on 2026-12-07 (first recorded in "
+        "commit 3b26d30)"),
     "xc-flange-down": (
         "docs/engines-crosscheck.md", "the runs each row names: posedrop --group --units mm "
         "parts/flanged_bushing.off on each engine, scripts/referee-mujoco.py, "
