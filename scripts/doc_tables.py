@@ -1071,6 +1071,23 @@ RECORDS = {
         "docs/engines-crosscheck.md", "tests/unit/test_engine_extreme.c's parts and scenes, "
         "10 drops each, on the ODE and Bullet adapters before their fixes",
         "on 2026-11-26 (first recorded in commits ab5ee7b and 7a47f8f)"),
+    "xc-ode-units": (
+        "docs/engines-crosscheck.md", "posedrop --engine ode on the parts and sizes named, 300 "
+        "drops each, before and after the adapter's units (tests/unit/test_engine_ode.c)",
+        "on 2026-11-26 (first recorded in commit ab5ee7b)"),
+    "xc-floor-contacts": (
+        "docs/engines-crosscheck.md", "posedrop --engine ode|bullet on the flake, the rod and "
+        "the parts named, before and after the adapters' floor contacts "
+        "(tests/unit/test_engine_extreme.c's scenes)", "on 2026-11-26 (first recorded in "
+        "commits ab5ee7b and 7a47f8f)"),
+    "xc-gyroscopic": (
+        "docs/engines-crosscheck.md", "Bullet's free flight and the flake's bounce at e 1 with "
+        "the explicit and the implicit gyroscopic term (tests/unit/test_engine_bullet.c)",
+        "on 2026-11-26 (first recorded in commit 7a47f8f)"),
+    "xc-box-trace": (
+        "docs/engines-crosscheck.md", "posedrop -n 1 --seed 3 --group --engine E [--dt H] "
+        "--trace FILE --trace-drop 0 parts/canonical/box_1x2x3.off, 165ca49's engines",
+        "on 2026-12-07 (first recorded in commit 69f232e)"),
     "xc-white-button": (
         "docs/engines-crosscheck.md", "posedrop -n 600 --seed 5 (6, 7) [--engine ode|bullet] "
         "[--dt 1e-5] parts/white_button.off, on main ebdd1fe and on the two fixes' builds; "
