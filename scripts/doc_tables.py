@@ -43,6 +43,20 @@ CPU in all):
                  compared with the seeds' standard errors. About 20 s of CPU.
   topple-rules   docs/readings.md: --topple edge against the default on
                  every shipped part (static estimates); exact. Under 1 s.
+  compliant-checks  docs/contact.md: what make check measures of the
+                 compliant law (the law against an independent integration,
+                 random impacts' energy, flat landings, Housner's rocking
+                 block, the drops at half the tolerances), from the same test
+                 run as rigid-limit; compared exactly.
+  sphere-map     docs/figures.md: the gauss-sphere map against rays on the
+                 insulator cap, from the same test run as painter; exact.
+  pyramid-sums   docs/limits.md: the flat pyramids' probability sums
+                 against the bound's round-off term, from make check's own
+                 test (tests/unit/test_limits.c's note); exact. Under 1 s.
+  tie-spread     docs/method.md: a 32-gon prism written with 6, 7 and 17
+                 significant digits, the spread of its sides' QS
+                 probabilities (what the tie tolerance stands above); exact.
+                 Under 1 s.
   crn-coverage   docs/calibration.md: the fit's coverage test of make
                  check (tests/unit/test_fit.c's note); compared exactly.
                  About 2 s of CPU.
@@ -470,16 +484,10 @@ def painter(binary):
     notes, PD_TEST_VERBOSE=1): each part's worst and mean share of a pose's
     pixels that show another face's shade. Deterministic: compared exactly
     (as printed, to 0.01%)."""
-    test_bin = os.path.join(os.path.dirname(binary), "test_posedrop")
-    if not os.access(test_bin, os.X_OK):
-        sys.exit(f"doc_tables.py: {test_bin} not built (make {os.path.relpath(test_bin, ROOT)})")
-    run = subprocess.run([test_bin, "viz"], cwd=ROOT, capture_output=True, text=True,
-                         env=dict(os.environ, PD_TEST_VERBOSE="1"))
-    notes = [l for l in (run.stdout + run.stderr).splitlines()
+    notes = [l for l in test_notes(binary, "viz")
              if l.startswith("viz: painter's order vs depth buffer, parts/")]
-    if run.returncode != 0 or not notes:
-        sys.exit(f"doc_tables.py: test_posedrop viz failed or printed no notes:\n"
-                 f"{run.stdout[-1500:]}{run.stderr[-1500:]}")
+    if not notes:
+        sys.exit("doc_tables.py: no painter's-order notes in test_posedrop viz")
     out = ["| part | poses | triangles | worst pose | mean over poses |",
            "|---|---:|---:|---:|---:|",
            "| cube, box, icosahedron (convex: checked exact) | | | 0 | 0 |"]
@@ -591,6 +599,133 @@ def rigid_limit(binary):
             "test_rigid_limit, test_rigid_limit_stops, test_rigid_limit_strikes)",
             "\n".join(out),
             [(k, v, None if k == "limit vs Poisson frictionless" else 0.0) for k, v in numbers])
+
+
+def sphere_map(binary):
+    """docs/figures.md: the gauss-sphere map against rays on the insulator
+    cap, as tests/unit/test_viz.c's test_sphere_map measures it in every
+    make check (its note; the same run as painter's), with the rim's chords'
+    gap and band from the arcs' step (src/viz/viz_const.h). Deterministic:
+    compared exactly."""
+    num = r"([-0-9.e+]+)"
+    wrong, n, rim = note_numbers(
+        test_notes(binary, "viz"), "viz: sphere map:",
+        rf"{num} of {num} random directions in another facet's region, {num} in the rim's chords")
+    import re
+    with open(os.path.join(ROOT, "src/viz/viz_const.h")) as f:
+        step = float(re.search(r"#define VIZ_ARC_STEP_DEG ([0-9.]+)", f.read()).group(1))
+    gap = 1 - math.cos(math.radians(step) / 2)
+    band = math.sqrt(2 * gap)
+    text = ("| random directions (insulator cap) | in another facet's region (on region sides) "
+            "| in the rim's chords | arcs' points at most | their gap from the arc | "
+            "the rim's band |\n|---:|---:|---:|---:|---:|---:|\n"
+            f"| {n:.0f} | {wrong:.0f} | {rim:.0f} | {step:g} deg | {gap:.2g} of the radius | "
+            f"\\|z\\| < {band:.2g} |")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop viz (tests/unit/test_viz.c, "
+            "test_sphere_map; VIZ_ARC_STEP_DEG in src/viz/viz_const.h)", text,
+            [("directions", n, 0.0), ("another region", wrong, 0.0), ("rim", rim, 0.0)])
+
+
+def compliant_checks(binary):
+    """docs/contact.md: what make check measures of the compliant law
+    (tests/unit/test_compliant.c's notes; the same run as rigid-limit's):
+    the law against an independent integration, random impacts' energy,
+    flat landings, Housner's rocking block, and the drops at half the
+    integration tolerances. Deterministic: compared exactly (as printed)."""
+    import re
+    notes = test_notes(binary, "compliant")
+    num = r"([-0-9.e+]+)"
+    e_err, t_err = note_numbers(notes, "compliant: law vs independent integration",
+                                rf"e {num}, T {num} relative")
+    n_imp, worst = note_numbers([l for l in notes if " random impacts, " in l], "compliant: ",
+                                rf"{num} random impacts, energy change at most {num} of the start")
+    out = ["| checked | measured | bound |", "|---|---|---|",
+           f"| the law's rebound and duration against an independent dimensional integration | "
+           f"e {e_err:.2g}, T {t_err:.2g} relative at worst | 1e-6 |",
+           f"| {n_imp:.0f} random single-vertex impacts of random bodies (100000 under "
+           f"`--full`) | energy change at most {worst:.3g} of the start | no rise |"]
+    numbers = [("law e", e_err, None), ("law T", t_err, None), ("impacts", n_imp, 0.0),
+               ("impacts energy", worst, 0.0)]
+    def matches(pattern):
+        return [m for m in (re.match(pattern, l) for l in notes) if m]
+
+    flats = matches(rf"compliant: flat landing on (\d+) contacts: rebound off e by {num}, "
+                    rf"{num} at half")
+    numbers += [(f"flat {m.group(1)}", float(m.group(2)), 0.0) for m in flats]
+    out.append("| flat landings (rebound off e, no spin to round-off) | " + "; ".join(
+        f"{m.group(1)} contacts: {float(m.group(2)):.2g} ({float(m.group(3)):.2g} at half the "
+        f"step)" for m in flats) + " | PD_COMPLIANT_E_TOL, first order at half the step |")
+    blocks = matches(rf"compliant: Housner block alpha (\d+) deg: rate ratio {num}, "
+                     rf"closed form {num}")
+    numbers += [(f"housner {m.group(1)}", float(m.group(2)), 0.0) for m in blocks]
+    out.append("| Housner's rocking block, rate ratio against 1 - 1.5 sin^2 alpha | " + "; ".join(
+        f"{m.group(1)} deg: {float(m.group(2)):.3f} against {float(m.group(3)):.3f}"
+        for m in blocks) + " | 2% |")
+    drops = matches(rf"compliant: parts/(\S+), (\d+) drops at tolerance scale 1 and 0.5: "
+                    rf"chi-square {num} on (\d+) dof, p {num}; unsettled (\d+), (\d+)")
+    numbers += [(f"{m.group(1)} p", float(m.group(5)), 0.0) for m in drops]
+    out.append("| pose distributions at half of every integration tolerance (chi-square "
+               "homogeneity; depth and energy: the table of lasting contacts) | " + "; ".join(
+                   f"`{m.group(1)}` {m.group(2)} drops, p {m.group(5)}, unsettled {m.group(6)} "
+                   f"and {m.group(7)}" for m in drops) + " | p > 0.01, every drop settled |")
+    if len(flats) != 2 or len(blocks) != 3 or not drops:
+        sys.exit("doc_tables.py: missing flat-landing, Housner or drop notes in "
+                 "test_posedrop compliant")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop compliant (tests/unit/test_compliant.c: "
+            "test_law_closed_form, test_energy_random_impacts, test_flat_landings, "
+            "test_housner, test_convergence)",
+            "\n".join(out), numbers)
+
+
+def pyramid_sums(binary):
+    """docs/limits.md: how far the flat pyramids' probabilities sum off 1,
+    against the bound's second term DBL_EPSILON L/h, as
+    tests/unit/test_limits.c's test_flat_pyramids measures it in every make
+    check (its note). Deterministic: compared exactly."""
+    num = r"([-0-9.e+]+)"
+    answered, refused, worst = note_numbers(
+        test_notes(binary, "limits"), "limits: flat pyramids:",
+        rf"{num} answered, {num} refused; probability sums off 1 by at most {num} of")
+    text = ("| pyramids of 3 to 64 sides, h/r 1e-7 to 1e-3 | answered (both topple rules) | "
+            "refused | sums off 1 at most, in DBL_EPSILON L/h |\n|---|---:|---:|---:|\n"
+            f"| make check's sweep | {answered:.0f} | {refused:.0f} | {worst:.2g} |")
+    return ("PD_TEST_VERBOSE=1 build/opt/test_posedrop limits (tests/unit/test_limits.c, "
+            "test_flat_pyramids)", text,
+            [("answered", answered, 0.0), ("refused", refused, 0.0), ("worst", worst, 0.0)])
+
+
+def tie_spread(binary):
+    """docs/method.md: a regular 32-gon prism (circumradius 1, height 1)
+    written with 6, 7 and 17 significant digits: the spread of its 32 sides'
+    QS probabilities (largest minus smallest over their mean), what the tie
+    tolerance must stand above. Deterministic: compared exactly."""
+    out = ["| coordinates printed with | sides' QS probabilities spread by (relative) |",
+           "|---|---:|"]
+    numbers = []
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "prism.off")
+        n = 32
+        v = [(math.cos(2 * math.pi * k / n), math.sin(2 * math.pi * k / n), z)
+             for z in (0.0, 1.0) for k in range(n)]
+        faces = [tuple(reversed(range(n))), tuple(range(n, 2 * n))]
+        faces += [(k, (k + 1) % n, n + (k + 1) % n, n + k) for k in range(n)]
+        for digits in (6, 7, 17):
+            with open(path, "w") as f:
+                f.write(f"OFF\n{len(v)} {len(faces)} 0\n")
+                for p in v:
+                    f.write(" ".join(f"{c:.{digits}g}" for c in p) + "\n")
+                for t in faces:
+                    f.write(f"{len(t)} " + " ".join(str(i) for i in t) + "\n")
+            rows = list(csv.DictReader(posedrop(binary, [path]).splitlines()))
+            sides = [float(r["p_qs"]) for r in rows if abs(float(r["nz"])) < 0.5]
+            if len(sides) != n:
+                sys.exit(f"doc_tables.py: the 32-gon prism at {digits} digits has "
+                         f"{len(sides)} side poses")
+            spread = (max(sides) - min(sides)) / (sum(sides) / n)
+            out.append(f"| {digits} significant digits | {spread:.2g} |")
+            numbers.append((f"{digits} digits", float(f"{spread:.2g}"), 0.0))
+    return ("posedrop PRISM.off, a regular 32-gon prism of circumradius and height 1 written "
+            "by the script with 6, 7 and 17 significant digits", "\n".join(out), numbers)
 
 
 def extreme_scenes(binary):
@@ -805,6 +940,10 @@ TABLES = {"contact-time": ("docs/contact.md", contact_time, True),
           "crn-coverage": ("docs/calibration.md", crn_coverage, True),
           "topple-rules": ("docs/readings.md", topple_rules, True),
           "lasting-depth": ("docs/contact.md", lasting_depth, True),
+          "compliant-checks": ("docs/contact.md", compliant_checks, True),
+          "sphere-map": ("docs/figures.md", sphere_map, True),
+          "pyramid-sums": ("docs/limits.md", pyramid_sums, True),
+          "tie-spread": ("docs/method.md", tie_spread, True),
           "extreme-scenes": ("docs/engines-crosscheck.md", extreme_scenes, False),
           "trimesh": ("docs/python.md", trimesh_table, False),
           "fit-mirror": ("docs/calibration.md", fit_mirror, True),
@@ -868,6 +1007,51 @@ RECORDS = {
         "docs/calibration.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop fit (the coverage "
         "test) with the tempering, the Dirichlet-multinomial and the weighting on S/4 drops",
         "on 2026-12-07 (first recorded in commit 5cff1f7)"),
+    "contact-limits": (
+        "docs/contact.md", "the runs each item names: a cube's and a 32-gon coin's flat "
+        "landings (contact duration), posedrop -n 20000 on parts/canonical/coin_h0.25.off "
+        "with --trials (the longest drop), and 4000 drops before and after the rest step's fix; "
+        "the compliant impact's steps counted in an instrumented build",
+        "on 2026-11-26 (commits f21fb18 and 36195ce) and 2026-11-27 (the steps, commit "
+        "e86ff11)"),
+    "contact-slip-onset": (
+        "docs/contact.md", "posedrop -n 200 -j 1 --seed 1 --trials FILE on a 0.1 mm cube, drops "
+        "traced one by one (experimental builds), and paired runs of the cube, box, coin and "
+        "cap before and after the slip onset", "on 2026-11-27 (first recorded in commits "
+        "d1177b3 and 175182f)"),
+    "contact-auto-before": (
+        "docs/contact.md", "posedrop -n 200 on a 1 m x 1 mm needle, and 2000 (600) uniform drops "
+        "of the cube, box, coin and the paper's parts, before and after the volume entered the "
+        "automatic contact time", "on 2026-11-27 (first recorded in commit 19f10f0)"),
+    "contact-resting-before": (
+        "docs/contact.md", "the contact-time table's resting cube (600 drops) on the rigid model "
+        "before the compliant one, on ODE at 1 ms, Bullet and MuJoCo (scripts/referee-mujoco.py "
+        "of that day)", "on 2026-11-26 (first recorded in commit f21fb18)"),
+    "limits-outside-range": (
+        "docs/limits.md", "posedrop on cubes of 1e-89 m to 1e308 m written by hand, before the "
+        "size range was enforced", "on 2026-11-26 (first recorded in commit fa7f553)"),
+    "limits-stepping-golden": (
+        "docs/limits.md", "the golden test's four parts, 3000 drops each on ODE and Bullet "
+        "before and after the drilling friction, the margin and Bullet's mass unit",
+        "on 2026-11-27 (first recorded in commit 04daf37)"),
+    "limits-roundoff": (
+        "docs/limits.md", "flat pyramids turned and moved off the origin through the part build, "
+        "their second moments' most negative over the largest (an experimental build; no "
+        "script kept)", "on 2026-11-27 (first recorded in commit d41caf7)"),
+    "limits-rolling": (
+        "docs/limits.md", "Tabor's estimate worked from the scene's parameters; Housner's ratio "
+        "of the 64-gon coin's corner landings as measured for contact.md's known limits",
+        "on 2026-11-26 (the ratio, commit 36195ce) and 2026-11-27 (first recorded in commit "
+        "175182f)"),
+    "calibration-cost": (
+        "docs/calibration.md", "scripts/paper.sh -L on the paper's four parts, both seeds, its "
+        "folds' CPU seconds, evaluations and drops (validation.md's leave-one-out), on each "
+        "version of the fit the text names", "on 2026-12-07 (the first figures at commit "
+        "0cdda07; the earlier at 119e480 and 5cff1f7)"),
+    "readings-topple-before": (
+        "docs/readings.md", "posedrop [--topple edge] on parts/square_black_button.off as "
+        "shipped before its refit", "on 2026-11-27 (first recorded in commit 446b3d9; first "
+        "seen on 2026-11-26)"),
     "readings-eq2": (
         "docs/readings.md", "the paper's route of eq. (1)-(3) implemented in double precision "
         "against the closed form, on right isosceles triangles (no script kept)",
@@ -877,24 +1061,104 @@ RECORDS = {
         "CPU minutes)", "at commits bba359c and 61b4a6f (the bushing) on 2026-12-07"),
     "xc-contact-steps": (
         "docs/engines-crosscheck.md", "tests/unit/test_engine_contact.c's corner strike (a 1 cm "
-        "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since)",
+        "cube, 0.5 m/s) at each step, under the linear law of that day (replaced since), and "
+        "on ODE under the pulling formula", "on 2026-11-26 (first recorded in commit ab5ee7b)"),
+    "xc-rod-depth": (
+        "docs/engines-crosscheck.md", "posedrop -n 100 --engine ode [--contact-time 0.03] on "
+        "a 1 m x 3.3 mm rod written by hand, before and after the depth rule",
+        "on 2026-11-27 (first recorded in commit c5e6782)"),
+    "xc-extreme-before": (
+        "docs/engines-crosscheck.md", "tests/unit/test_engine_extreme.c's parts and scenes, "
+        "10 drops each, on the ODE and Bullet adapters before their fixes",
+        "on 2026-11-26 (first recorded in commits ab5ee7b and 7a47f8f)"),
+    "xc-ode-units": (
+        "docs/engines-crosscheck.md", "posedrop --engine ode on the parts and sizes named, 300 "
+        "drops each, before and after the adapter's units (tests/unit/test_engine_ode.c)",
         "on 2026-11-26 (first recorded in commit ab5ee7b)"),
+    "xc-floor-contacts": (
+        "docs/engines-crosscheck.md", "posedrop --engine ode|bullet on the flake, the rod and "
+        "the parts named, before and after the adapters' floor contacts "
+        "(tests/unit/test_engine_extreme.c's scenes)", "on 2026-11-26 (first recorded in "
+        "commits ab5ee7b and 7a47f8f)"),
+    "xc-gyroscopic": (
+        "docs/engines-crosscheck.md", "Bullet's free flight and the flake's bounce at e 1 with "
+        "the explicit and the implicit gyroscopic term (tests/unit/test_engine_bullet.c)",
+        "on 2026-11-26 (first recorded in commit 7a47f8f)"),
+    "xc-box-trace": (
+        "docs/engines-crosscheck.md", "posedrop -n 1 --seed 3 --group --engine E [--dt H] "
+        "--trace FILE --trace-drop 0 parts/canonical/box_1x2x3.off, 165ca49's engines",
+        "on 2026-12-07 (first recorded in commit 69f232e)"),
     "xc-white-button": (
         "docs/engines-crosscheck.md", "posedrop -n 600 --seed 5 (6, 7) [--engine ode|bullet] "
-        "[--dt 1e-5] parts/white_button.off, on main ebdd1fe and on the two fixes' builds",
-        "on 2026-11-28 (first recorded in commit 1035b5d)"),
-    "xc-strikes": (
-        "docs/engines-crosscheck.md", "an experimental strike harness on the stepping engines "
+        "[--dt 1e-5] parts/white_button.off, on main ebdd1fe and on the two fixes' builds; "
+        "an experimental strike harness on the stepping engines and the impulse engine's laws "
         "(no script kept)", "on 2026-11-28 (first recorded in commit 1035b5d)"),
     "xc-lone-vertex": (
         "docs/engines-crosscheck.md", "posedrop -n 6000 --seed 5 parts/white_button.off on "
-        "experimental builds (not committed)", "on 2026-11-28 (first recorded in commit d704941)"),
+        "experimental builds (not committed), and the strike harness of the record above on "
+        "the same generator", "on 2026-11-28 (first recorded in commit d704941)"),
+    "xc-white-button-drops": (
+        "docs/engines-crosscheck.md", "posedrop -n 600 --seed 5 (6, 7) parts/white_button.off "
+        "on the impulse engine (with Stronge's law, a contact time of 3.3e-4 s, no friction) "
+        "and on ODE after the first fix; the engines' law on test_engine_contact.c's cube "
+        "strike", "on 2026-11-28 (first recorded in commit 1035b5d)"),
     "xc-convergence": (
         "docs/engines-crosscheck.md", "scripts/engine-convergence.py -o DIR -n 300 --engines "
-        "impulse,ode --k 10,20,40,80 (and --engines bullet)", "at commit 9f2cb89 on 2026-12-07"),
+        "impulse,ode --k 10,20,40,80 (and --engines bullet), and 1000 drops per engine at the "
+        "old default steps", "at commit 9f2cb89 on 2026-12-07"),
+    "xc-contact-points": (
+        "docs/engines-crosscheck.md", "posedrop -n 300 --seed 3 --group --engine ode at T / 20 "
+        "on parts/flanged_bushing.off with up to 64 contact points (an experimental build, not "
+        "committed); --trace and scripts/trace-compare.py on the white button's drop 0",
+        "on 2026-12-07 (first recorded in commit d5ebddd)"),
     "xc-disc": (
         "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
         "(test_face_and_edge)", "at commit e6e11fa on 2026-12-07, before the Hunt-Crossley law"),
+    "xc-referee-reading": (
+        "docs/engines-crosscheck.md", "scripts/referee-mujoco.py -n 400 --mj-n 400 --check-n "
+        "100 --parts cube,box,hexnut,bushing (the table above, read); MuJoCo's CPU per drop "
+        "from its runs", "at commit 76c56d0 on 2026-12-07 (first recorded in commit 3afe403)"),
+    "xc-bushing-traces": (
+        "docs/engines-crosscheck.md", "scripts/referee-mujoco.py on the bushing (600 MuJoCo "
+        "drops at T/20, 200 at T/40); scripts/engine-convergence.py -n 4000 --seed S --engines "
+        "impulse --parts flanged_bushing; posedrop -n 3 --seed 3 --units mm --trace FILE "
+        "--trace-drop 2 and scripts/trace-compare.py", "on 2026-12-07 at commits e6e11fa and "
+        "ba38651 (first recorded in commits 96ad014 and 291121b)"),
+    "xc-law-fix": (
+        "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
+        "(test_face_and_edge); scripts/engine-convergence.py -n 1000 (400) --engines impulse,ode "
+        "--k auto (80) --parts flanged_bushing; the trace of drop 2 at T/200",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit 534feac)"),
+    "xc-corpus-new-law": (
+        "docs/engines-crosscheck.md", "scripts/engine-convergence.py -o DIR -n 1000 --engines "
+        "impulse,ode,bullet --k auto --parts hexnut,box_1x2x3cm",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit 3cc882a)"),
+    "xc-step-rebound-before": (
+        "docs/engines-crosscheck.md", "the first contact of the bushing's drop 2 on ODE at T/20 "
+        "and T/200 and on the impulse engine (the record of the law's fix)",
+        "at commit ba38651 on 2026-12-07 (first recorded in commit b96ba9f)"),
+    "xc-step-rebound-after": (
+        "docs/engines-crosscheck.md", "PD_TEST_VERBOSE=1 build/opt/test_posedrop engine_contact "
+        "with the spring at the step's start and with the implicit spring; the laws' omega T "
+        "under load; test_hard_parts.c's drops", "on 2026-12-07 (first recorded in commit "
+        "b96ba9f)"),
+    "xc-resting-cube": (
+        "docs/engines-crosscheck.md", "posedrop -n 1169 --seed 3 --initial stationary on "
+        "parts/canonical/cube.off on each engine, scripts/referee-mujoco.py at T/20 to T/160, "
+        "and --trace of drop 11 on every engine", "on 2026-12-07 (first recorded in commit "
+        "91fa0ec; the hold at b331935)"),
+    "xc-resting-cube-reading": (
+        "docs/engines-crosscheck.md", "the runs of the record above and the corpus table's "
+        "(the resting cube's rows)", "on 2026-12-07 (first recorded in commit 91fa0ec)"),
+    "xc-tolerance-reading": (
+        "docs/engines-crosscheck.md", "scripts/tolerance-study.py -n 4000 (the table above, "
+        "read)", "on 2026-12-07 (first recorded in commit 91fa0ec)"),
+    "xc-cap-belt": (
+        "docs/engines-crosscheck.md", "posedrop --initial stationary parts/insulator_cap.off on "
+        "ODE (shard 2 of 99, seed 1, d17ddd1's engines), --trace and scripts/trace-compare.py "
+        "on its first landing, and two experimental ODE builds (every vertex kept; the force "
+        "moved to the nearest kept point) at T/20 to T/200", "on 2026-12-07 (first recorded in "
+        "commit 3b26d30)"),
     "xc-flange-down": (
         "docs/engines-crosscheck.md", "the runs each row names: posedrop --group --units mm "
         "parts/flanged_bushing.off on each engine, scripts/referee-mujoco.py, "
@@ -914,7 +1178,7 @@ def record(name):
     doc = RECORDS[name][0]
     with open(os.path.join(ROOT, doc)) as f:
         body = block(f.read(), name, doc, "record").strip("\n")
-    if body.startswith("Measured on "):
+    if body.startswith("Measured "):
         body = body.split("\n\n", 1)[1] if "\n\n" in body else ""
     inner = put(ROOT, doc, name, record_header(name) + "\n\n" + body, "record")
     write_sidecar(os.path.join(ROOT, SIDECARS, name + ".csv"), name, doc, RECORDS[name][1],
