@@ -962,6 +962,23 @@ SIDECARS = "docs/figures/tables"
 # `scripts/doc_tables.py --record NAME`. name: (doc, command, when: the
 # commit and the date).
 RECORDS = {
+    "contact-top-spin": (
+        "docs/contact.md", "posedrop -n 30 on cubes of 1e-7 to 1e6 m (limits.md's cube table of "
+        "that day), the 0.1 mm cube's unsettled drops traced",
+        "on 2026-11-26 (first recorded in commit 67d36e5)"),
+    "contact-limit-checks": (
+        "docs/contact.md", "the sizes of tests/unit/test_compliant.c's rigid-limit tests (10 "
+        "bodies of 40 impacts; slips stopped at 0.15, 0.45 and 0.75 of the impact), as the "
+        "code gives them",
+        "on 2026-11-28 (first recorded in commit d704941)"),
+    "xc-referee-model": (
+        "docs/engines-crosscheck.md", "scripts/referee-mujoco.py on the cube started resting "
+        "on a face, MuJoCo at T/20 and T/40",
+        "on 2026-12-07 (first recorded in commit 91fa0ec)"),
+    "validation-flat-rest": (
+        "docs/validation.md", "tests/unit/test_flat_rest.c's drops with and without the early "
+        "decision, their collisions counted (an experimental build; no script kept)",
+        "on 2026-11-23 (first recorded in commit d704941)"),
     "limits-height": (
         "docs/limits.md", "posedrop -n 2 -j 1 cube.off, cubes of 1 mm, 0.1 mm and 10 um "
         "written by hand, the CPU seconds of each whole run",
