@@ -962,6 +962,16 @@ SIDECARS = "docs/figures/tables"
 # `scripts/doc_tables.py --record NAME`. name: (doc, command, when: the
 # commit and the date).
 RECORDS = {
+    "xc-corpus-reading": (
+        "docs/engines-crosscheck.md", "the corpus table's runs above (scripts/engine-convergence.py "
+        "--k auto, kept in docs/figures/corpus/) read against 165ca49's in "
+        "docs/figures/corpus-earlier.csv, and their CPU seconds",
+        "on 2026-12-07 at d17ddd1's engines (first recorded in commit 95e8773)"),
+    "xc-halving": (
+        "docs/engines-crosscheck.md", "scripts/engine-convergence.py --k 40 with the commands "
+        "the paragraph gives, runs kept in docs/figures/corpus/conv40*/",
+        "on 2026-12-07 at b96ba9f (165ca49's engines), d17ddd1 and 5e62da6 (first recorded "
+        "in commits 5e62da6 and 1af9231)"),
     "contact-top-spin": (
         "docs/contact.md", "posedrop -n 30 on cubes of 1e-7 to 1e6 m (limits.md's cube table of "
         "that day), the 0.1 mm cube's unsettled drops traced",
