@@ -962,6 +962,10 @@ SIDECARS = "docs/figures/tables"
 # `scripts/doc_tables.py --record NAME`. name: (doc, command, when: the
 # commit and the date).
 RECORDS = {
+    "figures-report-words": (
+        "docs/figures.md", "posedrop -n 1000 --group --mu 0.2:0.6 --report r.html "
+        "parts/insulator_cap.off, the report's words on poses 2 and 4",
+        "on 2026-12-07 at commit 1044ecc"),
     "xc-corpus-reading": (
         "docs/engines-crosscheck.md", "the corpus table's runs above (scripts/engine-convergence.py "
         "--k auto, kept in docs/figures/corpus/) read against 165ca49's in "
