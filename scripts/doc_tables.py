@@ -962,6 +962,11 @@ SIDECARS = "docs/figures/tables"
 # `scripts/doc_tables.py --record NAME`. name: (doc, command, when: the
 # commit and the date).
 RECORDS = {
+    "contact-sweeps": (
+        "docs/contact.md", "the compliant steps of the 64-gon coin and the insulator cap "
+        "traced, the sweeps' contraction and their stops at the cap of 32 counted (an "
+        "experimental build; no script kept)",
+        "on 2026-11-28 (first recorded in commit 05efb3e)"),
     "figures-report-words": (
         "docs/figures.md", "posedrop -n 1000 --group --mu 0.2:0.6 --report r.html "
         "parts/insulator_cap.off, the report's words on poses 2 and 4",
