@@ -963,7 +963,7 @@ SIDECARS = "docs/figures/tables"
 # commit and the date).
 RECORDS = {
     "contact-sweeps": (
-        "docs/contact.md", "the compliant steps of the 64-gon coin and the insulator cap "
+        "docs/contact.md", "the compliant steps of the coin and the insulator cap "
         "traced, the sweeps' contraction and their stops at the cap of 32 counted (an "
         "experimental build; no script kept)",
         "on 2026-11-28 (first recorded in commit 05efb3e)"),
