@@ -1938,8 +1938,17 @@ pd_status pd_mesh_self_crossing(const pd_mesh *m, pd_cancel_flag *cancel, int *t
             found = 1; /* the search's answer when cancelled */
         else if (sh == 0 && nk < 2)
             found = 0; /* a crossing takes two triangles */
-        else if (sh == 0 && nk < m->ntris - m->ntris / 10)
+        else if (sh == 0 && nk < m->ntris - m->ntris / 10) {
             found = search_part(&s, keep, nk, R);
+            /* A crossing found in the part is confirmed, and named, by the
+             * search over the whole: the part's flat patches may be split
+             * where their linking triangles were left out, so that a fold
+             * within one patch, which the whole search passes, would count
+             * as a crossing. A mesh that crosses is refused anyway; this
+             * costs only such meshes. */
+            if (found == 1 && !s.cancelled)
+                found = build_stars(&s) == 0 ? search_pairs(&s, R) : -1;
+        }
         else if (sh == 0)
             found = search_pairs(&s, R);
         free(keep);
