@@ -6,10 +6,13 @@
  * Every malformed input must fail with its own status and a message that
  * names the file and, for text formats, the line. */
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 #include "check.h"
 #include "base/predicates.h"
@@ -1218,6 +1221,65 @@ static void test_self_crossing_star(void)
     free(tri);
 }
 
+/* A cancel set by another thread after a given delay. */
+typedef struct {
+    pd_cancel_flag *flag;
+    long delay_ns;
+} late_cancel;
+
+static void *cancel_later(void *arg)
+{
+    const late_cancel *c = arg;
+    struct timespec ts = {c->delay_ns / 1000000000L, c->delay_ns % 1000000000L};
+    nanosleep(&ts, NULL);
+    atomic_store(c->flag, 1);
+    return NULL;
+}
+
+/* A cancel that lands anywhere in the check of a part that is not
+ * star-shaped (two spheres apart: the narrowing, the part's search, its
+ * flat patches and tree) ends it cleanly: PD_OK with the uncancelled
+ * answer (no crossing) when the check finished first, else
+ * PD_ERR_CANCELLED with no pair named; never a crash or a sanitizer report
+ * (a cancelled union-find was once read uninitialised). The moments are
+ * spread over the check's own duration, measured first; which stages they
+ * hit varies from run to run, what each must answer does not. */
+static void test_self_crossing_cancelled(void)
+{
+    enum { M = 90, NT = 2 * M * M, NV = M * M + 2, MOMENTS = 64 };
+    pd_vec3 *v = malloc(sizeof *v * 2 * NV);
+    int(*tri)[3] = malloc(sizeof *tri * 2 * NT);
+    test_rng g = {11};
+    uv_sphere(M, v3(0, 0, 0), 1.0, 0.01, &g, v, 0, tri, 0);
+    uv_sphere(M, v3(3, 0, 0), 1.0, 0.01, &g, v, NV, tri, NT);
+    pd_mesh m = {2 * NV, v, 2 * NT, tri};
+    int ta, tb;
+    pd_vec3 at;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    CHECK_STATUS(pd_mesh_self_crossing(&m, NULL, &ta, &tb, &at, NULL), PD_OK);
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    CHECK_INT(ta, -1);
+    long span = (t1.tv_sec - t0.tv_sec) * 1000000000L + (t1.tv_nsec - t0.tv_nsec);
+    int bad = 0, cancelled = 0;
+    for (int k = 0; k < MOMENTS; k++) {
+        pd_cancel_flag flag = 0;
+        late_cancel c = {&flag, span * k / MOMENTS};
+        pthread_t th;
+        if (pthread_create(&th, NULL, cancel_later, &c) != 0)
+            continue;
+        pd_status st = pd_mesh_self_crossing(&m, &flag, &ta, &tb, &at, NULL);
+        pthread_join(th, NULL);
+        cancelled += st == PD_ERR_CANCELLED;
+        bad += !((st == PD_OK || st == PD_ERR_CANCELLED) && ta == -1 && tb == -1);
+    }
+    pd_note("self-crossing cancelled at %d moments over %.3f s: %d cancelled\n", MOMENTS,
+            1e-9 * (double)span, cancelled);
+    CHECK_INT(bad, 0);
+    free(v);
+    free(tri);
+}
+
 /* Exact signs of triangle p's corners against the plane of q: 1 when one is
  * strictly positive and one strictly negative (a shared corner counts 0). */
 static int exact_straddle(const pd_vec3 *v, const int p[3], const int q[3])
@@ -1306,5 +1368,6 @@ void suite_mesh(void)
     test_self_crossing_many();
     test_self_crossing_rod();
     test_self_crossing_star();
+    test_self_crossing_cancelled();
     test_self_crossing_filter();
 }
