@@ -542,7 +542,18 @@ static void test_batch_keeps_results(void)
         snprintf(cmd, sizeof cmd, "(set -e; D=%s/keep; for f in all cap cube; do cmp $D/first/$f.csv "
                  "$D/out/$f.csv; done; test -z \"$(ls $D/out | grep -v -e '\\.csv$' -e '\\.err$')\")",
                  tmpdir);
-        CHECK_INT(run_cmd(cmd, 1, &out, &err), 0);
+        int left = run_cmd(cmd, 1, &out, &err);
+        if (left != 0) {
+            char ls[512];
+            snprintf(ls, sizeof ls, "ls -l %s/keep/out", tmpdir);
+            printf("     after '%s': the first run's files changed or others left:\n%s%s",
+                   cases[k].run, out, err);
+            free(out);
+            free(err);
+            run_cmd(ls, 1, &out, &err);
+            printf("%s%s", out, err);
+        }
+        CHECK_INT(left, 0);
         free(out);
         free(err);
     }
