@@ -432,7 +432,7 @@ static int kernel_point(search *s, const unsigned char *in, pd_vec3 *o, int *exa
             w[i] = w[r];
             w[r] = x;
         }
-        int st = pd_lp_solve(4, w, k, c, lo, hi, 1e-15 * diag, y);
+        int st = pd_lp_solve(4, w, k, c, lo, hi, PD_SELFX_KERNEL_LP_TOL_REL * diag, y);
         if (st < 0) {
             free(w);
             return -1;
@@ -440,7 +440,7 @@ static int kernel_point(search *s, const unsigned char *in, pd_vec3 *o, int *exa
         if (st == 0)
             break;
         solved = 1;
-        if (!(y[3] > 1e-12 * diag))
+        if (!(y[3] > PD_SELFX_KERNEL_RADIUS_REL * diag))
             break;
         /* The planes this centre is not y[3] inside of: all of them when
          * they are few (one pass), else a stride of them (a second). */
@@ -453,7 +453,9 @@ static int kernel_point(search *s, const unsigned char *in, pd_vec3 *o, int *exa
                 if (in && !in[t])
                     continue;
                 ok = kernel_row(m, t, sg, c0, &h);
-                if (ok && h.a[0] * y[0] + h.a[1] * y[1] + h.a[2] * y[2] + (1.0 - 1e-9) * y[3] > h.b) {
+                if (ok && h.a[0] * y[0] + h.a[1] * y[1] + h.a[2] * y[2] +
+                                  PD_SELFX_KERNEL_INSIDE_SHARE * y[3] >
+                              h.b) {
                     bad += pass == 0;
                     if (seen++ % every == 0 && added < KERNEL_ADD)
                         w[k + added++] = h;
@@ -527,15 +529,12 @@ static int star_shaped(search *s, int *closed)
  * holds the spherical triangle of its corners; a grazing triangle with o
  * inside it or on its boundary gives a radius of at least the square root
  * of 2 or a corner at o, and is kept), caps met by a chord test, widened
- * by CAP_PAD far above their round-off, which also covers the rounding of
- * the cells below.
+ * by PD_SELFX_CAP_PAD (mesh_tol.h).
  * A part that is nearly star-shaped (a scan with a few overhangs) leaves
  * few triangles to the search; on a pair of spheres apart, o in one, the
  * other and the first's triangles that lie in its directions, and with o
  * in the other too (narrow), only the triangles of each that the other
  * hides. */
-#define CAP_PAD 1e-9
-
 typedef struct dircap {
     double c[3], r; /* unit centre and chord radius */
 } dircap;
@@ -561,7 +560,7 @@ static int cap_of(const pd_mesh *m, int t, pd_vec3 o, dircap *x)
     double r = 0.0;
     for (int k = 0; k < 3; k++)
         r = dmax(r, v3_norm(v3_sub(u[k], c)));
-    r = r * (1.0 + 1e-12) + CAP_PAD;
+    r = r * (1.0 + PD_SELFX_CAP_ROUND_REL) + PD_SELFX_CAP_PAD;
     if (!(r < 1.0))
         return 0;
     x->c[0] = c.x;
@@ -574,7 +573,7 @@ static int cap_of(const pd_mesh *m, int t, pd_vec3 o, dircap *x)
 static int caps_meet(const dircap *a, const dircap *b)
 {
     double dx = a->c[0] - b->c[0], dy = a->c[1] - b->c[1], dz = a->c[2] - b->c[2];
-    double rr = a->r + b->r + CAP_PAD;
+    double rr = a->r + b->r + PD_SELFX_CAP_PAD;
     return dx * dx + dy * dy + dz * dz <= rr * rr;
 }
 

@@ -42,4 +42,27 @@
  * margin. */
 #define PD_SELFX_ARC_PAD 1e-12
 
+/* The caps of directions of the narrowed search (mesh_selfx.c, shadow_subset):
+ * each triangle's directions from o lie in a cap about the mean of its
+ * corners' unit directions, of chord radius r computed from unit vectors
+ * (round-off a few 1e-16). r is scaled by 1 + PD_SELFX_CAP_ROUND_REL and
+ * widened by PD_SELFX_CAP_PAD, and two caps meet within another
+ * PD_SELFX_CAP_PAD: far above that round-off, and above the rounding of the
+ * cells the caps are hashed into, so that no pair of triangles that cross is
+ * left out of the search. Larger: more triangles searched (slower, never
+ * wrong); below the round-off, a crossing could be missed. */
+#define PD_SELFX_CAP_ROUND_REL 1e-12
+#define PD_SELFX_CAP_PAD 1e-9
+
+/* The kernel point o of the star-shaped test and of the narrowing is only
+ * proposed in floating point (exact signs then decide), so these set its
+ * cost, never an answer: the linear program's feasibility tolerance, 1e-15
+ * of the bounding diagonal (round-off of the planes' offsets); the least
+ * inscribed radius, 1e-12 of it, below which the kernel counts as empty; and
+ * the share of that radius, 1 - 1e-9, by which a plane must hold the centre
+ * not to be added to the next round. */
+#define PD_SELFX_KERNEL_LP_TOL_REL 1e-15
+#define PD_SELFX_KERNEL_RADIUS_REL 1e-12
+#define PD_SELFX_KERNEL_INSIDE_SHARE (1.0 - 1e-9)
+
 #endif
